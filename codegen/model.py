@@ -1,0 +1,245 @@
+"""The validated spec: what every emitter and the runtime tables read.
+
+Built by spec_loader from YAML, checked by validate; positions point back into the YAML for errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from .diagnostics import Pos
+from .typesys import DsdlType, RosType, split_composite_name
+
+Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
+OutOfRange = Literal["saturate", "reject"]
+Scalar = bool | int | float | str
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    type: RosType | DsdlType
+    comment: str = ""
+    pos: Pos = Pos("")
+    default: Scalar | None = None
+
+
+@dataclass(frozen=True)
+class Constant:
+    name: str
+    type: RosType | DsdlType
+    value: Scalar
+    comment: str = ""
+    pos: Pos = Pos("")
+
+
+@dataclass
+class RosMessage:
+    package: str
+    name: str
+    fields: list[Field]
+    constants: list[Constant] = field(default_factory=list)
+    description: str = ""
+    derived_from: str | None = None
+    external: bool = False
+    pos: Pos = Pos("")
+
+    @property
+    def full_name(self) -> str:
+        return f"{self.package}/{self.name}"
+
+    def field(self, name: str) -> Field | None:
+        return next((f for f in self.fields if f.name == name), None)
+
+
+@dataclass
+class DsdlStruct:
+    """A DSDL composite type: one of the spec's own, or a standard one read from CYPHAL_PATH."""
+
+    name: str  # full name with version: sam.sensor.RawIMU.0.1
+    fields: list[Field]
+    constants: list[Constant] = field(default_factory=list)
+    description: str = ""
+    sealed: bool = True
+    extent: int | None = None
+    standard: bool = False
+    union: bool = False
+    pos: Pos = Pos("")
+
+    @property
+    def full_name(self) -> str:
+        return split_composite_name(self.name)[0]
+
+    @property
+    def version(self) -> tuple[int, int]:
+        _, major, minor = split_composite_name(self.name)
+        return major, minor
+
+    @property
+    def namespace(self) -> str:
+        return self.full_name.rsplit(".", 1)[0]
+
+    @property
+    def short_name(self) -> str:
+        return self.full_name.rsplit(".", 1)[1]
+
+    def field(self, name: str) -> Field | None:
+        return next((f for f in self.fields if f.name == name), None)
+
+
+@dataclass
+class Topic:
+    name: str
+    type: str  # pkg/Name
+    description: str = ""
+    section: str = ""
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Parameter:
+    name: str
+    type: str
+    default: Scalar
+    unit: str = ""
+    minimum: float | None = None
+    maximum: float | None = None
+    description: str = ""
+    section: str = ""
+    pos: Pos = Pos("")
+
+
+@dataclass
+class ParameterRule:
+    left: str
+    op: str
+    right: str
+    description: str = ""
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Frame:
+    name: str
+    parent: str | None = None
+    description: str = ""
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Transform:
+    parent: str
+    child: str
+    publisher: str
+    description: str = ""
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Port:
+    subject_id: int
+    type: str  # DSDL full name with version
+    rate_hz: float
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Device:
+    name: str
+    node_id: int
+    description: str = ""
+    publishes: list[Port] = field(default_factory=list)
+    subscribes: list[Port] = field(default_factory=list)
+    pos: Pos = Pos("")
+
+
+@dataclass
+class FieldLink:
+    """One `ros_path: uavcan_source` line of a mapping."""
+
+    ros_path: str
+    uavcan_path: str | None = None
+    scale: float | None = None
+    offset: float | None = None
+    table: dict[int, int] | None = None
+    value: Scalar | None = None
+    limits: tuple[float, float] | None = None
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Mapping:
+    name: str
+    direction: Direction
+    topic: str
+    subject_id: int
+    source_node_ids: list[int] = field(default_factory=list)
+    destination_node_id: int | None = None
+    frame_id: str | None = None
+    links: list[FieldLink] = field(default_factory=list)
+    ignore: list[str] = field(default_factory=list)
+    uavcan_values: dict[str, Scalar] = field(default_factory=dict)
+    auto: bool = False
+    on_out_of_range: OutOfRange = "saturate"
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Bridge:
+    name: str
+    node_id: int
+    mappings: list[Mapping] = field(default_factory=list)
+    pos: Pos = Pos("")
+
+
+@dataclass
+class Node:
+    name: str
+    description: str = ""
+    publishes: list[str] = field(default_factory=list)
+    subscribes: list[str] = field(default_factory=list)
+    parameters: list[str] = field(default_factory=list)
+    transforms: list[tuple[str, str]] = field(default_factory=list)
+    pos: Pos = Pos("")
+
+
+@dataclass
+class RosPackageInfo:
+    name: str
+    version: str = "0.1.0"
+    description: str = ""
+    maintainer: str = "maintainer"
+    maintainer_email: str = "maintainer@example.org"
+    license: str = "MIT"
+
+
+@dataclass
+class Spec:
+    file: str
+    vehicle: str
+    description: str
+    ros: RosPackageInfo
+    dsdl_root: str
+    external_messages: dict[str, RosMessage] = field(default_factory=dict)
+    messages: dict[str, RosMessage] = field(default_factory=dict)  # by full name pkg/Name
+    dsdl_types: dict[str, DsdlStruct] = field(default_factory=dict)  # by full name with version
+    frames: dict[str, Frame] = field(default_factory=dict)
+    transforms: list[Transform] = field(default_factory=list)
+    topics: dict[str, Topic] = field(default_factory=dict)
+    parameters: dict[str, Parameter] = field(default_factory=dict)
+    parameter_rules: list[ParameterRule] = field(default_factory=list)
+    devices: dict[str, Device] = field(default_factory=dict)
+    bridge: Bridge | None = None
+    nodes: dict[str, Node] = field(default_factory=dict)
+
+    def devices_by_node_id(self) -> dict[int, Device]:
+        return {d.node_id: d for d in self.devices.values()}
+
+    def subject_types(self) -> dict[int, str]:
+        """Subject id -> DSDL type, from every device port."""
+        result: dict[int, str] = {}
+        for device in self.devices.values():
+            for port in device.publishes + device.subscribes:
+                result.setdefault(port.subject_id, port.type)
+        return result

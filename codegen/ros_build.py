@@ -1,0 +1,205 @@
+"""Build and install a generated ROS 2 interface package with plain CMake.
+
+The ROS 2 Jazzy pip wheels install an ament prefix inside the virtual environment; there is no
+colcon workspace or ``setup.bash`` here, so the handful of variables a sourced workspace would set
+are passed explicitly (see shared/notes/ros2-jazzy-wheels.md).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+__all__ = ["RosBuildError", "build_ros_package", "is_installed", "ros_runtime_env"]
+
+# Lines of CMake output kept in an error: enough to include rosidl's message and CMake's call stack.
+_TAIL_LINES = 40
+# A clean build takes ~10 s on two cores; this only guards against a hung compiler or generator.
+_STEP_TIMEOUT_S = 1800.0
+
+
+# Lines that name the actual problem: CMake's own errors, rosidl_adapter's, the compiler's.
+_ERROR_LINE = re.compile(r"CMake Error|Error processing|\berror:|\bError:")
+
+
+class RosBuildError(Exception):
+    """A CMake step failed; the message ends with the tail of that step's output."""
+
+    def __init__(self, message: str, output: str = "") -> None:
+        self.output = output
+        lines = output.splitlines()
+        self.tail = "\n".join(lines[-_TAIL_LINES:])
+        # A long Python traceback from a generator can push the real cause out of the tail,
+        # so the first few errors are repeated up front.
+        parts = [message, *_error_summaries(lines)]
+        if self.tail:
+            parts += ["--- last lines of output ---", self.tail]
+        super().__init__("\n".join(parts))
+
+
+def _error_summaries(lines: Sequence[str], limit: int = 3) -> list[str]:
+    """The first ``limit`` error paragraphs, each on one line.
+
+    CMake wraps a message over several indented lines up to a blank one; the first line alone
+    ("CMake Error in CMakeLists.txt:") names no cause.
+    """
+    found: list[str] = []
+    for i, line in enumerate(lines):
+        if len(found) == limit:
+            break
+        if not _ERROR_LINE.search(line):
+            continue
+        paragraph = [line.strip()]
+        for follow in lines[i + 1 : i + 6]:
+            if not follow.strip() or _ERROR_LINE.search(follow):
+                break
+            paragraph.append(follow.strip())
+        found.append(" ".join(paragraph))
+    return found
+
+
+def _join_paths(*parts: str | None, sep: str = os.pathsep) -> str:
+    """Join path lists, dropping empty entries and later duplicates (earlier entries win lookups)."""
+    seen: list[str] = []
+    for part in parts:
+        for entry in (part or "").split(sep):
+            if entry and entry not in seen:
+                seen.append(entry)
+    return sep.join(seen)
+
+
+def _python_prefix(python: Path) -> Path:
+    """sys.prefix of another interpreter.
+
+    Asked rather than derived from the path: a venv's bin/python is a symlink to the base
+    interpreter, so resolving it would point outside the venv that holds the ROS wheels.
+    """
+    try:
+        proc = subprocess.run(
+            [str(python), "-c", "import sys; print(sys.prefix)"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+        )
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        raise RosBuildError(f"cannot run Python interpreter {python}: {exc}") from None
+    if proc.returncode != 0 or not proc.stdout.strip():
+        raise RosBuildError(f"cannot query sys.prefix of {python}", proc.stdout + proc.stderr)
+    return Path(proc.stdout.strip().splitlines()[-1])
+
+
+def _run_step(what: str, cmd: Sequence[str], env: Mapping[str, str]) -> None:
+    try:
+        proc = subprocess.run(
+            list(cmd),
+            env=dict(env),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,  # interleaved, so the tail shows errors next to their context
+            text=True,
+            errors="replace",
+            timeout=_STEP_TIMEOUT_S,
+            check=False,
+        )
+    except subprocess.TimeoutExpired as exc:
+        out = exc.output.decode(errors="replace") if isinstance(exc.output, bytes) else exc.output or ""
+        raise RosBuildError(f"CMake {what} timed out after {_STEP_TIMEOUT_S:.0f} s", out) from None
+    except OSError as exc:
+        raise RosBuildError(f"cannot run CMake {what}: {exc}") from None
+    if proc.returncode != 0:
+        raise RosBuildError(f"CMake {what} failed (exit code {proc.returncode})", proc.stdout)
+
+
+def build_ros_package(
+    package_dir: Path,
+    build_dir: Path,
+    install_prefix: Path,
+    *,
+    python: Path | None = None,
+    jobs: int = 2,
+) -> None:
+    """Configure, build and install the ament package in ``package_dir`` into ``install_prefix``.
+
+    ``python`` is the interpreter whose environment holds the ROS wheels (default: the running one);
+    its prefix is the ROS prefix CMake searches. Raises RosBuildError on any failure.
+    """
+    cmake = shutil.which("cmake")
+    if cmake is None:
+        raise RosBuildError("cmake was not found on PATH; install CMake (>= 3.8) to build ROS packages")
+
+    package_dir = Path(package_dir).absolute()
+    build_dir = Path(build_dir).absolute()
+    install_prefix = Path(install_prefix).absolute()
+    if not (package_dir / "CMakeLists.txt").is_file():
+        raise RosBuildError(f"{package_dir} has no CMakeLists.txt")
+
+    if python is None:
+        # Not sys.executable's resolved path: keep the venv's own bin/python so it finds the wheels.
+        interpreter = Path(sys.executable)
+        ros_prefix = Path(sys.prefix)
+    else:
+        interpreter = Path(python).absolute()
+        ros_prefix = _python_prefix(interpreter)
+
+    env = dict(os.environ)
+    # Without the ROS prefix in AMENT_PREFIX_PATH rosidl finds no type support ("No
+    # 'rosidl_typesupport_c' found"); install_prefix lets one generated package use another.
+    env["AMENT_PREFIX_PATH"] = _join_paths(str(install_prefix), str(ros_prefix), env.get("AMENT_PREFIX_PATH"))
+    env["CMAKE_PREFIX_PATH"] = _join_paths(str(install_prefix), str(ros_prefix), env.get("CMAKE_PREFIX_PATH"))
+    # Whatever ament runs by name (its tools, python3) must come from the ROS environment, not the system.
+    env["PATH"] = _join_paths(str(interpreter.parent), env.get("PATH"))
+    # A stale setting from the caller's shell would override the prefix variables above.
+    env.pop("COLCON_PREFIX_PATH", None)
+
+    build_dir.mkdir(parents=True, exist_ok=True)
+    cmake_prefix_path = ";".join(env["CMAKE_PREFIX_PATH"].split(os.pathsep))
+    _run_step(
+        "configure",
+        [
+            cmake,
+            "-S",
+            str(package_dir),
+            "-B",
+            str(build_dir),
+            f"-DCMAKE_PREFIX_PATH={cmake_prefix_path}",
+            f"-DCMAKE_INSTALL_PREFIX={install_prefix}",
+            f"-DPython3_EXECUTABLE={interpreter}",
+            "-DCMAKE_BUILD_TYPE=Release",
+            # The generated package has no tests; skipping ament's lint/test hooks saves configure time.
+            "-DBUILD_TESTING=OFF",
+        ],
+        env,
+    )
+    _run_step("build", [cmake, "--build", str(build_dir), "-j", str(max(1, jobs))], env)
+    _run_step("install", [cmake, "--install", str(build_dir)], env)
+
+
+def ros_runtime_env(install_prefix: Path, base: Mapping[str, str] | None = None) -> dict[str, str]:
+    """Environment in which a subprocess can import and use a package installed in ``install_prefix``.
+
+    Only needed when ``install_prefix`` is not the venv itself. The new entries come first so a
+    freshly built package shadows an older copy elsewhere on the paths.
+    """
+    env = dict(os.environ if base is None else base)
+    prefix = Path(install_prefix).absolute()
+    py_version = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    site_packages = prefix / "lib" / py_version / "site-packages"
+    env["PYTHONPATH"] = _join_paths(str(site_packages), env.get("PYTHONPATH"))
+    # The type-support libraries are dlopen()ed by name; the loader reads this only at process start.
+    env["LD_LIBRARY_PATH"] = _join_paths(str(prefix / "lib"), env.get("LD_LIBRARY_PATH"))
+    # The venv prefix stays behind the overlay: when AMENT_PREFIX_PATH names only the overlay,
+    # ament_index no longer finds the wheels' packages (std_msgs, rclpy's resources).
+    env["AMENT_PREFIX_PATH"] = _join_paths(str(prefix), env.get("AMENT_PREFIX_PATH"), sys.prefix)
+    # Fast DDS otherwise sends discovery multicast off the machine, which is not allowed here.
+    env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    return env
+
+
+def is_installed(package: str, prefix: Path) -> bool:
+    """Whether an ament package is installed in ``prefix`` (its package.xml is where ament puts it)."""
+    return (Path(prefix) / "share" / package / "package.xml").is_file()

@@ -1,0 +1,485 @@
+"""YAML spec -> model: structure, field names and value types. Cross-references are checked in validate."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+from .diagnostics import Diagnostics, Pos, SpecError
+from .model import (
+    Bridge,
+    Constant,
+    Device,
+    DsdlStruct,
+    Field,
+    FieldLink,
+    Frame,
+    Mapping,
+    Node,
+    Parameter,
+    ParameterRule,
+    Port,
+    RosMessage,
+    RosPackageInfo,
+    Scalar,
+    Spec,
+    Topic,
+    Transform,
+)
+from .typesys import parse_dsdl_type, parse_ros_type
+from .yaml_source import YMap, YNode, YScalar, YSeq, load_yaml
+
+T = TypeVar("T")
+_MISSING = object()
+
+
+def _kind(node: YNode) -> str:
+    if isinstance(node, YMap):
+        return "a mapping"
+    if isinstance(node, YSeq):
+        return "a list"
+    value = node.value
+    return "null" if value is None else f"{type(value).__name__} {value!r}"
+
+
+class _Reader:
+    """Typed access to a YAML mapping that records what is wrong instead of raising."""
+
+    def __init__(self, node: YNode, what: str, diag: Diagnostics, allowed: tuple[str, ...]) -> None:
+        self.diag = diag
+        self.what = what
+        self.ok = isinstance(node, YMap)
+        self.map = node if isinstance(node, YMap) else YMap(node.pos)
+        self.pos = node.pos
+        if not self.ok:
+            diag.error(node.pos, f"{what} must be a mapping, found {_kind(node)}", "a mapping")
+            return
+        _report_duplicates(self.map, what, diag)
+        for key, key_pos in self.map.key_pos.items():
+            if key not in allowed:
+                diag.error(key_pos, f"unknown field {key!r} in {what}", "one of " + ", ".join(allowed))
+
+    def node(self, key: str) -> YNode | None:
+        return self.map.entries.get(key)
+
+    def key_pos(self, key: str) -> Pos:
+        return self.map.key_pos.get(key, self.pos)
+
+    def get(self, key: str, kind: type | tuple[type, ...], default: Any = _MISSING) -> Any:
+        node = self.map.entries.get(key)
+        if node is None:
+            if default is _MISSING:
+                if self.ok:
+                    self.diag.error(self.pos, f"missing field {key!r} in {self.what}")
+                return None
+            return default
+        return scalar(node, kind, f"{key!r} of {self.what}", self.diag)
+
+
+def scalar(node: YNode, kind: type | tuple[type, ...], what: str, diag: Diagnostics) -> Any:
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    if isinstance(node, YScalar) and isinstance(node.value, kinds):
+        # bool is an int in Python; a spec's `true` is never a number.
+        if isinstance(node.value, bool) and bool not in kinds:
+            pass
+        else:
+            return node.value
+    names = " or ".join("number" if k is float else k.__name__ for k in kinds)
+    diag.error(node.pos, f"{what} must be {names}, found {_kind(node)}", names)
+    return None
+
+
+def _report_duplicates(node: YMap, what: str, diag: Diagnostics) -> None:
+    for key, pos, _ in node.duplicates:
+        diag.error(pos, f"duplicate key {key!r} in {what} (first at line {node.key_pos[key].line})", "unique keys")
+
+
+def _items(
+    node: YNode | None, what: str, diag: Diagnostics, duplicates: bool = True
+) -> list[tuple[str, Pos, YNode]]:
+    if node is None:
+        return []
+    if not isinstance(node, YMap):
+        diag.error(node.pos, f"{what} must be a mapping, found {_kind(node)}", "a mapping")
+        return []
+    if duplicates:
+        _report_duplicates(node, what, diag)
+    return [(k, node.key_pos[k], v) for k, v in node.entries.items()]
+
+
+def _list(node: YNode | None, what: str, diag: Diagnostics) -> list[YNode]:
+    if node is None:
+        return []
+    if not isinstance(node, YSeq):
+        diag.error(node.pos, f"{what} must be a list, found {_kind(node)}", "a list")
+        return []
+    return node.items
+
+
+def _str_list(node: YNode | None, what: str, diag: Diagnostics) -> list[tuple[str, Pos]]:
+    result = []
+    for item in _list(node, what, diag):
+        value = scalar(item, str, f"an entry of {what}", diag)
+        if value is not None:
+            result.append((value, item.pos))
+    return result
+
+
+def _text(reader: _Reader, key: str) -> str:
+    value = reader.get(key, str, "")
+    return value if isinstance(value, str) else ""
+
+
+def _parse_type(text: str | None, pos: Pos, parse: Callable[[str], T], diag: Diagnostics) -> T | None:
+    if text is None:
+        return None
+    try:
+        return parse(text)
+    except ValueError as exc:
+        diag.error(pos, str(exc))
+        return None
+
+
+_FIELD_KEYS = ("name", "type", "comment", "default")
+_CONST_KEYS = ("name", "type", "value", "comment")
+
+
+def _fields(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics) -> list[Field]:
+    result = []
+    for item in _list(node, f"the fields of {what}", diag):
+        r = _Reader(item, f"a field of {what}", diag, _FIELD_KEYS)
+        name, type_text = r.get("name", str), r.get("type", str)
+        type_ = _parse_type(type_text, r.key_pos("type"), parse, diag)
+        default = r.get("default", (bool, int, float, str), None)
+        if name is not None and type_ is not None:
+            result.append(Field(name, type_, _text(r, "comment"), item.pos, default))
+    return result
+
+
+def _constants(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics) -> list[Constant]:
+    result = []
+    for item in _list(node, f"the constants of {what}", diag):
+        r = _Reader(item, f"a constant of {what}", diag, _CONST_KEYS)
+        name, type_text = r.get("name", str), r.get("type", str)
+        value = r.get("value", (bool, int, float, str))
+        type_ = _parse_type(type_text, r.key_pos("type"), parse, diag)
+        if name is not None and type_ is not None and value is not None:
+            result.append(Constant(name, type_, value, _text(r, "comment"), item.pos))
+    return result
+
+
+def _ros_message(key: str, pos: Pos, node: YNode, package: str, external: bool, diag: Diagnostics) -> RosMessage:
+    what = f"message {key!r}"
+    r = _Reader(node, what, diag, ("description", "fields", "constants", "derive_from"))
+    pkg, _, name = key.rpartition("/")
+    pkg = pkg.replace("/msg", "") or package
+
+    def parse(text: str) -> Any:
+        return parse_ros_type(text, pkg)
+
+    derive = r.get("derive_from", str, None)
+    if derive is not None and r.node("fields") is not None:
+        diag.error(r.key_pos("fields"), f"{what} is derived from {derive}: it cannot also list fields")
+    fields = _fields(r.node("fields"), what, parse, diag)
+    if derive is None and not fields and r.ok and not external:
+        diag.error(pos, f"{what} has no fields", "a `fields` list or `derive_from`")
+    return RosMessage(
+        pkg, name, fields, _constants(r.node("constants"), what, parse, diag),
+        _text(r, "description"), derive, external, pos,
+    )
+
+
+def _dsdl_struct(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> DsdlStruct:
+    what = f"DSDL type {key!r}"
+    r = _Reader(node, what, diag, ("description", "fields", "constants", "sealed", "extent"))
+    sealed = r.get("sealed", bool, False)
+    extent = r.get("extent", int, None)
+    if r.ok and not sealed and extent is None:
+        diag.error(pos, f"{what} needs `sealed: true` or `extent: <bytes>`", "sealed or extent (DSDL requires one)")
+    if sealed and extent is not None:
+        diag.error(r.key_pos("extent"), f"{what} cannot be both sealed and have an extent")
+    fields = _fields(r.node("fields"), what, parse_dsdl_type, diag)
+    return DsdlStruct(
+        key, fields, _constants(r.node("constants"), what, parse_dsdl_type, diag),
+        _text(r, "description"), bool(sealed), extent, pos=pos,
+    )
+
+
+def _number(node: YNode | None, what: str, diag: Diagnostics) -> float | None:
+    if node is None:
+        return None
+    value = scalar(node, (int, float), what, diag)
+    if value is not None and not math.isfinite(value):
+        diag.error(node.pos, f"{what} must be finite")
+        return None
+    return value
+
+
+def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics) -> FieldLink | None:
+    what = f"field {ros_path!r} of mapping {mapping!r}"
+    if isinstance(node, YScalar):
+        path = scalar(node, str, what, diag)
+        return FieldLink(ros_path, path, pos=pos) if path is not None else None
+    r = _Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits"))
+    if not r.ok:
+        return None
+    link = FieldLink(ros_path, r.get("from", str, None), pos=pos)
+    link.scale = _number(r.node("scale"), f"'scale' of {what}", diag)
+    link.offset = _number(r.node("offset"), f"'offset' of {what}", diag)
+    if link.scale == 0:
+        diag.error(r.key_pos("scale"), f"'scale' of {what} must not be 0 (the reverse conversion divides by it)")
+    if r.node("value") is not None:
+        link.value = r.get("value", (bool, int, float, str))
+        if link.uavcan_path is not None:
+            diag.error(pos, f"{what} has both 'from' and 'value'", "one of them")
+    elif link.uavcan_path is None:
+        diag.error(pos, f"{what} needs 'from' (a UAVCAN field) or 'value' (a constant)")
+    table_node = r.node("table")
+    if table_node is not None:
+        table: dict[int, int] = {}
+        for key, key_pos, value_node in _items(table_node, f"'table' of {what}", diag):
+            try:
+                source = int(key)
+            except ValueError:
+                diag.error(key_pos, f"table key {key!r} of {what} is not an integer")
+                continue
+            target = scalar(value_node, int, f"table value of {what}", diag)
+            if target is not None:
+                table[source] = target
+        link.table = table
+    limits_node = r.node("limits")
+    if limits_node is not None:
+        values = [_number(n, f"'limits' of {what}", diag) for n in _list(limits_node, f"'limits' of {what}", diag)]
+        if len(values) != 2 or None in values or values[0] >= values[1]:  # type: ignore[operator]
+            diag.error(limits_node.pos, f"'limits' of {what} must be [low, high] with low < high")
+        else:
+            link.limits = (values[0], values[1])  # type: ignore[assignment]
+    return link
+
+
+_MAPPING_KEYS = (
+    "direction", "topic", "subject_id", "source_node_ids", "destination_node_id", "frame_id",
+    "fields", "ignore", "uavcan_values", "on_out_of_range",
+)
+
+
+def _mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -> Mapping | None:
+    what = f"mapping {name!r}"
+    r = _Reader(node, what, diag, _MAPPING_KEYS)
+    if not r.ok:
+        return None
+    direction = r.get("direction", str)
+    if direction not in (None, "uavcan_to_ros", "ros_to_uavcan"):
+        diag.error(r.node("direction").pos, f"direction {direction!r} of {what} is unknown",  # type: ignore[union-attr]
+                   "uavcan_to_ros or ros_to_uavcan")
+        direction = None
+    policy = r.get("on_out_of_range", str, "saturate")
+    if policy not in ("saturate", "reject"):
+        diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range {policy!r} of {what} is unknown",
+                   "saturate or reject")
+    mapping = Mapping(
+        name, direction or "uavcan_to_ros", r.get("topic", str) or "", r.get("subject_id", int) or 0,
+        [n for n in (scalar(i, int, f"a source node id of {what}", diag)
+                     for i in _list(r.node("source_node_ids"), f"source_node_ids of {what}", diag)) if n is not None],
+        r.get("destination_node_id", int, None), r.get("frame_id", str, None),
+        on_out_of_range=policy if policy in ("saturate", "reject") else "saturate", pos=pos,
+    )
+    fields = r.node("fields")
+    if isinstance(fields, YScalar) and fields.value == "auto":
+        mapping.auto = True
+    elif fields is not None:
+        for ros_path, key_pos, link_node in _items(fields, f"the fields of {what}", diag):
+            link = _link(ros_path, key_pos, link_node, name, diag)
+            if link is not None:
+                mapping.links.append(link)
+    elif r.ok:
+        diag.error(pos, f"missing field 'fields' in {what}", "a mapping of ros_field: uavcan_field, or `auto`")
+    mapping.ignore = [p for p, _ in _str_list(r.node("ignore"), f"ignore of {what}", diag)]
+    for path, _, value_node in _items(r.node("uavcan_values"), f"uavcan_values of {what}", diag):
+        value = scalar(value_node, (bool, int, float), f"uavcan value {path!r} of {what}", diag)
+        if value is not None:
+            mapping.uavcan_values[path] = value
+    if direction == "uavcan_to_ros" and mapping.destination_node_id is not None:
+        diag.error(r.key_pos("destination_node_id"), f"{what} goes UAVCAN->ROS: it has sources, not a destination",
+                   "source_node_ids")
+    if direction == "ros_to_uavcan" and r.node("source_node_ids") is not None:
+        diag.error(r.key_pos("source_node_ids"), f"{what} goes ROS->UAVCAN: it has a destination, not sources",
+                   "destination_node_id")
+    if direction == "uavcan_to_ros" and not mapping.source_node_ids:
+        diag.error(pos, f"{what} needs source_node_ids: the node ids whose messages it accepts")
+    if direction == "ros_to_uavcan" and mapping.destination_node_id is None:
+        diag.error(pos, f"{what} needs destination_node_id: the node its commands are meant for")
+    return mapping
+
+
+def _ports(node: YNode | None, what: str, diag: Diagnostics) -> list[Port]:
+    ports = []
+    for item in _list(node, what, diag):
+        r = _Reader(item, f"a port of {what}", diag, ("subject_id", "type", "rate_hz"))
+        subject, type_ = r.get("subject_id", int), r.get("type", str)
+        rate = _number(r.node("rate_hz"), f"rate_hz of {what}", diag) if r.node("rate_hz") else None
+        if r.ok and r.node("rate_hz") is None:
+            diag.error(item.pos, f"missing field 'rate_hz' in a port of {what}", "the nominal rate in Hz")
+        if rate is not None and rate <= 0:
+            diag.error(r.key_pos("rate_hz"), f"rate_hz of {what} must be positive")
+        if subject is not None and type_ is not None:
+            ports.append(Port(subject, type_, float(rate or 0.0), item.pos))
+    return ports
+
+
+_TOP_KEYS = (
+    "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "frames",
+    "transforms", "topics", "parameters", "parameter_rules", "devices", "bridge", "nodes",
+)
+
+
+def parse_spec(root: YNode, file: str) -> Spec:
+    """Build the model from a YAML tree; raises SpecError with every structural problem found."""
+    diag = Diagnostics()
+    top = _Reader(root, "the spec", diag, _TOP_KEYS)
+    if not top.ok:
+        diag.check()
+    version = top.get("spec_version", int)
+    if version is not None and version != 1:
+        diag.error(top.key_pos("spec_version"), f"spec_version {version} is not supported", "1")
+    vehicle = _Reader(top.node("vehicle") or YMap(top.pos), "vehicle", diag, ("name", "description"))
+    ros = _Reader(top.node("ros") or YMap(top.pos), "ros", diag,
+                  ("package", "version", "description", "maintainer", "maintainer_email", "license"))
+    cyphal = _Reader(top.node("cyphal") or YMap(top.pos), "cyphal", diag, ("root_namespace",))
+    package = ros.get("package", str) or ""
+    spec = Spec(
+        file, vehicle.get("name", str) or "", _text(vehicle, "description"),
+        RosPackageInfo(package, ros.get("version", str, "0.1.0"), _text(ros, "description"),
+                       ros.get("maintainer", str, "maintainer"),
+                       ros.get("maintainer_email", str, "maintainer@example.org"), ros.get("license", str, "MIT")),
+        cyphal.get("root_namespace", str) or "",
+    )
+    for key, pos, node in _items(top.node("external_messages"), "external_messages", diag):
+        if "/" not in key:
+            diag.error(pos, f"external message {key!r} needs its package", "pkg/Name")
+            continue
+        message = _ros_message(key, pos, node, package, True, diag)
+        spec.external_messages[message.full_name] = message
+    for key, pos, node in _items(top.node("messages"), "messages", diag):
+        if "/" in key:
+            diag.error(pos, f"message {key!r} is declared in package {package}: give its bare name", "Name")
+            continue
+        message = _ros_message(key, pos, node, package, False, diag)
+        spec.messages[message.full_name] = message
+    for key, pos, node in _items(top.node("dsdl_types"), "dsdl_types", diag):
+        spec.dsdl_types[key] = _dsdl_struct(key, pos, node, diag)
+    for key, pos, node in _items(top.node("frames"), "frames", diag):
+        r = _Reader(node, f"frame {key!r}", diag, ("parent", "description"))
+        spec.frames[key] = Frame(key, r.get("parent", str, None), _text(r, "description"), pos)
+    for item in _list(top.node("transforms"), "transforms", diag):
+        r = _Reader(item, "a transform", diag, ("parent", "child", "publisher", "description"))
+        parent, child, publisher = r.get("parent", str), r.get("child", str), r.get("publisher", str)
+        if parent and child and publisher:
+            spec.transforms.append(Transform(parent, child, publisher, _text(r, "description"), item.pos))
+    topics = top.node("topics")
+    if isinstance(topics, YMap):
+        for key, pos, again in topics.duplicates:
+            first = topics.entries[key]
+            types = [n.entries["type"].value for n in (first, again)
+                     if isinstance(n, YMap) and isinstance(n.entries.get("type"), YScalar)]
+            diag.error(pos, f"topic {key!r} is declared twice (first at line {topics.key_pos[key].line}"
+                       + (f", types {' and '.join(map(str, types))}" if types else "")
+                       + "): two types on one topic", "one type per topic; give the second its own topic")
+    for key, pos, node in _items(topics, "topics", diag, duplicates=False):
+        r = _Reader(node, f"topic {key!r}", diag, ("type", "description", "section"))
+        type_ = r.get("type", str)
+        if type_ is not None:
+            spec.topics[key] = Topic(key, type_.replace("/msg/", "/"), _text(r, "description"),
+                                     str(r.get("section", (str, float, int), "")), pos)
+    for key, pos, node in _items(top.node("parameters"), "parameters", diag):
+        _parameter(spec, key, pos, node, diag)
+    for item in _list(top.node("parameter_rules"), "parameter_rules", diag):
+        r = _Reader(item, "a parameter rule", diag, ("left", "op", "right", "description"))
+        left, op, right = r.get("left", str), r.get("op", str), r.get("right", str)
+        if op is not None and op not in ("<", "<=", ">", ">="):
+            diag.error(r.key_pos("op"), f"parameter rule operator {op!r} is unknown", "<, <=, > or >=")
+        elif left and op and right:
+            spec.parameter_rules.append(ParameterRule(left, op, right, _text(r, "description"), item.pos))
+    for key, pos, node in _items(top.node("devices"), "devices", diag):
+        r = _Reader(node, f"device {key!r}", diag, ("node_id", "description", "publishes", "subscribes"))
+        node_id = r.get("node_id", int)
+        spec.devices[key] = Device(
+            key, node_id if node_id is not None else -1, _text(r, "description"),
+            _ports(r.node("publishes"), f"device {key!r}", diag),
+            _ports(r.node("subscribes"), f"device {key!r}", diag), pos,
+        )
+    bridge_node = top.node("bridge")
+    if bridge_node is not None:
+        r = _Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings"))
+        bridge = Bridge(r.get("name", str) or "bridge", r.get("node_id", int) or 0, pos=bridge_node.pos)
+        for key, pos, node in _items(r.node("mappings"), "bridge mappings", diag):
+            mapping = _mapping(key, pos, node, diag)
+            if mapping is not None:
+                bridge.mappings.append(mapping)
+        spec.bridge = bridge
+    for key, pos, node in _items(top.node("nodes"), "nodes", diag):
+        _node(spec, key, pos, node, diag)
+    diag.check()
+    return spec
+
+
+def _parameter(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -> None:
+    what = f"parameter {key!r}"
+    r = _Reader(node, what, diag, ("type", "unit", "default", "min", "max", "description", "section"))
+    type_ = r.get("type", str)
+    kinds: dict[str, tuple[type, ...]] = {
+        "double": (int, float), "integer": (int,), "bool": (bool,), "string": (str,),
+    }
+    if type_ is not None and type_ not in kinds:
+        diag.error(r.key_pos("type"), f"type {type_!r} of {what} is unknown", "double, integer, bool or string")
+        return
+    if type_ is None:
+        return
+    default: Scalar | None = r.get("default", kinds[type_])
+    minimum = _number(r.node("min"), f"min of {what}", diag)
+    maximum = _number(r.node("max"), f"max of {what}", diag)
+    if (minimum is not None or maximum is not None) and type_ not in ("double", "integer"):
+        diag.error(pos, f"{what} of type {type_} cannot have a range")
+    if minimum is not None and maximum is not None and minimum > maximum:
+        diag.error(r.key_pos("min"), f"{what}: min {minimum} is above max {maximum}")
+    if isinstance(default, (int, float)) and not isinstance(default, bool):
+        if minimum is not None and default < minimum or maximum is not None and default > maximum:
+            diag.error(r.key_pos("default"), f"default {default} of {what} is outside its range",
+                       f"a value in [{minimum}, {maximum}]")
+    if default is not None:
+        spec.parameters[key] = Parameter(
+            key, type_, float(default) if type_ == "double" else default, r.get("unit", str, ""),
+            minimum, maximum, _text(r, "description"), str(r.get("section", (str, int, float), "")), pos,
+        )
+
+
+def _node(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -> None:
+    what = f"node {key!r}"
+    r = _Reader(node, what, diag, ("description", "publishes", "subscribes", "parameters", "transforms"))
+    transforms = []
+    for text, item_pos in _str_list(r.node("transforms"), f"transforms of {what}", diag):
+        parent, sep, child = text.partition("->")
+        if not sep or not parent.strip() or not child.strip():
+            diag.error(item_pos, f"transform {text!r} of {what} is not parent->child", "parent->child")
+            continue
+        transforms.append((parent.strip(), child.strip()))
+    spec.nodes[key] = Node(
+        key, _text(r, "description"),
+        [t for t, _ in _str_list(r.node("publishes"), f"publishes of {what}", diag)],
+        [t for t, _ in _str_list(r.node("subscribes"), f"subscribes of {what}", diag)],
+        [t for t, _ in _str_list(r.node("parameters"), f"parameters of {what}", diag)],
+        transforms, pos,
+    )
+
+
+def load_spec_file(path: Path) -> Spec:
+    """Read and structurally parse a spec file (no cross-reference checks)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        from .diagnostics import Diagnostic
+
+        raise SpecError([Diagnostic(Pos(str(path)), f"cannot read the spec: {exc}")]) from None
+    return parse_spec(load_yaml(text, str(path)), str(path))

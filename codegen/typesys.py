@@ -1,0 +1,245 @@
+"""Type expressions of both sides: ROS 2 .msg field types and Cyphal DSDL field types.
+
+Pure data and parsing; the rules that relate the two live in mapping_rules.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Literal
+
+ArrayKind = Literal["", "fixed", "bounded", "dynamic"]
+
+ROS_INT_RANGES: dict[str, tuple[int, int]] = {
+    "byte": (0, 255),
+    "char": (0, 255),
+    "int8": (-(2**7), 2**7 - 1),
+    "uint8": (0, 2**8 - 1),
+    "int16": (-(2**15), 2**15 - 1),
+    "uint16": (0, 2**16 - 1),
+    "int32": (-(2**31), 2**31 - 1),
+    "uint32": (0, 2**32 - 1),
+    "int64": (-(2**63), 2**63 - 1),
+    "uint64": (0, 2**64 - 1),
+}
+ROS_FLOAT_BITS = {"float32": 32, "float64": 64}
+ROS_PRIMITIVES = frozenset({"bool", "string", "wstring", *ROS_INT_RANGES, *ROS_FLOAT_BITS})
+# The ROS integer widths in increasing order, per signedness: the targets of the widening rule.
+ROS_SIGNED_INTS = ("int8", "int16", "int32", "int64")
+ROS_UNSIGNED_INTS = ("uint8", "uint16", "uint32", "uint64")
+
+ROS_FIELD_NAME = re.compile(r"^[a-z](?:[a-z0-9]|_(?!_))*(?<!_)$")
+ROS_MESSAGE_NAME = re.compile(r"^[A-Z][A-Za-z0-9]*$")
+ROS_CONSTANT_NAME = re.compile(r"^[A-Z](?:[A-Z0-9]|_(?!_))*(?<!_)$")
+ROS_PACKAGE_NAME = re.compile(r"^[a-z](?:[a-z0-9]|_(?!_))*(?<!_)$")
+ROS_TOPIC_NAME = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
+
+_ROS_TYPE = re.compile(
+    r"^(?P<base>[A-Za-z][A-Za-z0-9_]*(?:/(?:msg/)?[A-Za-z][A-Za-z0-9_]*)?)"
+    r"(?:<=(?P<strbound>[0-9]+))?"
+    r"(?:\[(?P<array>(?:<=)?[0-9]*)\])?$"
+)
+
+
+@dataclass(frozen=True)
+class RosType:
+    """A ROS 2 field type: a primitive or `pkg/Name`, optionally an array."""
+
+    base: str
+    array: ArrayKind = ""
+    capacity: int | None = None
+    string_bound: int | None = None
+
+    @property
+    def is_primitive(self) -> bool:
+        return self.base in ROS_PRIMITIVES
+
+    @property
+    def package(self) -> str | None:
+        return self.base.split("/")[0] if "/" in self.base else None
+
+    @property
+    def element(self) -> RosType:
+        return RosType(self.base, string_bound=self.string_bound)
+
+    def __str__(self) -> str:
+        text = self.base
+        if self.string_bound is not None:
+            text += f"<={self.string_bound}"
+        if self.array == "fixed":
+            text += f"[{self.capacity}]"
+        elif self.array == "bounded":
+            text += f"[<={self.capacity}]"
+        elif self.array == "dynamic":
+            text += "[]"
+        return text
+
+
+def parse_ros_type(text: str, package: str | None = None) -> RosType:
+    """Parse a .msg field type; a bare message name refers to `package`.
+
+    >>> str(parse_ros_type("float32[<=36]"))
+    'float32[<=36]'
+    >>> parse_ros_type("sensor_msgs/msg/Imu").base
+    'sensor_msgs/Imu'
+    >>> parse_ros_type("Header", "std_msgs").base
+    'std_msgs/Header'
+    """
+    match = _ROS_TYPE.match(text.strip())
+    if not match:
+        raise ValueError(f"{text!r} is not a ROS field type")
+    base = match["base"].replace("/msg/", "/")
+    if "/" not in base and base not in ROS_PRIMITIVES:
+        if not ROS_MESSAGE_NAME.match(base):
+            raise ValueError(f"unknown ROS type {base!r}")
+        if package is None:
+            raise ValueError(f"message type {base!r} needs its package, as pkg/{base}")
+        base = f"{package}/{base}"
+    if "/" in base:
+        pkg, name = base.split("/")
+        if not ROS_PACKAGE_NAME.match(pkg) or not ROS_MESSAGE_NAME.match(name):
+            raise ValueError(f"{base!r} is not a valid ROS message type name")
+    string_bound = int(match["strbound"]) if match["strbound"] else None
+    if string_bound is not None and base not in ("string", "wstring"):
+        raise ValueError(f"only strings take a bound (<=N), not {base}")
+    array_text = match["array"]
+    if array_text is None:
+        return RosType(base, string_bound=string_bound)
+    if array_text == "":
+        return RosType(base, "dynamic", None, string_bound)
+    if array_text.startswith("<="):
+        capacity, kind = int(array_text[2:]), "bounded"
+    else:
+        capacity, kind = int(array_text), "fixed"
+    if capacity < 1:
+        raise ValueError(f"array size of {text!r} must be at least 1")
+    return RosType(base, kind, capacity, string_bound)  # type: ignore[arg-type]
+
+
+DsdlKind = Literal["bool", "int", "uint", "float", "byte", "utf8", "void", "composite"]
+
+DSDL_IDENTIFIER = re.compile(r"^[a-zA-Z_][a-zA-Z0-9_]*$")
+DSDL_SHORT_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+DSDL_NAMESPACE_COMPONENT = re.compile(r"^[a-z_][a-z0-9_]*$")
+# Words pydsdl reserves (keywords, type names and the patterns of primitive names).
+_DSDL_RESERVED = re.compile(
+    r"^(truncated|saturated|true|false|bool|byte|utf8|optional|aligned|const|struct|super|template|"
+    r"enum|self|and|or|not|auto|type|con|prn|aux|nul|(com|lpt)[1-9]|"
+    r"(u?int|u?q|float|void)\d*|(u?int|float|void)\d+x\d+)$",
+    re.IGNORECASE,
+)
+_DSDL_TYPE = re.compile(
+    r"^(?:(?P<cast>saturated|truncated)\s+)?"
+    r"(?P<base>bool|byte|utf8|u?int[0-9]+|float(?:16|32|64)|void[0-9]+|"
+    r"(?:[a-z_][a-z0-9_]*\.)+[A-Za-z_][A-Za-z0-9_]*\.[0-9]+\.[0-9]+)"
+    r"(?:\[(?P<array>(?:<=)?[0-9]+)\])?$"
+)
+_COMPOSITE_NAME = re.compile(r"^(?P<full>(?:[a-z_][a-z0-9_]*\.)+[A-Za-z_][A-Za-z0-9_]*)\.(?P<maj>[0-9]+)\.(?P<min>[0-9]+)$")
+
+
+def is_dsdl_identifier(name: str) -> bool:
+    """A DSDL attribute name: an identifier that is not reserved.
+
+    >>> is_dsdl_identifier("rpm"), is_dsdl_identifier("uint8"), is_dsdl_identifier("2x")
+    (True, False, False)
+    """
+    return bool(DSDL_IDENTIFIER.match(name)) and not _DSDL_RESERVED.match(name) and not name.startswith("_")
+
+
+@dataclass(frozen=True)
+class DsdlType:
+    """A DSDL field type: primitive (with bit length) or composite (full name with version)."""
+
+    kind: DsdlKind
+    bits: int = 0
+    composite: str | None = None
+    array: ArrayKind = ""
+    capacity: int | None = None
+    truncated: bool = False
+
+    @property
+    def element(self) -> DsdlType:
+        return DsdlType(self.kind, self.bits, self.composite, truncated=self.truncated)
+
+    @property
+    def range(self) -> tuple[int, int]:
+        """The value range of an integer type."""
+        if self.kind == "uint" or self.kind == "byte":
+            return 0, 2**self.bits - 1
+        if self.kind == "int":
+            return -(2 ** (self.bits - 1)), 2 ** (self.bits - 1) - 1
+        raise ValueError(f"{self} is not an integer type")
+
+    @property
+    def base_name(self) -> str:
+        if self.kind == "composite":
+            assert self.composite
+            return self.composite
+        if self.kind in ("bool", "byte", "utf8"):
+            return self.kind
+        return f"{self.kind}{self.bits}"
+
+    def __str__(self) -> str:
+        text = ("truncated " if self.truncated else "") + self.base_name
+        if self.array == "fixed":
+            text += f"[{self.capacity}]"
+        elif self.array == "bounded":
+            text += f"[<={self.capacity}]"
+        return text
+
+
+def split_composite_name(name: str) -> tuple[str, int, int]:
+    """`uavcan.time.SynchronizedTimestamp.1.0` -> (`uavcan.time.SynchronizedTimestamp`, 1, 0)."""
+    match = _COMPOSITE_NAME.match(name)
+    if not match:
+        raise ValueError(f"{name!r} is not a versioned DSDL type name (namespace.Name.MAJOR.MINOR)")
+    return match["full"], int(match["maj"]), int(match["min"])
+
+
+def parse_dsdl_type(text: str) -> DsdlType:
+    """Parse a DSDL field type.
+
+    >>> str(parse_dsdl_type("float16[<=36]")), parse_dsdl_type("int18").range
+    ('float16[<=36]', (-131072, 131071))
+    >>> parse_dsdl_type("uavcan.time.SynchronizedTimestamp.1.0").composite
+    'uavcan.time.SynchronizedTimestamp.1.0'
+    """
+    match = _DSDL_TYPE.match(" ".join(text.split()))
+    if not match:
+        raise ValueError(f"{text!r} is not a DSDL field type")
+    base, cast = match["base"], match["cast"]
+    kind: DsdlKind
+    bits = 0
+    composite = None
+    if base in ("bool", "byte", "utf8"):
+        kind, bits = base, (1 if base == "bool" else 8)  # type: ignore[assignment]
+    elif base.startswith("float"):
+        kind, bits = "float", int(base[5:])
+    elif base.startswith("uint"):
+        kind, bits = "uint", int(base[4:])
+    elif base.startswith("int"):
+        kind, bits = "int", int(base[3:])
+    elif base.startswith("void"):
+        kind, bits = "void", int(base[4:])
+    else:
+        kind, composite = "composite", base
+        split_composite_name(base)
+    if kind == "uint" and not 1 <= bits <= 64 or kind == "int" and not 2 <= bits <= 64:
+        raise ValueError(f"{base}: integer bit length must be 1..64 (unsigned) or 2..64 (signed)")
+    if kind == "void" and not 1 <= bits <= 64:
+        raise ValueError(f"{base}: void bit length must be 1..64")
+    if cast and kind not in ("uint", "float", "bool"):
+        raise ValueError(f"cast mode {cast!r} applies only to unsigned integers, floats and bool, not {base}")
+    if kind in ("byte", "utf8") and match["array"] is None:
+        raise ValueError(f"{base} is allowed only as an array element")
+    array_text = match["array"]
+    if array_text is None:
+        return DsdlType(kind, bits, composite, truncated=cast == "truncated")
+    if kind == "void":
+        raise ValueError("void cannot be an array element")
+    bounded = array_text.startswith("<=")
+    capacity = int(array_text[2:] if bounded else array_text)
+    if capacity < 1:
+        raise ValueError(f"array capacity of {text!r} must be at least 1")
+    return DsdlType(kind, bits, composite, "bounded" if bounded else "fixed", capacity, cast == "truncated")
