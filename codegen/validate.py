@@ -420,9 +420,13 @@ class _Validator:
             return None
         resolved = ResolvedMapping(mapping, ros_message, struct, has_header=has_header, rate_hz=port.rate_hz)
         ros_targets: dict[str, Pos] = {}
+        self.failed_paths: set[str] = set()
         for link in links:
             step = self.resolve_link(link, ros_message, struct, mapping, what)
             if step is None:
+                # Its UAVCAN side is reported already; do not report it again as unmapped.
+                if link.uavcan_path:
+                    self.failed_paths.add(link.uavcan_path.split("[")[0].split(".")[0])
                 continue
             if step.ros in ros_targets:
                 self.error(link.pos, f"ROS field {step.ros!r} is set twice in {what}")
@@ -545,7 +549,7 @@ class _Validator:
 
     def check_coverage(self, resolved: ResolvedMapping, what: str) -> None:
         mapping = resolved.mapping
-        linked = {s.uavcan for s in resolved.steps if s.uavcan_path}
+        linked = {s.uavcan for s in resolved.steps if s.uavcan_path} | self.failed_paths
         valued = {format_path(list(p)) for p, _, _ in resolved.uavcan_values}
         ignored = set(mapping.ignore)
 

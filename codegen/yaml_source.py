@@ -38,7 +38,7 @@ class YMap:
 YNode = YScalar | YSeq | YMap
 
 
-_STANDARD_TAG = "tag:yaml.org,2002:"
+_COLLECTION_TAGS = ("tag:yaml.org,2002:map", "tag:yaml.org,2002:seq")
 
 
 def _pos(file: str, node: yaml.Node) -> Pos:
@@ -53,7 +53,7 @@ class _Converter:
 
     def convert(self, node: yaml.Node) -> YNode:
         pos = _pos(self.file, node)
-        if not isinstance(node, yaml.ScalarNode) and not node.tag.startswith(_STANDARD_TAG):
+        if not isinstance(node, yaml.ScalarNode) and node.tag not in _COLLECTION_TAGS:
             self.errors.append(Diagnostic(pos, f"YAML tag {node.tag!r} is not allowed in a spec"))
         if isinstance(node, yaml.ScalarNode):
             try:

@@ -1,0 +1,353 @@
+"""Broken specs: each case breaks tests/specs/minimal.yaml one way and names the error it must give.
+
+`old` is replaced by `new` once (the case fails loudly if `old` is not in the base spec); `errors` are the
+exact diagnostics, with the file shown as its base name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    old: str
+    new: str
+    errors: tuple[str, ...]
+
+
+CASES: tuple[Case, ...] = (
+    Case(
+        'yaml_syntax',
+        '  /level: {type: buoy_msgs/Level}',
+        '  /level: {type: buoy_msgs/Level',
+        (
+            "minimal.yaml:26:9: error: YAML syntax error: expected ',' or '}', but got ':' while parsing a flow mapping",
+        ),
+    ),
+    Case(
+        'yaml_tab_indent',
+        'vehicle: {name: buoy',
+        'vehicle:\n\t{name: buoy',
+        (
+            "minimal.yaml:4:1: error: YAML syntax error: found character '\\t' that cannot start any token while scanning for the next token",
+        ),
+    ),
+    Case(
+        'python_tag',
+        '  base_link: {}',
+        "  base_link: !!python/object/apply:os.system ['true']",
+        (
+            "minimal.yaml:23:14: error: YAML tag 'tag:yaml.org,2002:python/object/apply:os.system' is not allowed in a spec",
+        ),
+    ),
+    Case(
+        'unknown_ros_type',
+        '/valve: {type: std_msgs/UInt8}',
+        '/valve: {type: std_msgs/UInt7}',
+        (
+            "minimal.yaml:26:3: error: unknown ROS type 'std_msgs/UInt7' of topic /valve (expected a message of this spec, an external_messages entry or an installed ROS message)",
+        ),
+    ),
+    Case(
+        'unknown_dsdl_type',
+        'type: uavcan.time.SynchronizedTimestamp.1.0}',
+        'type: uavcan.time.Timestamp.1.0}',
+        (
+            "minimal.yaml:16:9: error: unknown DSDL type 'uavcan.time.Timestamp.1.0' in DSDL type buoy.Level.0.1 (expected a type of this spec or of CYPHAL_PATH (uavcan.*, reg.*))",
+            "minimal.yaml:52:9: error: mapping 'level', field 'header.stamp': timestamp is a uavcan.time.Timestamp.1.0, it has no field 'microsecond'",
+        ),
+    ),
+    Case(
+        'bad_dsdl_primitive',
+        'type: int18}',
+        'type: int65}',
+        (
+            'minimal.yaml:17:26: error: int65: integer bit length must be 1..64 (unsigned) or 2..64 (signed)',
+        ),
+    ),
+    Case(
+        'unknown_top_field',
+        'spec_version: 1',
+        'spec_version: 1\ntopic: {}',
+        (
+            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, frames, transforms, topics, parameters, parameter_rules, devices, bridge, nodes)",
+        ),
+    ),
+    Case(
+        'unknown_mapping_field',
+        '      subject_id: 100\n',
+        '      subject_id: 100\n      subjectid: 100\n',
+        (
+            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+        ),
+    ),
+    Case(
+        'missing_field_type',
+        '      - {name: level, type: int32, comment: "Level [mm]."}',
+        '      - {name: level, comment: "Level [mm]."}',
+        (
+            "minimal.yaml:11:9: error: missing field 'type' in a field of message 'Level'",
+        ),
+    ),
+    Case(
+        'two_types_one_topic',
+        '  /valve: {type: std_msgs/UInt8}',
+        '  /valve: {type: std_msgs/UInt8}\n  /level: {type: std_msgs/UInt8}',
+        (
+            "minimal.yaml:27:3: error: topic '/level' is declared twice (first at line 25, types buoy_msgs/Level and std_msgs/UInt8): two types on one topic (expected one type per topic; give the second its own topic)",
+        ),
+    ),
+    Case(
+        'ros_field_narrower',
+        '      - {name: level, type: int32, comment: "Level [mm]."}',
+        '      - {name: level, type: int16, comment: "Level [mm]."}',
+        (
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': ROS int16 is narrower than the UAVCAN int18 it receives (range [-131072, 131071]); expected int32 or wider",
+        ),
+    ),
+    Case(
+        'unsigned_into_signed',
+        '/valve: {type: std_msgs/UInt8}',
+        '/valve: {type: std_msgs/Int8}',
+        (
+            "minimal.yaml:60:9: error: mapping 'valve', field 'data': ROS int8 is narrower than the UAVCAN uint8 it receives (range [0, 255]); expected uint8 or wider",
+        ),
+    ),
+    Case(
+        'node_id_out_of_range',
+        '    node_id: 10',
+        '    node_id: 128',
+        (
+            'minimal.yaml:33:3: error: node id 128 of device gauge is out of range for Cyphal/CAN (expected 0..127)',
+            "minimal.yaml:45:5: error: source node id 10 of mapping 'level' does not publish subject 100 (expected the node id of a device that publishes it: 128)",
+        ),
+    ),
+    Case(
+        'bridge_node_id_out_of_range',
+        '  node_id: 100\n  mappings',
+        '  node_id: 200\n  mappings',
+        (
+            'minimal.yaml:42:3: error: bridge node id 200 is out of range for Cyphal/CAN (expected 0..127)',
+        ),
+    ),
+    Case(
+        'subject_id_out_of_range',
+        '- {subject_id: 101, type: buoy.Valve.0.1',
+        '- {subject_id: 8192, type: buoy.Valve.0.1',
+        (
+            'minimal.yaml:40:9: error: subject id 8192 of device valve is out of range (expected 0..8191)',
+            "minimal.yaml:54:5: error: subject id 101 of mapping 'valve' is used by no device (expected a subject a device publishes or subscribes)",
+        ),
+    ),
+    Case(
+        'duplicate_subject_id',
+        '    subscribes:\n      - {subject_id: 101',
+        '    publishes:\n      - {subject_id: 100, type: buoy.Level.0.1, rate_hz: 1}\n    subscribes:\n      - {subject_id: 101',
+        (
+            'minimal.yaml:40:9: error: duplicate subject id 100: already published by device gauge (expected one publisher per subject)',
+        ),
+    ),
+    Case(
+        'duplicate_node_id',
+        '    node_id: 11',
+        '    node_id: 10',
+        (
+            'minimal.yaml:37:3: error: node id 10 of device valve is already used by device gauge (expected a unique node id)',
+            "minimal.yaml:54:5: error: destination node id 11 of mapping 'valve' does not subscribe to subject 101 (expected the node id of a device that subscribes to it)",
+        ),
+    ),
+    Case(
+        'bad_ros_field_name',
+        '{name: level, type: int32',
+        '{name: Level, type: int32',
+        (
+            "minimal.yaml:11:9: error: 'Level' is not a valid ROS field name in message buoy_msgs/Level (expected lower_case with single underscores, not a Python keyword)",
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': buoy_msgs/Level has no field 'level'",
+        ),
+    ),
+    Case(
+        'bad_ros_field_double_underscore',
+        '{name: level, type: int32',
+        '{name: le__vel, type: int32',
+        (
+            "minimal.yaml:11:9: error: 'le__vel' is not a valid ROS field name in message buoy_msgs/Level (expected lower_case with single underscores, not a Python keyword)",
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': buoy_msgs/Level has no field 'level'",
+        ),
+    ),
+    Case(
+        'bad_dsdl_identifier',
+        '{name: level_mm, type: int18}',
+        '{name: uint8, type: int18}',
+        (
+            "minimal.yaml:17:9: error: 'uint8' is not a valid DSDL identifier in DSDL type buoy.Level.0.1 (expected letters, digits and underscores, not reserved (e.g. uint8, bool, saturated) nor a Python keyword)",
+            "minimal.yaml:45:5: error: required field left unmapped: UAVCAN field 'uint8' (int18) of buoy.Level.0.1 is neither mapped nor ignored in mapping 'level' (expected a `ros_field: uint8` line or `uint8` in ignore)",
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': buoy.Level.0.1 has no field 'level_mm'",
+        ),
+    ),
+    Case(
+        'bad_topic_name',
+        '  /valve: {type: std_msgs/UInt8}',
+        '  /valve/: {type: std_msgs/UInt8}',
+        (
+            "minimal.yaml:26:3: error: topic name '/valve/' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
+        ),
+    ),
+    Case(
+        'bad_message_name',
+        '  Level:\n    description',
+        '  level_msg:\n    description',
+        (
+            "minimal.yaml:7:3: error: 'level_msg' is not a valid ROS message name (expected CamelCase, e.g. ThrusterRPMs)",
+            "minimal.yaml:25:3: error: unknown ROS type 'buoy_msgs/Level' of topic /level (expected a message of this spec, an external_messages entry or an installed ROS message)",
+        ),
+    ),
+    Case(
+        'required_field_unmapped_to_ros',
+        '        level: level_mm\n',
+        '',
+        (
+            "minimal.yaml:45:5: error: required field left unmapped: UAVCAN field 'level_mm' (int18) of buoy.Level.0.1 is neither mapped nor ignored in mapping 'level' (expected a `ros_field: level_mm` line or `level_mm` in ignore)",
+        ),
+    ),
+    Case(
+        'required_field_unmapped_to_uavcan',
+        '        data: open_pct\n',
+        '        {}\n',
+        (
+            "minimal.yaml:54:5: error: required field left unmapped: UAVCAN field 'open_pct' (uint8) of buoy.Valve.0.1 gets no value in mapping 'valve' (expected a `ros_field: open_pct` line or an entry in uavcan_values)",
+        ),
+    ),
+    Case(
+        'inconsistent_parameter_limits',
+        'default: 2.0, min: 0.0',
+        'default: 0.5, min: 0.0',
+        (
+            'minimal.yaml:31:5: error: inconsistent parameter limits: /alarm_level = 0.5 must be > /warn_level = 1.0',
+        ),
+    ),
+    Case(
+        'parameter_default_outside_range',
+        'default: 1.0, min: 0.0, max: 10.0',
+        'default: 11.0, min: 0.0, max: 10.0',
+        (
+            "minimal.yaml:28:40: error: default 11.0 of parameter '/warn_level' is outside its range (expected a value in [0.0, 10.0])",
+        ),
+    ),
+    Case(
+        'source_node_not_publisher',
+        'source_node_ids: [10]',
+        'source_node_ids: [11]',
+        (
+            "minimal.yaml:45:5: error: source node id 11 of mapping 'level' does not publish subject 100 (it is device valve) (expected the node id of a device that publishes it: 10)",
+        ),
+    ),
+    Case(
+        'destination_not_subscriber',
+        'destination_node_id: 11',
+        'destination_node_id: 10',
+        (
+            "minimal.yaml:54:5: error: destination node id 10 of mapping 'valve' does not subscribe to subject 101 (expected the node id of a device that subscribes to it)",
+        ),
+    ),
+    Case(
+        'unknown_topic_in_mapping',
+        '      topic: /level\n',
+        '      topic: /levels\n',
+        (
+            "minimal.yaml:45:5: error: mapping 'level' uses undeclared topic '/levels' (expected a topic of `topics`)",
+        ),
+    ),
+    Case(
+        'unknown_frame',
+        'frame_id: base_link',
+        'frame_id: odom',
+        (
+            "minimal.yaml:45:5: error: frame_id 'odom' of mapping 'level' is not a declared frame (expected one of base_link)",
+        ),
+    ),
+    Case(
+        'wrong_value_type',
+        '    node_id: 10',
+        '    node_id: ten',
+        (
+            "minimal.yaml:34:14: error: 'node_id' of device 'gauge' must be int, found str 'ten' (expected int)",
+        ),
+    ),
+    Case(
+        'duplicate_key',
+        '  /warn_level:',
+        '  /alarm_level: {type: double, default: 3.0}\n  /warn_level:',
+        (
+            "minimal.yaml:30:3: error: duplicate key '/alarm_level' in parameters (first at line 28) (expected unique keys)",
+        ),
+    ),
+    Case(
+        'neither_sealed_nor_extent',
+        '  buoy.Valve.0.1:\n    sealed: true',
+        '  buoy.Valve.0.1:\n    description: valve',
+        (
+            "minimal.yaml:18:3: error: DSDL type 'buoy.Valve.0.1' needs `sealed: true` or `extent: <bytes>` (expected sealed or extent (DSDL requires one))",
+        ),
+    ),
+    Case(
+        'wrong_root_namespace',
+        '  buoy.Valve.0.1:',
+        '  other.Valve.0.1:',
+        (
+            "minimal.yaml:18:3: error: DSDL type other.Valve.0.1 is outside the spec's root namespace 'buoy' (expected buoy.<namespace>.Name.MAJOR.MINOR)",
+            "minimal.yaml:40:9: error: unknown DSDL type 'buoy.Valve.0.1' of device valve (expected a type of this spec or of CYPHAL_PATH)",
+        ),
+    ),
+    Case(
+        'truncated_signed',
+        '{name: level_mm, type: int18}',
+        '{name: level_mm, type: truncated int18}',
+        (
+            "minimal.yaml:17:26: error: cast mode 'truncated' applies only to unsigned integers, floats and bool, not int18",
+        ),
+    ),
+    Case(
+        'index_into_scalar',
+        '        level: level_mm',
+        '        level: level_mm[0]',
+        (
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': level_mm[0]: only fixed-size arrays take an index, level_mm is int18",
+        ),
+    ),
+    Case(
+        'scale_into_int',
+        '        level: level_mm',
+        '        level: {from: level_mm, scale: 0.5}',
+        (
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': scale/offset give fractions: int18 with a scale needs a float ROS field, not int32",
+        ),
+    ),
+    Case(
+        'table_value_out_of_range',
+        '        level: level_mm',
+        '        level: {from: level_mm, table: {0: 3000000000}}',
+        (
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': table value 3000000000 is outside the range of int32",
+        ),
+    ),
+    Case(
+        'node_unknown_topic',
+        '    subscribes: [/level]',
+        '    subscribes: [/levle]',
+        (
+            "minimal.yaml:62:3: error: node logger uses undeclared topic '/levle'",
+        ),
+    ),
+    Case(
+        'python_keyword_field',
+        '{name: level, type: int32',
+        '{name: class, type: int32',
+        (
+            "minimal.yaml:11:9: error: 'class' is not a valid ROS field name in message buoy_msgs/Level (expected lower_case with single underscores, not a Python keyword)",
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': buoy_msgs/Level has no field 'level'",
+        ),
+    ),
+)
