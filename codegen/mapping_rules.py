@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .diagnostics import Pos
+from .diagnostics import NOWHERE, Pos
 from .model import Constant, DsdlStruct, Field, FieldLink, Mapping, RosMessage, Scalar
 from .typesys import (
     ROS_FLOAT_BITS,
@@ -95,7 +95,10 @@ def _is_sync_timestamp(t: DsdlType) -> bool:
 
 def derive_message(struct: DsdlStruct, package: str, name: str, description: str, pos: Pos) -> RosMessage:
     """A ROS message derived from a DSDL type: a header, then every field widened; constants kept."""
-    fields = [Field("header", RosType(HEADER), "Stamp from the device's timestamp (receive time when 0).", pos)]
+    has_stamp = any(isinstance(f.type, DsdlType) and _is_sync_timestamp(f.type) for f in struct.fields)
+    stamp = ("Stamp from the device's timestamp (the receive time when it is 0)." if has_stamp
+             else "Stamp: the bridge's receive time (the UAVCAN type has no timestamp).")
+    fields = [Field("header", RosType(HEADER), stamp, pos)]
     stamp_taken = False
     for f in struct.fields:
         assert isinstance(f.type, DsdlType)
@@ -131,7 +134,7 @@ def auto_links(struct: DsdlStruct, pos: Pos) -> list[FieldLink]:
 class Step:
     """One resolved link, ready for an emitter. Paths are relative to the ROS / UAVCAN message."""
 
-    kind: str  # number | array | time | table | value
+    kind: str  # number | array | time | table | value | string
     ros_path: tuple[PathSeg, ...]
     ros_type: RosType
     uavcan_path: tuple[PathSeg, ...] = ()
@@ -142,7 +145,7 @@ class Step:
     value: Scalar | None = None
     limits: tuple[float, float] | None = None
     exact: bool = True  # UAVCAN -> ROS -> UAVCAN gives the value back
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
     @property
     def ros(self) -> str:
@@ -223,6 +226,17 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
                             f"expected {expected} or wider")
         return "number", True
     raise RuleError(f"UAVCAN {uav} cannot be linked to a ROS field")
+
+
+def check_string(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:
+    """Check a UAVCAN utf8[<=N] / ROS string pair (step kind `string`); returns whether the round trip is exact."""
+    if uav.kind != "utf8" or uav.array != "bounded" or ros.base != "string" or ros.array:
+        raise RuleError(f"a UAVCAN utf8[<=N] maps to a ROS string, not {uav} to {ros}")
+    if link.scale is not None or link.offset is not None or link.table is not None or link.limits is not None:
+        raise RuleError("scale, offset, table and limits do not apply to strings")
+    if ros.string_bound is not None and ros.string_bound < (uav.capacity or 0):
+        raise RuleError(f"ROS {ros} is shorter than UAVCAN {uav}; expected string<={uav.capacity} or unbounded")
+    return True  # for valid UTF-8; invalid bytes are replaced when decoding
 
 
 def check_arrays(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:

@@ -21,6 +21,7 @@ def environment() -> jinja2.Environment:
         lstrip_blocks=True,
         undefined=jinja2.StrictUndefined,
         autoescape=False,
+        extensions=["jinja2.ext.do"],
     )
     env.filters.update(FILTERS)
     return env
