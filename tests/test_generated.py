@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from sam_codegen.build import MARKER, build, compare, generate
+from sam_codegen.build import MARKER, compare, generate
 from sam_codegen.cli import main
 
 ROOT = Path(__file__).parents[1]
@@ -90,7 +90,8 @@ def test_second_spec_builds(tmp_path: Path) -> None:
     """Nothing SAM-specific hides in the generator: another vehicle's spec builds through the CLI too."""
     out = tmp_path / "generated"
     assert main(["build", "--spec", str(Path(__file__).parent / "specs" / "rover.yaml"), "--out", str(out)]) == 0
-    assert list((out / "ros").iterdir()) and list((out / "dsdl").iterdir()) and (out / "docs" / "interfaces.md").exists()
+    assert list((out / "ros").iterdir()) and list((out / "dsdl").iterdir())
+    assert (out / "docs" / "interfaces.md").exists()
     assert main(["build", "--check", "--spec", str(Path(__file__).parent / "specs" / "rover.yaml"),
                  "--out", str(out)]) == 0
 
