@@ -43,7 +43,7 @@ def parse_path(text: str) -> list[PathSeg]:
     """
     segments: list[PathSeg] = []
     for part in text.split("."):
-        match = _SEGMENT.match(part)
+        match = _SEGMENT.fullmatch(part)
         if not match:
             raise RuleError(f"{text!r} is not a field path (name, name.sub or name[index])")
         segments.append((match["name"], int(match["index"]) if match["index"] is not None else None))

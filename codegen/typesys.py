@@ -86,19 +86,19 @@ def parse_ros_type(text: str, package: str | None = None) -> RosType:
     >>> parse_ros_type("Header", "std_msgs").base
     'std_msgs/Header'
     """
-    match = _ROS_TYPE.match(text.strip())
+    match = _ROS_TYPE.fullmatch(text.strip())
     if not match:
         raise ValueError(f"{text!r} is not a ROS field type")
     base = match["base"].replace("/msg/", "/")
     if "/" not in base and base not in ROS_PRIMITIVES:
-        if not ROS_MESSAGE_NAME.match(base):
+        if not ROS_MESSAGE_NAME.fullmatch(base):
             raise ValueError(f"unknown ROS type {base!r}")
         if package is None:
             raise ValueError(f"message type {base!r} needs its package, as pkg/{base}")
         base = f"{package}/{base}"
     if "/" in base:
         pkg, name = base.split("/")
-        if not ROS_PACKAGE_NAME.match(pkg) or not ROS_MESSAGE_NAME.match(name):
+        if not ROS_PACKAGE_NAME.fullmatch(pkg) or not ROS_MESSAGE_NAME.fullmatch(name):
             raise ValueError(f"{base!r} is not a valid ROS message type name")
     string_bound = int(match["strbound"]) if match["strbound"] else None
     if string_bound is not None and base not in ("string", "wstring"):
@@ -135,7 +135,9 @@ _DSDL_TYPE = re.compile(
     r"(?:[a-z_][a-z0-9_]*\.)+[A-Za-z_][A-Za-z0-9_]*\.[0-9]+\.[0-9]+)"
     r"(?:\[(?P<array>(?:<=)?[0-9]+)\])?$"
 )
-_COMPOSITE_NAME = re.compile(r"^(?P<full>(?:[a-z_][a-z0-9_]*\.)+[A-Za-z_][A-Za-z0-9_]*)\.(?P<maj>[0-9]+)\.(?P<min>[0-9]+)$")
+_COMPOSITE_NAME = re.compile(
+    r"^(?P<full>(?:[a-z_][a-z0-9_]*\.)+[A-Za-z_][A-Za-z0-9_]*)\.(?P<maj>[0-9]+)\.(?P<min>[0-9]+)$"
+)
 
 
 def is_dsdl_identifier(name: str) -> bool:
@@ -144,7 +146,7 @@ def is_dsdl_identifier(name: str) -> bool:
     >>> is_dsdl_identifier("rpm"), is_dsdl_identifier("uint8"), is_dsdl_identifier("2x")
     (True, False, False)
     """
-    return bool(DSDL_IDENTIFIER.match(name)) and not _DSDL_RESERVED.match(name) and not name.startswith("_")
+    return bool(DSDL_IDENTIFIER.fullmatch(name)) and not _DSDL_RESERVED.fullmatch(name) and not name.startswith("_")
 
 
 @dataclass(frozen=True)
@@ -191,7 +193,7 @@ class DsdlType:
 
 def split_composite_name(name: str) -> tuple[str, int, int]:
     """`uavcan.time.SynchronizedTimestamp.1.0` -> (`uavcan.time.SynchronizedTimestamp`, 1, 0)."""
-    match = _COMPOSITE_NAME.match(name)
+    match = _COMPOSITE_NAME.fullmatch(name)
     if not match:
         raise ValueError(f"{name!r} is not a versioned DSDL type name (namespace.Name.MAJOR.MINOR)")
     return match["full"], int(match["maj"]), int(match["min"])
@@ -205,7 +207,7 @@ def parse_dsdl_type(text: str) -> DsdlType:
     >>> parse_dsdl_type("uavcan.time.SynchronizedTimestamp.1.0").composite
     'uavcan.time.SynchronizedTimestamp.1.0'
     """
-    match = _DSDL_TYPE.match(" ".join(text.split()))
+    match = _DSDL_TYPE.fullmatch(" ".join(text.split()))
     if not match:
         raise ValueError(f"{text!r} is not a DSDL field type")
     base, cast = match["base"], match["cast"]
@@ -225,7 +227,7 @@ def parse_dsdl_type(text: str) -> DsdlType:
     else:
         kind, composite = "composite", base
         split_composite_name(base)
-    if kind == "uint" and not 1 <= bits <= 64 or kind == "int" and not 2 <= bits <= 64:
+    if (kind == "uint" and not 1 <= bits <= 64) or (kind == "int" and not 2 <= bits <= 64):
         raise ValueError(f"{base}: integer bit length must be 1..64 (unsigned) or 2..64 (signed)")
     if kind == "void" and not 1 <= bits <= 64:
         raise ValueError(f"{base}: void bit length must be 1..64")

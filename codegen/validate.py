@@ -20,6 +20,7 @@ from .mapping_rules import (
     auto_links,
     check_arrays,
     check_scalar,
+    check_string,
     derive_message,
     format_path,
     parse_path,
@@ -76,15 +77,15 @@ class _Validator:
     # ---- names and types -------------------------------------------------------------------------------
     def check_header(self) -> None:
         s = self.spec
-        if not ROS_PACKAGE_NAME.match(s.ros.name):
+        if not ROS_PACKAGE_NAME.fullmatch(s.ros.name):
             self.error(Pos(s.file, 1, 1), f"ROS package name {s.ros.name!r} is not valid",
                        "lower case letters, digits and single underscores, starting with a letter")
-        if not DSDL_NAMESPACE_COMPONENT.match(s.dsdl_root) or not is_dsdl_identifier(s.dsdl_root):
+        if not DSDL_NAMESPACE_COMPONENT.fullmatch(s.dsdl_root) or not is_dsdl_identifier(s.dsdl_root):
             self.error(Pos(s.file, 1, 1), f"DSDL root namespace {s.dsdl_root!r} is not valid",
                        "a lower case DSDL identifier")
         if s.dsdl_root in ("uavcan", "reg"):
             self.error(Pos(s.file, 1, 1), f"root namespace {s.dsdl_root!r} is reserved for the standard types")
-        if not re.match(r"^[a-z][a-z0-9_]*$", s.vehicle):
+        if not re.fullmatch(r"[a-z][a-z0-9_]*", s.vehicle):
             self.error(Pos(s.file, 1, 1), f"vehicle name {s.vehicle!r} is not valid", "a lower case identifier")
 
     def ros_type_exists(self, t: RosType, pos: Pos, what: str) -> bool:
@@ -98,11 +99,11 @@ class _Validator:
 
     def check_ros_message(self, message: RosMessage) -> None:
         what = f"message {message.full_name}"
-        if not ROS_MESSAGE_NAME.match(message.name):
+        if not ROS_MESSAGE_NAME.fullmatch(message.name):
             self.error(message.pos, f"{message.name!r} is not a valid ROS message name", "CamelCase, e.g. ThrusterRPMs")
         seen: set[str] = set()
         for f in message.fields:
-            if not ROS_FIELD_NAME.match(f.name) or not _python_safe(f.name):
+            if not ROS_FIELD_NAME.fullmatch(f.name) or not _python_safe(f.name):
                 self.error(f.pos, f"{f.name!r} is not a valid ROS field name in {what}",
                            "lower_case with single underscores, not a Python keyword")
             if f.name in seen:
@@ -113,7 +114,7 @@ class _Validator:
             if f.default is not None:
                 self.check_ros_value(f.type, f.default, f.pos, f"default of {f.name!r}")
         for c in message.constants:
-            if not ROS_CONSTANT_NAME.match(c.name):
+            if not ROS_CONSTANT_NAME.fullmatch(c.name):
                 self.error(c.pos, f"{c.name!r} is not a valid ROS constant name in {what}", "UPPER_CASE")
             assert isinstance(c.type, RosType)
             if not c.type.is_primitive or c.type.array:
@@ -167,9 +168,9 @@ class _Validator:
             self.error(struct.pos, f"{what} is outside the spec's root namespace {self.spec.dsdl_root!r}",
                        f"{self.spec.dsdl_root}.<namespace>.Name.MAJOR.MINOR")
         for part in parts[:-1]:
-            if not DSDL_NAMESPACE_COMPONENT.match(part) or not is_dsdl_identifier(part):
+            if not DSDL_NAMESPACE_COMPONENT.fullmatch(part) or not is_dsdl_identifier(part):
                 self.error(struct.pos, f"namespace {part!r} of {what} is not a valid DSDL identifier")
-        if not DSDL_SHORT_NAME.match(parts[-1]) or not is_dsdl_identifier(parts[-1]) or not parts[-1][0].isupper():
+        if not DSDL_SHORT_NAME.fullmatch(parts[-1]) or not is_dsdl_identifier(parts[-1]) or not parts[-1][0].isupper():
             self.error(struct.pos, f"{parts[-1]!r} is not a valid DSDL type name", "CamelCase identifier")
         if not (0 <= major <= 255 and 0 <= minor <= 255) or (major, minor) == (0, 0):
             self.error(struct.pos, f"version {major}.{minor} of {what} is not valid", "MAJOR.MINOR in 0..255, not 0.0")
@@ -238,7 +239,7 @@ class _Validator:
     def check_frames_and_parameters(self) -> None:
         s = self.spec
         for frame in s.frames.values():
-            if not _FRAME_NAME.match(frame.name):
+            if not _FRAME_NAME.fullmatch(frame.name):
                 self.error(frame.pos, f"frame {frame.name!r} is not a valid TF frame id", "an identifier")
             if frame.parent is not None and frame.parent not in s.frames:
                 self.error(frame.pos, f"frame {frame.name!r} has unknown parent {frame.parent!r}")
@@ -257,7 +258,7 @@ class _Validator:
             if t.publisher not in s.nodes:
                 self.error(t.pos, f"transform {t.parent}->{t.child} is published by unknown node {t.publisher!r}")
         for p in s.parameters.values():
-            if not _PARAM_NAME.match(p.name):
+            if not _PARAM_NAME.fullmatch(p.name):
                 self.error(p.pos, f"parameter name {p.name!r} is not a valid ROS name", "/name")
         for rule in s.parameter_rules:
             left, right = s.parameters.get(rule.left), s.parameters.get(rule.right)
@@ -279,7 +280,7 @@ class _Validator:
     def check_topics_and_nodes(self) -> None:
         s = self.spec
         for topic in s.topics.values():
-            if not ROS_TOPIC_NAME.match(topic.name):
+            if not ROS_TOPIC_NAME.fullmatch(topic.name):
                 self.error(topic.pos, f"topic name {topic.name!r} is not a valid ROS name",
                            "/segment[/segment...], each a letter or underscore then letters, digits, underscores")
             if "/" not in topic.type:
@@ -288,7 +289,7 @@ class _Validator:
                 self.error(topic.pos, f"unknown ROS type {topic.type!r} of topic {topic.name}",
                            "a message of this spec, an external_messages entry or an installed ROS message")
         for node in s.nodes.values():
-            if not re.match(r"^[a-z][a-z0-9_]*$", node.name):
+            if not re.fullmatch(r"[a-z][a-z0-9_]*", node.name):
                 self.error(node.pos, f"node name {node.name!r} is not a valid ROS node name", "lower_case")
             for topic in [*node.publishes, *node.subscribes]:
                 if topic not in s.topics:
@@ -316,7 +317,7 @@ class _Validator:
         subject_types: dict[int, tuple[str, Pos]] = {}
         publishers: dict[int, str] = {}
         for device in s.devices.values():
-            if not re.match(r"^[a-z][a-z0-9_]*$", device.name):
+            if not re.fullmatch(r"[a-z][a-z0-9_]*", device.name):
                 self.error(device.pos, f"device name {device.name!r} is not valid", "lower_case")
             if device.node_id not in CAN_NODE_IDS:
                 self.error(device.pos, f"node id {device.node_id} of device {device.name} is out of range for "
@@ -359,7 +360,7 @@ class _Validator:
 
     def resolve_mapping(self, mapping: Mapping, devices_by_id: dict) -> ResolvedMapping | None:
         s, what = self.spec, f"mapping {mapping.name!r}"
-        if not re.match(r"^[a-z][a-z0-9_]*$", mapping.name) or not _python_safe(mapping.name):
+        if not re.fullmatch(r"[a-z][a-z0-9_]*", mapping.name) or not _python_safe(mapping.name):
             self.error(mapping.pos, f"mapping name {mapping.name!r} is not valid", "lower_case identifier")
         topic = s.topics.get(mapping.topic)
         if topic is None:
@@ -523,7 +524,10 @@ class _Validator:
                 raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one")
             if link.limits is not None and (ros_type.array or ros_type.base not in {*ROS_INT_RANGES, *ROS_FLOAT_BITS}):
                 raise RuleError("limits apply to numeric scalar fields")
-            if uav_type.array or ros_type.array:
+            if uav_type.kind == "utf8" or ros_type.base == "string":
+                exact = check_string(ros_type, uav_type, link)
+                kind = "string"
+            elif uav_type.array or ros_type.array:
                 exact = check_arrays(ros_type, uav_type, link)
                 kind = "array"
             else:
