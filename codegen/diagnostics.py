@@ -17,6 +17,9 @@ class Pos:
         return f"{self.file}:{self.line}:{self.column}" if self.line else self.file
 
 
+NOWHERE = Pos("")
+
+
 @dataclass(frozen=True)
 class Diagnostic:
     pos: Pos

@@ -33,7 +33,8 @@ def from_pydsdl(data_type: pydsdl.Any) -> DsdlType:
         kind = "fixed" if isinstance(data_type, pydsdl.FixedLengthArrayType) else "bounded"
         return DsdlType(element.kind, element.bits, element.composite, kind, data_type.capacity, element.truncated)
     if isinstance(data_type, pydsdl.CompositeType):
-        return DsdlType("composite", composite=f"{data_type.full_name}.{data_type.version.major}.{data_type.version.minor}")
+        version = data_type.version
+        return DsdlType("composite", composite=f"{data_type.full_name}.{version.major}.{version.minor}")
     truncated = getattr(data_type, "cast_mode", None) == pydsdl.PrimitiveType.CastMode.TRUNCATED
     if isinstance(data_type, pydsdl.BooleanType):
         return DsdlType("bool", 1)

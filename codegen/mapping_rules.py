@@ -215,6 +215,11 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
             exact = max(abs(lo), abs(hi)) <= 2**mantissa
             if not exact and not transformed:
                 raise RuleError(f"ROS {ros_base} cannot hold every {uav.base_name} exactly; expected a wider type")
+            if transformed:
+                # v * scale + offset is off by up to 2^-(mantissa-1) of its size; back in UAVCAN units the error
+                # must stay below the half step that round() absorbs.
+                reach = max(abs(lo), abs(hi)) + abs((link.offset or 0.0) / (link.scale or 1.0))
+                exact = reach < 2 ** (mantissa - 2)
             return "number", exact
         raise RuleError(f"a UAVCAN {uav.base_name} cannot map to ROS {ros_base}")
     if uav.kind == "float":
@@ -224,7 +229,12 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
             expected = "float32" if uav.bits <= 32 else "float64"
             raise RuleError(f"ROS {ros_base} is narrower than the UAVCAN {uav.base_name} it receives; "
                             f"expected {expected} or wider")
-        return "number", True
+        # An offset moves small values onto a coarser grid (0.001 K - 273.15 loses the 0.001); a scale costs one
+        # rounding, harmless only when the ROS float has at least two more mantissa bits than the UAVCAN one.
+        mantissa = {16: 11, 32: 24, 64: 53}
+        exact = link.offset is None and (
+            link.scale is None or mantissa[ROS_FLOAT_BITS[ros_base]] >= mantissa.get(uav.bits, 53) + 2)
+        return "number", exact
     raise RuleError(f"UAVCAN {uav} cannot be linked to a ROS field")
 
 

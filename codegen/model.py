@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from .diagnostics import Pos
+from .diagnostics import NOWHERE, Pos
 from .typesys import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
@@ -21,7 +21,7 @@ class Field:
     name: str
     type: RosType | DsdlType
     comment: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
     default: Scalar | None = None
 
 
@@ -31,7 +31,7 @@ class Constant:
     type: RosType | DsdlType
     value: Scalar
     comment: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -43,7 +43,7 @@ class RosMessage:
     description: str = ""
     derived_from: str | None = None
     external: bool = False
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
     @property
     def full_name(self) -> str:
@@ -65,7 +65,7 @@ class DsdlStruct:
     extent: int | None = None
     standard: bool = False
     union: bool = False
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
     @property
     def full_name(self) -> str:
@@ -94,7 +94,7 @@ class Topic:
     type: str  # pkg/Name
     description: str = ""
     section: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -107,7 +107,7 @@ class Parameter:
     maximum: float | None = None
     description: str = ""
     section: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -116,7 +116,7 @@ class ParameterRule:
     op: str
     right: str
     description: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -124,7 +124,7 @@ class Frame:
     name: str
     parent: str | None = None
     description: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -133,7 +133,7 @@ class Transform:
     child: str
     publisher: str
     description: str = ""
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -141,7 +141,7 @@ class Port:
     subject_id: int
     type: str  # DSDL full name with version
     rate_hz: float
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -151,7 +151,7 @@ class Device:
     description: str = ""
     publishes: list[Port] = field(default_factory=list)
     subscribes: list[Port] = field(default_factory=list)
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -165,7 +165,7 @@ class FieldLink:
     table: dict[int, int] | None = None
     value: Scalar | None = None
     limits: tuple[float, float] | None = None
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -182,7 +182,7 @@ class Mapping:
     uavcan_values: dict[str, Scalar] = field(default_factory=dict)
     auto: bool = False
     on_out_of_range: OutOfRange = "saturate"
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -190,7 +190,7 @@ class Bridge:
     name: str
     node_id: int
     mappings: list[Mapping] = field(default_factory=list)
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass
@@ -201,7 +201,7 @@ class Node:
     subscribes: list[str] = field(default_factory=list)
     parameters: list[str] = field(default_factory=list)
     transforms: list[tuple[str, str]] = field(default_factory=list)
-    pos: Pos = Pos("")
+    pos: Pos = NOWHERE
 
 
 @dataclass

@@ -445,7 +445,7 @@ def _parameter(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -
     if minimum is not None and maximum is not None and minimum > maximum:
         diag.error(r.key_pos("min"), f"{what}: min {minimum} is above max {maximum}")
     if isinstance(default, (int, float)) and not isinstance(default, bool):
-        if minimum is not None and default < minimum or maximum is not None and default > maximum:
+        if (minimum is not None and default < minimum) or (maximum is not None and default > maximum):
             diag.error(r.key_pos("default"), f"default {default} of {what} is outside its range",
                        f"a value in [{minimum}, {maximum}]")
     if default is not None:

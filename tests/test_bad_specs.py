@@ -48,7 +48,8 @@ def test_cli_reports_all_errors_and_leaves_output_alone(tmp_path: Path, capsys: 
     assert main(["build", "--spec", str(SPECS / "minimal.yaml"), "--out", str(out)]) == 0
     before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     broken = tmp_path / "broken.yaml"
-    text = BASE.replace("    node_id: 10", "    node_id: 128").replace("{name: level, type: int32", "{name: Level, type: int32")
+    text = BASE.replace("    node_id: 10", "    node_id: 128")
+    text = text.replace("{name: level, type: int32", "{name: Level, type: int32")
     broken.write_text(text, encoding="utf-8")
     capsys.readouterr()
     assert main(["build", "--spec", str(broken), "--out", str(out)]) == 1

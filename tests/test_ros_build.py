@@ -20,6 +20,7 @@ from pathlib import Path
 
 import jinja2
 import pytest
+
 from sam_codegen.ros_build import RosBuildError, build_ros_package, is_installed, ros_runtime_env
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "templates" / "ros"
