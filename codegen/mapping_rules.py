@@ -246,7 +246,7 @@ def check_string(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:
         raise RuleError("scale, offset, table and limits do not apply to strings")
     if ros.string_bound is not None and ros.string_bound < (uav.capacity or 0):
         raise RuleError(f"ROS {ros} is shorter than UAVCAN {uav}; expected string<={uav.capacity} or unbounded")
-    return True  # for valid UTF-8; invalid bytes are replaced when decoding
+    return True  # for valid UTF-8 without NUL (which ends a ROS string); invalid bytes are replaced
 
 
 def check_arrays(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:

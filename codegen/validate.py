@@ -47,6 +47,7 @@ CAN_NODE_IDS = range(0, 128)
 SUBJECT_IDS = range(0, 8192)
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _PARAM_NAME = ROS_TOPIC_NAME
+_CONVERTER_LOCALS = frozenset({"src", "msg", "stats", "receive_ns", "us", "stamp", "typing", "collections"})
 
 
 @dataclass
@@ -85,6 +86,10 @@ class _Validator:
                        "a lower case DSDL identifier")
         if s.dsdl_root in ("uavcan", "reg"):
             self.error(Pos(s.file, 1, 1), f"root namespace {s.dsdl_root!r} is reserved for the standard types")
+        if s.dsdl_root in _CONVERTER_LOCALS or s.dsdl_root == s.ros.name:
+            # The generated converters import the root namespace as a Python module beside these names.
+            self.error(Pos(s.file, 1, 1), f"root namespace {s.dsdl_root!r} would shadow a name of the generated "
+                       "converters", "another name")
         if not re.fullmatch(r"[a-z][a-z0-9_]*", s.vehicle):
             self.error(Pos(s.file, 1, 1), f"vehicle name {s.vehicle!r} is not valid", "a lower case identifier")
 

@@ -1,0 +1,784 @@
+# Generated from interfaces.yaml by sam-codegen; do not edit.
+"""The sam interface as data: devices, topics, bridge mappings, parameters and frames.
+
+Standard library only: the bridge runtime reads this module without importing ROS or the DSDL packages.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class PortInfo:
+    """A UAVCAN subject a device publishes or subscribes to."""
+
+    subject_id: int
+    dsdl_type: str  # full name with version, e.g. "sam.sensor.RawIMU.0.1"
+    dsdl_module: str  # the pycyphal module, e.g. "sam.sensor"
+    dsdl_class: str  # the pycyphal class in it, e.g. "RawIMU_0_1"
+    rate_hz: float
+
+
+@dataclass(frozen=True)
+class DeviceInfo:
+    """A UAVCAN node of the vehicle."""
+
+    name: str
+    node_id: int
+    description: str
+    publishes: tuple[PortInfo, ...]
+    subscribes: tuple[PortInfo, ...]
+
+
+@dataclass(frozen=True)
+class TopicInfo:
+    """A ROS topic."""
+
+    name: str
+    ros_type: str  # e.g. "sensor_msgs/msg/Imu"
+    ros_module: str  # e.g. "sensor_msgs.msg"
+    ros_class: str  # e.g. "Imu"
+    description: str
+
+
+@dataclass(frozen=True)
+class MappingInfo:
+    """One mapping of the bridge between a UAVCAN subject and a ROS topic."""
+
+    name: str
+    direction: str  # "uavcan_to_ros" | "ros_to_uavcan"
+    topic: TopicInfo
+    port: PortInfo
+    source_node_ids: frozenset[int]  # UAVCAN->ROS: the nodes whose messages are accepted
+    destination_node_id: int | None  # ROS->UAVCAN: the node the commands are meant for
+    frame_id: str | None
+    rate_hz: float
+    on_out_of_range: str  # "saturate" | "reject"
+    to_ros: str  # name of the converter function in convert.py
+    to_uavcan: str
+    # UAVCAN paths whose value survives UAVCAN->ROS->UAVCAN exactly (but a timestamp of 0, "unknown", comes
+    # back as the receive time; and text only when it is UTF-8 without NUL characters)
+    exact_uavcan_fields: tuple[str, ...]
+    linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
+
+
+@dataclass(frozen=True)
+class ParameterInfo:
+    """A ROS parameter of the vehicle's nodes."""
+
+    name: str
+    type: str  # "double" | "integer" | "bool" | "string"
+    default: float | int | bool | str
+    minimum: float | None
+    maximum: float | None
+    unit: str
+    description: str
+
+
+@dataclass(frozen=True)
+class ParameterRuleInfo:
+    """A relation two parameters must keep: `left op right`."""
+
+    left: str
+    op: str
+    right: str
+    description: str
+
+
+VEHICLE = 'sam'
+ROS_PACKAGE = 'sam_msgs'
+DSDL_ROOT_NAMESPACE = 'sam'
+BRIDGE_NAME = 'uavcan_ros_bridge'
+BRIDGE_NODE_ID = 100
+
+DEVICES: tuple[DeviceInfo, ...] = (
+    DeviceInfo(
+        name='imu',
+        node_id=11,
+        description='Inertial measurement unit.',
+        publishes=(
+            PortInfo(1100, 'sam.sensor.RawIMU.0.1', 'sam.sensor', 'RawIMU_0_1', 100.0),
+        ),
+        subscribes=(),
+    ),
+    DeviceInfo(
+        name='magnetometer',
+        node_id=12,
+        description='Three-axis magnetometer.',
+        publishes=(
+            PortInfo(
+                subject_id=1101,
+                dsdl_type='sam.sensor.MagneticFieldStrength.0.1',
+                dsdl_module='sam.sensor',
+                dsdl_class='MagneticFieldStrength_0_1',
+                rate_hz=50.0,
+            ),
+        ),
+        subscribes=(),
+    ),
+    DeviceInfo(
+        name='gps',
+        node_id=13,
+        description='GPS receiver, usable at the surface.',
+        publishes=(
+            PortInfo(1102, 'sam.sensor.GNSSFix.0.1', 'sam.sensor', 'GNSSFix_0_1', 5.0),
+        ),
+        subscribes=(),
+    ),
+    DeviceInfo(
+        name='pressure',
+        node_id=14,
+        description='Water pressure sensor.',
+        publishes=(
+            PortInfo(1103, 'sam.sensor.StaticPressure.0.1', 'sam.sensor', 'StaticPressure_0_1', 20.0),
+        ),
+        subscribes=(),
+    ),
+    DeviceInfo(
+        name='battery',
+        node_id=15,
+        description='Battery management system.',
+        publishes=(
+            PortInfo(1104, 'sam.power.BatteryInfo.0.1', 'sam.power', 'BatteryInfo_0_1', 1.0),
+        ),
+        subscribes=(),
+    ),
+    DeviceInfo(
+        name='thruster_1',
+        node_id=21,
+        description='Thruster 1 motor controller.',
+        publishes=(
+            PortInfo(1300, 'sam.actuator.ThrusterFeedback.0.1', 'sam.actuator', 'ThrusterFeedback_0_1', 10.0),
+        ),
+        subscribes=(
+            PortInfo(1200, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
+        ),
+    ),
+    DeviceInfo(
+        name='thruster_2',
+        node_id=22,
+        description='Thruster 2 motor controller.',
+        publishes=(
+            PortInfo(1301, 'sam.actuator.ThrusterFeedback.0.1', 'sam.actuator', 'ThrusterFeedback_0_1', 10.0),
+        ),
+        subscribes=(
+            PortInfo(1201, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
+        ),
+    ),
+    DeviceInfo(
+        name='thrust_vector',
+        node_id=23,
+        description='Thrust vectoring nozzle servos.',
+        publishes=(
+            PortInfo(
+                subject_id=1302,
+                dsdl_type='sam.actuator.ThrustVectorFeedback.0.1',
+                dsdl_module='sam.actuator',
+                dsdl_class='ThrustVectorFeedback_0_1',
+                rate_hz=10.0,
+            ),
+        ),
+        subscribes=(
+            PortInfo(1202, 'sam.actuator.ThrustVector.0.1', 'sam.actuator', 'ThrustVector_0_1', 10.0),
+        ),
+    ),
+    DeviceInfo(
+        name='ballast',
+        node_id=24,
+        description='The two ballast weights.',
+        publishes=(),
+        subscribes=(
+            PortInfo(1203, 'sam.actuator.BallastAngles.0.1', 'sam.actuator', 'BallastAngles_0_1', 10.0),
+        ),
+    ),
+    DeviceInfo(
+        name='longitudinal_weight',
+        node_id=25,
+        description='Longitudinal trim weight.',
+        publishes=(
+            PortInfo(1304, 'sam.actuator.PositionFeedback.0.1', 'sam.actuator', 'PositionFeedback_0_1', 10.0),
+        ),
+        subscribes=(
+            PortInfo(1204, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
+        ),
+    ),
+    DeviceInfo(
+        name='buoyancy_piston',
+        node_id=26,
+        description='Variable buoyancy piston.',
+        publishes=(
+            PortInfo(1305, 'sam.actuator.PositionFeedback.0.1', 'sam.actuator', 'PositionFeedback_0_1', 10.0),
+        ),
+        subscribes=(
+            PortInfo(1205, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
+        ),
+    ),
+)
+
+TOPICS: tuple[TopicInfo, ...] = (
+    TopicInfo(
+        name='/imu',
+        ros_type='sensor_msgs/msg/Imu',
+        ros_module='sensor_msgs.msg',
+        ros_class='Imu',
+        description='IMU samples.',
+    ),
+    TopicInfo(
+        name='/magnetic_field',
+        ros_type='sensor_msgs/msg/MagneticField',
+        ros_module='sensor_msgs.msg',
+        ros_class='MagneticField',
+        description='Magnetometer samples.',
+    ),
+    TopicInfo(
+        name='/gps_fix',
+        ros_type='sensor_msgs/msg/NavSatFix',
+        ros_module='sensor_msgs.msg',
+        ros_class='NavSatFix',
+        description='GPS fixes, at the surface.',
+    ),
+    TopicInfo(
+        name='/pressure',
+        ros_type='sensor_msgs/msg/FluidPressure',
+        ros_module='sensor_msgs.msg',
+        ros_class='FluidPressure',
+        description='Water pressure.',
+    ),
+    TopicInfo(
+        name='/thruster_rpms',
+        ros_type='sam_msgs/msg/ThrusterRPMs',
+        ros_module='sam_msgs.msg',
+        ros_class='ThrusterRPMs',
+        description='Thruster speed commands.',
+    ),
+    TopicInfo(
+        name='/thruster_angles',
+        ros_type='sam_msgs/msg/ThrusterAngles',
+        ros_module='sam_msgs.msg',
+        ros_class='ThrusterAngles',
+        description='Thrust vector commands.',
+    ),
+    TopicInfo(
+        name='/ballast_angles',
+        ros_type='sam_msgs/msg/BallastAngles',
+        ros_module='sam_msgs.msg',
+        ros_class='BallastAngles',
+        description='Ballast weight commands.',
+    ),
+    TopicInfo(
+        name='/longitudinal_weight_position',
+        ros_type='sam_msgs/msg/PercentStamped',
+        ros_module='sam_msgs.msg',
+        ros_class='PercentStamped',
+        description='Longitudinal weight position command.',
+    ),
+    TopicInfo(
+        name='/buoyancy_piston_position',
+        ros_type='sam_msgs/msg/PercentStamped',
+        ros_module='sam_msgs.msg',
+        ros_class='PercentStamped',
+        description='Buoyancy piston position command.',
+    ),
+    TopicInfo(
+        name='/tf',
+        ros_type='tf2_msgs/msg/TFMessage',
+        ros_module='tf2_msgs.msg',
+        ros_class='TFMessage',
+        description='Transforms odom->base_link (DR) and world->odom (SLAM).',
+    ),
+    TopicInfo(
+        name='/nav_heading',
+        ros_type='sam_msgs/msg/HeadingStamped',
+        ros_module='sam_msgs.msg',
+        ros_class='HeadingStamped',
+        description='Heading goal; z < 0 depth, z > 0 altitude.',
+    ),
+    TopicInfo(
+        name='/nav_goal',
+        ros_type='geometry_msgs/msg/PoseStamped',
+        ros_module='geometry_msgs.msg',
+        ros_class='PoseStamped',
+        description='Pose goal in /world; position.z < 0 depth, > 0 altitude.',
+    ),
+    TopicInfo(
+        name='/global_plan',
+        ros_type='nav_msgs/msg/Path',
+        ros_module='nav_msgs.msg',
+        ros_class='Path',
+        description='The planned path the controller follows.',
+    ),
+    TopicInfo(
+        name='/battery_state',
+        ros_type='sensor_msgs/msg/BatteryState',
+        ros_module='sensor_msgs.msg',
+        ros_class='BatteryState',
+        description='Battery health and charge.',
+    ),
+    TopicInfo(
+        name='/battery_info',
+        ros_type='sam_msgs/msg/BatteryInfo',
+        ros_module='sam_msgs.msg',
+        ros_class='BatteryInfo',
+        description="The battery's full UAVCAN report.",
+    ),
+    TopicInfo(
+        name='/thruster_1/feedback',
+        ros_type='sam_msgs/msg/ThrusterFeedback',
+        ros_module='sam_msgs.msg',
+        ros_class='ThrusterFeedback',
+        description='Thruster 1 feedback.',
+    ),
+    TopicInfo(
+        name='/thruster_2/feedback',
+        ros_type='sam_msgs/msg/ThrusterFeedback',
+        ros_module='sam_msgs.msg',
+        ros_class='ThrusterFeedback',
+        description='Thruster 2 feedback.',
+    ),
+    TopicInfo(
+        name='/thrust_vector/feedback',
+        ros_type='sam_msgs/msg/ThrustVectorFeedback',
+        ros_module='sam_msgs.msg',
+        ros_class='ThrustVectorFeedback',
+        description='Thrust vector feedback.',
+    ),
+    TopicInfo(
+        name='/longitudinal_weight/feedback',
+        ros_type='sam_msgs/msg/PositionFeedback',
+        ros_module='sam_msgs.msg',
+        ros_class='PositionFeedback',
+        description='Longitudinal weight position.',
+    ),
+    TopicInfo(
+        name='/buoyancy_piston/feedback',
+        ros_type='sam_msgs/msg/PositionFeedback',
+        ros_module='sam_msgs.msg',
+        ros_class='PositionFeedback',
+        description='Buoyancy piston position.',
+    ),
+)
+
+_TOPICS_BY_NAME = {topic.name: topic for topic in TOPICS}
+
+MAPPINGS: tuple[MappingInfo, ...] = (
+    MappingInfo(
+        name='imu',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/imu'],
+        port=PortInfo(1100, 'sam.sensor.RawIMU.0.1', 'sam.sensor', 'RawIMU_0_1', 100.0),
+        source_node_ids=frozenset({11}),
+        destination_node_id=None,
+        frame_id='imu_link',
+        rate_hz=100.0,
+        on_out_of_range='saturate',
+        to_ros='imu_to_ros',
+        to_uavcan='imu_to_uavcan',
+        exact_uavcan_fields=(
+            'timestamp.microsecond',
+            'rate_gyro_latest[0]',
+            'rate_gyro_latest[1]',
+            'rate_gyro_latest[2]',
+            'accelerometer_latest[0]',
+            'accelerometer_latest[1]',
+            'accelerometer_latest[2]',
+        ),
+        linked_uavcan_fields=(
+            'timestamp.microsecond',
+            'rate_gyro_latest[0]',
+            'rate_gyro_latest[1]',
+            'rate_gyro_latest[2]',
+            'accelerometer_latest[0]',
+            'accelerometer_latest[1]',
+            'accelerometer_latest[2]',
+        ),
+    ),
+    MappingInfo(
+        name='magnetic_field',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/magnetic_field'],
+        port=PortInfo(
+            subject_id=1101,
+            dsdl_type='sam.sensor.MagneticFieldStrength.0.1',
+            dsdl_module='sam.sensor',
+            dsdl_class='MagneticFieldStrength_0_1',
+            rate_hz=50.0,
+        ),
+        source_node_ids=frozenset({12}),
+        destination_node_id=None,
+        frame_id='magnetometer_link',
+        rate_hz=50.0,
+        on_out_of_range='saturate',
+        to_ros='magnetic_field_to_ros',
+        to_uavcan='magnetic_field_to_uavcan',
+        exact_uavcan_fields=('magnetic_field_ga[0]', 'magnetic_field_ga[1]', 'magnetic_field_ga[2]'),
+        linked_uavcan_fields=(
+            'magnetic_field_ga[0]',
+            'magnetic_field_ga[1]',
+            'magnetic_field_ga[2]',
+            'magnetic_field_covariance',
+        ),
+    ),
+    MappingInfo(
+        name='gps_fix',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/gps_fix'],
+        port=PortInfo(1102, 'sam.sensor.GNSSFix.0.1', 'sam.sensor', 'GNSSFix_0_1', 5.0),
+        source_node_ids=frozenset({13}),
+        destination_node_id=None,
+        frame_id='gps_link',
+        rate_hz=5.0,
+        on_out_of_range='saturate',
+        to_ros='gps_fix_to_ros',
+        to_uavcan='gps_fix_to_uavcan',
+        exact_uavcan_fields=(
+            'timestamp.microsecond',
+            'latitude_deg_1e8',
+            'longitude_deg_1e8',
+            'height_ellipsoid_mm',
+        ),
+        linked_uavcan_fields=(
+            'timestamp.microsecond',
+            'latitude_deg_1e8',
+            'longitude_deg_1e8',
+            'height_ellipsoid_mm',
+            'status',
+            'position_covariance',
+        ),
+    ),
+    MappingInfo(
+        name='pressure',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/pressure'],
+        port=PortInfo(1103, 'sam.sensor.StaticPressure.0.1', 'sam.sensor', 'StaticPressure_0_1', 20.0),
+        source_node_ids=frozenset({14}),
+        destination_node_id=None,
+        frame_id='pressure_link',
+        rate_hz=20.0,
+        on_out_of_range='saturate',
+        to_ros='pressure_to_ros',
+        to_uavcan='pressure_to_uavcan',
+        exact_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+        linked_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+    ),
+    MappingInfo(
+        name='battery_state',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/battery_state'],
+        port=PortInfo(1104, 'sam.power.BatteryInfo.0.1', 'sam.power', 'BatteryInfo_0_1', 1.0),
+        source_node_ids=frozenset({15}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=1.0,
+        on_out_of_range='saturate',
+        to_ros='battery_state_to_ros',
+        to_uavcan='battery_state_to_uavcan',
+        exact_uavcan_fields=('voltage', 'current', 'state_of_charge_pct'),
+        linked_uavcan_fields=('voltage', 'current', 'temperature', 'state_of_charge_pct'),
+    ),
+    MappingInfo(
+        name='battery_info',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/battery_info'],
+        port=PortInfo(1104, 'sam.power.BatteryInfo.0.1', 'sam.power', 'BatteryInfo_0_1', 1.0),
+        source_node_ids=frozenset({15}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=1.0,
+        on_out_of_range='saturate',
+        to_ros='battery_info_to_ros',
+        to_uavcan='battery_info_to_uavcan',
+        exact_uavcan_fields=(
+            'temperature',
+            'voltage',
+            'current',
+            'average_power_10sec',
+            'remaining_capacity_wh',
+            'full_charge_capacity_wh',
+            'hours_to_full_charge',
+            'status_flags',
+            'state_of_health_pct',
+            'state_of_charge_pct',
+            'state_of_charge_pct_stdev',
+            'battery_id',
+            'model_instance_id',
+            'model_name',
+        ),
+        linked_uavcan_fields=(
+            'temperature',
+            'voltage',
+            'current',
+            'average_power_10sec',
+            'remaining_capacity_wh',
+            'full_charge_capacity_wh',
+            'hours_to_full_charge',
+            'status_flags',
+            'state_of_health_pct',
+            'state_of_charge_pct',
+            'state_of_charge_pct_stdev',
+            'battery_id',
+            'model_instance_id',
+            'model_name',
+        ),
+    ),
+    MappingInfo(
+        name='thruster_1_rpm',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/thruster_rpms'],
+        port=PortInfo(1200, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
+        source_node_ids=frozenset(),
+        destination_node_id=21,
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_1_rpm_to_ros',
+        to_uavcan='thruster_1_rpm_to_uavcan',
+        exact_uavcan_fields=('rpm',),
+        linked_uavcan_fields=('rpm',),
+    ),
+    MappingInfo(
+        name='thruster_2_rpm',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/thruster_rpms'],
+        port=PortInfo(1201, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
+        source_node_ids=frozenset(),
+        destination_node_id=22,
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_2_rpm_to_ros',
+        to_uavcan='thruster_2_rpm_to_uavcan',
+        exact_uavcan_fields=('rpm',),
+        linked_uavcan_fields=('rpm',),
+    ),
+    MappingInfo(
+        name='thrust_vector',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/thruster_angles'],
+        port=PortInfo(1202, 'sam.actuator.ThrustVector.0.1', 'sam.actuator', 'ThrustVector_0_1', 10.0),
+        source_node_ids=frozenset(),
+        destination_node_id=23,
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thrust_vector_to_ros',
+        to_uavcan='thrust_vector_to_uavcan',
+        exact_uavcan_fields=('vertical_radians', 'horizontal_radians'),
+        linked_uavcan_fields=('vertical_radians', 'horizontal_radians'),
+    ),
+    MappingInfo(
+        name='ballast',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/ballast_angles'],
+        port=PortInfo(1203, 'sam.actuator.BallastAngles.0.1', 'sam.actuator', 'BallastAngles_0_1', 10.0),
+        source_node_ids=frozenset(),
+        destination_node_id=24,
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='ballast_to_ros',
+        to_uavcan='ballast_to_uavcan',
+        exact_uavcan_fields=('weight_1_offset_radians', 'weight_2_offset_radians'),
+        linked_uavcan_fields=('weight_1_offset_radians', 'weight_2_offset_radians'),
+    ),
+    MappingInfo(
+        name='longitudinal_weight',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/longitudinal_weight_position'],
+        port=PortInfo(1204, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
+        source_node_ids=frozenset(),
+        destination_node_id=25,
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='longitudinal_weight_to_ros',
+        to_uavcan='longitudinal_weight_to_uavcan',
+        exact_uavcan_fields=('percent',),
+        linked_uavcan_fields=('percent',),
+    ),
+    MappingInfo(
+        name='buoyancy_piston',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/buoyancy_piston_position'],
+        port=PortInfo(1205, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
+        source_node_ids=frozenset(),
+        destination_node_id=26,
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='buoyancy_piston_to_ros',
+        to_uavcan='buoyancy_piston_to_uavcan',
+        exact_uavcan_fields=('percent',),
+        linked_uavcan_fields=('percent',),
+    ),
+    MappingInfo(
+        name='thruster_1_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/thruster_1/feedback'],
+        port=PortInfo(
+            subject_id=1300,
+            dsdl_type='sam.actuator.ThrusterFeedback.0.1',
+            dsdl_module='sam.actuator',
+            dsdl_class='ThrusterFeedback_0_1',
+            rate_hz=10.0,
+        ),
+        source_node_ids=frozenset({21}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_1_feedback_to_ros',
+        to_uavcan='thruster_1_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+        linked_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+    ),
+    MappingInfo(
+        name='thruster_2_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/thruster_2/feedback'],
+        port=PortInfo(
+            subject_id=1301,
+            dsdl_type='sam.actuator.ThrusterFeedback.0.1',
+            dsdl_module='sam.actuator',
+            dsdl_class='ThrusterFeedback_0_1',
+            rate_hz=10.0,
+        ),
+        source_node_ids=frozenset({22}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_2_feedback_to_ros',
+        to_uavcan='thruster_2_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+        linked_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+    ),
+    MappingInfo(
+        name='thrust_vector_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/thrust_vector/feedback'],
+        port=PortInfo(
+            subject_id=1302,
+            dsdl_type='sam.actuator.ThrustVectorFeedback.0.1',
+            dsdl_module='sam.actuator',
+            dsdl_class='ThrustVectorFeedback_0_1',
+            rate_hz=10.0,
+        ),
+        source_node_ids=frozenset({23}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thrust_vector_feedback_to_ros',
+        to_uavcan='thrust_vector_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.microsecond', 'vertical_mrad', 'horizontal_mrad'),
+        linked_uavcan_fields=('timestamp.microsecond', 'vertical_mrad', 'horizontal_mrad'),
+    ),
+    MappingInfo(
+        name='longitudinal_weight_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/longitudinal_weight/feedback'],
+        port=PortInfo(
+            subject_id=1304,
+            dsdl_type='sam.actuator.PositionFeedback.0.1',
+            dsdl_module='sam.actuator',
+            dsdl_class='PositionFeedback_0_1',
+            rate_hz=10.0,
+        ),
+        source_node_ids=frozenset({25}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='longitudinal_weight_feedback_to_ros',
+        to_uavcan='longitudinal_weight_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+        linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+    ),
+    MappingInfo(
+        name='buoyancy_piston_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/buoyancy_piston/feedback'],
+        port=PortInfo(
+            subject_id=1305,
+            dsdl_type='sam.actuator.PositionFeedback.0.1',
+            dsdl_module='sam.actuator',
+            dsdl_class='PositionFeedback_0_1',
+            rate_hz=10.0,
+        ),
+        source_node_ids=frozenset({26}),
+        destination_node_id=None,
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='buoyancy_piston_feedback_to_ros',
+        to_uavcan='buoyancy_piston_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+        linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+    ),
+)
+
+PARAMETERS: tuple[ParameterInfo, ...] = (
+    ParameterInfo(
+        name='/safe_altitude',
+        type='double',
+        default=5.0,
+        minimum=0.0,
+        maximum=100.0,
+        unit='m',
+        description='The motion planner always tries to stay above this height over the sea floor.',
+    ),
+    ParameterInfo(
+        name='/safe_depth',
+        type='double',
+        default=50.0,
+        minimum=0.0,
+        maximum=200.0,
+        unit='m',
+        description='The motion planner always tries to stay above this water depth.',
+    ),
+    ParameterInfo(
+        name='/critical_altitude',
+        type='double',
+        default=2.0,
+        minimum=0.0,
+        maximum=100.0,
+        unit='m',
+        description='The monitor triggers an emergency ascent when below this altitude.',
+    ),
+    ParameterInfo(
+        name='/critical_depth',
+        type='double',
+        default=60.0,
+        minimum=0.0,
+        maximum=200.0,
+        unit='m',
+        description='The monitor triggers an emergency ascent when below this water depth.',
+    ),
+)
+
+PARAMETER_RULES: tuple[ParameterRuleInfo, ...] = (
+    ParameterRuleInfo(
+        left='/critical_altitude',
+        op='<',
+        right='/safe_altitude',
+        description='The critical altitude lies below the safe altitude (closer to the sea floor).',
+    ),
+    ParameterRuleInfo(
+        left='/critical_depth',
+        op='>',
+        right='/safe_depth',
+        description='The critical depth lies below the safe depth (deeper).',
+    ),
+)
+
+# (frame, parent); a frame with a parent is a static child frame of it.
+FRAMES: tuple[tuple[str, str | None], ...] = (
+    ('world', None),
+    ('odom', None),
+    ('base_link', None),
+    ('imu_link', 'base_link'),
+    ('magnetometer_link', 'base_link'),
+    ('gps_link', 'base_link'),
+    ('pressure_link', 'base_link'),
+)
