@@ -51,6 +51,5 @@ def build(session: nox.Session) -> None:
 def run(session: nox.Session) -> None:
     """The main job: simulated devices -> Cyphal/UDP on 127.0.0.1 -> bridge -> ROS 2, shown live until Ctrl-C."""
     _install(session, "runtime,rosbuild")
-    session.run("sam-codegen", "build")
-    _ros_install(session)
+    # `run` regenerates generated/ and (re)builds sam_msgs into this environment when they are stale.
     session.run("sam-codegen", "run", *session.posargs, env=LOOPBACK)

@@ -72,6 +72,7 @@ def _cmd_ros_install(args: argparse.Namespace) -> int:
 
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__)
+    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, run."
     sub = parser.add_subparsers(dest="command", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:
@@ -93,7 +94,20 @@ def make_parser() -> argparse.ArgumentParser:
     return parser
 
 
+RUNTIME_COMMANDS = ("bridge", "sim", "run")
+
+
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] in RUNTIME_COMMANDS:
+        # The runtime has its own options (transports, durations); it is an optional part of the install.
+        try:
+            from sam_runtime.cli import main as runtime_main
+        except ImportError as exc:
+            print(f"sam-codegen {argv[0]}: the runtime is not installed ({exc}); install with the [runtime] extra",
+                  file=sys.stderr)
+            return 1
+        return int(runtime_main(argv))
     args = make_parser().parse_args(argv)
     try:
         return int(args.func(args))

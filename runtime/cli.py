@@ -1,0 +1,341 @@
+"""Command line of the runtime: ``bridge``, ``sim`` and ``run`` (the main job).
+
+Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_main`, ``sam-run`` =
+:func:`run_main`; ``sam-codegen bridge|sim|run ...`` dispatches to :func:`main`. Also ``python -m
+sam_runtime.cli {bridge,sim,run} ...``.
+
+Transport selection (bridge and sim): ``--transport udp|can|loopback|env``; without it, the standard
+Cyphal register environment variables are used when one of UAVCAN__UDP__IFACE, UAVCAN__CAN__IFACE,
+UAVCAN__LOOPBACK or UAVCAN__SERIAL__IFACE is set, else Cyphal/UDP on 127.0.0.1.
+"""
+
+from __future__ import annotations
+
+import os
+
+# Every process of the runtime may start rclpy: loopback-only discovery, before anything imports it.
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import argparse
+import asyncio
+import contextlib
+import json
+import logging
+import signal
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = ["bridge_main", "main", "run_main", "sim_main"]
+
+_ENV_TRANSPORT_KEYS = ("UAVCAN__UDP__IFACE", "UAVCAN__CAN__IFACE", "UAVCAN__LOOPBACK", "UAVCAN__SERIAL__IFACE")
+EXIT_OK, EXIT_ERROR, EXIT_USAGE = 0, 1, 2
+
+
+def _setup_logging(level: str) -> None:
+    logging.basicConfig(
+        level=getattr(logging, level.upper(), logging.INFO),
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+        stream=sys.stderr,
+    )
+    for noisy in ("pydsdl", "nunavut", "pycyphal", "can"):
+        logging.getLogger(noisy).setLevel(max(logging.WARNING, logging.getLogger().level))
+
+
+def _add_generated_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--generated", type=Path, default=None,
+                   help="generated package directory (default: $SAM_GENERATED_DIR or <repo>/generated)")
+    p.add_argument("--package", default=None, help="python package name under generated/python (default: the "
+                   "only *_bridge package)")
+
+
+def _add_transport_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--transport", choices=("udp", "can", "loopback", "env"), default=None,
+                   help="Cyphal transport (default: env if UAVCAN__*__IFACE is set, else udp)")
+    p.add_argument("--iface", default=None,
+                   help="UDP: local IP (default 127.0.0.1); CAN: e.g. virtual:bus0 or socketcan:can0")
+    p.add_argument("--mtu", type=int, default=None, help="CAN: 8 = Classic CAN, 64 = CAN FD (default 64)")
+    p.add_argument("--log-level", default="INFO")
+
+
+def _transport_kind(args: argparse.Namespace) -> str:
+    if args.transport:
+        return str(args.transport)
+    if args.iface:
+        return "can" if ":" in args.iface else "udp"
+    if any(str(os.environ.get(k, "")).strip() for k in _ENV_TRANSPORT_KEYS):
+        return "env"
+    return "udp"
+
+
+def _generated(args: argparse.Namespace) -> Any:
+    from sam_runtime.genpkg import GeneratedPackage, default_generated_dir
+
+    return GeneratedPackage(args.generated or default_generated_dir(), args.package)
+
+
+def _install_stop_handlers(loop: asyncio.AbstractEventLoop, stop: asyncio.Event) -> None:
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(NotImplementedError, RuntimeError):
+            loop.add_signal_handler(sig, stop.set)
+
+
+def _write_json_atomic(path: Path, data: Any) -> None:
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+    tmp.write_text(json.dumps(data, indent=1, sort_keys=True, default=str))
+    os.replace(tmp, path)
+
+
+async def _wait(stop: asyncio.Event, seconds: float | None) -> None:
+    if seconds is None:
+        await stop.wait()
+    else:
+        with contextlib.suppress(TimeoutError):
+            await asyncio.wait_for(stop.wait(), timeout=max(0.0, seconds))
+
+
+async def _drain_tasks(timeout: float) -> list[str]:
+    """Cancel every task still running, repeatedly (a cancellation that lands inside ``wait_for`` can be lost
+    on Python 3.11, see sam_runtime.transport.aclose), until all are done or the deadline passes. Returns the
+    names of the tasks that refused to end."""
+    me = asyncio.current_task()
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + timeout
+    while True:
+        pending = [t for t in asyncio.all_tasks() if t is not me and not t.done()]
+        if not pending:
+            return []
+        if loop.time() >= deadline:
+            return [t.get_name() for t in pending]
+        for t in pending:
+            t.cancel()
+        await asyncio.wait(pending, timeout=min(0.1, max(0.0, deadline - loop.time())))
+
+
+def _run_async(main: Any, drain_timeout: float = 3.0) -> int:
+    """Like asyncio.run(main()), but the shutdown is bounded: leftover tasks are cancelled with a deadline
+    instead of awaited forever (asyncio.run would hang on a task that lost its cancellation)."""
+    loop = asyncio.new_event_loop()
+    asyncio.set_event_loop(loop)
+    try:
+        return int(loop.run_until_complete(main()))
+    finally:
+        try:
+            stuck = loop.run_until_complete(_drain_tasks(drain_timeout))
+            if stuck:
+                logging.getLogger("sam_runtime").warning("tasks still running at exit: %s", ", ".join(stuck))
+            loop.run_until_complete(loop.shutdown_asyncgens())
+            with contextlib.suppress(TimeoutError):
+                loop.run_until_complete(asyncio.wait_for(loop.shutdown_default_executor(), drain_timeout))
+        finally:
+            asyncio.set_event_loop(None)
+            loop.close()
+
+
+def _parse_params(items: Sequence[str]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for item in items:
+        if "=" not in item:
+            raise SystemExit(f"--param expects NAME=VALUE, got {item!r}")
+        k, v = item.split("=", 1)
+        val: Any = v
+        for conv in (int, float):
+            try:
+                val = conv(v)
+                break
+            except ValueError:
+                continue
+        if v.lower() in ("true", "false"):
+            val = v.lower() == "true"
+        out[k.strip()] = val
+    return out
+
+
+# ============================================================================================ bridge
+def _bridge_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="sam-bridge", description="The UAVCAN (Cyphal) <-> ROS 2 bridge of the spec.")
+    _add_generated_args(p)
+    _add_transport_args(p)
+    p.add_argument("--node-id", type=int, default=None,
+                   help="Cyphal node id (default: UAVCAN__NODE__ID with --transport env, else the spec's)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="initial value of a spec parameter (range and rules are checked)")
+    p.add_argument("--qos-depth", type=int, default=100)
+    p.add_argument("--command-qos", choices=("reliable", "best_effort"), default="reliable")
+    p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
+    p.add_argument("--stats-file", type=Path, default=None,
+                   help="write the counters as JSON here every second and at exit")
+    p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
+    return p
+
+
+def bridge_main(argv: Sequence[str] | None = None) -> int:
+    args = _bridge_parser().parse_args(argv)
+    _setup_logging(args.log_level)
+    from sam_runtime.bridge import Bridge, BridgeConfigError, TransportConfig
+    from sam_runtime.genpkg import GeneratedPackageError
+    from sam_runtime.transport import TransportConfigError
+
+    async def run() -> int:
+        stop = asyncio.Event()
+        _install_stop_handlers(asyncio.get_running_loop(), stop)
+        bridge = Bridge(
+            _generated(args),
+            node_id=args.node_id,
+            transport=TransportConfig(_transport_kind(args), args.iface, args.mtu),
+            ros_args=args.ros_args,
+            parameter_overrides=_parse_params(args.param),
+            qos_depth=args.qos_depth,
+            command_reliability=args.command_qos,
+        )
+        await bridge.start()
+        print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.transport_config.describe()}",
+              flush=True)
+        try:
+            deadline = None if args.duration is None else time.monotonic() + args.duration
+            while not stop.is_set():
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    break
+                await _wait(stop, 1.0 if left is None else min(1.0, left))
+                if args.stats_file:
+                    _write_json_atomic(args.stats_file, bridge.stats())
+        finally:
+            snapshot = bridge.stats()
+            await bridge.close()
+            if args.stats_file:
+                _write_json_atomic(args.stats_file, snapshot)
+        return EXIT_OK
+
+    try:
+        return _run_async(run)
+    except (BridgeConfigError, GeneratedPackageError, TransportConfigError) as ex:
+        print(f"sam-bridge: {ex}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        return EXIT_OK
+
+
+# ============================================================================================ sim
+def _sim_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="sam-sim", description="Simulated devices of the spec, one Cyphal node each.")
+    _add_generated_args(p)
+    _add_transport_args(p)
+    p.add_argument("--devices", default=None, help="comma-separated subset of device names (default: all)")
+    p.add_argument("--rate-scale", type=float, default=1.0, help="multiply every nominal rate (default 1)")
+    p.add_argument("--bridge-node-id", type=int, default=None,
+                   help="accept commands only from this node (default: the spec's bridge)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="publish for S seconds, then write the report and exit (default: until signal)")
+    p.add_argument("--start-file", type=Path, default=None,
+                   help="heartbeats at once, but publish only once this file exists (for scripted tests)")
+    p.add_argument("--record", type=Path, default=None, help="JSON lines of every message sent and received")
+    p.add_argument("--report", type=Path, default=None, help="write the counters as JSON here at exit")
+    return p
+
+
+def sim_main(argv: Sequence[str] | None = None) -> int:
+    args = _sim_parser().parse_args(argv)
+    _setup_logging(args.log_level)
+    from sam_runtime.genpkg import GeneratedPackageError
+    from sam_runtime.sim import SimConfig, Simulator
+    from sam_runtime.transport import TransportConfigError
+
+    async def run() -> int:
+        stop = asyncio.Event()
+        _install_stop_handlers(asyncio.get_running_loop(), stop)
+        kind = _transport_kind(args)
+        cfg = SimConfig(
+            kind=kind, iface=args.iface, mtu=args.mtu, environ=dict(os.environ) if kind == "env" else None,
+            bridge_node_id=args.bridge_node_id,
+            devices=None if not args.devices else [d.strip() for d in args.devices.split(",") if d.strip()],
+            rate_scale=args.rate_scale, record=args.record,
+        )
+        sim = Simulator(_generated(args), cfg)
+        await sim.start()
+        print(f"READY sim devices={len(sim.devices)} transport={kind}", flush=True)
+        try:
+            if args.start_file is not None:
+                while not args.start_file.exists() and not stop.is_set():
+                    await _wait(stop, 0.01)
+            if not stop.is_set():
+                sim.start_publishing(duration=args.duration)
+                print("PUBLISHING", flush=True)
+                if args.duration is None:
+                    await stop.wait()
+                else:
+                    done = asyncio.ensure_future(sim.wait_publishing_done())
+                    stopper = asyncio.ensure_future(stop.wait())
+                    await asyncio.wait({done, stopper}, return_when=asyncio.FIRST_COMPLETED)
+                    stopper.cancel()
+                    if not done.done():
+                        done.cancel()
+        finally:
+            report = sim.report()
+            await sim.close()
+            if args.report:
+                _write_json_atomic(args.report, report)
+        print("DONE " + json.dumps({k: v["published"] for k, v in report["devices"].items()}), flush=True)
+        return EXIT_OK
+
+    try:
+        return _run_async(run)
+    except (GeneratedPackageError, TransportConfigError, ValueError) as ex:
+        print(f"sam-sim: {ex}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        return EXIT_OK
+
+
+# ============================================================================================ run
+def _run_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sam-run",
+        description="Build, start the simulated devices and the bridge, and show live what flows (Ctrl-C stops).")
+    p.add_argument("--spec", type=Path, default=None, help="the spec (default: <repo>/spec/interfaces.yaml)")
+    _add_generated_args(p)
+    p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface of sim and bridge (default 127.0.0.1)")
+    p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until Ctrl-C)")
+    p.add_argument("--no-build", action="store_true", help="use generated/ as it is")
+    p.add_argument("--no-demo-commands", dest="demo_commands", action="store_false",
+                   help="do not publish demo actuator commands (by default slow sweeps move the actuators)")
+    p.add_argument("--window", type=float, default=2.0, help="rate window [s] (default 2)")
+    p.add_argument("--plain", action="store_true", help="plain lines every second even on a terminal")
+    p.add_argument("--log-dir", type=Path, default=None, help="children's logs (default <repo>/.cache/run-logs)")
+    p.add_argument("--ros-prefix", type=Path, default=None,
+                   help="install prefix of the generated ROS package (default: the running venv)")
+    p.add_argument("--log-level", default="WARNING")
+    return p
+
+
+def run_main(argv: Sequence[str] | None = None) -> int:
+    args = _run_parser().parse_args(argv)
+    _setup_logging(args.log_level)
+    from sam_runtime.monitor import RunOptions, run
+
+    return run(RunOptions(
+        spec=args.spec, generated=args.generated, package=args.package, iface=args.iface,
+        duration=args.duration, build=not args.no_build, demo_commands=args.demo_commands,
+        window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
+        argv=list(sys.argv[1:] if argv is None else argv),
+    ))
+
+
+# ============================================================================================ dispatch
+_COMMANDS = {"bridge": bridge_main, "sim": sim_main, "run": run_main}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``main(["bridge", ...])`` etc.: the entry ``sam-codegen bridge|sim|run`` dispatches to."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0] not in _COMMANDS:
+        print(f"usage: {Path(sys.argv[0]).name} {{{','.join(_COMMANDS)}}} [options]  (--help per command)",
+              file=sys.stderr)
+        return EXIT_USAGE
+    return _COMMANDS[argv[0]](argv[1:])
+
+
+if __name__ == "__main__":
+    sys.exit(main())

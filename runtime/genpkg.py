@@ -1,0 +1,208 @@
+"""Locate and load the generated package a spec produced (``generated/`` by default).
+
+Layout (written by ``sam-codegen build``)::
+
+    <generated>/dsdl/<root namespace>/...       Cyphal DSDL of the vehicle's own types
+    <generated>/ros/<ros package>/              the ament package of the custom ROS messages
+    <generated>/python/<vehicle>_bridge/        tables.py (stdlib only) and convert.py (converters)
+
+Nothing here is SAM-specific: the Python package is found by scanning ``<generated>/python`` for a
+``*_bridge`` package holding ``tables.py``. Import order matters and is enforced here:
+:meth:`GeneratedPackage.tables` imports nothing but the standard library; :meth:`GeneratedPackage.convert`
+first compiles the DSDL (once per process, before ``uavcan``/``pycyphal.application`` are imported) and
+needs the ROS message package importable.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from sam_codegen.cyphal_path import repo_root
+
+__all__ = [
+    "GENERATED_ENV_VAR",
+    "GeneratedPackage",
+    "GeneratedPackageError",
+    "default_generated_dir",
+    "ensure_ros_package",
+    "ros_package_hash",
+]
+
+GENERATED_ENV_VAR = "SAM_GENERATED_DIR"
+_HASH_STAMP = ".sam_codegen_source_hash"
+
+
+class GeneratedPackageError(Exception):
+    """The generated package is missing or incomplete; ``str()`` says what to run."""
+
+
+def default_generated_dir() -> Path:
+    """``$SAM_GENERATED_DIR`` or ``<repo>/generated``."""
+    env = os.environ.get(GENERATED_ENV_VAR, "").strip()
+    return Path(env).expanduser().resolve() if env else repo_root() / "generated"
+
+
+def _find_python_package(python_dir: Path, name: str | None) -> str:
+    if name:
+        if not (python_dir / name / "tables.py").is_file():
+            raise GeneratedPackageError(f"{python_dir / name}/tables.py does not exist")
+        return name
+    found = sorted(
+        p.name for p in python_dir.glob("*_bridge") if p.is_dir() and (p / "tables.py").is_file()
+    ) if python_dir.is_dir() else []
+    if not found:
+        raise GeneratedPackageError(
+            f"no generated bridge package (<vehicle>_bridge/tables.py) under {python_dir}; "
+            "run `sam-codegen build` first"
+        )
+    if len(found) > 1:
+        raise GeneratedPackageError(
+            f"several generated bridge packages under {python_dir}: {', '.join(found)}; pick one explicitly"
+        )
+    return found[0]
+
+
+@dataclass
+class GeneratedPackage:
+    """One generated package; modules are imported lazily and cached."""
+
+    root: Path = field(default_factory=default_generated_dir)
+    package: str | None = None  # python package name, e.g. "sam_bridge"; default: the only *_bridge found
+
+    def __post_init__(self) -> None:
+        self.root = Path(self.root).expanduser().resolve()
+        self.package = _find_python_package(self.python_dir, self.package)
+        self._tables: ModuleType | None = None
+        self._convert: ModuleType | None = None
+
+    # -------------------------------------------------------------------- locations
+    @property
+    def python_dir(self) -> Path:
+        return self.root / "python"
+
+    @property
+    def dsdl_dirs(self) -> list[Path]:
+        """The root namespace directories under ``<generated>/dsdl`` (usually one)."""
+        base = self.root / "dsdl"
+        if not base.is_dir():
+            return []
+        return sorted(p for p in base.iterdir() if p.is_dir() and any(p.rglob("*.dsdl")))
+
+    def ros_package_dir(self) -> Path:
+        return self.root / "ros" / self.tables().ROS_PACKAGE
+
+    # -------------------------------------------------------------------- modules
+    def _import(self, sub: str) -> ModuleType:
+        path = str(self.python_dir)
+        if path not in sys.path:
+            sys.path.insert(0, path)
+            importlib.invalidate_caches()
+        name = f"{self.package}.{sub}"
+        mod = importlib.import_module(name)
+        origin = Path(getattr(mod, "__file__", "") or "").resolve()
+        if self.python_dir not in origin.parents:
+            raise GeneratedPackageError(
+                f"{name} was imported from {origin}, not from {self.python_dir}: another copy shadows it"
+            )
+        return mod
+
+    def tables(self) -> ModuleType:
+        """``<pkg>.tables`` (standard library only: safe to import anywhere, anytime)."""
+        if self._tables is None:
+            self._tables = self._import("tables")
+        return self._tables
+
+    def compile_dsdl(self) -> Path:
+        """Compile the generated DSDL + ``uavcan`` (cached) and put it on sys.path. Call before importing
+        ``uavcan`` or ``pycyphal.application`` anywhere in the process."""
+        from sam_runtime.dsdl import ensure_compiled
+
+        dirs = self.dsdl_dirs
+        if not dirs:
+            raise GeneratedPackageError(f"no DSDL under {self.root / 'dsdl'}; run `sam-codegen build` first")
+        return ensure_compiled(dirs)
+
+    def convert(self) -> ModuleType:
+        """``<pkg>.convert``: compiles the DSDL first; the ROS message package must be importable."""
+        if self._convert is None:
+            self.compile_dsdl()
+            try:
+                self._convert = self._import("convert")
+            except ModuleNotFoundError as ex:
+                ros_pkg = getattr(self.tables(), "ROS_PACKAGE", "?")
+                if ex.name and ex.name.split(".")[0] == ros_pkg:
+                    raise GeneratedPackageError(
+                        f"the ROS message package {ros_pkg!r} is not importable: build it "
+                        f"(sam_runtime.genpkg.ensure_ros_package) and use its environment"
+                    ) from ex
+                raise
+        return self._convert
+
+    # -------------------------------------------------------------------- types
+    @staticmethod
+    def dsdl_class(port: Any) -> type:
+        """The compiled pycyphal class of a PortInfo (``port.dsdl_module``/``port.dsdl_class``)."""
+        return getattr(importlib.import_module(port.dsdl_module), port.dsdl_class)
+
+    @staticmethod
+    def ros_class(topic: Any) -> type:
+        """The ROS message class of a TopicInfo (``topic.ros_module``/``topic.ros_class``)."""
+        return getattr(importlib.import_module(topic.ros_module), topic.ros_class)
+
+
+def ros_package_hash(package_dir: Path) -> str:
+    """Hash of every file of a ROS package source tree (to tell whether an install is current)."""
+    h = hashlib.sha256()
+    for p in sorted(Path(package_dir).rglob("*")):
+        if p.is_file():
+            h.update(p.relative_to(package_dir).as_posix().encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()[:24]
+
+
+def _same_interfaces(src: Path, installed: Path) -> bool:
+    """Whether an install (e.g. by ``sam-codegen ros-install``) holds exactly the source's interface files."""
+    def files(root: Path) -> dict[str, bytes]:
+        return {p.relative_to(root).as_posix(): p.read_bytes()
+                for sub in ("msg", "srv") for p in sorted((root / sub).glob("*.*")) if p.suffix in (".msg", ".srv")}
+
+    try:
+        mine = files(src)
+        return bool(mine) and mine == files(installed)
+    except OSError:
+        return False
+
+
+def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log: Any = None) -> Path:
+    """Build and install the generated ROS package into ``prefix`` (default: ``sys.prefix``, the venv) unless
+    an install of the same sources is already there. Returns the prefix.
+
+    The build directory is ``<repo>/.cache/ros-build/<package>-<hash>``; the install is stamped with the
+    sources' hash, so a changed spec triggers a rebuild and an unchanged one costs a few ms.
+    """
+    from sam_codegen.ros_build import build_ros_package, is_installed
+
+    prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
+    pkg_dir = gen.ros_package_dir()
+    if not (pkg_dir / "package.xml").is_file():
+        raise GeneratedPackageError(f"{pkg_dir} has no package.xml; run `sam-codegen build` first")
+    name = gen.tables().ROS_PACKAGE
+    digest = ros_package_hash(pkg_dir)
+    stamp = prefix / "share" / name / _HASH_STAMP
+    if is_installed(name, prefix) and (
+        (stamp.is_file() and stamp.read_text().strip() == digest) or _same_interfaces(pkg_dir, prefix / "share" / name)
+    ):
+        return prefix
+    if log is not None:
+        log(f"building ROS package {name} into {prefix} (about 30 s)...")
+    build_dir = repo_root() / ".cache" / "ros-build" / f"{name}-{digest}"
+    build_ros_package(pkg_dir, build_dir, prefix)
+    stamp.parent.mkdir(parents=True, exist_ok=True)
+    stamp.write_text(digest + "\n")
+    return prefix

@@ -1,0 +1,428 @@
+"""The main job: build, start the simulated devices and the bridge, and show live what flows.
+
+:func:`run` (``sam-run`` / ``sam-codegen run``):
+
+1. regenerates ``generated/`` from the spec (``sam_codegen.build.build``) unless ``build=False``;
+2. builds and installs the generated ROS message package into the venv if it is missing or stale;
+3. compiles the DSDL once (the children reuse the cache);
+4. starts ``sam-sim`` and ``sam-bridge`` as subprocesses on Cyphal/UDP 127.0.0.1 (own sessions, logs under
+   ``.cache/run-logs``);
+5. runs an rclpy monitor node in this process: every bridged topic's rate over a sliding window and its last
+   value, every device's heartbeat (from the bridge's /diagnostics) and the bridge's drop counters; a
+   refreshing table on a terminal, plain lines every second otherwise. By default it also publishes slow
+   demo sweeps on the command topics so the simulated actuators move;
+6. stops on ``--duration``, Ctrl-C or SIGTERM: children get SIGTERM (SIGKILL after a deadline), exit 0.
+   A child that dies on its own ends the run with exit code 1 and the tail of its log.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import collections
+import importlib
+import math
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sam_codegen.cyphal_path import repo_root
+
+__all__ = ["RunOptions", "TopicMonitor", "run", "summarize_message"]
+
+CHILD_STOP_TIMEOUT_S = 8.0
+
+
+@dataclass
+class RunOptions:
+    spec: Path | None = None
+    generated: Path | None = None
+    package: str | None = None
+    iface: str = "127.0.0.1"
+    duration: float | None = None
+    build: bool = True
+    demo_commands: bool = True
+    window: float = 2.0
+    plain: bool = False
+    log_dir: Path | None = None
+    refresh_s: float = 0.5
+    ros_prefix: Path | None = None  # where the generated ROS package is installed (default: the venv)
+    argv: list[str] | None = None  # for the re-exec when ros_prefix needs a new process environment
+
+
+# ============================================================================================ formatting
+def _fmt_num(v: Any) -> str:
+    if isinstance(v, bool):
+        return "T" if v else "F"
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        return f"{v:.4g}"
+    return str(v)
+
+
+def _flatten(msg: Any, prefix: str = "") -> list[tuple[str, Any]]:
+    out: list[tuple[str, Any]] = []
+    fields = getattr(msg, "get_fields_and_field_types", None)
+    if fields is None:
+        return out
+    for name in fields():
+        if name == "header" or "covariance" in name:
+            continue
+        v = getattr(msg, name)
+        if hasattr(v, "get_fields_and_field_types"):
+            try:
+                if v == type(v)():
+                    continue  # a nested message left at its default (e.g. an orientation not provided)
+            except Exception:  # pragma: no cover - a type without a default constructor
+                pass
+            sub = _flatten(v, "")
+            if sub and len(sub) <= 4 and all(isinstance(x, int | float) for _, x in sub):
+                out.append((prefix + name, "(" + ",".join(_fmt_num(x) for _, x in sub) + ")"))
+            else:
+                out.extend((f"{prefix}{name}.{k}", x) for k, x in sub)
+        elif isinstance(v, str):
+            if v:
+                out.append((prefix + name, v))
+        elif hasattr(v, "__len__") and not isinstance(v, bytes | bytearray):
+            seq = list(v)
+            if seq and not hasattr(seq[0], "get_fields_and_field_types"):
+                shown = ",".join(_fmt_num(x.item() if hasattr(x, "item") else x) for x in seq[:3])
+                out.append((prefix + name, f"[{shown}{',...' if len(seq) > 3 else ''}]"))
+        else:
+            out.append((prefix + name, v.item() if hasattr(v, "item") else v))
+    return out
+
+
+def summarize_message(msg: Any, width: int = 70) -> str:
+    """A short one-line view of any ROS message: header and covariances left out, nested vectors as tuples."""
+    parts: list[str] = []
+    used = 0
+    for k, v in _flatten(msg):
+        text = f"{k}={_fmt_num(v) if not isinstance(v, str) else v}"
+        if used + len(text) + 1 > width:
+            parts.append("…")
+            break
+        parts.append(text)
+        used += len(text) + 1
+    return " ".join(parts)
+
+
+# ============================================================================================ monitor node
+class _TopicState:
+    def __init__(self, name: str, direction: str, nominal: float) -> None:
+        self.name, self.direction, self.nominal = name, direction, nominal
+        self.count = 0
+        self.arrivals: collections.deque[float] = collections.deque()
+        self.first: float | None = None
+        self.last: Any = None
+
+    def on_msg(self, msg: Any) -> None:
+        now = time.monotonic()
+        self.count += 1
+        self.arrivals.append(now)
+        if self.first is None:
+            self.first = now
+        self.last = msg
+
+    def rate(self, window: float) -> float:
+        now = time.monotonic()
+        while self.arrivals and self.arrivals[0] < now - window:
+            self.arrivals.popleft()
+        if self.first is None:
+            return 0.0
+        span = min(window, now - self.first)
+        return len(self.arrivals) / span if span > 0.2 else 0.0
+
+
+class TopicMonitor:
+    """An rclpy node subscribing to every bridged topic and to /diagnostics (own context)."""
+
+    def __init__(self, tables: Any, gen: Any, *, window: float = 2.0, demo_commands: bool = False) -> None:
+        import rclpy
+        from diagnostic_msgs.msg import DiagnosticArray
+        from rclpy.node import Node
+        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+        from rclpy.signals import SignalHandlerOptions
+
+        self.tables, self.window = tables, window
+        self.ctx = rclpy.Context()
+        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
+        self.node = Node(f"{tables.BRIDGE_NAME}_monitor", context=self.ctx)
+        best_effort = QoSProfile(depth=50, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.BEST_EFFORT)
+        self.topics: dict[str, _TopicState] = {}
+        for m in tables.MAPPINGS:
+            st = self.topics.get(m.topic.name)
+            if st is None:
+                st = _TopicState(m.topic.name, "in" if m.direction == "uavcan_to_ros" else "out", m.rate_hz)
+                self.topics[m.topic.name] = st
+                self.node.create_subscription(gen.ros_class(m.topic), m.topic.name, st.on_msg, best_effort)
+        self.diagnostics: dict[str, Any] = {}
+        self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 10)
+        self._demo: list[tuple[Any, type, float, str]] = []
+        self._demo_t0 = time.monotonic()
+        if demo_commands:
+            seen = set()
+            for m in tables.MAPPINGS:
+                if m.direction == "ros_to_uavcan" and m.topic.name not in seen:
+                    seen.add(m.topic.name)
+                    cls = gen.ros_class(m.topic)
+                    pub = self.node.create_publisher(cls, m.topic.name, 10)
+                    rate = m.rate_hz if m.rate_hz and m.rate_hz > 0 else 10.0
+                    self._demo.append((pub, cls, rate, m.topic.name))
+            for i, (_pub, _cls, rate, _name) in enumerate(self._demo):
+                self.node.create_timer(1.0 / rate, lambda i=i: self._publish_demo(i))
+        from rclpy.executors import SingleThreadedExecutor
+
+        self.executor = SingleThreadedExecutor(context=self.ctx)
+        self.executor.add_node(self.node)
+
+    def _on_diag(self, arr: Any) -> None:
+        for s in arr.status:
+            self.diagnostics[s.name] = {
+                "level": int(s.level[0]) if isinstance(s.level, bytes | bytearray) else int(s.level),
+                "message": s.message, "hardware_id": s.hardware_id,
+                "values": {kv.key: kv.value for kv in s.values}, "at": time.monotonic(),
+            }
+
+    def _publish_demo(self, i: int) -> None:
+        pub, cls, _rate, _name = self._demo[i]
+        t = time.monotonic() - self._demo_t0
+        msg = cls()
+        fields = msg.get_fields_and_field_types()
+        for k, (name, typ) in enumerate(fields.items()):
+            if name == "header":
+                msg.header.stamp = self.node.get_clock().now().to_msg()
+                continue
+            s = math.sin(2 * math.pi * t / 30.0 + k)
+            if "percent" in name:
+                val: Any = 50.0 + 40.0 * s
+            elif "rpm" in name:
+                val = 1000.0 * s
+            elif "radian" in name:
+                val = 0.3 * s
+            else:
+                val = s
+            try:
+                if typ.startswith(("int", "uint")):
+                    setattr(msg, name, round(val))
+                elif typ.startswith(("float", "double")):
+                    setattr(msg, name, float(val))
+            except (AssertionError, TypeError, ValueError):
+                pass
+        pub.publish(msg)
+
+    def spin_for(self, seconds: float) -> None:
+        deadline = time.monotonic() + seconds
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return
+            self.executor.spin_once(timeout_sec=min(left, 0.05))
+
+    def close(self) -> None:
+        try:
+            self.executor.shutdown(timeout_sec=1.0)
+            self.node.destroy_node()
+        finally:
+            if self.ctx.ok():
+                self.ctx.shutdown()
+
+    # ---------------------------------------------------------------------------------- table
+    def table(self, header: str) -> list[str]:
+        bridge = self.tables.BRIDGE_NAME
+        drops_by_topic: dict[str, int] = collections.Counter()
+        for name, d in self.diagnostics.items():
+            if name.startswith(f"{bridge}/mapping/"):
+                v = d["values"]
+                drops_by_topic[v.get("topic", "?")] += int(v.get("dropped", "0") or 0)
+        lines = [header, ""]
+        lines.append(f"{'TOPIC':32} {'DIR':3} {'RATE Hz':>8} {'NOMINAL':>7} {'COUNT':>7} {'DROPS':>5}  LAST VALUE")
+        for st in self.topics.values():
+            last = summarize_message(st.last, 60) if st.last is not None else "-"
+            lines.append(f"{st.name:32} {st.direction:3} {st.rate(self.window):8.1f} {st.nominal:7.0f} "
+                         f"{st.count:7d} {drops_by_topic.get(st.name, 0):5d}  {last}")
+        lines.append("")
+        lines.append(f"{'DEVICE':22} {'NODE':>4} {'HEARTBEAT':>10} {'HEALTH':9} {'MODE':12} STATUS")
+        now = time.monotonic()
+        for d in self.tables.DEVICES:
+            diag = self.diagnostics.get(f"{bridge}/device/{d.name}")
+            if diag is None:
+                lines.append(f"{d.name:22} {d.node_id:4d} {'-':>10} {'-':9} {'-':12} waiting for the bridge")
+                continue
+            v = diag["values"]
+            age = v.get("age_s")
+            age_txt = f"{float(age) + (now - diag['at']):.1f} s" if age not in (None, "") else "never"
+            status = "ok" if diag["level"] == 0 else diag["message"]
+            lines.append(f"{d.name:22} {d.node_id:4d} {age_txt:>10} {v.get('health', '-'):9} "
+                         f"{v.get('mode', '-'):12} {status}")
+        total = self.diagnostics.get(bridge)
+        drops = []
+        for n, d in sorted(self.diagnostics.items()):
+            if n.startswith(f"{bridge}/mapping/") and d["level"] != 0:
+                why = ", ".join(f"{k}={x}" for k, x in d["values"].items() if k.startswith("dropped."))
+                drops.append(f"{n.split('/')[-1]}: {d['message']} ({why})")
+        lines.append("")
+        lines.append(f"bridge: {total['message'] if total else 'no /diagnostics yet'}")
+        lines.extend("  drop " + x for x in drops)
+        return lines
+
+
+# ============================================================================================ processes
+class _Child:
+    def __init__(self, name: str, cmd: list[str], env: Mapping[str, str], log: Path) -> None:
+        self.name, self.log = name, log
+        log.parent.mkdir(parents=True, exist_ok=True)
+        self._fh = open(log, "w")
+        # Own session: the terminal's Ctrl-C reaches only us; we stop the children in order.
+        self.proc = subprocess.Popen(cmd, env=dict(env), stdout=self._fh, stderr=subprocess.STDOUT,
+                                     stdin=subprocess.DEVNULL, start_new_session=True)
+
+    def alive(self) -> bool:
+        return self.proc.poll() is None
+
+    def stop(self, timeout: float = CHILD_STOP_TIMEOUT_S) -> int | None:
+        if self.proc.poll() is None:
+            try:
+                self.proc.send_signal(signal.SIGTERM)
+                self.proc.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(timeout=5)
+        self._fh.close()
+        return self.proc.returncode
+
+    def tail(self, n: int = 15) -> str:
+        try:
+            return "\n".join(self.log.read_text(errors="replace").splitlines()[-n:])
+        except OSError:
+            return ""
+
+
+def _build(opts: RunOptions, gen_dir: Path, say: Any) -> None:
+    spec = opts.spec or repo_root() / "spec" / "interfaces.yaml"
+    try:
+        from sam_codegen.build import build  # type: ignore[import-not-found]
+    except ImportError:
+        # TODO(wire): sam_codegen.build.build(spec_path, out_dir, check=False) is not there yet; until it is,
+        # generated/ is used as it is.
+        say(f"note: sam_codegen.build is not available; using {gen_dir} as it is")
+        return
+    stale = build(spec, gen_dir, check=False)
+    lines = stale.lines() if hasattr(stale, "lines") else []
+    say(f"generated {gen_dir} from {spec}: " + (f"{len(lines)} file(s) updated" if stale else "up to date"))
+
+
+def run(opts: RunOptions) -> int:
+    from sam_codegen.ros_build import ros_runtime_env
+    from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, default_generated_dir, ensure_ros_package
+
+    def say(text: str) -> None:
+        print(text, flush=True)
+
+    gen_dir = (opts.generated or default_generated_dir()).resolve()
+    stop_reason: list[str] = []
+
+    def on_signal(signum: int, _frame: Any) -> None:
+        stop_reason.append(signal.Signals(signum).name)
+
+    old_handlers = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    children: list[_Child] = []
+    monitor: TopicMonitor | None = None
+    exit_code = 0
+    try:
+        if opts.build:
+            from sam_codegen.diagnostics import SpecError
+
+            try:
+                _build(opts, gen_dir, say)
+            except SpecError as ex:
+                say(f"sam-run: the spec is invalid:\n{ex}")
+                return 1
+        try:
+            gen = GeneratedPackage(gen_dir, opts.package)
+            prefix = ensure_ros_package(gen, opts.ros_prefix, log=say)
+            importlib.invalidate_caches()  # a package installed just now into this venv
+            gen.compile_dsdl()
+        except GeneratedPackageError as ex:
+            say(f"sam-run: {ex}")
+            return 1
+        if stop_reason:
+            return 0
+        env = ros_runtime_env(prefix) if prefix != Path(sys.prefix).absolute() else dict(os.environ)
+        ld_path = os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep)
+        if str(prefix / "lib") not in ld_path and opts.argv is not None:
+            # The ROS type support libraries of a separate prefix are found only through LD_LIBRARY_PATH,
+            # which the loader reads at process start: continue in a process that has it (built already).
+            for sig, h in old_handlers.items():
+                signal.signal(sig, h)
+            sys.stdout.flush()
+            os.execve(sys.executable, [sys.executable, "-m", "sam_runtime.cli", "run", *opts.argv, "--no-build"],
+                      env)
+        env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "LOCALHOST"
+        env["PYTHONUNBUFFERED"] = "1"
+        env.setdefault("SAM_GENERATED_DIR", str(gen_dir))
+        log_dir = (opts.log_dir or repo_root() / ".cache" / "run-logs").resolve()
+        common = ["--generated", str(gen_dir), "--transport", "udp", "--iface", opts.iface]
+        if opts.package:
+            common += ["--package", opts.package]
+        py = [sys.executable, "-m", "sam_runtime.cli"]
+        children.append(_Child("sim", [*py, "sim", *common], env, log_dir / "sim.log"))
+        children.append(_Child("bridge", [*py, "bridge", *common], env, log_dir / "bridge.log"))
+        monitor = TopicMonitor(gen.tables(), gen, window=opts.window, demo_commands=opts.demo_commands)
+
+        tty = sys.stdout.isatty() and not opts.plain
+        started = time.monotonic()
+        next_draw = started
+        refresh = opts.refresh_s if tty else 1.0
+        while not stop_reason:
+            elapsed = time.monotonic() - started
+            if opts.duration is not None and elapsed >= opts.duration:
+                stop_reason.append("duration")
+                break
+            dead = [c for c in children if not c.alive()]
+            if dead:
+                for c in dead:
+                    say(f"sam-run: {c.name} exited with code {c.proc.returncode}; its log ({c.log}):\n{c.tail()}")
+                exit_code = 1
+                stop_reason.append("child exited")
+                break
+            monitor.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
+            if time.monotonic() >= next_draw:
+                next_draw += refresh
+                header = (f"{gen.tables().VEHICLE} bridge run  t={elapsed:6.1f} s  "
+                          + "  ".join(f"{c.name} pid {c.proc.pid}" for c in children)
+                          + ("" if opts.duration is None else f"  (stops at {opts.duration:.0f} s)")
+                          + ("  Ctrl-C to stop" if tty else ""))
+                lines = monitor.table(header)
+                if tty:
+                    cols = shutil.get_terminal_size((120, 40)).columns
+                    sys.stdout.write("\x1b[H\x1b[2J" + "\n".join(line[:cols] for line in lines) + "\n")
+                    sys.stdout.flush()
+                else:
+                    say("\n".join(lines) + "\n")
+        final = monitor.table(f"final ({stop_reason[0] if stop_reason else 'stopped'}) after "
+                              f"{time.monotonic() - started:.1f} s")
+        say("\n".join(final))
+    finally:
+        for s, h in old_handlers.items():
+            signal.signal(s, h)
+        # Bridge first (it consumes), then the devices.
+        for c in reversed(children):
+            rc = c.stop()
+            if rc not in (0, None, -signal.SIGTERM) and exit_code == 0 and (not stop_reason or
+                                                                           stop_reason[0] != "child exited"):
+                say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
+        if monitor is not None:
+            monitor.close()
+        if children:
+            say("logs: " + ", ".join(str(c.log) for c in children))
+    return exit_code

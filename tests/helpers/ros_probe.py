@@ -1,0 +1,200 @@
+"""A separate rclpy process for the bridge tests: listens to topics or publishes commands.
+
+listen:  python ros_probe.py listen --generated DIR --topics /imu,/pressure --out OUT.json [--record REC.jsonl]
+    Subscribes (reliable, deep history) to the topics with the generated package's types, prints READY once
+    every topic has a publisher, records every message as a JSON line (topic, receive wall time, fields) and
+    rewrites OUT.json ({"counts": {topic: n}}) every 0.2 s and at exit (SIGTERM/SIGINT).
+publish: python ros_probe.py publish --generated DIR --plan PLAN.json --out OUT.json
+    PLAN.json: {"rate_hz": 20, "topics": {"/thruster_rpms": [{"thruster_1_rpm": 5, ...}, ...], ...}}. Waits
+    until every topic has a subscriber (the bridge), publishes the messages in order, interleaved across
+    topics, writes {"sent": {topic: n}} and exits.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import argparse
+import json
+import math
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+
+def to_plain(msg: Any) -> Any:
+    """A ROS message as JSON-able nested dicts/lists."""
+    if hasattr(msg, "get_fields_and_field_types"):
+        return {name: to_plain(getattr(msg, name)) for name in msg.get_fields_and_field_types()}
+    if isinstance(msg, bytes | bytearray):
+        return list(msg)
+    if hasattr(msg, "tolist"):
+        return msg.tolist()
+    if isinstance(msg, list | tuple):
+        return [to_plain(x) for x in msg]
+    if isinstance(msg, float) and not math.isfinite(msg):
+        return repr(msg)  # "nan", "inf": JSON has no such numbers
+    return msg
+
+
+def _tables_and_classes(generated: Path, topics: list[str]) -> dict[str, type]:
+    from sam_runtime.genpkg import GeneratedPackage
+
+    gen = GeneratedPackage(generated)
+    by_topic = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
+    missing = [t for t in topics if t not in by_topic]
+    if missing:
+        raise SystemExit(f"topics not in the generated tables: {missing}")
+    return {t: gen.ros_class(by_topic[t]) for t in topics}
+
+
+def _write(path: Path, data: Any) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data))
+    os.replace(tmp, path)
+
+
+def listen(args: argparse.Namespace) -> int:
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+    topics = [t for t in args.topics.split(",") if t]
+    classes = _tables_and_classes(args.generated, topics)
+    rclpy.init(args=[])
+    node = Node("test_probe_listener")
+    qos = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
+    counts = dict.fromkeys(topics, 0)
+    rec = open(args.record, "w", buffering=1 << 16) if args.record else None
+
+    def make_cb(topic: str) -> Any:
+        def cb(msg: Any) -> None:
+            counts[topic] += 1
+            if rec is not None:
+                rec.write(json.dumps({"topic": topic, "wall_ns": time.time_ns(), "msg": to_plain(msg)}) + "\n")
+        return cb
+
+    subs = {t: node.create_subscription(classes[t], t, make_cb(t), qos) for t in topics}
+    diagnostics: dict[str, Any] = {}
+    if args.diagnostics:
+        from diagnostic_msgs.msg import DiagnosticArray
+
+        def on_diag(arr: Any) -> None:
+            for st in arr.status:
+                diagnostics[st.name] = {"level": st.level[0] if isinstance(st.level, bytes) else int(st.level),
+                                        "message": st.message, "values": {kv.key: kv.value for kv in st.values}}
+
+        subs["/diagnostics"] = node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 10)
+    stop = []
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+    signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+    ex = SingleThreadedExecutor()
+    ex.add_node(node)
+    ready = False
+    deadline = time.monotonic() + args.discovery_timeout
+    next_write = 0.0
+    while not stop:
+        ex.spin_once(timeout_sec=0.05)
+        now = time.monotonic()
+        if not ready:
+            if all(node.count_publishers(t) > 0 for t in topics):
+                ready = True
+                print("READY", flush=True)
+            elif now > deadline:
+                print("TIMEOUT no publisher on " + ",".join(t for t in topics if node.count_publishers(t) == 0),
+                      flush=True)
+                deadline = math.inf
+        if now >= next_write:
+            _write(args.out, {"counts": counts, "ready": ready, "diagnostics": diagnostics})
+            next_write = now + 0.2
+    # Drain what is already here, then the final counts.
+    end = time.monotonic() + 0.2
+    while time.monotonic() < end:
+        ex.spin_once(timeout_sec=0.02)
+    _write(args.out, {"counts": counts, "ready": ready, "diagnostics": diagnostics, "final": True})
+    if rec is not None:
+        rec.close()
+    del subs
+    node.destroy_node()
+    rclpy.shutdown()
+    return 0
+
+
+def _fill(msg: Any, values: dict[str, Any]) -> Any:
+    for k, v in values.items():
+        setattr(msg, k, v)
+    return msg
+
+
+def publish(args: argparse.Namespace) -> int:
+    import rclpy
+    from rclpy.duration import Duration
+    from rclpy.node import Node
+    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+    plan = json.loads(args.plan.read_text())
+    topics = list(plan["topics"])
+    classes = _tables_and_classes(args.generated, topics)
+    rclpy.init(args=[])
+    node = Node("test_probe_publisher")
+    qos = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
+    pubs = {t: node.create_publisher(classes[t], t, qos) for t in topics}
+    deadline = time.monotonic() + args.discovery_timeout
+    while not all(p.get_subscription_count() > 0 for p in pubs.values()):
+        if time.monotonic() > deadline:
+            print("TIMEOUT no subscriber on " + ",".join(t for t, p in pubs.items()
+                                                          if p.get_subscription_count() == 0), flush=True)
+            return 1
+        rclpy.spin_once(node, timeout_sec=0.02)
+    print("READY", flush=True)
+    period = 1.0 / float(plan.get("rate_hz", 20.0))
+    sent = dict.fromkeys(topics, 0)
+    n = max(len(v) for v in plan["topics"].values())
+    t0 = time.monotonic()
+    for i in range(n):
+        for t in topics:
+            items = plan["topics"][t]
+            if i < len(items):
+                msg = _fill(classes[t](), items[i])
+                msg.header.stamp = node.get_clock().now().to_msg()
+                pubs[t].publish(msg)
+                sent[t] += 1
+        delay = t0 + (i + 1) * period - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+    # Reliable delivery: wait until the writers have no unacknowledged samples (bounded).
+    for p in pubs.values():
+        p.wait_for_all_acked(Duration(seconds=5.0))
+    _write(args.out, {"sent": sent})
+    print("DONE", flush=True)
+    node.destroy_node()
+    rclpy.shutdown()
+    return 0
+
+
+def main() -> int:
+    p = argparse.ArgumentParser()
+    sub = p.add_subparsers(dest="mode", required=True)
+    a = sub.add_parser("listen")
+    a.add_argument("--generated", type=Path, required=True)
+    a.add_argument("--topics", required=True)
+    a.add_argument("--out", type=Path, required=True)
+    a.add_argument("--record", type=Path, default=None)
+    a.add_argument("--diagnostics", action="store_true", help="also keep the last /diagnostics per status name")
+    a.add_argument("--discovery-timeout", type=float, default=15.0)
+    b = sub.add_parser("publish")
+    b.add_argument("--generated", type=Path, required=True)
+    b.add_argument("--plan", type=Path, required=True)
+    b.add_argument("--out", type=Path, required=True)
+    b.add_argument("--discovery-timeout", type=float, default=15.0)
+    args = p.parse_args()
+    return listen(args) if args.mode == "listen" else publish(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
