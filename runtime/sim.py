@@ -434,9 +434,8 @@ class Simulator:
         if self._closed:
             return
         self._closed = True
-        from sam_runtime.transport import aclose
-
         from sam_runtime.bridge import cancel_and_wait
+        from sam_runtime.transport import aclose
 
         stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None])
         if stuck:
