@@ -7,6 +7,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 from .diagnostics import Diagnostics, Pos
 from .dsdl_catalog import DsdlCatalog
@@ -43,6 +44,7 @@ from .typesys import (
     split_composite_name,
 )
 
+T = TypeVar("T", RosType, DsdlType)
 CAN_NODE_IDS = range(0, 128)
 SUBJECT_IDS = range(0, 8192)
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -60,6 +62,17 @@ class Resolved:
     messages: list[RosMessage] = field(default_factory=list)  # the spec's package, sorted by name
     dsdl_types: list[DsdlStruct] = field(default_factory=list)  # the spec's root namespace, sorted by name
     mappings: list[ResolvedMapping] = field(default_factory=list)
+
+
+def _indexed(leaf: T, name: str, index: int | None) -> T:
+    """The element type for `name[index]`, which only a fixed-size array allows."""
+    if index is None:
+        return leaf
+    if leaf.array != "fixed":
+        raise RuleError(f"{name}[{index}]: only fixed-size arrays take an index, {name} is {leaf}")
+    if index >= (leaf.capacity or 0):
+        raise RuleError(f"{name}[{index}]: index out of range, {name} has {leaf.capacity} elements")
+    return leaf.element
 
 
 def _python_safe(name: str) -> bool:
@@ -463,16 +476,10 @@ class _Validator:
                 raise RuleError(f"{format_path(path[:i])} is a {leaf}, it has no field {name!r}")
             f = current.field(name)
             if f is None:
-                raise RuleError(f"{current.full_name} has no field {name!r}",
-                                ) if True else None
+                raise RuleError(f"{current.full_name} has no field {name!r}")
             assert isinstance(f.type, RosType)
             leaf = f.type
-            if index is not None:
-                if leaf.array != "fixed":
-                    raise RuleError(f"{name}[{index}]: only fixed-size arrays take an index, {name} is {leaf}")
-                if index >= (leaf.capacity or 0):
-                    raise RuleError(f"{name}[{index}]: index out of range, {name} has {leaf.capacity} elements")
-                leaf = leaf.element
+            leaf = _indexed(leaf, name, index)
             current = None if leaf.is_primitive or leaf.array or leaf.base == TIME else self.ros.get(leaf.base)
         assert leaf is not None
         return leaf
@@ -485,15 +492,10 @@ class _Validator:
                 raise RuleError(f"{format_path(path[:i])} is a {leaf}, it has no field {name!r}")
             f = current.field(name)
             if f is None:
-                raise RuleError(f"{current.name} has no field {name!r}",)
+                raise RuleError(f"{current.name} has no field {name!r}")
             assert isinstance(f.type, DsdlType)
             leaf = f.type
-            if index is not None:
-                if leaf.array != "fixed":
-                    raise RuleError(f"{name}[{index}]: only fixed-size arrays take an index, {name} is {leaf}")
-                if index >= (leaf.capacity or 0):
-                    raise RuleError(f"{name}[{index}]: index out of range, {name} has {leaf.capacity} elements")
-                leaf = leaf.element
+            leaf = _indexed(leaf, name, index)
             current = self.dsdl.get(leaf.composite) if leaf.kind == "composite" and not leaf.array else None
             if current is not None and current.union:
                 raise RuleError(f"{name} is a union ({current.name}); unions cannot be mapped")
