@@ -18,6 +18,70 @@ never an exception out of a loop. The bridge is also a proper Cyphal node (heart
 and a proper ROS node (its parameters declared from the spec with their ranges, the spec's parameter rules
 enforced on every set); it tracks every device's heartbeat and publishes its counters and the devices'
 state as diagnostic_msgs/DiagnosticArray on /diagnostics once a second.
+
+Faults, and what the bridge does about them (issue 4). Nothing raises out of either loop; every message that
+does not become a publication is counted per mapping under ``dropped.<reason>``:
+
+=====================  ====================================================================================
+reason                 when
+=====================  ====================================================================================
+``unknown_source``     a transfer from a node id the mapping does not accept (spoofing, a stray node)
+``rejected``           the converter refused a value under the mapping's ``reject`` policy (NaN into an
+                       integer or a limited field, a value missing from a table, ...)
+``convert_error``      the converter raised (a bug: logged, counted, the loop goes on)
+``handler_error``      the receive handler itself failed (a bug: likewise)
+``publish_error``      the ROS publish or the Cyphal publish raised (e.g. a CAN bus error, ENOBUFS)
+``not_sent``           the Cyphal transport did not send every frame before the 1 s deadline (pycyphal's
+                       python-can media also reports a ``can.CanError`` this way)
+``queue_full``         ROS -> UAVCAN: the mapping's bounded Cyphal publish queue was full (overload)
+``link_down``          ROS -> UAVCAN: the Cyphal transport was being reopened after it failed
+``shutdown``           the bridge was closing
+``lost``               transfers of an accepted source that never reached the bridge: gaps in that source's
+                       transfer ids. Whatever the cause below the bridge - a datagram the kernel dropped in a
+                       burst, a frame that failed its CRC, a transfer that did not deserialize, the subject's
+                       bounded receive queue (``rx_queue_size``) overflowing - each such transfer is counted
+                       exactly once, when the next transfer of that source arrives. Exact on Cyphal/UDP
+                       (64-bit transfer ids); on Cyphal/CAN (modulo 32) only gaps within the 2 s transfer-id
+                       timeout are counted: a lower bound.
+=====================  ====================================================================================
+
+So per UAVCAN -> ROS mapping, once nothing is in flight and the sources sent again after a loss: the transfers
+its accepted sources sent == ``published + dropped_total - dropped.unknown_source``, and ``received`` (what
+reached the bridge) == ``published`` + the drops other than ``lost``. The causes below the bridge are
+pycyphal's counters of the subject, polled every 0.2 s and on every :meth:`Bridge.stats`, reported per
+mapping as ``cyphal.*``: ``errors`` (datagrams/frames that do not parse, transfers failing their CRC,
+multi-frame transfers with missing frames, duplicate or stale transfer ids - ``error.<kind>`` names them, per
+source node on UDP), ``deserialization_failures``, ``overruns`` (receive queue full), ``drops`` (the transport's
+own queue). They count frames from any sender, also ones that never were a valid transfer of an accepted
+source, so they are not added to ``dropped``; any of them, like any drop, makes the mapping WARN in
+/diagnostics for 10 s. Saturated values are counted per field under ``saturated.<mapping>.<field>`` (the
+message is still published), rejected ones under ``rejected.<...>``.
+
+- Out-of-order data: pycyphal itself discards a transfer whose transfer id is not newer than the last one of
+  that source within the 2 s transfer-id timeout (a duplicate or a reordered frame: ``cyphal.errors``). A
+  device timestamp (``header.stamp``) older than the previous message of the same source on the same mapping
+  is published anyway, in arrival order, and counted under ``out_of_order``: the bridge never reorders or
+  holds data back, and the stamp tells ROS consumers (tf2, message_filters, estimators) what to do with it.
+- Unknown timestamps (0): the ROS receive time. float16 NaN/+-inf from a device are passed to ROS unchanged
+  (float32/float64 hold them); the devices' ranges are the consumers' business.
+- Logging is bounded: the first occurrence of a (mapping, reason) is a WARNING at once, later ones are
+  summed and logged at most once per ``log_interval`` seconds (default 10) with the count since the previous
+  line; saturations and rejections likewise. Nothing stays unlogged: pending counts are flushed at close.
+- Heartbeats: a device is alive while its last uavcan.node.Heartbeat is younger than the Cyphal offline
+  timeout (3 s). The moment it is not, /diagnostics shows it at ERROR (published at once, not at the next
+  period), and it is logged; when heartbeats come back it is OK again (a restart - uptime going backwards - is
+  counted). A device never heard of is STALE.
+- A Cyphal transport that dies (pycyphal's CAN media close themselves for good on unrecoverable OS errors,
+  e.g. ENETDOWN when a SocketCAN interface goes down) is detected within 0.2 s and reopened with back-off
+  (0.5 s doubling to 5 s) until it works again; meanwhile commands are dropped as ``link_down`` and
+  /diagnostics shows the bridge at ERROR. Transient bus errors (a send raising) are counted and the next
+  message goes through.
+- A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last (``qos_depth``),
+  so DDS drops that subscriber's oldest samples instead of blocking the bridge.
+- Security: a mapping accepts transfers only from its spec's source node ids (``unknown_source`` otherwise);
+  actuators (the simulated ones too) accept commands only from the bridge's node id. Cyphal/UDP binds
+  127.0.0.1 and ROS discovery stays on localhost (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) unless the user
+  configures an interface (``--iface``, UAVCAN__UDP__IFACE, or that variable) explicitly.
 """
 
 from __future__ import annotations
@@ -45,6 +109,7 @@ __all__ = [
     "Bridge",
     "BridgeConfigError",
     "MappingStats",
+    "RateLimitedLog",
     "TransportConfig",
     "cancel_and_wait",
     "quiet_late_media_completions",
@@ -53,9 +118,17 @@ __all__ = [
 
 _log = logging.getLogger("sam_runtime.bridge")
 
-HEARTBEAT_STALE_S = 3.0
+HEARTBEAT_STALE_S = 3.0  # uavcan.node.Heartbeat.OFFLINE_TIMEOUT
 DEFAULT_QUEUE_SIZE = 256
+DEFAULT_RX_QUEUE_SIZE = 1000
 DEFAULT_QOS_DEPTH = 100
+DEFAULT_LOG_INTERVAL_S = 10.0
+HOUSEKEEPING_PERIOD_S = 0.2
+RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
+TRANSFER_ID_TIMEOUT_S = 2.0  # Cyphal's default transfer-id timeout
+REOPEN_BACKOFF_S = (0.5, 5.0)
+DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
+                "queue_full", "link_down", "shutdown", "lost")
 _RULE_OPS: dict[str, Callable[[Any, Any], bool]] = {
     "<": operator.lt,
     "<=": operator.le,
@@ -79,15 +152,19 @@ class TransportConfig:
     ``kind``: ``udp`` (default, ``iface`` default 127.0.0.1), ``can`` (``iface`` like ``virtual:bus0`` or
     ``socketcan:can0``, ``mtu`` 8 = Classic CAN, 64 = CAN FD), ``loopback``, or ``env``: the standard
     register environment variables (UAVCAN__UDP__IFACE, UAVCAN__CAN__IFACE, UAVCAN__CAN__MTU, ...) in
-    ``environ`` (default ``os.environ``).
+    ``environ`` (default ``os.environ``), or ``custom``: ``factory(node_id)`` returns a new pycyphal transport
+    (called again whenever the bridge reopens a failed transport; e.g. special CAN media, fault injection).
     """
 
     kind: str = "udp"
     iface: str | None = None
     mtu: int | None = None
     environ: Mapping[str, str] | None = None
+    factory: Callable[[int], Any] | None = None
 
     def describe(self) -> str:
+        if self.kind == "custom":
+            return f"custom({getattr(self.factory, '__name__', self.factory)!s})"
         if self.kind == "env":
             env = os.environ if self.environ is None else self.environ
             keys = sorted(k for k in env if k.startswith("UAVCAN__") and k != "UAVCAN__NODE__ID")
@@ -99,27 +176,98 @@ class TransportConfig:
         return self.kind
 
 
+class RateLimitedLog:
+    """At most one log line per key (e.g. (mapping, reason)) per ``interval`` seconds, with the count since the
+    previous line. The first occurrence of a key is logged at once. Thread-safe; formatting is lazy."""
+
+    def __init__(self, logger: logging.Logger, interval: float = DEFAULT_LOG_INTERVAL_S) -> None:
+        self.logger = logger
+        self.interval = float(interval)
+        self._lock = threading.Lock()
+        # key -> [last_emit_monotonic, pending, total, level, msg, args]
+        self._state: dict[tuple[str, str], list[Any]] = {}
+        self.lines: collections.Counter[tuple[str, str]] = collections.Counter()  # lines written per key
+
+    def note(self, key: tuple[str, str], level: int, msg: str, *args: Any, count: int = 1) -> None:
+        now = time.monotonic()
+        emit: tuple[int, float, int] | None = None
+        with self._lock:
+            st = self._state.get(key)
+            if st is None:
+                self._state[key] = [now, 0, count, level, msg, args]
+                emit = (count, 0.0, count)
+            else:
+                st[1] += count
+                st[2] += count
+                st[3], st[4], st[5] = level, msg, args
+                if now - st[0] >= self.interval:
+                    emit = (st[1], now - st[0], st[2])
+                    st[0], st[1] = now, 0
+            if emit is not None:
+                self.lines[key] += 1
+        if emit is not None:
+            self._emit(key, level, msg, args, *emit)
+
+    def flush(self, force: bool = False) -> None:
+        """Write the pending counts whose interval has passed (all of them with ``force``)."""
+        now = time.monotonic()
+        out = []
+        with self._lock:
+            for key, st in self._state.items():
+                if st[1] and (force or now - st[0] >= self.interval):
+                    out.append((key, st[3], st[4], st[5], st[1], now - st[0], st[2]))
+                    st[0], st[1] = now, 0
+                    self.lines[key] += 1
+        for key, level, msg, args, n, dt, total in out:
+            self._emit(key, level, msg, args, n, dt, total)
+
+    def _emit(self, key: tuple[str, str], level: int, msg: str, args: tuple[Any, ...], n: int, dt: float,
+              total: int) -> None:
+        if not self.logger.isEnabledFor(level):
+            return
+        try:
+            detail = msg % args if args else msg
+        except Exception:  # a bad format must not break the caller
+            detail = f"{msg} {args!r}"
+        if dt == 0.0 and n == total:
+            self.logger.log(level, "%s: %s: %s (%d; more are summed at most every %.0f s)", key[0], key[1],
+                            detail, n, self.interval)
+        else:
+            self.logger.log(level, "%s: %s: %d in the last %.1f s (%d in all); the last: %s", key[0], key[1], n,
+                            dt, total, detail)
+
+
 class MappingStats:
     """Counters of one mapping. Also the ``stats`` object handed to the generated converters
-    (``saturate(key)``, ``reject(key)``). Thread-safe: both event loops may touch it."""
+    (``saturate(key)``, ``reject(key)``). Thread-safe: both event loops may touch it.
 
-    def __init__(self, lock: threading.Lock) -> None:
+    ``name`` and ``log`` (optional) make saturations and rejections logged at a bounded rate."""
+
+    def __init__(self, lock: threading.Lock, name: str = "", log: RateLimitedLog | None = None) -> None:
         self._lock = lock
+        self.name = name
+        self._log = log
         self.received = 0
         self.published = 0
+        self.out_of_order = 0
         self.dropped: collections.Counter[str] = collections.Counter()
         self.saturated: collections.Counter[str] = collections.Counter()
         self.rejected: collections.Counter[str] = collections.Counter()
         self.last_published_monotonic: float | None = None
+        self.last_drop_monotonic: float | None = None
 
     # converter interface
     def saturate(self, key: str) -> None:
         with self._lock:
             self.saturated[str(key)] += 1
+        if self._log is not None:
+            self._log.note((self.name, "saturated"), logging.WARNING, "saturated %s", key)
 
     def reject(self, key: str) -> None:
         with self._lock:
             self.rejected[str(key)] += 1
+        if self._log is not None:
+            self._log.note((self.name, "rejected"), logging.WARNING, "rejected a message for %s", key)
 
     # bridge interface
     def receive(self) -> None:
@@ -131,9 +279,16 @@ class MappingStats:
             self.published += 1
             self.last_published_monotonic = time.monotonic()
 
-    def drop(self, reason: str) -> None:
+    def drop(self, reason: str, count: int = 1) -> None:
+        if count <= 0:
+            return
         with self._lock:
-            self.dropped[reason] += 1
+            self.dropped[reason] += count
+            self.last_drop_monotonic = time.monotonic()
+
+    def reorder(self) -> None:
+        with self._lock:
+            self.out_of_order += 1
 
     def snapshot(self) -> dict[str, Any]:
         with self._lock:
@@ -143,7 +298,11 @@ class MappingStats:
                 "dropped": dict(self.dropped),
                 "dropped_total": sum(self.dropped.values()),
                 "saturated": dict(self.saturated),
+                "saturated_total": sum(self.saturated.values()),
                 "rejected_fields": dict(self.rejected),
+                "out_of_order": self.out_of_order,
+                "last_drop_age_s": None if self.last_drop_monotonic is None
+                else round(time.monotonic() - self.last_drop_monotonic, 3),
             }
 
 
@@ -156,6 +315,9 @@ class _HeartbeatRecord:
     uptime: int
     vssc: int
     count: int = 1
+    alive: bool = True  # as last reported (transitions are logged and published at once)
+    lost_events: int = 0  # times the heartbeat timed out
+    restarts: int = 0  # times the uptime went backwards
 
 
 @dataclass
@@ -179,6 +341,7 @@ class _InMapping:
     stats: MappingStats
     ros_publisher: Any = None
     has_header: bool = False
+    last_stamp_ns: dict[int, int] = field(default_factory=dict)  # per source: stamp of the last published message
 
 
 @dataclass
@@ -187,6 +350,14 @@ class _SubjectGroup:
     dtype: type
     mappings: list[_InMapping] = field(default_factory=list)
     subscriber: Any = None
+    accepted_sources: frozenset[int] = frozenset()
+    last_tid: dict[int, tuple[int, float]] = field(default_factory=dict)  # source -> (transfer id, monotonic s)
+    # pycyphal's counters of the current subscriber already turned into drops (reset with a new subscriber)
+    seen: dict[str, int] = field(default_factory=dict)
+    # cumulative pycyphal counters over every subscriber this group had (transport reopened)
+    cyphal_total: dict[str, int] = field(default_factory=dict)
+    error_kinds: collections.Counter[str] = field(default_factory=collections.Counter)
+    last_problem_monotonic: float | None = None
 
 
 def quiet_late_media_completions(loop: asyncio.AbstractEventLoop) -> None:
@@ -231,10 +402,23 @@ def ros_parameter_name(spec_name: str) -> str:
     return spec_name.lstrip("/").replace("/", ".")
 
 
-def _limited_log(counter: collections.Counter[tuple[str, str]], key: tuple[str, str], msg: str, *args: Any) -> None:
-    """Warn on the first occurrence of a (mapping, reason), then only at DEBUG level (counters tell the rest)."""
-    counter[key] += 1
-    (_log.warning if counter[key] == 1 else _log.debug)(msg, *args)
+def _error_kinds(session_stats: Any) -> dict[str, int]:
+    """pycyphal's breakdown of a session's errors, where the transport gives one (UDP: reassembly errors per
+    source node; CAN: reception error counters)."""
+    out: collections.Counter[str] = collections.Counter()
+    per_src = getattr(session_stats, "reassembly_errors_per_source_node_id", None)
+    if isinstance(per_src, dict):
+        for src, errs in per_src.items():
+            for err, n in errs.items():
+                if n:
+                    out[f"{getattr(err, 'name', err)}.node{src}"] += int(n)
+    for attr in ("reassembly_errors", "reception_error_counters"):
+        errs = getattr(session_stats, attr, None)
+        if isinstance(errs, dict):
+            for err, n in errs.items():
+                if n:
+                    out[str(getattr(err, "name", err))] += int(n)
+    return dict(out)
 
 
 class Bridge:
@@ -249,6 +433,9 @@ class Bridge:
     :param qos_depth: history depth of the ROS publishers and subscriptions (reliable, keep-last).
     :param command_reliability: ``reliable`` (default) or ``best_effort`` for the ROS command subscriptions.
     :param diagnostics_period: seconds between /diagnostics messages (0 disables them).
+    :param queue_size: bound of each ROS -> UAVCAN mapping's Cyphal publish queue (beyond: ``queue_full``).
+    :param rx_queue_size: bound of each subject's pycyphal receive queue (beyond: ``overrun``); 0 = unbounded.
+    :param log_interval: seconds between two log lines of one (mapping, reason); the first is immediate.
     """
 
     def __init__(
@@ -263,6 +450,8 @@ class Bridge:
         queue_size: int = DEFAULT_QUEUE_SIZE,
         command_reliability: str = "reliable",
         diagnostics_period: float = 1.0,
+        rx_queue_size: int = DEFAULT_RX_QUEUE_SIZE,
+        log_interval: float = DEFAULT_LOG_INTERVAL_S,
     ) -> None:
         self.gen = gen
         self.tables = gen.tables()
@@ -277,8 +466,10 @@ class Bridge:
         self._command_reliability = command_reliability
         self._diag_period = float(diagnostics_period)
 
+        self._rx_queue_size = int(rx_queue_size)
         self._lock = threading.Lock()
-        self._log_counts: collections.Counter[tuple[str, str]] = collections.Counter()
+        self._poll_lock = threading.Lock()
+        self.log = RateLimitedLog(_log, log_interval)
         self._mstats: dict[str, MappingStats] = {}
         self._in_groups: dict[int, _SubjectGroup] = {}
         self._out: dict[str, _OutMapping] = {}
@@ -300,6 +491,15 @@ class Bridge:
         self._diag_pub: Any = None
         self._ros_pubs: dict[str, Any] = {}
         self._ros_subs: dict[str, Any] = {}
+        self._housekeeping_task: asyncio.Task[None] | None = None
+        # The Cyphal link: reopened when the transport dies (see _check_link).
+        self._link_up = False
+        self._link_state = "not started"
+        self._link_suspect: str | None = None
+        self._link_down_since: float | None = None
+        self._link_outages = 0
+        self._link_down_s = 0.0
+        self._tid_modulo = 2**64
 
     # ------------------------------------------------------------------------------------------ set-up
     def _resolve_node_id(self, node_id: int | None) -> int:
@@ -338,6 +538,7 @@ class Bridge:
         self._stop_spin.clear()
         self._spin_thread = threading.Thread(target=self._spin, name=f"{self.name}-rclpy", daemon=True)
         self._spin_thread.start()
+        self._housekeeping_task = asyncio.create_task(self._housekeeping(), name=f"{self.name}-housekeeping")
         _log.info(
             "%s started: Cyphal node %d on %s, %d UAVCAN->ROS and %d ROS->UAVCAN mappings",
             self.name, self.node_id, self.transport_config.describe(),
@@ -390,7 +591,7 @@ class Bridge:
             else ReliabilityPolicy.BEST_EFFORT,
         )
         for m in self.tables.MAPPINGS:
-            stats = self._mstats.setdefault(m.name, MappingStats(self._lock))
+            stats = self._mstats.setdefault(m.name, MappingStats(self._lock, m.name, self.log))
             ros_cls = self.gen.ros_class(m.topic)
             if m.direction == "uavcan_to_ros":
                 pub = self._ros_pubs.get(m.topic.name)
@@ -499,55 +700,256 @@ class Bridge:
 
     # Cyphal side --------------------------------------------------------------------------------
     async def _start_cyphal(self, converters: Mapping[str, Any]) -> None:
-        import uavcan.node
+        for om in self._out.values():
+            om.queue = asyncio.Queue(maxsize=self._queue_size)
+        for group in self._in_groups.values():
+            group.accepted_sources = frozenset(n for im in group.mappings for n in im.info.source_node_ids)
+        self._open_cyphal()
+        for om in self._out.values():
+            om.worker = asyncio.create_task(self._out_worker(om), name=f"bridge-out-{om.info.name}")
 
-        from sam_runtime.transport import make_node, transport_from_env
+    def _make_transport(self) -> Any:
+        from sam_runtime.transport import make_transport, transport_from_env
 
         tc = self.transport_config
-        name = f"org.{self.tables.VEHICLE}.{self.name}"[:50]
         if tc.kind == "env":
             env = dict(os.environ if tc.environ is None else tc.environ)
             env["UAVCAN__NODE__ID"] = str(self.node_id)
-            transport = transport_from_env(env)
-            self._cy_node = make_node(name, self.node_id, transport=transport)
-        else:
-            self._cy_node = make_node(name, self.node_id, tc.kind, iface=tc.iface, mtu=tc.mtu)
-        self._cy_node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+            return transport_from_env(env)
+        if tc.kind == "custom":
+            if tc.factory is None:
+                raise BridgeConfigError("a custom transport needs a factory")
+            return tc.factory(self.node_id)
+        return make_transport(tc.kind, node_id=self.node_id, iface=tc.iface, mtu=tc.mtu)
+
+    def _open_cyphal(self) -> None:
+        """The Cyphal node and every port (at start and whenever the transport is reopened)."""
+        import uavcan.node
+
+        from sam_runtime.transport import make_node
+
+        name = f"org.{self.tables.VEHICLE}.{self.name}"[:50]
+        node = make_node(name, self.node_id, transport=self._make_transport())
+        try:
+            node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+            transport = node.presentation.transport
+            self._tid_modulo = int(transport.protocol_parameters.transfer_id_modulo)
+            if hasattr(transport, "add_error_hook"):  # CAN: media errors (bus off, error passive, ...) counted
+                transport.add_error_hook(self._on_transport_error)
+            rxq = self._rx_queue_size if self._rx_queue_size > 0 else None
+            for om in self._out.values():
+                pub = node.make_publisher(self.gen.dsdl_class(om.info.port), om.info.port.subject_id)
+                pub.send_timeout = 1.0
+                om.publisher = pub
+            for group in self._in_groups.values():
+                group.subscriber = node.presentation.make_subscriber(group.dtype, group.subject_id, rxq)
+                group.seen = {}
+                group.subscriber.receive_in_background(
+                    lambda msg, transfer, group=group: self._on_uavcan(group, msg, transfer))
+            self._hb_sub = node.make_subscriber(uavcan.node.Heartbeat_1_0)
+            self._hb_sub.receive_in_background(self._on_heartbeat)
+        except BaseException:
+            node.close()
+            raise
+        self._cy_node = node
+        self._link_up, self._link_state, self._link_suspect = True, "up", None
+
+    async def _close_cyphal(self) -> None:
+        """Close every Cyphal port and the node (the workers and their queues stay)."""
+        from sam_runtime.transport import aclose
+
+        self._poll_cyphal_stats()  # what the old subscribers counted is not lost
+        ports: list[Any] = [g.subscriber for g in self._in_groups.values()] + [
+            om.publisher for om in self._out.values()]
+        ports.append(self._hb_sub)
+        for g in self._in_groups.values():
+            g.subscriber = None
         for om in self._out.values():
-            om.publisher = self._cy_node.make_publisher(self.gen.dsdl_class(om.info.port), om.info.port.subject_id)
-            om.publisher.send_timeout = 1.0
-            om.queue = asyncio.Queue(maxsize=self._queue_size)
-            om.worker = asyncio.create_task(self._out_worker(om), name=f"bridge-out-{om.info.name}")
-        for group in self._in_groups.values():
-            group.subscriber = self._cy_node.make_subscriber(group.dtype, group.subject_id)
-            group.subscriber.receive_in_background(
-                lambda msg, transfer, group=group: self._on_uavcan(group, msg, transfer))
-        self._hb_sub = self._cy_node.make_subscriber(uavcan.node.Heartbeat_1_0)
-        self._hb_sub.receive_in_background(self._on_heartbeat)
+            om.publisher = None
+        self._hb_sub = None
+        node, self._cy_node = self._cy_node, None
+        try:
+            await aclose(*[p for p in ports if p is not None])
+            if node is not None:
+                await aclose(node)
+        except Exception as ex:  # a dead transport may refuse to close cleanly
+            _log.warning("closing the Cyphal node: %s: %s", type(ex).__name__, ex)
+
+    def _on_transport_error(self, timestamp: Any, error: Any) -> None:
+        kind = getattr(error, "name", str(error))
+        self._errors[f"cyphal.{kind}"] += 1
+        self.log.note(("cyphal", kind), logging.WARNING, "transport error %s", kind)
+
+    @staticmethod
+    def _transport_dead(transport: Any) -> bool:
+        """Best effort: pycyphal's CAN media close themselves for good on unrecoverable OS errors (the python-can
+        media on any OSError of its receive thread, SocketCAN on ENETDOWN & co.); the transport then only raises
+        ResourceClosedError. A redundant transport is dead when all its inferiors are."""
+        inferiors = getattr(transport, "inferiors", None)
+        if isinstance(inferiors, list | tuple) and inferiors:
+            return all(Bridge._transport_dead(t) for t in inferiors)
+        if not hasattr(transport, "_maybe_media"):
+            return False
+        media = transport._maybe_media
+        return media is None or bool(getattr(media, "_closed", False))
+
+    def _check_link(self) -> str | None:
+        """Why the Cyphal link needs reopening, or None."""
+        if self._cy_node is None:
+            return "no Cyphal node"
+        if self._link_suspect:
+            return self._link_suspect
+        try:
+            if self._transport_dead(self._cy_node.presentation.transport):
+                return "the transport's media closed itself"
+        except Exception as ex:
+            return f"{type(ex).__name__}: {ex}"
+        return None
+
+    async def _reopen_cyphal(self, reason: str) -> None:
+        """Close the failed node and open a new one, with back-off, until it works or the bridge closes."""
+        self._link_up, self._link_state = False, f"down: {reason}"
+        self._link_outages += 1
+        self._link_down_since = time.monotonic()
+        self._errors["transport_down"] += 1
+        _log.error("Cyphal transport %s failed (%s): reopening", self.transport_config.describe(), reason)
+        self._publish_diagnostics()
+        await self._close_cyphal()
+        delay = REOPEN_BACKOFF_S[0]
+        attempts = 0
+        while not self._closed:
+            attempts += 1
+            try:
+                self._open_cyphal()
+                break
+            except Exception as ex:
+                self._errors["transport_reopen_failed"] += 1
+                self._link_state = f"down: {reason}; reopen attempt {attempts}: {type(ex).__name__}: {ex}"
+                self.log.note(("cyphal", "reopen_failed"), logging.WARNING, "reopening the transport: %s: %s",
+                              type(ex).__name__, ex)
+                await asyncio.sleep(delay)
+                delay = min(delay * 2.0, REOPEN_BACKOFF_S[1])
+        if self._link_down_since is not None:
+            down = time.monotonic() - self._link_down_since
+            self._link_down_s += down
+            self._link_down_since = None
+            if self._link_up:
+                self._errors["transport_reopened"] += 1
+                _log.warning("Cyphal transport reopened after %.1f s (%d attempts)", down, attempts)
+                self._publish_diagnostics()
+
+    # ------------------------------------------------------------------------------------------ housekeeping
+    async def _housekeeping(self) -> None:
+        """Every 0.2 s on the asyncio loop: pycyphal's counters into drops, heartbeat timeouts, the link, the
+        bounded-rate log. Never raises (a failure is counted and the next round runs)."""
+        while not self._closed:
+            await asyncio.sleep(HOUSEKEEPING_PERIOD_S)
+            try:
+                self._poll_cyphal_stats()
+                self._check_heartbeats()
+                self.log.flush()
+                why = self._check_link()
+                if why is not None and not self._closed:
+                    await self._reopen_cyphal(why)
+            except asyncio.CancelledError:
+                raise
+            except Exception as ex:
+                self._errors["housekeeping_error"] += 1
+                self.log.note(("bridge", "housekeeping_error"), logging.ERROR, "housekeeping: %s: %s",
+                              type(ex).__name__, ex)
+
+    _CYPHAL_PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
+
+    def _poll_cyphal_stats(self) -> None:
+        """Accumulate pycyphal's per-subject counters (they restart with each new subscriber) and log their
+        increments at a bounded rate (thread-safe)."""
+        with self._poll_lock:
+            for group in self._in_groups.values():
+                sub = group.subscriber
+                if sub is None:
+                    continue
+                try:
+                    s = sub.sample_statistics()
+                except Exception:  # closed meanwhile
+                    continue
+                ts = s.transport_session
+                now = {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
+                       "deserialization_failures": s.deserialization_failures, "overruns": s.overruns}
+                kinds = _error_kinds(ts)
+                for key, value in now.items():
+                    delta = int(value) - group.seen.get(key, 0)
+                    if delta <= 0:
+                        continue
+                    group.seen[key] = int(value)
+                    group.cyphal_total[key] = group.cyphal_total.get(key, 0) + delta
+                    if key in self._CYPHAL_PROBLEMS:
+                        group.last_problem_monotonic = time.monotonic()
+                        self.log.note((f"subject {group.subject_id}", f"cyphal.{key}"), logging.WARNING,
+                                      "%d discarded by pycyphal below the bridge%s", delta,
+                                      f" ({', '.join(f'{k} {v}' for k, v in sorted(kinds.items()))} in all)"
+                                      if kinds else "", count=delta)
+                for k, v in kinds.items():
+                    base = group.seen.get(f"kind.{k}", 0)
+                    if v > base:
+                        group.error_kinds[k] += v - base
+                        group.seen[f"kind.{k}"] = v
 
     # ------------------------------------------------------------------------------------------ UAVCAN -> ROS
     def _on_uavcan(self, group: _SubjectGroup, msg: Any, transfer: Any) -> None:
-        """Runs on the asyncio loop for every received transfer of the group's subject."""
+        """Runs on the asyncio loop for every received transfer of the group's subject. Never raises."""
+        try:
+            self._bridge_transfer(group, msg, transfer)
+        except Exception as ex:  # a bug: counted and logged, the receive loop goes on
+            for im in group.mappings:
+                im.stats.drop("handler_error")
+            self._errors["handler_error"] += 1
+            self.log.note((f"subject {group.subject_id}", "handler_error"), logging.ERROR, "%s: %s",
+                          type(ex).__name__, ex)
+
+    def _track_transfer_id(self, group: _SubjectGroup, src: int, transfer: Any) -> int:
+        """Transfers lost before this one from ``src`` (a gap in its transfer ids), 0 if none or unknown."""
+        tid = int(transfer.transfer_id)
+        try:
+            now = float(transfer.timestamp.monotonic)
+        except Exception:
+            now = time.monotonic()
+        prev = group.last_tid.get(src)
+        group.last_tid[src] = (tid, now)
+        if prev is None:
+            return 0
+        modulo = self._tid_modulo
+        d = (tid - prev[0]) % modulo
+        if d <= 1 or d >= modulo // 2:  # next in sequence, duplicate, or backwards (the source restarted)
+            return 0
+        if modulo < 2**32 and now - prev[1] > TRANSFER_ID_TIMEOUT_S:  # CAN: the ids may have wrapped meanwhile
+            return 0
+        return d - 1
+
+    def _bridge_transfer(self, group: _SubjectGroup, msg: Any, transfer: Any) -> None:
         src = transfer.source_node_id
         receive_ns: int | None = None
+        lost = self._track_transfer_id(group, src, transfer) if src in group.accepted_sources else 0
         for im in group.mappings:
             st = im.stats
             st.receive()
             name = im.info.name
             if src is None or src not in im.info.source_node_ids:
                 st.drop("unknown_source")
-                _limited_log(self._log_counts, (name, "unknown_source"),
-                             "mapping %s: dropped a transfer from node %s (accepted: %s)",
-                             name, src, sorted(im.info.source_node_ids))
+                self.log.note((name, "unknown_source"), logging.WARNING,
+                              "dropped a transfer from node %s (accepted: %s)", src, sorted(im.info.source_node_ids))
                 continue
+            if lost:
+                st.drop("lost", lost)
+                self.log.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "
+                              "(transfer id gap before %d)", lost, src, transfer.transfer_id, count=lost)
             if receive_ns is None:
                 receive_ns = self._clock.now().nanoseconds
             try:
                 ros_msg = im.to_ros(msg, receive_ns, st)
             except Exception as ex:
                 st.drop("convert_error")
-                _limited_log(self._log_counts, (name, "convert_error"),
-                             "mapping %s: conversion failed: %s: %s", name, type(ex).__name__, ex)
+                self.log.note((name, "convert_error"), logging.ERROR, "conversion failed: %s: %s",
+                              type(ex).__name__, ex)
                 continue
             if ros_msg is None:
                 st.drop("rejected")
@@ -558,12 +960,20 @@ class Bridge:
                     hdr.frame_id = im.info.frame_id
                 if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
                     hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
+                stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec
+                last = im.last_stamp_ns.get(src)
+                im.last_stamp_ns[src] = stamp
+                if last is not None and stamp < last:  # published anyway, in arrival order (see the docstring)
+                    st.reorder()
+                    self.log.note((name, "out_of_order"), logging.WARNING,
+                                  "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
+                                  src, stamp * 1e-9, last * 1e-9)
             try:
                 im.ros_publisher.publish(ros_msg)
             except Exception as ex:
                 st.drop("publish_error")
-                _limited_log(self._log_counts, (name, "publish_error"),
-                             "mapping %s: ROS publish failed: %s: %s", name, type(ex).__name__, ex)
+                self.log.note((name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s",
+                              type(ex).__name__, ex)
                 continue
             st.publish()
 
@@ -577,9 +987,37 @@ class Bridge:
             self._heartbeats[nid] = _HeartbeatRecord(
                 nid, now, int(msg.health.value), int(msg.mode.value), int(msg.uptime),
                 int(msg.vendor_specific_status_code))
-        else:
-            rec.last_seen, rec.health, rec.mode = now, int(msg.health.value), int(msg.mode.value)
-            rec.uptime, rec.vssc, rec.count = int(msg.uptime), int(msg.vendor_specific_status_code), rec.count + 1
+            return
+        uptime = int(msg.uptime)
+        if uptime < rec.uptime:
+            rec.restarts += 1
+        rec.last_seen, rec.health, rec.mode = now, int(msg.health.value), int(msg.mode.value)
+        rec.uptime, rec.vssc, rec.count = uptime, int(msg.vendor_specific_status_code), rec.count + 1
+        if not rec.alive:
+            self._check_heartbeats()  # back: report at once
+
+    def _device_name(self, nid: int) -> str:
+        dev = self._devices_by_id.get(nid)
+        return f"device {dev.name} (node {nid})" if dev is not None else f"node {nid}"
+
+    def _check_heartbeats(self) -> None:
+        """Log and publish (at once) every change between alive and lost of a node's heartbeat."""
+        now = time.monotonic()
+        changed = False
+        for nid, rec in list(self._heartbeats.items()):
+            alive = now - rec.last_seen < HEARTBEAT_STALE_S
+            if alive == rec.alive:
+                continue
+            rec.alive = alive
+            changed = True
+            if alive:
+                _log.warning("%s: heartbeat back (uptime %d s, %d restarts seen)", self._device_name(nid),
+                             rec.uptime, rec.restarts)
+            else:
+                rec.lost_events += 1
+                _log.warning("%s: heartbeat lost (none for %.1f s)", self._device_name(nid), now - rec.last_seen)
+        if changed:
+            self._publish_diagnostics()
 
     # ------------------------------------------------------------------------------------------ ROS -> UAVCAN
     def _on_ros(self, oms: list[_OutMapping], msg: Any) -> None:
@@ -593,8 +1031,8 @@ class Bridge:
                 obj = om.to_uavcan(msg, st)
             except Exception as ex:
                 st.drop("convert_error")
-                _limited_log(self._log_counts, (name, "convert_error"),
-                             "mapping %s: conversion failed: %s: %s", name, type(ex).__name__, ex)
+                self.log.note((name, "convert_error"), logging.ERROR, "conversion failed: %s: %s",
+                              type(ex).__name__, ex)
                 continue
             if obj is None:
                 st.drop("rejected")
@@ -614,27 +1052,42 @@ class Bridge:
             om.queue.put_nowait(obj)
         except asyncio.QueueFull:
             om.stats.drop("queue_full")
-            _limited_log(self._log_counts, (om.info.name, "queue_full"),
-                         "mapping %s: Cyphal publish queue full (%d): dropping", om.info.name, self._queue_size)
+            self.log.note((om.info.name, "queue_full"), logging.WARNING, "Cyphal publish queue full (%d): dropping",
+                          self._queue_size)
 
     async def _out_worker(self, om: _OutMapping) -> None:
+        import pycyphal.transport
+
         assert om.queue is not None
+        name = om.info.name
         while not self._closed:
             obj = await om.queue.get()
+            pub = om.publisher
+            if pub is None or not self._link_up:
+                om.stats.drop("link_down")
+                self.log.note((name, "link_down"), logging.WARNING, "the Cyphal transport is being reopened")
+                continue
             try:
-                ok = await om.publisher.publish(obj)
+                ok = await pub.publish(obj)
             except asyncio.CancelledError:
                 om.stats.drop("shutdown")
                 raise
             except Exception as ex:
+                if self._closed:
+                    om.stats.drop("shutdown")
+                    continue
+                if isinstance(ex, pycyphal.transport.ResourceClosedError) and om.publisher is pub:
+                    self._link_suspect = f"publish on {om.info.port.subject_id}: {type(ex).__name__}: {ex}"
                 om.stats.drop("publish_error")
-                _limited_log(self._log_counts, (om.info.name, "publish_error"),
-                             "mapping %s: Cyphal publish failed: %s: %s", om.info.name, type(ex).__name__, ex)
+                self.log.note((name, "publish_error"), logging.WARNING, "Cyphal publish failed: %s: %s",
+                              type(ex).__name__, ex)
                 continue
             if ok:
                 om.stats.publish()
             else:
-                om.stats.drop("publish_timeout")
+                om.stats.drop("not_sent")
+                self.log.note((name, "not_sent"), logging.WARNING,
+                              "Cyphal publish: not every frame sent within %.1f s", pub.send_timeout)
 
     # ------------------------------------------------------------------------------------------ rclpy thread
     def _spin(self) -> None:
@@ -645,36 +1098,42 @@ class Bridge:
                 if self._stop_spin.is_set() or not self._ros_ctx.ok():
                     break
                 self._errors["spin_error"] += 1
-                _limited_log(self._log_counts, ("executor", "spin_error"),
-                             "rclpy executor: %s: %s", type(ex).__name__, ex)
+                self.log.note(("executor", "spin_error"), logging.ERROR, "rclpy executor: %s: %s",
+                              type(ex).__name__, ex)
 
     # ------------------------------------------------------------------------------------------ reporting
     def stats(self) -> dict[str, Any]:
-        """A JSON-serialisable snapshot of every counter, the devices' heartbeats and the bridge itself."""
+        """A JSON-serialisable snapshot of every counter, the devices' heartbeats and the bridge itself.
+        Polls pycyphal's counters first, so the below-bridge drops are current."""
+        self._poll_cyphal_stats()
         now = time.monotonic()
         mappings: dict[str, Any] = {}
+        empty = MappingStats(threading.Lock()).snapshot()
         for m in self.tables.MAPPINGS:
             st = self._mstats.get(m.name)
             entry = {
                 "direction": m.direction,
                 "topic": m.topic.name,
                 "subject_id": m.port.subject_id,
-                **(st.snapshot() if st else {"received": 0, "published": 0, "dropped": {}, "dropped_total": 0,
-                                             "saturated": {}, "rejected_fields": {}}),
+                **(st.snapshot() if st else empty),
             }
             if m.direction == "uavcan_to_ros":
                 entry["source_node_ids"] = sorted(m.source_node_ids)
                 group = self._in_groups.get(m.port.subject_id)
-                if group is not None and group.subscriber is not None:
-                    try:
-                        s = group.subscriber.sample_statistics()
-                        entry["cyphal"] = {
-                            "transfers": s.transport_session.transfers, "frames": s.transport_session.frames,
-                            "errors": s.transport_session.errors, "drops": s.transport_session.drops,
-                            "deserialization_failures": s.deserialization_failures,
-                        }
-                    except Exception:  # closed
-                        pass
+                if group is not None:
+                    with self._poll_lock:
+                        tot = dict(group.cyphal_total)
+                        kinds = dict(group.error_kinds)
+                    entry["cyphal"] = {
+                        "transfers": tot.get("transfers", 0), "frames": tot.get("frames", 0),
+                        "errors": tot.get("errors", 0), "drops": tot.get("drops", 0),
+                        "deserialization_failures": tot.get("deserialization_failures", 0),
+                        "overruns": tot.get("overruns", 0),
+                    }
+                    if kinds:
+                        entry["cyphal"]["error_kinds"] = kinds
+                    if group.last_problem_monotonic is not None:
+                        entry["cyphal"]["last_problem_age_s"] = round(now - group.last_problem_monotonic, 3)
                 pub = self._ros_pubs.get(m.topic.name)
                 entry["ros_subscribers"] = self._safe_count(pub, "get_subscription_count")
             else:
@@ -690,6 +1149,7 @@ class Bridge:
         known = {d.node_id for d in self.tables.DEVICES} | {self.node_id}
         others = {str(nid): self._hb_entry(nid, rec, now) for nid, rec in sorted(self._heartbeats.items())
                   if nid not in known}
+        down_s = self._link_down_s + (now - self._link_down_since if self._link_down_since is not None else 0.0)
         return {
             "bridge": {
                 "name": self.name,
@@ -697,6 +1157,9 @@ class Bridge:
                 "transport": self.transport_config.describe(),
                 "uptime_s": round(now - self._started_monotonic, 3) if self._started_monotonic else 0.0,
                 "errors": dict(self._errors),
+                "link": {"up": self._link_up, "state": self._link_state, "outages": self._link_outages,
+                         "down_s": round(down_s, 3)},
+                "log_lines": sum(self.log.lines.values()),
             },
             "mappings": mappings,
             "devices": devices,
@@ -715,23 +1178,34 @@ class Bridge:
     @staticmethod
     def _hb_entry(nid: int, rec: _HeartbeatRecord | None, now: float) -> dict[str, Any]:
         if rec is None:
-            return {"node_id": nid, "seen": False}
+            return {"node_id": nid, "seen": False, "alive": False, "state": "never seen"}
         age = now - rec.last_seen
+        alive = age < HEARTBEAT_STALE_S
         return {
-            "node_id": nid, "seen": True, "age_s": round(age, 3), "alive": age < HEARTBEAT_STALE_S,
+            "node_id": nid, "seen": True, "age_s": round(age, 3), "alive": alive,
+            "state": "alive" if alive else "stale",
             "health": _HEALTH.get(rec.health, str(rec.health)), "mode": _MODE.get(rec.mode, str(rec.mode)),
-            "uptime_s": rec.uptime, "vssc": rec.vssc, "heartbeats": rec.count,
+            "uptime_s": rec.uptime, "vssc": rec.vssc, "heartbeats": rec.count, "lost_events": rec.lost_events,
+            "restarts": rec.restarts,
         }
 
     def _publish_diagnostics(self) -> None:
-        """rclpy timer (executor thread): the counters and device states as a DiagnosticArray."""
+        """The counters and device states as a DiagnosticArray (rclpy timer, and at once on a device or link
+        change; rclpy's publish is thread-safe). Never raises."""
+        if self._diag_pub is None or self._closed:
+            return
         try:
             self._diag_pub.publish(self.diagnostics_message())
         except Exception as ex:
             self._errors["diagnostics_error"] += 1
-            _limited_log(self._log_counts, ("diagnostics", "error"), "diagnostics: %s: %s", type(ex).__name__, ex)
+            self.log.note(("diagnostics", "error"), logging.ERROR, "diagnostics: %s: %s", type(ex).__name__, ex)
 
     def diagnostics_message(self) -> Any:
+        """diagnostic_msgs/DiagnosticArray: one status for the bridge (ERROR while its Cyphal link is down), one
+        per mapping (received, published, dropped and dropped.<reason>, saturated and saturated.<field>,
+        rejected.<field>, out_of_order, pycyphal's counters; WARN while it dropped within the last 10 s), one per
+        device (OK while its heartbeat is alive and its health NOMINAL/ADVISORY, WARN on CAUTION, ERROR on
+        WARNING health or when the heartbeat is lost, STALE when never seen)."""
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
         snap = self.stats()
@@ -743,12 +1217,18 @@ class Bridge:
             return [KeyValue(key=str(k), value=str(v)) for k, v in values.items()]
 
         b = snap["bridge"]
+        link = b["link"]
         total_drop = sum(m["dropped_total"] for m in snap["mappings"].values())
+        bmsg = f"{len(snap['mappings'])} mappings, {total_drop} dropped"
+        if not link["up"]:
+            bmsg = f"Cyphal link {link['state']}; " + bmsg
         arr.status.append(DiagnosticStatus(
-            level=ok, name=f"{self.name}", hardware_id=f"cyphal node {b['node_id']}",
-            message=f"{len(snap['mappings'])} mappings, {total_drop} dropped",
+            level=ok if link["up"] else err, name=f"{self.name}", hardware_id=f"cyphal node {b['node_id']}",
+            message=bmsg,
             values=kv({"node_id": b["node_id"], "transport": b["transport"], "uptime_s": b["uptime_s"],
-                       "dropped_total": total_drop, **{f"error.{k}": v for k, v in b["errors"].items()}}),
+                       "dropped_total": total_drop, "link_up": link["up"], "link_state": link["state"],
+                       "link_outages": link["outages"], "link_down_s": link["down_s"],
+                       **{f"error.{k}": v for k, v in sorted(b["errors"].items())}}),
         ))
         for name, m in snap["mappings"].items():
             values: dict[str, Any] = {
@@ -756,23 +1236,37 @@ class Bridge:
                 "received": m["received"], "published": m["published"], "dropped": m["dropped_total"],
             }
             values.update({f"dropped.{k}": v for k, v in sorted(m["dropped"].items())})
+            values["saturated"] = m["saturated_total"]
             values.update({f"saturated.{k}": v for k, v in sorted(m["saturated"].items())})
             values.update({f"rejected.{k}": v for k, v in sorted(m["rejected_fields"].items())})
-            cy = m.get("cyphal") or {}
+            values["out_of_order"] = m["out_of_order"]
+            cy = dict(m.get("cyphal") or {})
+            kinds = cy.pop("error_kinds", {})
+            problem_age = cy.pop("last_problem_age_s", None)
             values.update({f"cyphal.{k}": v for k, v in cy.items()})
-            bad_frames = int(cy.get("errors", 0)) + int(cy.get("deserialization_failures", 0))
-            level = warn if m["dropped_total"] or bad_frames else ok
-            msg = f"{m['dropped_total']} dropped" if m["dropped_total"] else "ok"
-            if bad_frames:
-                msg += f", {bad_frames} bad Cyphal frames/transfers"
+            values.update({f"cyphal.error.{k}": v for k, v in sorted(kinds.items())})
+            recent = any(age is not None and age < RECENT_DROP_WINDOW_S
+                         for age in (m["last_drop_age_s"], problem_age))
+            level = warn if recent else ok
+            if m["dropped_total"]:
+                parts = ", ".join(f"{k} {v}" for k, v in sorted(m["dropped"].items()))
+                msg = f"{m['dropped_total']} dropped ({parts})" + (
+                    f", the last {m['last_drop_age_s']:.0f} s ago" if m["last_drop_age_s"] is not None else "")
+            else:
+                msg = "ok"
+            if m["saturated_total"]:
+                msg += f", {m['saturated_total']} values saturated"
+            bad = sum(int(cy.get(k, 0)) for k in self._CYPHAL_PROBLEMS)
+            if bad:
+                msg += f", {bad} frames/transfers discarded by pycyphal"
             arr.status.append(DiagnosticStatus(
                 level=level, name=f"{self.name}/mapping/{name}", hardware_id=f"subject {m['subject_id']}",
                 message=msg, values=kv(values)))
         for name, d in snap["devices"].items():
             if not d["seen"]:
-                level, msg = stale, "no heartbeat"
+                level, msg = stale, "no heartbeat yet"
             elif not d["alive"]:
-                level, msg = stale, f"heartbeat {d['age_s']:.1f} s old"
+                level, msg = err, f"heartbeat lost: none for {d['age_s']:.1f} s"
             else:
                 level = {"NOMINAL": ok, "ADVISORY": ok, "CAUTION": warn}.get(d["health"], err)
                 msg = f"{d['health']} {d['mode']}"
@@ -790,19 +1284,18 @@ class Bridge:
         self._stop_spin.set()
         if self._spin_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._spin_thread.join, 5.0)
-        stuck = await cancel_and_wait([om.worker for om in self._out.values() if om.worker is not None])
+        tasks = [om.worker for om in self._out.values() if om.worker is not None]
+        if self._housekeeping_task is not None:
+            tasks.append(self._housekeeping_task)
+        stuck = await cancel_and_wait(tasks)
         if stuck:
-            _log.warning("%d publish workers did not stop", len(stuck))
-        from sam_runtime.transport import aclose
-
-        ports = [g.subscriber for g in self._in_groups.values()] + [om.publisher for om in self._out.values()]
-        ports.append(self._hb_sub)
+            _log.warning("%d bridge tasks did not stop", len(stuck))
         try:
-            await aclose(*[p for p in ports if p is not None])
-            if self._cy_node is not None:
-                await aclose(self._cy_node)
+            await self._close_cyphal()
         except Exception as ex:  # never let a close problem hide the ROS shutdown
             _log.warning("closing the Cyphal node: %s: %s", type(ex).__name__, ex)
+        self._link_up, self._link_state = False, "closed"
+        self.log.flush(force=True)  # no count stays unlogged
         if self._executor is not None:
             try:
                 self._executor.shutdown(timeout_sec=1.0)

@@ -339,6 +339,8 @@ class _SimDevice:
     node: Any = None
     pubs: list[_PubPort] = field(default_factory=list)
     subs: list[_SubPort] = field(default_factory=list)
+    powered: bool = False
+    power_cycles: int = 0
 
 
 class Simulator:
@@ -371,10 +373,8 @@ class Simulator:
         """Create every device's node (heartbeats start at once) and its ports; sensors wait for
         :meth:`start_publishing` unless ``publish_now``."""
         self.gen.compile_dsdl()
-        import uavcan.node
 
         from sam_runtime.bridge import quiet_late_media_completions
-        from sam_runtime.transport import make_node, transport_from_env
 
         quiet_late_media_completions(asyncio.get_running_loop())
         self._go = asyncio.Event()
@@ -382,35 +382,83 @@ class Simulator:
             self._record = open(self.config.record, "w", buffering=1)
         try:
             for dev in self.devices:
-                name = f"org.{self.tables.VEHICLE}.sim.{dev.info.name}"[:50]
-                if self.config.kind == "env":
-                    env = dict(self.config.environ or {})
-                    env["UAVCAN__NODE__ID"] = str(dev.info.node_id)
-                    dev.node = make_node(name, dev.info.node_id, transport=transport_from_env(env))
-                else:
-                    dev.node = make_node(name, dev.info.node_id, self.config.kind, iface=self.config.iface,
-                                         mtu=self.config.mtu)
-                dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
                 for port in dev.info.subscribes:
-                    sp = _SubPort(port, self.gen.dsdl_class(port))
-                    sp.subscriber = dev.node.make_subscriber(sp.dtype, port.subject_id)
-                    sp.subscriber.receive_in_background(
-                        lambda msg, tr, dev=dev, sp=sp: self._on_command(dev, sp, msg, tr))
-                    dev.subs.append(sp)
+                    dev.subs.append(_SubPort(port, self.gen.dsdl_class(port)))
                 for port in dev.info.publishes:
-                    pp = _PubPort(port, self.gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type)))
-                    pp.publisher = dev.node.make_publisher(pp.dtype, port.subject_id)
-                    pp.publisher.send_timeout = 1.0
-                    dev.pubs.append(pp)
+                    dev.pubs.append(_PubPort(port, self.gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type))))
+                self._open_device(dev)
             for dev in self.devices:
-                for pp in dev.pubs:
-                    pp.task = asyncio.create_task(self._publish_loop(dev, pp),
-                                                  name=f"sim-{dev.info.name}-{pp.port.subject_id}")
+                self._start_device_tasks(dev)
         except BaseException:
             await self.close()
             raise
         if publish_now:
             self.start_publishing()
+
+    def _open_device(self, dev: _SimDevice) -> None:
+        """The device's node (heartbeats start at once) and its ports."""
+        import uavcan.node
+
+        from sam_runtime.transport import make_node, transport_from_env
+
+        name = f"org.{self.tables.VEHICLE}.sim.{dev.info.name}"[:50]
+        if self.config.kind == "env":
+            env = dict(self.config.environ or {})
+            env["UAVCAN__NODE__ID"] = str(dev.info.node_id)
+            dev.node = make_node(name, dev.info.node_id, transport=transport_from_env(env))
+        else:
+            dev.node = make_node(name, dev.info.node_id, self.config.kind, iface=self.config.iface,
+                                 mtu=self.config.mtu)
+        dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+        for sp in dev.subs:
+            sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
+            sp.subscriber.receive_in_background(lambda msg, tr, dev=dev, sp=sp: self._on_command(dev, sp, msg, tr))
+        for pp in dev.pubs:
+            pp.publisher = dev.node.make_publisher(pp.dtype, pp.port.subject_id)
+            pp.publisher.send_timeout = 1.0
+        dev.powered = True
+
+    def _start_device_tasks(self, dev: _SimDevice, restart: bool = False) -> None:
+        for pp in dev.pubs:
+            pp.task = asyncio.create_task(self._publish_loop(dev, pp, restart),
+                                          name=f"sim-{dev.info.name}-{pp.port.subject_id}")
+
+    def device(self, name: str) -> _SimDevice:
+        for dev in self.devices:
+            if dev.info.name == name:
+                return dev
+        raise KeyError(f"no simulated device {name!r}")
+
+    async def power_off(self, name: str) -> None:
+        """Cut the device's power: its node closes, so its heartbeats and publications stop (a device that stops
+        sending, for heartbeat-timeout tests). Its counters are kept."""
+        from sam_runtime.bridge import cancel_and_wait
+        from sam_runtime.transport import aclose
+
+        dev = self.device(name)
+        if not dev.powered:
+            return
+        dev.powered = False
+        await cancel_and_wait([pp.task for pp in dev.pubs if pp.task is not None])
+        ports = [pp.publisher for pp in dev.pubs] + [sp.subscriber for sp in dev.subs]
+        for pp in dev.pubs:
+            pp.task, pp.publisher = None, None
+        for sp in dev.subs:
+            sp.subscriber = None
+        node, dev.node = dev.node, None
+        await aclose(*[p for p in ports if p is not None])
+        if node is not None:
+            await aclose(node)
+        dev.power_cycles += 1
+
+    async def power_on(self, name: str) -> None:
+        """Power a device back on: a new node (uptime and transfer ids from 0, like a reboot) that publishes on
+        its schedule again (if publishing was started)."""
+        dev = self.device(name)
+        if dev.powered or self._closed:
+            return
+        self._open_device(dev)
+        self._start_device_tasks(dev, restart=True)
 
     def start_publishing(self, duration: float | None = None) -> None:
         """Open the gate: every publisher starts its schedule now; with ``duration``, stops after it."""
@@ -462,7 +510,7 @@ class Simulator:
         dev.state.last_update = t
         return obj
 
-    async def _publish_loop(self, dev: _SimDevice, pp: _PubPort) -> None:
+    async def _publish_loop(self, dev: _SimDevice, pp: _PubPort, restart: bool = False) -> None:
         assert self._go is not None
         await self._go.wait()
         rate = float(pp.port.rate_hz) * float(self.config.rate_scale)
@@ -472,6 +520,8 @@ class Simulator:
         # Align every port to the gate, offset a little per subject so that not all fire at once.
         offset = (pp.port.subject_id % 17) * period / 17.0
         started = self._publishing_since if self._publishing_since is not None else time.monotonic()
+        if restart:  # powered on again: a new schedule from now
+            started = time.monotonic() - offset
         k = 0
         while not self._closed:
             due = started + offset + k * period
@@ -488,6 +538,8 @@ class Simulator:
                 k += missed
                 continue
             obj = self.make_sample(dev, pp, period)
+            if pp.publisher is None:  # powered off meanwhile
+                return
             try:
                 ok = await pp.publisher.publish(obj)
             except asyncio.CancelledError:
@@ -539,6 +591,8 @@ class Simulator:
         for d in self.devices:
             devices[d.info.name] = {
                 "node_id": d.info.node_id,
+                "powered": d.powered,
+                "power_cycles": d.power_cycles,
                 "published": {str(p.port.subject_id): p.sent for p in d.pubs},
                 "late": {str(p.port.subject_id): p.late for p in d.pubs if p.late},
                 "failed": {str(p.port.subject_id): p.failed for p in d.pubs if p.failed},
