@@ -53,3 +53,12 @@ def run(session: nox.Session) -> None:
     _install(session, "runtime,rosbuild")
     # `run` regenerates generated/ and (re)builds sam_msgs into this environment when they are stale.
     session.run("sam-codegen", "run", *session.posargs, env=LOOPBACK)
+
+
+@nox.session(python="3.11")
+def bench(session: nox.Session) -> None:
+    """Benchmarks (not part of the tests): bench/results/results.md, results.json and scaling.png."""
+    _install(session, "runtime,rosbuild,bench")
+    session.run("sam-codegen", "build", "--check")
+    _ros_install(session)
+    session.run("python", "-m", "bench.run", *session.posargs, env=LOOPBACK)

@@ -25,10 +25,10 @@ from sam_msgs.msg import (
     BatteryInfo,
     PercentStamped,
     PositionFeedback,
-    ThrustVectorFeedback,
     ThrusterAngles,
     ThrusterFeedback,
     ThrusterRPMs,
+    ThrustVectorFeedback,
 )
 from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix
 
