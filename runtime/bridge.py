@@ -41,8 +41,13 @@ reason                 when
                        burst, a frame that failed its CRC, a transfer that did not deserialize, the subject's
                        bounded receive queue (``rx_queue_size``) overflowing - each such transfer is counted
                        exactly once, when the next transfer of that source arrives. Exact on Cyphal/UDP
-                       (64-bit transfer ids); on Cyphal/CAN (modulo 32) only gaps within the 2 s transfer-id
-                       timeout are counted: a lower bound.
+                       (64-bit transfer ids); on Cyphal/CAN (modulo 32) exact while fewer than 16 transfers
+                       of the source were due in the gap (by its measured or nominal rate), not counted
+                       beyond (unless the bridge's link was down: next reason). A source that restarted
+                       meanwhile (heartbeat uptime shorter than the gap) is not counted.
+``lost_link_down``     Cyphal/CAN only, an estimate: transfers of an accepted source missed while the bridge's
+                       own Cyphal link was down (see ``_can_gap``: the transfer-id gap modulo 32 plus the
+                       multiple of 32 closest to the source's rate x the time without data)
 =====================  ====================================================================================
 
 So per UAVCAN -> ROS mapping, once nothing is in flight and the sources sent again after a loss: the transfers
@@ -73,7 +78,7 @@ message is still published), rejected ones under ``rejected.<...>``.
   counted). A device never heard of is STALE.
 - A Cyphal transport that dies (pycyphal's CAN media close themselves for good on unrecoverable OS errors,
   e.g. ENETDOWN when a SocketCAN interface goes down) is detected within 0.2 s and reopened with back-off
-  (0.5 s doubling to 5 s) until it works again; meanwhile commands are dropped as ``link_down`` and
+  (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
   /diagnostics shows the bridge at ERROR. Transient bus errors (a send raising) are counted and the next
   message goes through.
 - A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last (``qos_depth``),
@@ -126,9 +131,9 @@ DEFAULT_LOG_INTERVAL_S = 10.0
 HOUSEKEEPING_PERIOD_S = 0.2
 RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
 TRANSFER_ID_TIMEOUT_S = 2.0  # Cyphal's default transfer-id timeout
-REOPEN_BACKOFF_S = (0.5, 5.0)
+REOPEN_BACKOFF_S = (0.5, 2.0)
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
-                "queue_full", "link_down", "shutdown", "lost")
+                "queue_full", "link_down", "shutdown", "lost", "lost_link_down")
 _RULE_OPS: dict[str, Callable[[Any, Any], bool]] = {
     "<": operator.lt,
     "<=": operator.le,
@@ -352,6 +357,7 @@ class _SubjectGroup:
     subscriber: Any = None
     accepted_sources: frozenset[int] = frozenset()
     last_tid: dict[int, tuple[int, float]] = field(default_factory=dict)  # source -> (transfer id, monotonic s)
+    rate: dict[int, tuple[float, int, float]] = field(default_factory=dict)  # source -> (since, count, rate)
     # pycyphal's counters of the current subscriber already turned into drops (reset with a new subscriber)
     seen: dict[str, int] = field(default_factory=dict)
     # cumulative pycyphal counters over every subscriber this group had (transport reopened)
@@ -492,6 +498,7 @@ class Bridge:
         self._ros_pubs: dict[str, Any] = {}
         self._ros_subs: dict[str, Any] = {}
         self._housekeeping_task: asyncio.Task[None] | None = None
+        self._reopen_task: asyncio.Task[None] | None = None
         # The Cyphal link: reopened when the transport dies (see _check_link).
         self._link_up = False
         self._link_state = "not started"
@@ -500,6 +507,9 @@ class Bridge:
         self._link_outages = 0
         self._link_down_s = 0.0
         self._tid_modulo = 2**64
+        self._outage_windows: collections.deque[tuple[float, float]] = collections.deque(maxlen=16)
+        self._nominal_rates = {(d.node_id, p.subject_id): float(p.rate_hz) for d in self.tables.DEVICES
+                               for p in d.publishes if getattr(p, "rate_hz", None)}
 
     # ------------------------------------------------------------------------------------------ set-up
     def _resolve_node_id(self, node_id: int | None) -> int:
@@ -831,6 +841,7 @@ class Bridge:
                 delay = min(delay * 2.0, REOPEN_BACKOFF_S[1])
         if self._link_down_since is not None:
             down = time.monotonic() - self._link_down_since
+            self._outage_windows.append((self._link_down_since, time.monotonic()))
             self._link_down_s += down
             self._link_down_since = None
             if self._link_up:
@@ -848,9 +859,11 @@ class Bridge:
                 self._poll_cyphal_stats()
                 self._check_heartbeats()
                 self.log.flush()
-                why = self._check_link()
-                if why is not None and not self._closed:
-                    await self._reopen_cyphal(why)
+                if self._reopen_task is None or self._reopen_task.done():
+                    why = self._check_link()
+                    if why is not None and not self._closed:
+                        self._reopen_task = asyncio.create_task(self._reopen_cyphal(why),
+                                                                name=f"{self.name}-reopen")
             except asyncio.CancelledError:
                 raise
             except Exception as ex:
@@ -884,10 +897,11 @@ class Bridge:
                     group.cyphal_total[key] = group.cyphal_total.get(key, 0) + delta
                     if key in self._CYPHAL_PROBLEMS:
                         group.last_problem_monotonic = time.monotonic()
+                        detail = ""
+                        if key == "errors" and kinds:
+                            detail = f" ({', '.join(f'{k} {v}' for k, v in sorted(kinds.items()))} in all)"
                         self.log.note((f"subject {group.subject_id}", f"cyphal.{key}"), logging.WARNING,
-                                      "%d discarded by pycyphal below the bridge%s", delta,
-                                      f" ({', '.join(f'{k} {v}' for k, v in sorted(kinds.items()))} in all)"
-                                      if kinds else "", count=delta)
+                                      "%d discarded by pycyphal below the bridge%s", delta, detail, count=delta)
                 for k, v in kinds.items():
                     base = group.seen.get(f"kind.{k}", 0)
                     if v > base:
@@ -906,8 +920,9 @@ class Bridge:
             self.log.note((f"subject {group.subject_id}", "handler_error"), logging.ERROR, "%s: %s",
                           type(ex).__name__, ex)
 
-    def _track_transfer_id(self, group: _SubjectGroup, src: int, transfer: Any) -> int:
-        """Transfers lost before this one from ``src`` (a gap in its transfer ids), 0 if none or unknown."""
+    def _track_transfer_id(self, group: _SubjectGroup, src: int, transfer: Any) -> tuple[int, int]:
+        """(lost, estimated): transfers lost before this one from ``src`` (a gap in its transfer ids), and, on
+        CAN only, an estimate of those missed while the bridge's own link was down (see _can_gap)."""
         tid = int(transfer.transfer_id)
         try:
             now = float(transfer.timestamp.monotonic)
@@ -916,19 +931,55 @@ class Bridge:
         prev = group.last_tid.get(src)
         group.last_tid[src] = (tid, now)
         if prev is None:
-            return 0
+            return 0, 0
         modulo = self._tid_modulo
         d = (tid - prev[0]) % modulo
-        if d <= 1 or d >= modulo // 2:  # next in sequence, duplicate, or backwards (the source restarted)
-            return 0
         if modulo < 2**32 and now - prev[1] > TRANSFER_ID_TIMEOUT_S:  # CAN: the ids may have wrapped meanwhile
-            return 0
-        return d - 1
+            res = self._can_gap(group, src, prev[1], now, d, modulo)
+            group.rate.pop(src, None)
+            return res
+        if d == 1:  # the source's actual rate over a long window (for _can_gap)
+            t0, n, rate = group.rate.get(src, (prev[1], 0, 0.0))
+            n += 1
+            if now - t0 >= 2.0:
+                rate = n / (now - t0)
+            if now - t0 > 60.0:  # a new window, the old rate kept meanwhile
+                t0, n = now, 0
+            group.rate[src] = (t0, n, rate)
+        elif d != 0:
+            group.rate.pop(src, None)
+        if d <= 1 or d >= modulo // 2:  # next in sequence, duplicate, or backwards (the source restarted)
+            return 0, 0
+        return d - 1, 0
+
+    def _can_gap(self, group: _SubjectGroup, src: int, t_prev: float, t_now: float, d: int,
+                 modulo: int) -> tuple[int, int]:
+        """A gap longer than the transfer-id timeout on Cyphal/CAN, where transfer ids wrap every 32: the gap is
+        known only modulo 32, so the source's rate (measured before, else the spec's nominal rate) decides.
+        A source whose heartbeat uptime is shorter than the gap restarted meanwhile: nothing is counted.
+        If the bridge's own link was down in between (it knows it was deaf), (0, estimate): the gap modulo 32
+        plus the multiple of 32 closest to rate x elapsed time, counted as ``lost_link_down``. Otherwise, if
+        fewer than 16 transfers were due (no wrap possible) and the gap fits, (gap, 0): exact, as ``lost``."""
+        rate = group.rate.get(src, (0.0, 0, 0.0))[2] or self._nominal_rates.get((src, group.subject_id))
+        if not rate:
+            return 0, 0
+        elapsed = t_now - t_prev
+        hb = self._heartbeats.get(src)
+        if hb is not None and hb.uptime + 1 < elapsed:
+            return 0, 0
+        base = (d - 1) % modulo
+        expected = rate * elapsed - 1.0
+        if any(start < t_now and end > t_prev for start, end in self._outage_windows):
+            k = max(0, round((expected - base) / modulo))
+            return 0, base + k * modulo
+        if expected < modulo / 2 and base <= expected + 2:
+            return base, 0
+        return 0, 0
 
     def _bridge_transfer(self, group: _SubjectGroup, msg: Any, transfer: Any) -> None:
         src = transfer.source_node_id
         receive_ns: int | None = None
-        lost = self._track_transfer_id(group, src, transfer) if src in group.accepted_sources else 0
+        lost, lost_est = self._track_transfer_id(group, src, transfer) if src in group.accepted_sources else (0, 0)
         for im in group.mappings:
             st = im.stats
             st.receive()
@@ -942,6 +993,11 @@ class Bridge:
                 st.drop("lost", lost)
                 self.log.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "
                               "(transfer id gap before %d)", lost, src, transfer.transfer_id, count=lost)
+            if lost_est:
+                st.drop("lost_link_down", lost_est)
+                self.log.note((name, "lost_link_down"), logging.WARNING, "about %d transfers from node %s missed "
+                              "while the Cyphal link was down (estimated from the nominal rate)", lost_est, src,
+                              count=lost_est)
             if receive_ns is None:
                 receive_ns = self._clock.now().nanoseconds
             try:
@@ -1143,11 +1199,12 @@ class Bridge:
                 entry["ros_publishers"] = self._safe_count(self._ros_subs.get(m.topic.name), "get_publisher_count")
             mappings[m.name] = entry
         devices: dict[str, Any] = {}
+        heartbeats = self._heartbeats.copy()  # atomic: the asyncio thread may add a node meanwhile
         for d in self.tables.DEVICES:
-            rec = self._heartbeats.get(d.node_id)
+            rec = heartbeats.get(d.node_id)
             devices[d.name] = self._hb_entry(d.node_id, rec, now)
         known = {d.node_id for d in self.tables.DEVICES} | {self.node_id}
-        others = {str(nid): self._hb_entry(nid, rec, now) for nid, rec in sorted(self._heartbeats.items())
+        others = {str(nid): self._hb_entry(nid, rec, now) for nid, rec in sorted(heartbeats.items())
                   if nid not in known}
         down_s = self._link_down_s + (now - self._link_down_since if self._link_down_since is not None else 0.0)
         return {
@@ -1267,6 +1324,8 @@ class Bridge:
                 level, msg = stale, "no heartbeat yet"
             elif not d["alive"]:
                 level, msg = err, f"heartbeat lost: none for {d['age_s']:.1f} s"
+                if not link["up"]:
+                    msg += " (the bridge's Cyphal link is down)"
             else:
                 level = {"NOMINAL": ok, "ADVISORY": ok, "CAUTION": warn}.get(d["health"], err)
                 msg = f"{d['health']} {d['mode']}"
@@ -1285,8 +1344,7 @@ class Bridge:
         if self._spin_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._spin_thread.join, 5.0)
         tasks = [om.worker for om in self._out.values() if om.worker is not None]
-        if self._housekeeping_task is not None:
-            tasks.append(self._housekeeping_task)
+        tasks += [t for t in (self._housekeeping_task, self._reopen_task) if t is not None]
         stuck = await cancel_and_wait(tasks)
         if stuck:
             _log.warning("%d bridge tasks did not stop", len(stuck))

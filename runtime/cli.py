@@ -164,6 +164,11 @@ def _bridge_parser() -> argparse.ArgumentParser:
                    help="initial value of a spec parameter (range and rules are checked)")
     p.add_argument("--qos-depth", type=int, default=100)
     p.add_argument("--command-qos", choices=("reliable", "best_effort"), default="reliable")
+    p.add_argument("--rx-queue-size", type=int, default=None,
+                   help="bound of each subject's Cyphal receive queue; beyond it transfers are dropped and counted "
+                        "(default 1000; 0 = unbounded)")
+    p.add_argument("--log-interval", type=float, default=None,
+                   help="seconds between two log lines of one mapping and drop reason (default 10)")
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
     p.add_argument("--stats-file", type=Path, default=None,
                    help="write the counters as JSON here every second and at exit")
@@ -189,6 +194,8 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             parameter_overrides=_parse_params(args.param),
             qos_depth=args.qos_depth,
             command_reliability=args.command_qos,
+            **({} if args.rx_queue_size is None else {"rx_queue_size": args.rx_queue_size}),
+            **({} if args.log_interval is None else {"log_interval": args.log_interval}),
         )
         await bridge.start()
         print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.transport_config.describe()}",

@@ -16,6 +16,8 @@
 
 ``Simulator.report()`` gives counts per device and subject (published, commands accepted/rejected, the
 last command); ``record`` writes every transmitted and received message (as transmitted) as JSON lines.
+For fault tests: ``power_off(name)``/``power_on(name)`` (a device that stops - its heartbeat too - and
+reboots) and ``pause()``/``resume()`` (hold every publication, heartbeats go on, nothing left in flight).
 """
 
 from __future__ import annotations
@@ -319,6 +321,7 @@ class _PubPort:
     sent: int = 0
     late: int = 0
     failed: int = 0
+    busy: bool = False  # a publish in flight
 
 
 @dataclass
@@ -363,6 +366,7 @@ class Simulator:
             if wanted is None or d.name in wanted
         ]
         self._go: asyncio.Event | None = None  # created in start() (inside the loop)
+        self._running: asyncio.Event | None = None  # cleared by pause()
         self._record: TextIO | None = None
         self._publishing_since: float | None = None
         self._publishing_until: float | None = None
@@ -378,6 +382,8 @@ class Simulator:
 
         quiet_late_media_completions(asyncio.get_running_loop())
         self._go = asyncio.Event()
+        self._running = asyncio.Event()
+        self._running.set()
         if self.config.record is not None:
             self._record = open(self.config.record, "w", buffering=1)
         try:
@@ -468,6 +474,20 @@ class Simulator:
         self._publishing_until = None if duration is None else now + duration
         self._go.set()
 
+    async def pause(self, timeout: float = 2.0) -> None:
+        """Hold every publication (heartbeats go on) and wait until none is in flight: afterwards the counts of
+        sent messages do not move (for exact before/after accounting in tests)."""
+        assert self._running is not None, "start() first"
+        self._running.clear()
+        deadline = time.monotonic() + timeout
+        while any(pp.busy for d in self.devices for pp in d.pubs) and time.monotonic() < deadline:
+            await asyncio.sleep(0.005)
+
+    def resume(self) -> None:
+        """Publish again, each port on a new schedule from now (no burst to catch up, no late ticks)."""
+        assert self._running is not None, "start() first"
+        self._running.set()
+
     @property
     def publishing_done(self) -> bool:
         return self._publishing_until is not None and time.monotonic() >= self._publishing_until and all(
@@ -524,6 +544,10 @@ class Simulator:
             started = time.monotonic() - offset
         k = 0
         while not self._closed:
+            if self._running is not None and not self._running.is_set():
+                await self._running.wait()
+                started, k = time.monotonic() - offset, 0
+                continue
             due = started + offset + k * period
             until = self._publishing_until
             if until is not None and due >= until:
@@ -537,9 +561,12 @@ class Simulator:
                 pp.late += missed
                 k += missed
                 continue
+            if self._running is not None and not self._running.is_set():
+                continue  # paused while sleeping
             obj = self.make_sample(dev, pp, period)
             if pp.publisher is None:  # powered off meanwhile
                 return
+            pp.busy = True
             try:
                 ok = await pp.publisher.publish(obj)
             except asyncio.CancelledError:
@@ -549,6 +576,8 @@ class Simulator:
                 _log.warning("%s: publish on %d failed: %s: %s", dev.info.name, pp.port.subject_id,
                              type(ex).__name__, ex)
                 ok = False
+            finally:
+                pp.busy = False
             if ok:
                 pp.sent += 1
                 if self._record is not None:

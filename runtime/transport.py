@@ -305,8 +305,10 @@ async def aclose(*closables: Any, timeout: float = 2.0) -> None:
 
     ``close()`` alone is synchronous and leaves pycyphal's subscriber/server tasks to notice on their own,
     which can take up to their 1 s receive timeout: on Python 3.11 a cancellation that arrives while such a
-    task sits in ``asyncio.wait_for`` can be lost. Here the still-running pycyphal tasks are cancelled
-    again and awaited, so nothing outlives the call (no "Task was destroyed but it is pending").
+    task sits in ``asyncio.wait_for`` can be lost. Here the still-running pycyphal tasks of closed objects are
+    cancelled again and awaited, so nothing outlives the call (no "Task was destroyed but it is pending").
+    Only those: the tasks of other nodes and ports that live on in the same loop (a bridge and simulated
+    devices in one process, a node being reopened) are left alone.
     Call it from inside the event loop that created the objects.
     """
     me = asyncio.current_task()
@@ -318,7 +320,7 @@ async def aclose(*closables: Any, timeout: float = 2.0) -> None:
     loop = asyncio.get_running_loop()
     deadline = loop.time() + timeout
     while True:
-        pending = [t for t in before if not t.done() and _is_pycyphal_task(t)]
+        pending = [t for t in before if not t.done() and _is_pycyphal_task(t) and _owner_closed(t)]
         if not pending or loop.time() >= deadline:
             break
         for t in pending:
@@ -329,3 +331,22 @@ async def aclose(*closables: Any, timeout: float = 2.0) -> None:
 def _is_pycyphal_task(task: asyncio.Task[Any]) -> bool:
     code = getattr(task.get_coro(), "cr_code", None)
     return code is not None and f"{os.sep}pycyphal{os.sep}" in code.co_filename
+
+
+def _owner_closed(task: asyncio.Task[Any]) -> bool:
+    """Whether the pycyphal object running the task (``self`` of its coroutine: a Subscriber, SubscriberImpl,
+    Server, Client, HeartbeatPublisher, ...) has been closed. Unknown owners count as not closed."""
+    frame = getattr(task.get_coro(), "cr_frame", None)
+    owner = None if frame is None else frame.f_locals.get("self")
+    if owner is None:
+        return False
+    for attr in ("_closed", "is_closed"):
+        try:
+            value = getattr(owner, attr, None)
+        except Exception:
+            continue
+        if isinstance(value, bool):
+            return value
+    if "_maybe_task" in getattr(owner, "__dict__", {}):  # HeartbeatPublisher: the task is dropped on close
+        return owner._maybe_task is None
+    return False
