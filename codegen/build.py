@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import os
 import shutil
 import tempfile
@@ -50,6 +51,18 @@ def verify_dsdl(resolved: Resolved, files: dict[str, str]) -> None:
 
 def generate(spec_path: Path) -> dict[str, str]:
     """Every generated file as {path relative to generated/: text}; raises SpecError."""
+    # The model is built once and kept: the cyclic collector's full passes over it only made large specs
+    # superlinear (2.5x slower at 1000 types), so it is paused for the run.
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _generate(spec_path)
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _generate(spec_path: Path) -> dict[str, str]:
     resolved = validate(load_spec_file(spec_path))
     files: dict[str, str] = {}
     for emit in emitters():

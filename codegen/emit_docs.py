@@ -489,16 +489,24 @@ def svg_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         y += b.h + ROW_GAP
     topics_bottom = y - ROW_GAP
 
+    # Heights of the topics each box is linked to, in link order then edge order (one pass: large specs).
+    linked_ys: dict[tuple[str, str], list[float]] = {}
+    topic_of_edge: dict[int, int] = {}  # device edge -> the topic edge of its mapping (first link wins)
+    for _, dev_edges, topic_edge in graph.links:
+        t = graph.edges[topic_edge]
+        ty = boxes[t.src if t.src[0] == "topic" else t.dst].cy
+        for key in dict.fromkeys(k for i in dev_edges for k in (graph.edges[i].src, graph.edges[i].dst)):
+            linked_ys.setdefault(key, []).append(ty)
+        for i in dev_edges:
+            topic_of_edge.setdefault(i, topic_edge)
+    for e in graph.edges:
+        if e.kind in (SUBSCRIBE, PUBLISH):
+            ty = boxes[e.src if e.src[0] == "topic" else e.dst].cy
+            for key in dict.fromkeys((e.src, e.dst)):
+                linked_ys.setdefault(key, []).append(ty)
+
     def neighbours(key: tuple[str, str]) -> list[float]:
-        ys = []
-        for _, dev_edges, topic_edge in graph.links:
-            if any(key in (graph.edges[i].src, graph.edges[i].dst) for i in dev_edges):
-                t = graph.edges[topic_edge]
-                ys.append(boxes[t.src if t.src[0] == "topic" else t.dst].cy)
-        for e in graph.edges:
-            if e.kind in (SUBSCRIBE, PUBLISH) and key in (e.src, e.dst):
-                ys.append(boxes[e.src if e.src[0] == "topic" else e.dst].cy)
-        return ys
+        return linked_ys.get(key, [])
 
     for kind in ("device", "node"):
         members = column(kind)
@@ -514,11 +522,9 @@ def svg_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     def other_y(i: int, end: str) -> float:
         e = graph.edges[i]
         other = e.dst if end == "src" else e.src
-        if other[0] == "bridge":  # follow the bridge to the topic the mapping leads to
-            for _, dev_edges, topic_edge in graph.links:
-                if i in dev_edges:
-                    t = graph.edges[topic_edge]
-                    return boxes[t.src if t.src[0] == "topic" else t.dst].cy
+        if other[0] == "bridge" and i in topic_of_edge:  # follow the bridge to the topic the mapping leads to
+            t = graph.edges[topic_of_edge[i]]
+            return boxes[t.src if t.src[0] == "topic" else t.dst].cy
         return boxes[other].cy
 
     def attach(box: Box, side: str, ends: list[tuple[int, str]]) -> None:
@@ -527,18 +533,20 @@ def svg_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         for k, end in enumerate(ends):
             ports[end] = (x, _spread(box, len(ends), k))
 
+    ends_of: dict[tuple[str, str], list[tuple[int, str]]] = {}  # box -> its edge ends, in edge order
+    for i, e in enumerate(graph.edges):
+        for end, which in (("src", e.src), ("dst", e.dst)):
+            ends_of.setdefault(which, []).append((i, end))
     for key, box in boxes.items():
         if box.kind == "bridge":
             continue
         left: list[tuple[int, str]] = []
         right: list[tuple[int, str]] = []
-        for i, e in enumerate(graph.edges):
-            for end, which in (("src", e.src), ("dst", e.dst)):
-                if which != key:
-                    continue
-                other = e.dst if end == "src" else e.src
-                faces_left = (box.kind == "topic" and other[0] == "bridge") or box.kind == "node"
-                (left if faces_left else right).append((i, end))
+        for i, end in ends_of.get(key, []):
+            e = graph.edges[i]
+            other = e.dst if end == "src" else e.src
+            faces_left = (box.kind == "topic" and other[0] == "bridge") or box.kind == "node"
+            (left if faces_left else right).append((i, end))
         attach(box, "left", left)
         attach(box, "right", right)
     if bridge_box is not None:  # the bridge meets each edge level with its other end

@@ -26,7 +26,7 @@ from .mapping_rules import (
     format_path,
     parse_path,
 )
-from .model import Constant, DsdlStruct, Field, FieldLink, Mapping, RosMessage, Scalar, Spec
+from .model import Constant, Device, DsdlStruct, Field, FieldLink, Mapping, Port, RosMessage, Scalar, Spec
 from .ros_catalog import RosCatalog
 from .typesys import (
     DSDL_NAMESPACE_COMPONENT,
@@ -369,6 +369,10 @@ class _Validator:
         if s.bridge is None:
             return []
         devices_by_id = s.devices_by_node_id()
+        self.ports_by_subject: dict[int, list[tuple[Device, Port, bool]]] = {}
+        for d in s.devices.values():
+            for p, publishing in [(p, True) for p in d.publishes] + [(p, False) for p in d.subscribes]:
+                self.ports_by_subject.setdefault(p.subject_id, []).append((d, p, publishing))
         result = []
         for mapping in s.bridge.mappings:
             resolved = self.resolve_mapping(mapping, devices_by_id)
@@ -385,9 +389,7 @@ class _Validator:
             self.error(mapping.pos, f"{what} uses undeclared topic {mapping.topic!r}", "a topic of `topics`")
         if mapping.subject_id not in SUBJECT_IDS:
             self.error(mapping.pos, f"subject id {mapping.subject_id} of {what} is out of range", "0..8191")
-        ports = [(d, p, pub) for d in s.devices.values()
-                 for p, pub in [(p, True) for p in d.publishes] + [(p, False) for p in d.subscribes]
-                 if p.subject_id == mapping.subject_id]
+        ports = self.ports_by_subject.get(mapping.subject_id, [])
         if not ports:
             self.error(mapping.pos, f"subject id {mapping.subject_id} of {what} is used by no device",
                        "a subject a device publishes or subscribes")
