@@ -17,13 +17,13 @@ import asyncio
 import json
 import math
 import sys
-import threading
 import time
+from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ros_probe import to_plain
+from ros_probe import ThreadedProbe, to_plain
 from runtime_support import command_plan
 
 ROGUE_NODE_ID = 42
@@ -38,50 +38,16 @@ async def wait_for(cond: Any, timeout: float, what: str) -> None:
         await asyncio.sleep(0.02)
 
 
-class Probe:
-    """An rclpy node in its own context, spun in a thread: records the bridged topics, publishes commands."""
+class Probe(ThreadedProbe):
+    """Records the bridged topics as plain values, publishes commands."""
 
-    def __init__(self, gen: Any, in_topics: list[str], out_topics: list[str]) -> None:
-        import rclpy
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-        from rclpy.signals import SignalHandlerOptions
+    node_name = "test_can_probe"
 
-        tables = gen.tables()
-        topic_info = {m.topic.name: m.topic for m in tables.MAPPINGS}
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node("test_can_probe", context=self.ctx)
-        qos = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
-        self.received: dict[str, list[Any]] = {t: [] for t in in_topics}
-        for t in in_topics:
-            self.node.create_subscription(gen.ros_class(topic_info[t]), t,
-                                          lambda msg, t=t: self.received[t].append(to_plain(msg)), qos)
-        self.classes = {t: gen.ros_class(topic_info[t]) for t in out_topics}
-        self.pubs = {t: self.node.create_publisher(self.classes[t], t, qos) for t in out_topics}
-        self.ex = SingleThreadedExecutor(context=self.ctx)
-        self.ex.add_node(self.node)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
+    def setup(self) -> None:
+        self.received: defaultdict[str, list[Any]] = defaultdict(list)
 
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.ex.spin_once(timeout_sec=0.05)
-
-    def publish(self, topic: str, values: dict[str, Any]) -> None:
-        msg = self.classes[topic]()
-        for k, v in values.items():
-            setattr(msg, k, v)
-        self.pubs[topic].publish(msg)
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.ex.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
+    def on_message(self, topic: str, msg: Any) -> None:
+        self.received[topic].append(to_plain(msg))
 
 
 def check_parameters(bridge: Any) -> dict[str, Any]:

@@ -33,6 +33,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ros_probe import ThreadedProbe
+
 HERE = Path(__file__).resolve().parent
 BRIDGE = "uavcan_ros_bridge"
 
@@ -61,44 +64,26 @@ def _level(st: Any) -> int:
     return st.level[0] if isinstance(st.level, bytes | bytearray) else int(st.level)
 
 
-class Probe:
-    """An rclpy node in its own context, spun in a thread: counts the bridged topics (optionally records /imu),
-    keeps the latest /diagnostics status per name and every level change, publishes commands."""
+class Probe(ThreadedProbe):
+    """Counts the bridged topics (optionally records /imu), keeps the latest /diagnostics status per name and
+    every level change, publishes commands."""
 
-    def __init__(self, gen: Any, in_topics: list[str], out_topics: list[str], depth: int = 1000) -> None:
-        import rclpy
+    node_name = "test_fault_probe"
+
+    def setup(self) -> None:
         from diagnostic_msgs.msg import DiagnosticArray
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-        from rclpy.signals import SignalHandlerOptions
 
-        info = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node("test_fault_probe", context=self.ctx)
-        qos = QoSProfile(depth=depth, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
         self.counts: Counter[str] = Counter()
         self.recording = False
         self.records: list[dict[str, Any]] = []
         self.latency_ms: list[float] | None = None
-        for t in in_topics:
-            self.node.create_subscription(gen.ros_class(info[t]), t, lambda msg, t=t: self._on_msg(t, msg), qos)
         self.diag_latest: dict[str, dict[str, Any]] = {}
         self.diag_events: list[dict[str, Any]] = []  # level changes: {"t": monotonic, "name", "level", "message"}
         self.diag_messages = 0
         self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 50)
-        self.classes = {t: gen.ros_class(info[t]) for t in out_topics}
-        self.pubs = {t: self.node.create_publisher(self.classes[t], t, qos) for t in out_topics}
-        self.ex = SingleThreadedExecutor(context=self.ctx)
-        self.ex.add_node(self.node)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
 
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.ex.spin_once(timeout_sec=0.05)
+    def on_message(self, topic: str, msg: Any) -> None:
+        self._on_msg(topic, msg)
 
     def _on_msg(self, topic: str, msg: Any) -> None:
         self.counts[topic] += 1
@@ -127,18 +112,6 @@ class Probe:
         d = self.diag_latest.get(name)
         return None if d is None else d["level"]
 
-    def publish(self, topic: str, values: dict[str, Any]) -> None:
-        msg = self.classes[topic]()
-        for k, v in values.items():
-            setattr(msg, k, v)
-        self.pubs[topic].publish(msg)
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.ex.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
 
 
 def delta(before: dict[str, Any], after: dict[str, Any]) -> dict[str, Any]:

@@ -41,6 +41,61 @@ def to_plain(msg: Any) -> Any:
     return msg
 
 
+class ThreadedProbe:
+    """An rclpy node in its own context, spun in a thread: subscribes to bridged topics (each message goes to
+    ``on_message``), publishes commands; the in-process scenarios extend it."""
+
+    node_name = "test_probe"
+
+    def __init__(self, gen: Any, in_topics: list[str], out_topics: list[str], depth: int = 1000) -> None:
+        import threading
+
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+        from rclpy.signals import SignalHandlerOptions
+
+        info = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
+        self.ctx = rclpy.Context()
+        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
+        self.node = Node(self.node_name, context=self.ctx)
+        qos = QoSProfile(depth=depth, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
+        self.setup()
+        for t in in_topics:
+            self.node.create_subscription(gen.ros_class(info[t]), t, lambda msg, t=t: self.on_message(t, msg), qos)
+        self.classes = {t: gen.ros_class(info[t]) for t in out_topics}
+        self.pubs = {t: self.node.create_publisher(self.classes[t], t, qos) for t in out_topics}
+        self.ex = SingleThreadedExecutor(context=self.ctx)
+        self.ex.add_node(self.node)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def setup(self) -> None:
+        """Extra state and subscriptions, before the topics are subscribed."""
+
+    def on_message(self, topic: str, msg: Any) -> None:
+        raise NotImplementedError
+
+    def _spin(self) -> None:
+        while not self._stop.is_set():
+            self.ex.spin_once(timeout_sec=0.05)
+
+    def publish(self, topic: str, values: dict[str, Any]) -> None:
+        msg = self.classes[topic]()
+        for k, v in values.items():
+            setattr(msg, k, v)
+        self.pubs[topic].publish(msg)
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5)
+        self.ex.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        self.ctx.shutdown()
+
+
 def _tables_and_classes(generated: Path, topics: list[str]) -> dict[str, type]:
     from sam_runtime.genpkg import GeneratedPackage
 
