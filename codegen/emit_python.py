@@ -24,7 +24,7 @@ from typing import Any
 
 from .filters import py_str
 from .mapping_rules import ResolvedMapping, Step, format_path
-from .model import DsdlStruct, Port, Scalar
+from .model import DsdlStruct, Port, RosMessage, Scalar
 from .templating import render
 from .typesys import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from .validate import Resolved
@@ -253,6 +253,27 @@ class _Function:
     result: list[str] = field(default_factory=list)  # lines of the final return (to_uavcan) or empty
 
 
+class _Ctor:
+    """A message under construction, a DSDL object or a ROS message: field name -> expression or nested node."""
+
+    def __init__(self, ref: str, fields: list[tuple[str, Any]], keyword=lambda name: name) -> None:
+        self.ref = ref  # what is called: the pycyphal class or the ROS message's constructor
+        self.types = dict(fields)  # field name -> DsdlType | RosType, in declaration order
+        self.keyword = keyword
+        self.kwargs: dict[str, Any] = {}
+
+    def arguments(self) -> list[tuple[str, Any]]:
+        return [(self.keyword(name), self.kwargs[name]) for name in self.types if name in self.kwargs]
+
+
+class _Arr:
+    """A fixed-size array written element by element; the other elements get `default`."""
+
+    def __init__(self, capacity: int, default: str) -> None:
+        self.capacity, self.default = capacity, default
+        self.items: dict[int, Any] = {}
+
+
 @dataclass
 class _Module:
     """What convert.py needs beyond the functions."""
@@ -272,19 +293,94 @@ class _Module:
         assert struct is not None, name
         return struct
 
+    def ros_message(self, full_name: str) -> RosMessage:
+        message = self.resolved.ros.get(full_name)
+        assert message is not None, full_name
+        return message
 
-class _Ctor:
-    """A DSDL composite under construction: field name -> expression or nested node."""
+    def dsdl_ctor(self, struct: DsdlStruct) -> _Ctor:
+        return _Ctor(self.dsdl_ref(struct), [(f.name, f.type) for f in struct.fields], py_attr)
 
-    def __init__(self, struct: DsdlStruct, ref: str) -> None:
-        self.struct, self.ref = struct, ref
-        self.kwargs: dict[str, Any] = {}
+    def ros_ctor(self, message: RosMessage) -> _Ctor:
+        return _Ctor(ros_factory_name(self.ros_aliases[message.full_name]), [(f.name, f.type) for f in message.fields])
 
+    def child(self, t: DsdlType | RosType) -> _Ctor:
+        """A node for a composite field (or element) of type t."""
+        if isinstance(t, DsdlType):
+            return self.dsdl_ctor(self.struct(t.composite))  # type: ignore[arg-type]
+        return self.ros_ctor(self.ros_message(t.base))
 
-class _Arr:
-    def __init__(self, t: DsdlType) -> None:
-        self.type = t
-        self.items: dict[int, Any] = {}
+    def element_default(self, t: DsdlType | RosType) -> str:
+        if isinstance(t, DsdlType):
+            if t.kind == "composite":
+                return f"{self.dsdl_ref(self.struct(t.composite))}()"  # type: ignore[arg-type]
+            return _typed_literal(0, "float" if t.kind == "float" else t.kind)
+        if not t.is_primitive:
+            return f"{ros_factory_name(self.ros_aliases[t.base])}()"
+        return _typed_literal(0, t.base)
+
+    @staticmethod
+    def is_composite(t: DsdlType | RosType) -> bool:
+        return bool(t.composite) if isinstance(t, DsdlType) else not t.is_primitive
+
+    def insert(self, root: _Ctor, path: tuple, value: str) -> None:
+        """Set the field at `path` (segments (name, index or None)) of the tree under root to `value`."""
+        node: Any = root
+        for i, (name, index) in enumerate(path):
+            last = i == len(path) - 1
+            t = node.types.get(name)
+            assert t is not None, (path, name)
+            if index is None:
+                if last:
+                    node.kwargs[name] = value
+                else:
+                    if name not in node.kwargs:
+                        node.kwargs[name] = self.child(t)
+                    node = node.kwargs[name]
+            else:
+                if name not in node.kwargs:
+                    node.kwargs[name] = _Arr(t.capacity or 0, self.element_default(t.element))
+                arr = node.kwargs[name]
+                if last:
+                    arr.items[index] = value
+                else:
+                    if index not in arr.items:
+                        arr.items[index] = self.child(t.element)
+                    node = arr.items[index]
+
+    def format_node(self, node: Any, indent: int) -> list[str]:
+        """Lines of an expression; the first line is not indented, the rest are (absolute indent)."""
+        if isinstance(node, str):
+            return [node]
+        if isinstance(node, _Arr):
+            items = [node.items.get(i, node.default) for i in range(node.capacity)]
+            parts = [self.format_node(item, indent + 4) for item in items]
+            one = "[" + ", ".join(p[0] for p in parts) + "]"
+            if all(len(p) == 1 for p in parts) and indent + len(one) <= LINE_LIMIT - 20:
+                return [one]
+            lines = ["["]
+            for p in parts:
+                lines.append(" " * (indent + 4) + p[0])
+                lines.extend(p[1:])
+                lines[-1] += ","
+            lines.append(" " * indent + "]")
+            return lines
+        parts = [(k, self.format_node(v, indent + 4)) for k, v in node.arguments()]
+        one = f"{node.ref}(" + ", ".join(f"{k}={p[0]}" for k, p in parts) + ")"
+        if all(len(p) == 1 for _, p in parts) and indent + len(one) <= LINE_LIMIT - 20:
+            return [one]
+        lines = [f"{node.ref}("]
+        for k, p in parts:
+            lines.append(" " * (indent + 4) + f"{k}={p[0]}")
+            lines.extend(p[1:])
+            lines[-1] += ","
+        lines.append(" " * indent + ")")
+        return lines
+
+    def format_return(self, root: _Ctor) -> list[str]:
+        lines = self.format_node(root, 4)
+        lines[0] = "return " + lines[0]
+        return [line[4:] if i else line for i, line in enumerate(lines)]
 
 
 class _MappingEmitter:
@@ -301,6 +397,7 @@ class _MappingEmitter:
 
     # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
     def to_ros(self) -> _Function:
+        """Values first (every check and drop before anything is built), then one nested constructor call."""
         rm = self.rm
         names = _Names(self.module.module_names)
         fn = _Function(
@@ -309,26 +406,7 @@ class _MappingEmitter:
             f"{self.ros_class} | None",
             [f"Mapping {self.name!r}, UAVCAN -> ROS.", "", f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"],
         )
-        fn.binds.append(_st("assign", target="msg", expr=f"{self.ros_class}()"))
         steps = list(rm.steps)
-        # Locals for ROS parents written more than once (msg.angular_velocity.x/y/z -> angular_velocity.x ...).
-        parents: dict[tuple, int] = {}
-        for s in steps:
-            if s.kind != "time" and len(s.ros_path) > 1:
-                parents[s.ros_path[:-1]] = parents.get(s.ros_path[:-1], 0) + 1
-        parent_local: dict[tuple, str] = {}
-        for parent, count in parents.items():
-            if count >= 2 and all(index is None for _, index in parent):
-                local = names.new(parent[-1][0])
-                parent_local[parent] = local
-                fn.binds.append(_st("assign", target=local, expr=_access("msg", parent)))
-
-        def ros_target(path: tuple) -> str:
-            parent = path[:-1]
-            if parent in parent_local:
-                return _access(parent_local[parent], path[-1:])
-            return _access("msg", path)
-
         # Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one .tolist() each.
         listed: dict[tuple, str] = {}
         for s in steps:
@@ -346,40 +424,45 @@ class _MappingEmitter:
                     return f"{listed[array_path]}[{path[-1][1]}]"
             return _access("src", path, py_attr)
 
+        root = self.module.ros_ctor(rm.ros_message)
         if rm.has_header and self.mapping.frame_id is not None:
-            fn.statements.append(_st("assign", target="msg.header.frame_id", expr=py_literal(self.mapping.frame_id)))
+            self.module.insert(root, (("header", None), ("frame_id", None)), py_literal(self.mapping.frame_id))
         if rm.has_header and not rm.stamp_from_source:
-            stamp = names.new("stamp")
-            fn.statements.append(_st("assign", target=stamp, expr="msg.header.stamp"))
-            fn.statements.append(_st("receive_stamp", stamp=stamp))
+            stamp = (("header", None), ("stamp", None))
+            self.module.insert(root, (*stamp, ("sec", None)), "receive_ns // 1_000_000_000")
+            self.module.insert(root, (*stamp, ("nanosec", None)), "receive_ns % 1_000_000_000")
         for s in steps:
-            fn.statements.extend(self.step_to_ros(s, names, ros_target, uav_read))
-        fn.result = ["return msg"]
+            for path, value in self.step_to_ros(s, names, uav_read, fn.statements):
+                self.module.insert(root, path, value)
+        fn.result = self.module.format_return(root)
         return fn
 
-    def step_to_ros(self, s: Step, names: _Names, ros_target, uav_read) -> list[dict[str, Any]]:
+    def step_to_ros(self, s: Step, names: _Names, uav_read, statements: list[dict[str, Any]]
+                    ) -> list[tuple[tuple, str]]:
+        """Append the statements of one link; return the (ROS path, expression) pairs it sets."""
         pol = self.policy(s.ros)
-        target = ros_target(s.ros_path)
         if s.kind == "value":
-            return [_st("assign", target=target, expr=_typed_literal(s.value, s.ros_type.base))]  # type: ignore[arg-type]
+            return [(s.ros_path, _typed_literal(s.value, s.ros_type.base))]  # type: ignore[arg-type]
         assert s.uavcan_type is not None
         read = uav_read(s.uavcan_path)
         if s.kind == "time":
-            us, stamp = names.new("us"), names.new("stamp")
+            us, sec, nanosec = names.new("us"), names.new("sec"), names.new("nanosec")
             lo, hi = s.uavcan_type.range
             checks = []
             if hi > TIME_US_MAX_TO_ROS:
                 checks.append((f"{us} > {TIME_US_MAX_TO_ROS}", str(INT32_MAX), "999_999_999"))
             if lo < TIME_US_MIN:
                 checks.append((f"{us} < {TIME_US_MIN}", str(-(2**31)), "0"))
-            return [_st("assign", target=stamp, expr=_access("msg", s.ros_path)),
-                    _st("time_to_ros", us=us, read=read, stamp=stamp, checks=checks, key=pol.key, reject=pol.reject)]
+            statements.append(_st("time_to_ros", us=us, read=read, sec=sec, nanosec=nanosec, checks=checks,
+                                  key=pol.key, reject=pol.reject))
+            return [((*s.ros_path, ("sec", None)), sec), ((*s.ros_path, ("nanosec", None)), nanosec)]
         if s.kind == "table":
             var = names.new(s.ros)
             table = self.module_table(s, "to_ros")
-            return [_st("table", var=var, table=table, read=read, key=pol.key), _st("assign", target=target, expr=var)]
+            statements.append(_st("table", var=var, table=table, read=read, key=pol.key))
+            return [(s.ros_path, var)]
         if s.kind == "string":
-            return [_st("assign", target=target, expr=f"{read}.tobytes().decode(errors='replace')")]
+            return [(s.ros_path, f"{read}.tobytes().decode(errors='replace')")]
         ros_base = s.ros_type.base
         uav = s.uavcan_type.element if s.kind == "array" else s.uavcan_type
         expr_of = self.to_ros_scalar_expr(s, uav, ros_base)
@@ -388,28 +471,28 @@ class _MappingEmitter:
             expr = expr_of(read)
             if overflow:
                 var = names.new(s.ros)
-                return [_st("assign", target=var, expr=expr),
-                        _bound_statement(var, [(f"{_num(FLOAT32_MAX)} < {var} < _INF", _num(FLOAT32_MAX)),
-                                               (f"-_INF < {var} < {_num(-FLOAT32_MAX)}", _num(-FLOAT32_MAX))], pol),
-                        _st("assign", target=target, expr=var)]
-            return [_st("assign", target=target, expr=expr)]
+                statements.append(_st("assign", target=var, expr=expr))
+                statements.append(_bound_statement(var, [(f"{_num(FLOAT32_MAX)} < {var} < _INF", _num(FLOAT32_MAX)),
+                                                         (f"-_INF < {var} < {_num(-FLOAT32_MAX)}",
+                                                          _num(-FLOAT32_MAX))], pol))
+                return [(s.ros_path, var)]
+            return [(s.ros_path, expr)]
         # array
         elem = expr_of("x")
         base_list = f"{read}.tolist()"
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
         pad = s.ros_type.array == "fixed" and s.uavcan_type.array == "bounded"
         if not pad and not overflow:
-            return [_st("assign", target=target, expr=expr)]
+            return [(s.ros_path, expr)]
         var = names.new(s.ros)
-        out = [_st("assign", target=var, expr=expr)]
+        statements.append(_st("assign", target=var, expr=expr))
         if overflow:
-            out.append(_st("helper", var=var, helper="_clamp_finite_floats",
-                           args=[var, _num(FLOAT32_MAX), "stats", pol.key, str(pol.reject)]))
+            statements.append(_st("helper", var=var, helper="_clamp_finite_floats",
+                                  args=[var, _num(FLOAT32_MAX), "stats", pol.key, str(pol.reject)]))
         if pad:
             zero = _typed_literal(0, ros_base)
-            out.append(_st("pad", var=var, size=s.ros_type.capacity, zero=zero))
-        out.append(_st("assign", target=target, expr=var))
-        return out
+            statements.append(_st("pad", var=var, size=s.ros_type.capacity, zero=zero))
+        return [(s.ros_path, var)]
 
     def to_ros_scalar_expr(self, s: Step, uav: DsdlType, ros_base: str):
         """A function from a UAVCAN-side element expression to the ROS-side one."""
@@ -504,13 +587,14 @@ class _MappingEmitter:
                 return _access(parent_local[parent], path[-1:])
             return _access("src", path)
 
-        root = _Ctor(rm.dsdl_struct, self.dsdl_ref)
+        root = self.module.dsdl_ctor(rm.dsdl_struct)
         for s in steps:
             value = self.step_to_uavcan(s, names, ros_read, fn.statements)
-            self.insert(root, s.uavcan_path, value)
+            self.module.insert(root, s.uavcan_path, value)
         for path, leaf_type, value in rm.uavcan_values:
-            self.insert(root, path, _typed_literal(value, "float" if leaf_type.kind == "float" else leaf_type.kind))
-        fn.result = self.format_return(root)
+            self.module.insert(root, path,
+                               _typed_literal(value, "float" if leaf_type.kind == "float" else leaf_type.kind))
+        fn.result = self.module.format_return(root)
         return fn
 
     def ros_array_read(self, expr: str, ros_type: RosType) -> str:
@@ -605,75 +689,6 @@ class _MappingEmitter:
         if value_range is not None and not math.isfinite(value_range[1]):
             value_range = None
         return value_is_float, value_range, expr
-
-    # -- constructor of the DSDL object --
-    def insert(self, root: _Ctor, path: tuple, value: str) -> None:
-        node: Any = root
-        for i, (name, index) in enumerate(path):
-            last = i == len(path) - 1
-            f = node.struct.field(name)
-            assert f is not None and isinstance(f.type, DsdlType), (path, name)
-            if index is None:
-                if last:
-                    node.kwargs[name] = value
-                else:
-                    child = node.kwargs.get(name)
-                    if child is None:
-                        struct = self.module.struct(f.type.composite)  # type: ignore[arg-type]
-                        child = node.kwargs[name] = _Ctor(struct, self.module.dsdl_ref(struct))
-                    node = child
-            else:
-                arr = node.kwargs.get(name)
-                if arr is None:
-                    arr = node.kwargs[name] = _Arr(f.type)
-                if last:
-                    arr.items[index] = value
-                else:
-                    child = arr.items.get(index)
-                    if child is None:
-                        struct = self.module.struct(f.type.composite)  # type: ignore[arg-type]
-                        child = arr.items[index] = _Ctor(struct, self.module.dsdl_ref(struct))
-                    node = child
-
-    def element_default(self, t: DsdlType) -> str:
-        if t.kind == "composite":
-            return f"{self.module.dsdl_ref(self.module.struct(t.composite))}()"  # type: ignore[arg-type]
-        return _typed_literal(0, "float" if t.kind == "float" else t.kind)
-
-    def format_node(self, node: Any, indent: int) -> list[str]:
-        """Lines of an expression; the first line is not indented, the rest are (absolute indent)."""
-        if isinstance(node, str):
-            return [node]
-        if isinstance(node, _Arr):
-            items = [node.items.get(i, self.element_default(node.type.element)) for i in range(node.type.capacity or 0)]
-            parts = [self.format_node(item, indent + 4) for item in items]
-            one = "[" + ", ".join(p[0] for p in parts) + "]"
-            if all(len(p) == 1 for p in parts) and indent + len(one) <= LINE_LIMIT - 20:
-                return [one]
-            lines = ["["]
-            for p in parts:
-                lines.append(" " * (indent + 4) + p[0])
-                lines.extend(p[1:])
-                lines[-1] += ","
-            lines.append(" " * indent + "]")
-            return lines
-        kwargs = [(py_attr(f.name), node.kwargs[f.name]) for f in node.struct.fields if f.name in node.kwargs]
-        parts = [(k, self.format_node(v, indent + 4)) for k, v in kwargs]
-        one = f"{node.ref}(" + ", ".join(f"{k}={p[0]}" for k, p in parts) + ")"
-        if all(len(p) == 1 for _, p in parts) and indent + len(one) <= LINE_LIMIT - 20:
-            return [one]
-        lines = [f"{node.ref}("]
-        for k, p in parts:
-            lines.append(" " * (indent + 4) + f"{k}={p[0]}")
-            lines.extend(p[1:])
-            lines[-1] += ","
-        lines.append(" " * indent + ")")
-        return lines
-
-    def format_return(self, root: _Ctor) -> list[str]:
-        lines = self.format_node(root, 4)
-        lines[0] = "return " + lines[0]
-        return [line[4:] if i else line for i, line in enumerate(lines)]
 
 
 # ---- tables.py -----------------------------------------------------------------------------------------------
@@ -786,9 +801,24 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
 # ---- convert.py ----------------------------------------------------------------------------------------------
 
 
+def _ros_closure(resolved: Resolved) -> list[str]:
+    """Every ROS message type the converters build: the mapped ones and, transitively, their nested types."""
+    seen: set[str] = set()
+    todo = [rm.ros_message.full_name for rm in resolved.mappings]
+    while todo:
+        full = todo.pop()
+        if full in seen:
+            continue
+        seen.add(full)
+        message = resolved.ros.get(full)
+        assert message is not None, full
+        todo.extend(f.type.base for f in message.fields if isinstance(f.type, RosType) and not f.type.is_primitive)
+    return sorted(seen)
+
+
 def _ros_aliases(resolved: Resolved) -> dict[str, str]:
     """A local class name per ROS message type the converters use; package-qualified when names clash."""
-    used = sorted({rm.ros_message.full_name for rm in resolved.mappings})
+    used = _ros_closure(resolved)
     by_name: dict[str, list[str]] = {}
     for full in used:
         by_name.setdefault(full.split("/")[1], []).append(full)
@@ -798,6 +828,61 @@ def _ros_aliases(resolved: Resolved) -> dict[str, str]:
         package, name = full.split("/")
         aliases[full] = name if len(by_name[name]) == 1 and name not in reserved else f"{package}_{name}"
     return aliases
+
+
+def ros_factory_name(alias: str) -> str:
+    """The generated constructor of a ROS message class.
+
+    >>> ros_factory_name("Imu")
+    '_new_Imu'
+    """
+    return f"_new_{alias}"
+
+
+# rosidl_generator_py keeps fixed-size arrays of these in numpy arrays (`char` is uint8 in ROS 2 IDL).
+_NUMPY_BASES = frozenset(base for base in [*ROS_INT_RANGES, *ROS_FLOAT_BITS] if base != "byte")
+_PY_TYPES = {"bool": "bool", "byte": "bytes", "string": "str", "wstring": "str"}
+
+
+def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
+    """What templates/python/convert.py.j2 needs to write the fast constructor of one ROS message class.
+
+    Scalars, strings and nested messages go straight into their slots, as rosidl_generator_py's setters put them
+    when field checks are off; arrays go through the setters (which convert to numpy / array.array), and their
+    defaults are copies of a default instance's.
+    """
+    message = module.ros_message(full)
+    alias = module.ros_aliases[full]
+    prototype = f"_DEFAULT_{alias}"
+    params: list[str] = []
+    fields: list[dict[str, Any]] = []
+    uses_prototype = False
+    for f in message.fields:
+        t = f.type
+        assert isinstance(t, RosType)
+        if t.array:
+            params.append(f"{f.name}: Any = None")
+            if not t.is_primitive:
+                nested = ros_factory_name(module.ros_aliases[t.base])
+                default = f"[{nested}() for _ in range({t.capacity})]" if t.array == "fixed" else "[]"
+            elif t.array == "fixed" and t.base in _NUMPY_BASES:
+                default, uses_prototype = f"{prototype}._{f.name}.copy()", True
+            else:
+                default, uses_prototype = f"_copy({prototype}._{f.name})", True
+            fields.append({"kind": "array", "name": f.name, "default": default})
+        elif not t.is_primitive:
+            params.append(f"{f.name}: {module.ros_aliases[t.base]} | None = None")
+            fields.append({"kind": "message", "name": f.name,
+                           "default": f"{ros_factory_name(module.ros_aliases[t.base])}()"})
+        else:
+            py_type = _PY_TYPES.get(t.base, "float" if t.base in ROS_FLOAT_BITS else "int")
+            default = _typed_literal(f.default if f.default is not None else 0, t.base)
+            if t.base in ("string", "wstring") and f.default is None:
+                default = "''"
+            params.append(f"{f.name}: {py_type} = {default}")
+            fields.append({"kind": "scalar", "name": f.name})
+    return {"name": ros_factory_name(alias), "cls": alias, "params": params, "fields": fields,
+            "prototype": prototype if uses_prototype else None}
 
 
 def _referenced_roots(resolved: Resolved) -> set[str]:
@@ -836,7 +921,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {py_attr(r) for r in roots}
         | {f"{rm.mapping.name}_to_ros" for rm in resolved.mappings}
         | {f"{rm.mapping.name}_to_uavcan" for rm in resolved.mappings}
-        | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF"}
+        | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF", "FAST_CONSTRUCTORS"}
     )
     functions = []
     for rm in resolved.mappings:
@@ -848,7 +933,11 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         ros_imports.setdefault(package, []).append(name if alias == name else f"{name} as {alias}")
     for names in ros_imports.values():
         names.sort(key=_isort_key)
+    factories = [_ros_factory(module, full) for full in sorted(module.ros_aliases)]
     return {
+        "factories": factories,
+        "uses_copy": any(f["prototype"] and any("_copy(" in x.get("default", "") for x in f["fields"])
+                         for f in factories),
         "dsdl_imports": sorted(module.dsdl_modules),
         "ros_imports": sorted(ros_imports.items()),
         "tables": module.tables,

@@ -137,15 +137,20 @@ if not WORKER:
     @pytest.mark.ros
     @pytest.mark.slow
     @needs_tools
+    @pytest.mark.parametrize("check_fields", ["1", "0"], ids=["rclpy-checks", "fast-constructors"])
     @pytest.mark.parametrize("spec", sorted(SPECS))
-    def test_converters_with_real_classes(spec: str, built: Any) -> None:
-        """Run this file's worker tests for `spec` in a child pytest that can load the built ROS package."""
+    def test_converters_with_real_classes(spec: str, check_fields: str, built: Any) -> None:
+        """Run this file's worker tests for `spec` in a child pytest that can load the built ROS package.
+
+        Twice: with ROS_PYTHON_CHECK_FIELDS=1, rclpy's setters check every value the converters set (and the
+        converters use the message classes); without, the converters' own fast constructors are in use.
+        """
         from sam_codegen.ros_build import ros_runtime_env
 
         config = built(spec)
         env = ros_runtime_env(Path(config["prefix"]))
         env[WORKER_ENV] = json.dumps(config)
-        env["ROS_PYTHON_CHECK_FIELDS"] = "1"  # rclpy checks every value the converters set
+        env["ROS_PYTHON_CHECK_FIELDS"] = check_fields
         env.pop("PYTEST_ADDOPTS", None)
         proc = subprocess.run(
             [sys.executable, "-m", "pytest", __file__, "-q", "-p", "no:cacheprovider", "--rootdir", str(ROOT),
@@ -457,6 +462,37 @@ if WORKER:
                                                           info.port.dsdl_class)
             assert ros_class(rm.ros_message.full_name) is getattr(importlib.import_module(info.topic.ros_module),
                                                                   info.topic.ros_class)
+
+    # ---------------------------------------------------------------------------------------- constructors
+
+    def test_fast_constructors_in_use_unless_rclpy_checks_fields() -> None:
+        assert convert.FAST_CONSTRUCTORS is (os.environ.get("ROS_PYTHON_CHECK_FIELDS") != "1")
+
+    def with_class_constructors() -> Any:
+        """A second copy of convert.py whose converters build messages with the message classes."""
+        spec = importlib.util.spec_from_file_location(f"_classes_{SPEC_NAME}_convert", convert.__file__)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        factories = [name for name in vars(module) if name.startswith("_new_")]
+        assert factories
+        for name in factories:
+            setattr(module, name, getattr(module, name.removeprefix("_new_")))
+        return module
+
+    CLASSES = with_class_constructors()
+
+    @pytest.mark.parametrize("name", sorted(MAPPINGS))
+    @SETTINGS
+    @given(data=st.data())
+    def test_fast_constructors_build_what_the_classes_build(name: str, data: st.DataObject) -> None:
+        """Same message, slot by slot and on the wire, whichever way convert.py constructs it."""
+        src = dsdl_wire(data.draw(uavcan_strategy(MAPPINGS[name]), label="uavcan"))
+        fast = convert.CONVERTERS[name][0](src, RECEIVE_NS, convert.ConversionStats())
+        slow = CLASSES.CONVERTERS[name][0](src, RECEIVE_NS, CLASSES.ConversionStats())
+        assert type(fast) is type(slow)
+        assert convert._same(fast, slow), (fast, slow)
+        assert convert._same(ros_wire(fast), ros_wire(slow))  # (CDR padding bytes are not zeroed: no byte compare)
 
     # ---------------------------------------------------------------------------------------- SAM checks
 

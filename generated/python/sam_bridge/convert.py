@@ -19,12 +19,15 @@ The pycyphal-compiled DSDL packages must be on sys.path and the ROS message pack
 from __future__ import annotations
 
 from collections.abc import Callable
+from copy import copy as _copy
 from typing import Any
 
 import sam.actuator
 import sam.power
 import sam.sensor
 import uavcan.time
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Quaternion, Vector3
 from sam_msgs.msg import (
     BallastAngles,
     BatteryInfo,
@@ -35,9 +38,10 @@ from sam_msgs.msg import (
     ThrusterRPMs,
     ThrustVectorFeedback,
 )
-from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix
+from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix, NavSatStatus
+from std_msgs.msg import Header
 
-__all__ = ["CONVERTERS", "ConversionStats"]
+__all__ = ["CONVERTERS", "FAST_CONSTRUCTORS", "ConversionStats"]
 
 _NAN = float("nan")
 _INF = float("inf")
@@ -136,37 +140,416 @@ def _round_ints(
     return out
 
 
+# ---- constructors of the ROS messages the converters build ----------------------------------------------
+# A rosidl_generator_py class's __init__ builds every default sub-message even when one is passed in, and
+# goes through a property per field (Imu(): ~6 us). These set each field's slot (`_<field>`) directly, as
+# the class's setters do when ROS_PYTHON_CHECK_FIELDS is not 1, with the class's defaults. _same() proves at
+# import that each builds what its class builds; if one does not (another rosidl_generator_py layout) or
+# field checks are on, FAST_CONSTRUCTORS is False and the classes themselves are used (same arguments).
+
+_NEW = object.__new__
+_DEFAULT_BatteryInfo = BatteryInfo()
+_DEFAULT_BatteryState = BatteryState()
+_DEFAULT_Imu = Imu()
+_DEFAULT_MagneticField = MagneticField()
+_DEFAULT_NavSatFix = NavSatFix()
+
+
+def _new_Time(sec: int = 0, nanosec: int = 0) -> Time:
+    _m = _NEW(Time)
+    _m._check_fields = False
+    _m._sec = sec
+    _m._nanosec = nanosec
+    return _m
+
+
+def _new_Quaternion(x: float = 0.0, y: float = 0.0, z: float = 0.0, w: float = 1.0) -> Quaternion:
+    _m = _NEW(Quaternion)
+    _m._check_fields = False
+    _m._x = x
+    _m._y = y
+    _m._z = z
+    _m._w = w
+    return _m
+
+
+def _new_Vector3(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> Vector3:
+    _m = _NEW(Vector3)
+    _m._check_fields = False
+    _m._x = x
+    _m._y = y
+    _m._z = z
+    return _m
+
+
+def _new_BallastAngles(
+    header: Header | None = None,
+    weight_1_offset_radians: float = 0.0,
+    weight_2_offset_radians: float = 0.0,
+) -> BallastAngles:
+    _m = _NEW(BallastAngles)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._weight_1_offset_radians = weight_1_offset_radians
+    _m._weight_2_offset_radians = weight_2_offset_radians
+    return _m
+
+
+def _new_BatteryInfo(
+    header: Header | None = None,
+    temperature: float = 0.0,
+    voltage: float = 0.0,
+    current: float = 0.0,
+    average_power_10sec: float = 0.0,
+    remaining_capacity_wh: float = 0.0,
+    full_charge_capacity_wh: float = 0.0,
+    hours_to_full_charge: float = 0.0,
+    status_flags: int = 0,
+    state_of_health_pct: int = 0,
+    state_of_charge_pct: int = 0,
+    state_of_charge_pct_stdev: int = 0,
+    battery_id: int = 0,
+    model_instance_id: int = 0,
+    model_name: Any = None,
+) -> BatteryInfo:
+    _m = _NEW(BatteryInfo)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._temperature = temperature
+    _m._voltage = voltage
+    _m._current = current
+    _m._average_power_10sec = average_power_10sec
+    _m._remaining_capacity_wh = remaining_capacity_wh
+    _m._full_charge_capacity_wh = full_charge_capacity_wh
+    _m._hours_to_full_charge = hours_to_full_charge
+    _m._status_flags = status_flags
+    _m._state_of_health_pct = state_of_health_pct
+    _m._state_of_charge_pct = state_of_charge_pct
+    _m._state_of_charge_pct_stdev = state_of_charge_pct_stdev
+    _m._battery_id = battery_id
+    _m._model_instance_id = model_instance_id
+    if model_name is None:
+        _m._model_name = _copy(_DEFAULT_BatteryInfo._model_name)
+    else:
+        _m.model_name = model_name
+    return _m
+
+
+def _new_PercentStamped(header: Header | None = None, percent: float = 0.0) -> PercentStamped:
+    _m = _NEW(PercentStamped)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._percent = percent
+    return _m
+
+
+def _new_PositionFeedback(
+    header: Header | None = None,
+    percent: float = 0.0,
+    encoder_count: int = 0,
+) -> PositionFeedback:
+    _m = _NEW(PositionFeedback)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._percent = percent
+    _m._encoder_count = encoder_count
+    return _m
+
+
+def _new_ThrustVectorFeedback(
+    header: Header | None = None,
+    vertical_mrad: int = 0,
+    horizontal_mrad: int = 0,
+) -> ThrustVectorFeedback:
+    _m = _NEW(ThrustVectorFeedback)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._vertical_mrad = vertical_mrad
+    _m._horizontal_mrad = horizontal_mrad
+    return _m
+
+
+def _new_ThrusterAngles(
+    header: Header | None = None,
+    thruster_vertical_radians: float = 0.0,
+    thruster_horizontal_radians: float = 0.0,
+) -> ThrusterAngles:
+    _m = _NEW(ThrusterAngles)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._thruster_vertical_radians = thruster_vertical_radians
+    _m._thruster_horizontal_radians = thruster_horizontal_radians
+    return _m
+
+
+def _new_ThrusterFeedback(
+    header: Header | None = None,
+    rpm: int = 0,
+    current: float = 0.0,
+    temperature_c: int = 0,
+) -> ThrusterFeedback:
+    _m = _NEW(ThrusterFeedback)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._rpm = rpm
+    _m._current = current
+    _m._temperature_c = temperature_c
+    return _m
+
+
+def _new_ThrusterRPMs(
+    header: Header | None = None,
+    thruster_1_rpm: int = 0,
+    thruster_2_rpm: int = 0,
+) -> ThrusterRPMs:
+    _m = _NEW(ThrusterRPMs)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._thruster_1_rpm = thruster_1_rpm
+    _m._thruster_2_rpm = thruster_2_rpm
+    return _m
+
+
+def _new_BatteryState(
+    header: Header | None = None,
+    voltage: float = 0.0,
+    temperature: float = 0.0,
+    current: float = 0.0,
+    charge: float = 0.0,
+    capacity: float = 0.0,
+    design_capacity: float = 0.0,
+    percentage: float = 0.0,
+    power_supply_status: int = 0,
+    power_supply_health: int = 0,
+    power_supply_technology: int = 0,
+    present: bool = False,
+    cell_voltage: Any = None,
+    cell_temperature: Any = None,
+    location: str = '',
+    serial_number: str = '',
+) -> BatteryState:
+    _m = _NEW(BatteryState)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._voltage = voltage
+    _m._temperature = temperature
+    _m._current = current
+    _m._charge = charge
+    _m._capacity = capacity
+    _m._design_capacity = design_capacity
+    _m._percentage = percentage
+    _m._power_supply_status = power_supply_status
+    _m._power_supply_health = power_supply_health
+    _m._power_supply_technology = power_supply_technology
+    _m._present = present
+    if cell_voltage is None:
+        _m._cell_voltage = _copy(_DEFAULT_BatteryState._cell_voltage)
+    else:
+        _m.cell_voltage = cell_voltage
+    if cell_temperature is None:
+        _m._cell_temperature = _copy(_DEFAULT_BatteryState._cell_temperature)
+    else:
+        _m.cell_temperature = cell_temperature
+    _m._location = location
+    _m._serial_number = serial_number
+    return _m
+
+
+def _new_FluidPressure(
+    header: Header | None = None,
+    fluid_pressure: float = 0.0,
+    variance: float = 0.0,
+) -> FluidPressure:
+    _m = _NEW(FluidPressure)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._fluid_pressure = fluid_pressure
+    _m._variance = variance
+    return _m
+
+
+def _new_Imu(
+    header: Header | None = None,
+    orientation: Quaternion | None = None,
+    orientation_covariance: Any = None,
+    angular_velocity: Vector3 | None = None,
+    angular_velocity_covariance: Any = None,
+    linear_acceleration: Vector3 | None = None,
+    linear_acceleration_covariance: Any = None,
+) -> Imu:
+    _m = _NEW(Imu)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._orientation = _new_Quaternion() if orientation is None else orientation
+    if orientation_covariance is None:
+        _m._orientation_covariance = _DEFAULT_Imu._orientation_covariance.copy()
+    else:
+        _m.orientation_covariance = orientation_covariance
+    _m._angular_velocity = _new_Vector3() if angular_velocity is None else angular_velocity
+    if angular_velocity_covariance is None:
+        _m._angular_velocity_covariance = _DEFAULT_Imu._angular_velocity_covariance.copy()
+    else:
+        _m.angular_velocity_covariance = angular_velocity_covariance
+    _m._linear_acceleration = _new_Vector3() if linear_acceleration is None else linear_acceleration
+    if linear_acceleration_covariance is None:
+        _m._linear_acceleration_covariance = _DEFAULT_Imu._linear_acceleration_covariance.copy()
+    else:
+        _m.linear_acceleration_covariance = linear_acceleration_covariance
+    return _m
+
+
+def _new_MagneticField(
+    header: Header | None = None,
+    magnetic_field: Vector3 | None = None,
+    magnetic_field_covariance: Any = None,
+) -> MagneticField:
+    _m = _NEW(MagneticField)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._magnetic_field = _new_Vector3() if magnetic_field is None else magnetic_field
+    if magnetic_field_covariance is None:
+        _m._magnetic_field_covariance = _DEFAULT_MagneticField._magnetic_field_covariance.copy()
+    else:
+        _m.magnetic_field_covariance = magnetic_field_covariance
+    return _m
+
+
+def _new_NavSatFix(
+    header: Header | None = None,
+    status: NavSatStatus | None = None,
+    latitude: float = 0.0,
+    longitude: float = 0.0,
+    altitude: float = 0.0,
+    position_covariance: Any = None,
+    position_covariance_type: int = 0,
+) -> NavSatFix:
+    _m = _NEW(NavSatFix)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._status = _new_NavSatStatus() if status is None else status
+    _m._latitude = latitude
+    _m._longitude = longitude
+    _m._altitude = altitude
+    if position_covariance is None:
+        _m._position_covariance = _DEFAULT_NavSatFix._position_covariance.copy()
+    else:
+        _m.position_covariance = position_covariance
+    _m._position_covariance_type = position_covariance_type
+    return _m
+
+
+def _new_NavSatStatus(status: int = -2, service: int = 0) -> NavSatStatus:
+    _m = _NEW(NavSatStatus)
+    _m._check_fields = False
+    _m._status = status
+    _m._service = service
+    return _m
+
+
+def _new_Header(stamp: Time | None = None, frame_id: str = '') -> Header:
+    _m = _NEW(Header)
+    _m._check_fields = False
+    _m._stamp = _new_Time() if stamp is None else stamp
+    _m._frame_id = frame_id
+    return _m
+
+
+def _same(a: Any, b: Any) -> bool:
+    """a and b hold equal values of the same Python types, slot by slot (arrays: element type too)."""
+    if type(a) is not type(b):
+        return False
+    slots = getattr(type(a), "__slots__", None)
+    if slots is not None:
+        return all(hasattr(a, s) and hasattr(b, s) and _same(getattr(a, s), getattr(b, s)) for s in slots)
+    if isinstance(a, float):
+        return a == b or (a != a and b != b)  # NaN (unknown) is the same value here
+    if hasattr(a, "tolist"):  # numpy array or array.array
+        if getattr(a, "dtype", None) != getattr(b, "dtype", None) or getattr(a, "typecode", None) != getattr(
+            b, "typecode", None
+        ):
+            return False
+        a, b = a.tolist(), b.tolist()
+    if isinstance(a, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return bool(a == b)
+
+
+def _fast_constructors_match() -> bool:
+    try:
+        return all(_same(new(), cls()) for new, cls in (
+            (_new_Time, Time),
+            (_new_Quaternion, Quaternion),
+            (_new_Vector3, Vector3),
+            (_new_BallastAngles, BallastAngles),
+            (_new_BatteryInfo, BatteryInfo),
+            (_new_PercentStamped, PercentStamped),
+            (_new_PositionFeedback, PositionFeedback),
+            (_new_ThrustVectorFeedback, ThrustVectorFeedback),
+            (_new_ThrusterAngles, ThrusterAngles),
+            (_new_ThrusterFeedback, ThrusterFeedback),
+            (_new_ThrusterRPMs, ThrusterRPMs),
+            (_new_BatteryState, BatteryState),
+            (_new_FluidPressure, FluidPressure),
+            (_new_Imu, Imu),
+            (_new_MagneticField, MagneticField),
+            (_new_NavSatFix, NavSatFix),
+            (_new_NavSatStatus, NavSatStatus),
+            (_new_Header, Header),
+        ))
+    except Exception:  # a slot or attribute this layout does not have: not the layout they were written for
+        return False
+
+
+FAST_CONSTRUCTORS: bool = _fast_constructors_match()
+if not FAST_CONSTRUCTORS:
+    _new_Time = Time
+    _new_Quaternion = Quaternion
+    _new_Vector3 = Vector3
+    _new_BallastAngles = BallastAngles
+    _new_BatteryInfo = BatteryInfo
+    _new_PercentStamped = PercentStamped
+    _new_PositionFeedback = PositionFeedback
+    _new_ThrustVectorFeedback = ThrustVectorFeedback
+    _new_ThrusterAngles = ThrusterAngles
+    _new_ThrusterFeedback = ThrusterFeedback
+    _new_ThrusterRPMs = ThrusterRPMs
+    _new_BatteryState = BatteryState
+    _new_FluidPressure = FluidPressure
+    _new_Imu = Imu
+    _new_MagneticField = MagneticField
+    _new_NavSatFix = NavSatFix
+    _new_NavSatStatus = NavSatStatus
+    _new_Header = Header
+
+
 def imu_to_ros(src: sam.sensor.RawIMU_0_1, receive_ns: int, stats: ConversionStats) -> Imu | None:
     """Mapping 'imu', UAVCAN -> ROS.
 
     sam.sensor.RawIMU.0.1 -> sensor_msgs/Imu
     """
-    msg = Imu()
-    angular_velocity = msg.angular_velocity
-    linear_acceleration = msg.linear_acceleration
     rate_gyro_latest = src.rate_gyro_latest.tolist()
     accelerometer_latest = src.accelerometer_latest.tolist()
-    msg.header.frame_id = 'imu_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('imu.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    angular_velocity.x = rate_gyro_latest[0]
-    angular_velocity.y = rate_gyro_latest[1]
-    angular_velocity.z = rate_gyro_latest[2]
-    linear_acceleration.x = accelerometer_latest[0]
-    linear_acceleration.y = accelerometer_latest[1]
-    linear_acceleration.z = accelerometer_latest[2]
-    msg.orientation_covariance[0] = -1.0
-    return msg
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_Imu(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='imu_link'),
+        orientation_covariance=[-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        angular_velocity=_new_Vector3(x=rate_gyro_latest[0], y=rate_gyro_latest[1], z=rate_gyro_latest[2]),
+        linear_acceleration=_new_Vector3(
+            x=accelerometer_latest[0],
+            y=accelerometer_latest[1],
+            z=accelerometer_latest[2],
+        ),
+    )
 
 
 def imu_to_uavcan(src: Imu, stats: ConversionStats) -> sam.sensor.RawIMU_0_1 | None:
@@ -237,20 +620,21 @@ def magnetic_field_to_ros(
 
     sam.sensor.MagneticFieldStrength.0.1 -> sensor_msgs/MagneticField
     """
-    msg = MagneticField()
-    magnetic_field = msg.magnetic_field
     magnetic_field_ga = src.magnetic_field_ga.tolist()
-    msg.header.frame_id = 'magnetometer_link'
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    magnetic_field.x = magnetic_field_ga[0] * 0.0001
-    magnetic_field.y = magnetic_field_ga[1] * 0.0001
-    magnetic_field.z = magnetic_field_ga[2] * 0.0001
     magnetic_field_covariance = [x * 1e-08 for x in src.magnetic_field_covariance.tolist()]
     magnetic_field_covariance += [0.0] * (9 - len(magnetic_field_covariance))  # zero = unknown
-    msg.magnetic_field_covariance = magnetic_field_covariance
-    return msg
+    return _new_MagneticField(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+            frame_id='magnetometer_link',
+        ),
+        magnetic_field=_new_Vector3(
+            x=magnetic_field_ga[0] * 0.0001,
+            y=magnetic_field_ga[1] * 0.0001,
+            z=magnetic_field_ga[2] * 0.0001,
+        ),
+        magnetic_field_covariance=magnetic_field_covariance,
+    )
 
 
 def magnetic_field_to_uavcan(
@@ -299,35 +683,32 @@ def gps_fix_to_ros(src: sam.sensor.GNSSFix_0_1, receive_ns: int, stats: Conversi
 
     sam.sensor.GNSSFix.0.1 -> sensor_msgs/NavSatFix
     """
-    msg = NavSatFix()
-    status = msg.status
-    msg.header.frame_id = 'gps_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('gps_fix.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    msg.latitude = src.latitude_deg_1e8 * 1e-08
-    msg.longitude = src.longitude_deg_1e8 * 1e-08
-    msg.altitude = src.height_ellipsoid_mm * 0.001
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
     status_status = _GPS_FIX_STATUS_STATUS_TO_ROS.get(src.status)
     if status_status is None:
         stats.reject('gps_fix.status.status')
         return None
-    status.status = status_status
-    status.service = 1
     position_covariance = src.position_covariance.tolist()
     position_covariance += [0.0] * (9 - len(position_covariance))  # zero = unknown
-    msg.position_covariance = position_covariance
-    msg.position_covariance_type = 3
-    return msg
+    return _new_NavSatFix(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='gps_link'),
+        status=_new_NavSatStatus(status=status_status, service=1),
+        latitude=src.latitude_deg_1e8 * 1e-08,
+        longitude=src.longitude_deg_1e8 * 1e-08,
+        altitude=src.height_ellipsoid_mm * 0.001,
+        position_covariance=position_covariance,
+        position_covariance_type=3,
+    )
 
 
 def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> sam.sensor.GNSSFix_0_1 | None:
@@ -403,14 +784,14 @@ def pressure_to_ros(
 
     sam.sensor.StaticPressure.0.1 -> sensor_msgs/FluidPressure
     """
-    msg = FluidPressure()
-    msg.header.frame_id = 'pressure_link'
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.fluid_pressure = src.static_pressure
-    msg.variance = src.static_pressure_variance
-    return msg
+    return _new_FluidPressure(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+            frame_id='pressure_link',
+        ),
+        fluid_pressure=src.static_pressure,
+        variance=src.static_pressure_variance,
+    )
 
 
 def pressure_to_uavcan(src: FluidPressure, stats: ConversionStats) -> sam.sensor.StaticPressure_0_1 | None:
@@ -445,20 +826,20 @@ def battery_state_to_ros(
 
     sam.power.BatteryInfo.0.1 -> sensor_msgs/BatteryState
     """
-    msg = BatteryState()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.voltage = src.voltage
-    msg.current = src.current
-    msg.temperature = src.temperature - 273.15
-    msg.percentage = src.state_of_charge_pct * 0.01
-    msg.charge = _NAN
-    msg.capacity = _NAN
-    msg.design_capacity = _NAN
-    msg.present = True
-    return msg
+    return _new_BatteryState(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+            frame_id='base_link',
+        ),
+        voltage=src.voltage,
+        temperature=src.temperature - 273.15,
+        current=src.current,
+        charge=_NAN,
+        capacity=_NAN,
+        design_capacity=_NAN,
+        percentage=src.state_of_charge_pct * 0.01,
+        present=True,
+    )
 
 
 def battery_state_to_uavcan(src: BatteryState, stats: ConversionStats) -> sam.power.BatteryInfo_0_1 | None:
@@ -514,26 +895,26 @@ def battery_info_to_ros(
 
     sam.power.BatteryInfo.0.1 -> sam_msgs/BatteryInfo
     """
-    msg = BatteryInfo()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.temperature = src.temperature
-    msg.voltage = src.voltage
-    msg.current = src.current
-    msg.average_power_10sec = src.average_power_10sec
-    msg.remaining_capacity_wh = src.remaining_capacity_wh
-    msg.full_charge_capacity_wh = src.full_charge_capacity_wh
-    msg.hours_to_full_charge = src.hours_to_full_charge
-    msg.status_flags = src.status_flags
-    msg.state_of_health_pct = src.state_of_health_pct
-    msg.state_of_charge_pct = src.state_of_charge_pct
-    msg.state_of_charge_pct_stdev = src.state_of_charge_pct_stdev
-    msg.battery_id = src.battery_id
-    msg.model_instance_id = src.model_instance_id
-    msg.model_name = src.model_name.tolist()
-    return msg
+    return _new_BatteryInfo(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+            frame_id='base_link',
+        ),
+        temperature=src.temperature,
+        voltage=src.voltage,
+        current=src.current,
+        average_power_10sec=src.average_power_10sec,
+        remaining_capacity_wh=src.remaining_capacity_wh,
+        full_charge_capacity_wh=src.full_charge_capacity_wh,
+        hours_to_full_charge=src.hours_to_full_charge,
+        status_flags=src.status_flags,
+        state_of_health_pct=src.state_of_health_pct,
+        state_of_charge_pct=src.state_of_charge_pct,
+        state_of_charge_pct_stdev=src.state_of_charge_pct_stdev,
+        battery_id=src.battery_id,
+        model_instance_id=src.model_instance_id,
+        model_name=src.model_name.tolist(),
+    )
 
 
 def battery_info_to_uavcan(src: BatteryInfo, stats: ConversionStats) -> sam.power.BatteryInfo_0_1 | None:
@@ -632,12 +1013,12 @@ def thruster_1_rpm_to_ros(
 
     sam.actuator.ThrusterRPM.0.1 -> sam_msgs/ThrusterRPMs
     """
-    msg = ThrusterRPMs()
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.thruster_1_rpm = src.rpm
-    return msg
+    return _new_ThrusterRPMs(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+        ),
+        thruster_1_rpm=src.rpm,
+    )
 
 
 def thruster_1_rpm_to_uavcan(
@@ -664,12 +1045,12 @@ def thruster_2_rpm_to_ros(
 
     sam.actuator.ThrusterRPM.0.1 -> sam_msgs/ThrusterRPMs
     """
-    msg = ThrusterRPMs()
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.thruster_2_rpm = src.rpm
-    return msg
+    return _new_ThrusterRPMs(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+        ),
+        thruster_2_rpm=src.rpm,
+    )
 
 
 def thruster_2_rpm_to_uavcan(
@@ -696,13 +1077,13 @@ def thrust_vector_to_ros(
 
     sam.actuator.ThrustVector.0.1 -> sam_msgs/ThrusterAngles
     """
-    msg = ThrusterAngles()
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.thruster_vertical_radians = src.vertical_radians
-    msg.thruster_horizontal_radians = src.horizontal_radians
-    return msg
+    return _new_ThrusterAngles(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+        ),
+        thruster_vertical_radians=src.vertical_radians,
+        thruster_horizontal_radians=src.horizontal_radians,
+    )
 
 
 def thrust_vector_to_uavcan(
@@ -739,13 +1120,13 @@ def ballast_to_ros(
 
     sam.actuator.BallastAngles.0.1 -> sam_msgs/BallastAngles
     """
-    msg = BallastAngles()
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.weight_1_offset_radians = src.weight_1_offset_radians
-    msg.weight_2_offset_radians = src.weight_2_offset_radians
-    return msg
+    return _new_BallastAngles(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+        ),
+        weight_1_offset_radians=src.weight_1_offset_radians,
+        weight_2_offset_radians=src.weight_2_offset_radians,
+    )
 
 
 def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> sam.actuator.BallastAngles_0_1 | None:
@@ -780,12 +1161,12 @@ def longitudinal_weight_to_ros(
 
     sam.actuator.PercentCommand.0.1 -> sam_msgs/PercentStamped
     """
-    msg = PercentStamped()
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.percent = src.percent
-    return msg
+    return _new_PercentStamped(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+        ),
+        percent=src.percent,
+    )
 
 
 def longitudinal_weight_to_uavcan(
@@ -815,12 +1196,12 @@ def buoyancy_piston_to_ros(
 
     sam.actuator.PercentCommand.0.1 -> sam_msgs/PercentStamped
     """
-    msg = PercentStamped()
-    stamp = msg.header.stamp
-    stamp.sec = receive_ns // 1_000_000_000
-    stamp.nanosec = receive_ns % 1_000_000_000
-    msg.percent = src.percent
-    return msg
+    return _new_PercentStamped(
+        header=_new_Header(
+            stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
+        ),
+        percent=src.percent,
+    )
 
 
 def buoyancy_piston_to_uavcan(
@@ -850,24 +1231,23 @@ def thruster_1_feedback_to_ros(
 
     sam.actuator.ThrusterFeedback.0.1 -> sam_msgs/ThrusterFeedback
     """
-    msg = ThrusterFeedback()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('thruster_1_feedback.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    msg.rpm = src.rpm
-    msg.current = src.current
-    msg.temperature_c = src.temperature_c
-    return msg
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_ThrusterFeedback(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='base_link'),
+        rpm=src.rpm,
+        current=src.current,
+        temperature_c=src.temperature_c,
+    )
 
 
 def thruster_1_feedback_to_uavcan(
@@ -915,24 +1295,23 @@ def thruster_2_feedback_to_ros(
 
     sam.actuator.ThrusterFeedback.0.1 -> sam_msgs/ThrusterFeedback
     """
-    msg = ThrusterFeedback()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('thruster_2_feedback.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    msg.rpm = src.rpm
-    msg.current = src.current
-    msg.temperature_c = src.temperature_c
-    return msg
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_ThrusterFeedback(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='base_link'),
+        rpm=src.rpm,
+        current=src.current,
+        temperature_c=src.temperature_c,
+    )
 
 
 def thruster_2_feedback_to_uavcan(
@@ -980,23 +1359,22 @@ def thrust_vector_feedback_to_ros(
 
     sam.actuator.ThrustVectorFeedback.0.1 -> sam_msgs/ThrustVectorFeedback
     """
-    msg = ThrustVectorFeedback()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('thrust_vector_feedback.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    msg.vertical_mrad = src.vertical_mrad
-    msg.horizontal_mrad = src.horizontal_mrad
-    return msg
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_ThrustVectorFeedback(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='base_link'),
+        vertical_mrad=src.vertical_mrad,
+        horizontal_mrad=src.horizontal_mrad,
+    )
 
 
 def thrust_vector_feedback_to_uavcan(
@@ -1039,23 +1417,22 @@ def longitudinal_weight_feedback_to_ros(
 
     sam.actuator.PositionFeedback.0.1 -> sam_msgs/PositionFeedback
     """
-    msg = PositionFeedback()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('longitudinal_weight_feedback.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    msg.percent = src.percent
-    msg.encoder_count = src.encoder_count
-    return msg
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_PositionFeedback(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='base_link'),
+        percent=src.percent,
+        encoder_count=src.encoder_count,
+    )
 
 
 def longitudinal_weight_feedback_to_uavcan(
@@ -1095,23 +1472,22 @@ def buoyancy_piston_feedback_to_ros(
 
     sam.actuator.PositionFeedback.0.1 -> sam_msgs/PositionFeedback
     """
-    msg = PositionFeedback()
-    msg.header.frame_id = 'base_link'
-    stamp = msg.header.stamp
     us = src.timestamp.microsecond
     if us == 0:  # unknown: the receive time
-        stamp.sec = receive_ns // 1_000_000_000
-        stamp.nanosec = receive_ns % 1_000_000_000
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
     elif us > 2147483647999999:  # beyond builtin_interfaces/Time
         stats.saturate('buoyancy_piston_feedback.header.stamp')
-        stamp.sec = 2147483647
-        stamp.nanosec = 999_999_999
+        sec = 2147483647
+        nanosec = 999_999_999
     else:
-        stamp.sec = us // 1_000_000
-        stamp.nanosec = us % 1_000_000 * 1000
-    msg.percent = src.percent
-    msg.encoder_count = src.encoder_count
-    return msg
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_PositionFeedback(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='base_link'),
+        percent=src.percent,
+        encoder_count=src.encoder_count,
+    )
 
 
 def buoyancy_piston_feedback_to_uavcan(
