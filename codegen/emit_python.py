@@ -283,6 +283,7 @@ class _Module:
     dsdl_modules: set[str] = field(default_factory=set)
     tables: list[dict[str, Any]] = field(default_factory=list)
     module_names: set[str] = field(default_factory=set)
+    dsdl_factories: dict[str, DsdlStruct] = field(default_factory=dict)  # full name -> struct, as used
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         self.dsdl_modules.add(py_module(struct.namespace))
@@ -298,8 +299,16 @@ class _Module:
         assert message is not None, full_name
         return message
 
+    def dsdl_new(self, struct: DsdlStruct) -> str:
+        """What builds an object of `struct`: its generated constructor, or the class where there is none."""
+        ref = self.dsdl_ref(struct)
+        if not dsdl_factory_supported(struct):
+            return ref
+        self.dsdl_factories.setdefault(struct.name, struct)
+        return dsdl_factory_name(struct)
+
     def dsdl_ctor(self, struct: DsdlStruct) -> _Ctor:
-        return _Ctor(self.dsdl_ref(struct), [(f.name, f.type) for f in struct.fields], py_attr)
+        return _Ctor(self.dsdl_new(struct), [(f.name, f.type) for f in struct.fields], py_attr)
 
     def ros_ctor(self, message: RosMessage) -> _Ctor:
         return _Ctor(ros_factory_name(self.ros_aliases[message.full_name]), [(f.name, f.type) for f in message.fields])
@@ -313,7 +322,7 @@ class _Module:
     def element_default(self, t: DsdlType | RosType) -> str:
         if isinstance(t, DsdlType):
             if t.kind == "composite":
-                return f"{self.dsdl_ref(self.struct(t.composite))}()"  # type: ignore[arg-type]
+                return f"{self.dsdl_new(self.struct(t.composite))}()"  # type: ignore[arg-type]
             return _typed_literal(0, "float" if t.kind == "float" else t.kind)
         if not t.is_primitive:
             return f"{ros_factory_name(self.ros_aliases[t.base])}()"
@@ -844,6 +853,18 @@ _NUMPY_BASES = frozenset(base for base in [*ROS_INT_RANGES, *ROS_FLOAT_BITS] if 
 _PY_TYPES = {"bool": "bool", "byte": "bytes", "string": "str", "wstring": "str"}
 
 
+def _factory_field(slot: str, param: str, default: str, given: list[tuple[str | None, str]] | None = None
+                   ) -> dict[str, Any]:
+    """One field of a generated constructor: `default` when the argument is None, else `given` (if/elif/else
+    branches: (condition or None, statement)); by default the argument goes into the slot as it is."""
+    if given is None:
+        line = f"_m.{slot} = {default} if {param} is None else {param}"
+        if len(line) + 4 <= LINE_LIMIT - 30:
+            return {"line": line}
+        given = [(None, f"_m.{slot} = {param}")]
+    return {"branches": [(f"{param} is None", f"_m.{slot} = {default}"), *given]}
+
+
 def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
     """What templates/python/convert.py.j2 needs to write the fast constructor of one ROS message class.
 
@@ -869,20 +890,90 @@ def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
                 default, uses_prototype = f"{prototype}._{f.name}.copy()", True
             else:
                 default, uses_prototype = f"_copy({prototype}._{f.name})", True
-            fields.append({"kind": "array", "name": f.name, "default": default})
+            # the setter converts a given sequence to the class's array type
+            fields.append(_factory_field(f"_{f.name}", f.name, default, [(None, f"_m.{f.name} = {f.name}")]))
         elif not t.is_primitive:
             params.append(f"{f.name}: {module.ros_aliases[t.base]} | None = None")
-            fields.append({"kind": "message", "name": f.name,
-                           "default": f"{ros_factory_name(module.ros_aliases[t.base])}()"})
+            fields.append(_factory_field(f"_{f.name}", f.name, f"{ros_factory_name(module.ros_aliases[t.base])}()"))
         else:
             py_type = _PY_TYPES.get(t.base, "float" if t.base in ROS_FLOAT_BITS else "int")
             default = _typed_literal(f.default if f.default is not None else 0, t.base)
             if t.base in ("string", "wstring") and f.default is None:
                 default = "''"
             params.append(f"{f.name}: {py_type} = {default}")
-            fields.append({"kind": "scalar", "name": f.name})
-    return {"name": ros_factory_name(alias), "cls": alias, "params": params, "fields": fields,
+            fields.append({"line": f"_m._{f.name} = {f.name}"})
+    return {"name": ros_factory_name(alias), "cls": alias, "ros": True, "params": params, "fields": fields,
             "prototype": prototype if uses_prototype else None}
+
+
+def dsdl_factory_name(struct: DsdlStruct) -> str:
+    """The generated constructor of a pycyphal class.
+
+    >>> from sam_codegen.model import DsdlStruct
+    >>> dsdl_factory_name(DsdlStruct("uavcan.time.SynchronizedTimestamp.1.0", []))
+    '_new_uavcan_time_SynchronizedTimestamp_1_0'
+    """
+    return "_new_" + py_module(struct.namespace).replace(".", "_") + "_" + py_class_name(struct)
+
+
+def dsdl_factory_supported(struct: DsdlStruct) -> bool:
+    """Structures of primitives, primitive arrays and nested composites get a constructor; unions and arrays of
+    composites (rare in bridged types) are built by their pycyphal class."""
+    return not struct.union and not any(
+        isinstance(f.type, DsdlType) and f.type.array and f.type.kind == "composite" for f in struct.fields)
+
+
+def _numpy_dtype(t: DsdlType) -> str:
+    """The numpy element type pycyphal (nunavut 2.3) keeps a primitive array in.
+
+    >>> [_numpy_dtype(DsdlType(k, b)) for k, b in (("float", 16), ("int", 18), ("uint", 7), ("bool", 1), ("utf8", 8))]
+    ['_np.float16', '_np.int32', '_np.uint8', '_np.bool_', '_np.uint8']
+    """
+    if t.kind == "float":
+        return f"_np.float{t.bits}"
+    if t.kind == "bool":
+        return "_np.bool_"
+    if t.kind in ("byte", "utf8"):
+        return "_np.uint8"
+    bits = next(b for b in (8, 16, 32, 64) if b >= t.bits)
+    return f"_np.{t.kind}{bits}"
+
+
+def _dsdl_factory(module: _Module, struct: DsdlStruct) -> dict[str, Any]:
+    """What templates/python/convert.py.j2 needs to write the fast constructor of one pycyphal class.
+
+    Values go straight into the attributes pycyphal's properties keep them in (`_<name>`), converted as its
+    setters convert them; the converters have already checked ranges and lengths, which the setters check again.
+    """
+    params: list[str] = []
+    fields: list[dict[str, Any]] = []
+    for f in struct.fields:
+        t = f.type
+        assert isinstance(t, DsdlType)
+        if t.kind == "void":
+            continue
+        name = py_attr(f.name)
+        if t.kind == "composite":
+            nested = module.struct(t.composite)  # type: ignore[arg-type]
+            params.append(f"{name}: Any = None")
+            fields.append(_factory_field(f"_{name}", name, f"{module.dsdl_new(nested)}()"))
+        elif t.array or t.kind == "utf8":
+            dtype = _numpy_dtype(t)
+            default = f"_np.zeros({t.capacity}, {dtype})" if t.array == "fixed" else f"_np.array([], {dtype})"
+            given: list[tuple[str | None, str]] = [(None, f"_m._{name} = _np.array({name}, {dtype})")]
+            if dtype == "_np.uint8":  # pycyphal takes bytes for these too (utf8 text, byte strings)
+                given.insert(0, (f"{name}.__class__ is bytes", f"_m._{name} = _np.frombuffer({name}, _np.uint8)"))
+            params.append(f"{name}: Any = None")
+            fields.append(_factory_field(f"_{name}", name, default, given))
+        elif t.kind == "float":
+            params.append(f"{name}: float = 0.0")
+            fields.append({"line": f"_m._{name} = float({name})"})
+        else:
+            params.append(f"{name}: {'bool' if t.kind == 'bool' else 'int'} = {'False' if t.kind == 'bool' else '0'}")
+            fields.append({"line": f"_m._{name} = {name}"})
+    return {"name": dsdl_factory_name(struct), "cls": module.dsdl_ref(struct), "ros": False, "params": params,
+            "fields": fields,
+            "prototype": None}
 
 
 def _referenced_roots(resolved: Resolved) -> set[str]:
@@ -921,7 +1012,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {py_attr(r) for r in roots}
         | {f"{rm.mapping.name}_to_ros" for rm in resolved.mappings}
         | {f"{rm.mapping.name}_to_uavcan" for rm in resolved.mappings}
-        | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF", "FAST_CONSTRUCTORS"}
+        | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF", "FAST_CONSTRUCTORS", "_np"}
     )
     functions = []
     for rm in resolved.mappings:
@@ -934,10 +1025,16 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
     for names in ros_imports.values():
         names.sort(key=_isort_key)
     factories = [_ros_factory(module, full) for full in sorted(module.ros_aliases)]
+    done: set[str] = set()
+    while len(done) < len(module.dsdl_factories):  # a constructor's defaults may bring in nested ones
+        for name in sorted(set(module.dsdl_factories) - done):
+            factories.append(_dsdl_factory(module, module.dsdl_factories[name]))
+            done.add(name)
+    if module.dsdl_factories:
+        module.dsdl_modules.add("numpy as _np")
     return {
         "factories": factories,
-        "uses_copy": any(f["prototype"] and any("_copy(" in x.get("default", "") for x in f["fields"])
-                         for f in factories),
+        "uses_copy": any("_copy(" in str(x) for f in factories for x in f["fields"]),
         "dsdl_imports": sorted(module.dsdl_modules),
         "ros_imports": sorted(ros_imports.items()),
         "tables": module.tables,

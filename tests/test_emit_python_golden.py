@@ -105,7 +105,7 @@ def test_modules_compile(which: str, request: pytest.FixtureRequest) -> None:
 @pytest.mark.parametrize("which", ["sam", "rover"])
 def test_imports(which: str, request: pytest.FixtureRequest) -> None:
     """tables.py imports only the standard library; convert.py adds only ROS message and DSDL packages: those of
-    the mapped types and of the messages nested in them (the converters build those too)."""
+    the mapped types and of the messages nested in them (the converters build those too), and numpy."""
     resolved: Resolved = request.getfixturevalue(which)
     files = emit_python.emit(resolved)
     package = f"python/{resolved.spec.vehicle}_bridge"
@@ -125,7 +125,7 @@ def test_imports(which: str, request: pytest.FixtureRequest) -> None:
     nested = {f"{full.split('/')[0]}.msg" for full in emit_python._ros_closure(resolved)}
     dsdl = {s.namespace for s in resolved.dsdl_types} | {"uavcan.time"}
     convert = imports(files[f"{package}/convert.py"])
-    assert convert - {"__future__", "collections.abc", "copy", "typing"} <= nested | dsdl
+    assert convert - {"__future__", "collections.abc", "copy", "numpy", "typing"} <= nested | dsdl
     assert mapped <= convert
 
 

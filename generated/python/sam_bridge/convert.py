@@ -22,6 +22,7 @@ from collections.abc import Callable
 from copy import copy as _copy
 from typing import Any
 
+import numpy as _np
 import sam.actuator
 import sam.power
 import sam.sensor
@@ -140,12 +141,14 @@ def _round_ints(
     return out
 
 
-# ---- constructors of the ROS messages the converters build ----------------------------------------------
+# ---- constructors of the messages the converters build ----------------------------------------------------
 # A rosidl_generator_py class's __init__ builds every default sub-message even when one is passed in, and
-# goes through a property per field (Imu(): ~6 us). These set each field's slot (`_<field>`) directly, as
-# the class's setters do when ROS_PYTHON_CHECK_FIELDS is not 1, with the class's defaults. _same() proves at
-# import that each builds what its class builds; if one does not (another rosidl_generator_py layout) or
-# field checks are on, FAST_CONSTRUCTORS is False and the classes themselves are used (same arguments).
+# goes through a property per field (Imu(): ~6 us); a pycyphal class's checks every value again and copies
+# every array twice (RawIMU: ~4 us). These set each field's attribute (`_<field>`) directly, as the classes'
+# setters do (rclpy's when ROS_PYTHON_CHECK_FIELDS is not 1), with the classes' defaults; the converters have
+# checked every value already. _same() proves at import that each builds what its class builds; if one does
+# not (another rosidl_generator_py or nunavut layout) or rclpy's field checks are on, FAST_CONSTRUCTORS is
+# False and the classes themselves are used (they take the same arguments).
 
 _NEW = object.__new__
 _DEFAULT_BatteryInfo = BatteryInfo()
@@ -385,12 +388,18 @@ def _new_Imu(
         _m._orientation_covariance = _DEFAULT_Imu._orientation_covariance.copy()
     else:
         _m.orientation_covariance = orientation_covariance
-    _m._angular_velocity = _new_Vector3() if angular_velocity is None else angular_velocity
+    if angular_velocity is None:
+        _m._angular_velocity = _new_Vector3()
+    else:
+        _m._angular_velocity = angular_velocity
     if angular_velocity_covariance is None:
         _m._angular_velocity_covariance = _DEFAULT_Imu._angular_velocity_covariance.copy()
     else:
         _m.angular_velocity_covariance = angular_velocity_covariance
-    _m._linear_acceleration = _new_Vector3() if linear_acceleration is None else linear_acceleration
+    if linear_acceleration is None:
+        _m._linear_acceleration = _new_Vector3()
+    else:
+        _m._linear_acceleration = linear_acceleration
     if linear_acceleration_covariance is None:
         _m._linear_acceleration_covariance = _DEFAULT_Imu._linear_acceleration_covariance.copy()
     else:
@@ -406,7 +415,10 @@ def _new_MagneticField(
     _m = _NEW(MagneticField)
     _m._check_fields = False
     _m._header = _new_Header() if header is None else header
-    _m._magnetic_field = _new_Vector3() if magnetic_field is None else magnetic_field
+    if magnetic_field is None:
+        _m._magnetic_field = _new_Vector3()
+    else:
+        _m._magnetic_field = magnetic_field
     if magnetic_field_covariance is None:
         _m._magnetic_field_covariance = _DEFAULT_MagneticField._magnetic_field_covariance.copy()
     else:
@@ -454,6 +466,229 @@ def _new_Header(stamp: Time | None = None, frame_id: str = '') -> Header:
     return _m
 
 
+def _new_sam_actuator_BallastAngles_0_1(
+    weight_1_offset_radians: float = 0.0,
+    weight_2_offset_radians: float = 0.0,
+) -> sam.actuator.BallastAngles_0_1:
+    _m = _NEW(sam.actuator.BallastAngles_0_1)
+    _m._weight_1_offset_radians = float(weight_1_offset_radians)
+    _m._weight_2_offset_radians = float(weight_2_offset_radians)
+    return _m
+
+
+def _new_sam_actuator_PercentCommand_0_1(percent: float = 0.0) -> sam.actuator.PercentCommand_0_1:
+    _m = _NEW(sam.actuator.PercentCommand_0_1)
+    _m._percent = float(percent)
+    return _m
+
+
+def _new_sam_actuator_PositionFeedback_0_1(
+    timestamp: Any = None,
+    percent: float = 0.0,
+    encoder_count: int = 0,
+) -> sam.actuator.PositionFeedback_0_1:
+    _m = _NEW(sam.actuator.PositionFeedback_0_1)
+    if timestamp is None:
+        _m._timestamp = _new_uavcan_time_SynchronizedTimestamp_1_0()
+    else:
+        _m._timestamp = timestamp
+    _m._percent = float(percent)
+    _m._encoder_count = encoder_count
+    return _m
+
+
+def _new_sam_actuator_ThrustVector_0_1(
+    vertical_radians: float = 0.0,
+    horizontal_radians: float = 0.0,
+) -> sam.actuator.ThrustVector_0_1:
+    _m = _NEW(sam.actuator.ThrustVector_0_1)
+    _m._vertical_radians = float(vertical_radians)
+    _m._horizontal_radians = float(horizontal_radians)
+    return _m
+
+
+def _new_sam_actuator_ThrustVectorFeedback_0_1(
+    timestamp: Any = None,
+    vertical_mrad: int = 0,
+    horizontal_mrad: int = 0,
+) -> sam.actuator.ThrustVectorFeedback_0_1:
+    _m = _NEW(sam.actuator.ThrustVectorFeedback_0_1)
+    if timestamp is None:
+        _m._timestamp = _new_uavcan_time_SynchronizedTimestamp_1_0()
+    else:
+        _m._timestamp = timestamp
+    _m._vertical_mrad = vertical_mrad
+    _m._horizontal_mrad = horizontal_mrad
+    return _m
+
+
+def _new_sam_actuator_ThrusterFeedback_0_1(
+    timestamp: Any = None,
+    rpm: int = 0,
+    current: float = 0.0,
+    temperature_c: int = 0,
+) -> sam.actuator.ThrusterFeedback_0_1:
+    _m = _NEW(sam.actuator.ThrusterFeedback_0_1)
+    if timestamp is None:
+        _m._timestamp = _new_uavcan_time_SynchronizedTimestamp_1_0()
+    else:
+        _m._timestamp = timestamp
+    _m._rpm = rpm
+    _m._current = float(current)
+    _m._temperature_c = temperature_c
+    return _m
+
+
+def _new_sam_actuator_ThrusterRPM_0_1(rpm: int = 0) -> sam.actuator.ThrusterRPM_0_1:
+    _m = _NEW(sam.actuator.ThrusterRPM_0_1)
+    _m._rpm = rpm
+    return _m
+
+
+def _new_sam_power_BatteryInfo_0_1(
+    temperature: float = 0.0,
+    voltage: float = 0.0,
+    current: float = 0.0,
+    average_power_10sec: float = 0.0,
+    remaining_capacity_wh: float = 0.0,
+    full_charge_capacity_wh: float = 0.0,
+    hours_to_full_charge: float = 0.0,
+    status_flags: int = 0,
+    state_of_health_pct: int = 0,
+    state_of_charge_pct: int = 0,
+    state_of_charge_pct_stdev: int = 0,
+    battery_id: int = 0,
+    model_instance_id: int = 0,
+    model_name: Any = None,
+) -> sam.power.BatteryInfo_0_1:
+    _m = _NEW(sam.power.BatteryInfo_0_1)
+    _m._temperature = float(temperature)
+    _m._voltage = float(voltage)
+    _m._current = float(current)
+    _m._average_power_10sec = float(average_power_10sec)
+    _m._remaining_capacity_wh = float(remaining_capacity_wh)
+    _m._full_charge_capacity_wh = float(full_charge_capacity_wh)
+    _m._hours_to_full_charge = float(hours_to_full_charge)
+    _m._status_flags = status_flags
+    _m._state_of_health_pct = state_of_health_pct
+    _m._state_of_charge_pct = state_of_charge_pct
+    _m._state_of_charge_pct_stdev = state_of_charge_pct_stdev
+    _m._battery_id = battery_id
+    _m._model_instance_id = model_instance_id
+    if model_name is None:
+        _m._model_name = _np.array([], _np.uint8)
+    elif model_name.__class__ is bytes:
+        _m._model_name = _np.frombuffer(model_name, _np.uint8)
+    else:
+        _m._model_name = _np.array(model_name, _np.uint8)
+    return _m
+
+
+def _new_sam_sensor_GNSSFix_0_1(
+    timestamp: Any = None,
+    longitude_deg_1e8: int = 0,
+    latitude_deg_1e8: int = 0,
+    height_ellipsoid_mm: int = 0,
+    height_msl_mm: int = 0,
+    ned_velocity: Any = None,
+    sats_used: int = 0,
+    status: int = 0,
+    pdop: float = 0.0,
+    position_covariance: Any = None,
+) -> sam.sensor.GNSSFix_0_1:
+    _m = _NEW(sam.sensor.GNSSFix_0_1)
+    if timestamp is None:
+        _m._timestamp = _new_uavcan_time_SynchronizedTimestamp_1_0()
+    else:
+        _m._timestamp = timestamp
+    _m._longitude_deg_1e8 = longitude_deg_1e8
+    _m._latitude_deg_1e8 = latitude_deg_1e8
+    _m._height_ellipsoid_mm = height_ellipsoid_mm
+    _m._height_msl_mm = height_msl_mm
+    if ned_velocity is None:
+        _m._ned_velocity = _np.zeros(3, _np.float32)
+    else:
+        _m._ned_velocity = _np.array(ned_velocity, _np.float32)
+    _m._sats_used = sats_used
+    _m._status = status
+    _m._pdop = float(pdop)
+    if position_covariance is None:
+        _m._position_covariance = _np.array([], _np.float16)
+    else:
+        _m._position_covariance = _np.array(position_covariance, _np.float16)
+    return _m
+
+
+def _new_sam_sensor_MagneticFieldStrength_0_1(
+    magnetic_field_ga: Any = None,
+    magnetic_field_covariance: Any = None,
+) -> sam.sensor.MagneticFieldStrength_0_1:
+    _m = _NEW(sam.sensor.MagneticFieldStrength_0_1)
+    if magnetic_field_ga is None:
+        _m._magnetic_field_ga = _np.zeros(3, _np.float16)
+    else:
+        _m._magnetic_field_ga = _np.array(magnetic_field_ga, _np.float16)
+    if magnetic_field_covariance is None:
+        _m._magnetic_field_covariance = _np.array([], _np.float16)
+    else:
+        _m._magnetic_field_covariance = _np.array(magnetic_field_covariance, _np.float16)
+    return _m
+
+
+def _new_sam_sensor_RawIMU_0_1(
+    timestamp: Any = None,
+    integration_interval: float = 0.0,
+    rate_gyro_latest: Any = None,
+    rate_gyro_integral: Any = None,
+    accelerometer_latest: Any = None,
+    accelerometer_integral: Any = None,
+    covariance: Any = None,
+) -> sam.sensor.RawIMU_0_1:
+    _m = _NEW(sam.sensor.RawIMU_0_1)
+    if timestamp is None:
+        _m._timestamp = _new_uavcan_time_SynchronizedTimestamp_1_0()
+    else:
+        _m._timestamp = timestamp
+    _m._integration_interval = float(integration_interval)
+    if rate_gyro_latest is None:
+        _m._rate_gyro_latest = _np.zeros(3, _np.float16)
+    else:
+        _m._rate_gyro_latest = _np.array(rate_gyro_latest, _np.float16)
+    if rate_gyro_integral is None:
+        _m._rate_gyro_integral = _np.zeros(3, _np.float32)
+    else:
+        _m._rate_gyro_integral = _np.array(rate_gyro_integral, _np.float32)
+    if accelerometer_latest is None:
+        _m._accelerometer_latest = _np.zeros(3, _np.float16)
+    else:
+        _m._accelerometer_latest = _np.array(accelerometer_latest, _np.float16)
+    if accelerometer_integral is None:
+        _m._accelerometer_integral = _np.zeros(3, _np.float32)
+    else:
+        _m._accelerometer_integral = _np.array(accelerometer_integral, _np.float32)
+    if covariance is None:
+        _m._covariance = _np.array([], _np.float16)
+    else:
+        _m._covariance = _np.array(covariance, _np.float16)
+    return _m
+
+
+def _new_sam_sensor_StaticPressure_0_1(
+    static_pressure: float = 0.0,
+    static_pressure_variance: float = 0.0,
+) -> sam.sensor.StaticPressure_0_1:
+    _m = _NEW(sam.sensor.StaticPressure_0_1)
+    _m._static_pressure = float(static_pressure)
+    _m._static_pressure_variance = float(static_pressure_variance)
+    return _m
+
+
+def _new_uavcan_time_SynchronizedTimestamp_1_0(microsecond: int = 0) -> uavcan.time.SynchronizedTimestamp_1_0:
+    _m = _NEW(uavcan.time.SynchronizedTimestamp_1_0)
+    _m._microsecond = microsecond
+    return _m
+
+
 def _same(a: Any, b: Any) -> bool:
     """a and b hold equal values of the same Python types, slot by slot (arrays: element type too)."""
     if type(a) is not type(b):
@@ -471,31 +706,50 @@ def _same(a: Any, b: Any) -> bool:
         a, b = a.tolist(), b.tolist()
     if isinstance(a, list):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if hasattr(a, "__dict__"):  # a pycyphal object
+        return vars(a).keys() == vars(b).keys() and all(_same(v, vars(b)[k]) for k, v in vars(a).items())
     return bool(a == b)
+
+
+# (generated constructor, class) pairs
+_FACTORIES: tuple[tuple[Callable[..., Any], type], ...] = (
+    (_new_Time, Time),
+    (_new_Quaternion, Quaternion),
+    (_new_Vector3, Vector3),
+    (_new_BallastAngles, BallastAngles),
+    (_new_BatteryInfo, BatteryInfo),
+    (_new_PercentStamped, PercentStamped),
+    (_new_PositionFeedback, PositionFeedback),
+    (_new_ThrustVectorFeedback, ThrustVectorFeedback),
+    (_new_ThrusterAngles, ThrusterAngles),
+    (_new_ThrusterFeedback, ThrusterFeedback),
+    (_new_ThrusterRPMs, ThrusterRPMs),
+    (_new_BatteryState, BatteryState),
+    (_new_FluidPressure, FluidPressure),
+    (_new_Imu, Imu),
+    (_new_MagneticField, MagneticField),
+    (_new_NavSatFix, NavSatFix),
+    (_new_NavSatStatus, NavSatStatus),
+    (_new_Header, Header),
+    (_new_sam_actuator_BallastAngles_0_1, sam.actuator.BallastAngles_0_1),
+    (_new_sam_actuator_PercentCommand_0_1, sam.actuator.PercentCommand_0_1),
+    (_new_sam_actuator_PositionFeedback_0_1, sam.actuator.PositionFeedback_0_1),
+    (_new_sam_actuator_ThrustVector_0_1, sam.actuator.ThrustVector_0_1),
+    (_new_sam_actuator_ThrustVectorFeedback_0_1, sam.actuator.ThrustVectorFeedback_0_1),
+    (_new_sam_actuator_ThrusterFeedback_0_1, sam.actuator.ThrusterFeedback_0_1),
+    (_new_sam_actuator_ThrusterRPM_0_1, sam.actuator.ThrusterRPM_0_1),
+    (_new_sam_power_BatteryInfo_0_1, sam.power.BatteryInfo_0_1),
+    (_new_sam_sensor_GNSSFix_0_1, sam.sensor.GNSSFix_0_1),
+    (_new_sam_sensor_MagneticFieldStrength_0_1, sam.sensor.MagneticFieldStrength_0_1),
+    (_new_sam_sensor_RawIMU_0_1, sam.sensor.RawIMU_0_1),
+    (_new_sam_sensor_StaticPressure_0_1, sam.sensor.StaticPressure_0_1),
+    (_new_uavcan_time_SynchronizedTimestamp_1_0, uavcan.time.SynchronizedTimestamp_1_0),
+)
 
 
 def _fast_constructors_match() -> bool:
     try:
-        return all(_same(new(), cls()) for new, cls in (
-            (_new_Time, Time),
-            (_new_Quaternion, Quaternion),
-            (_new_Vector3, Vector3),
-            (_new_BallastAngles, BallastAngles),
-            (_new_BatteryInfo, BatteryInfo),
-            (_new_PercentStamped, PercentStamped),
-            (_new_PositionFeedback, PositionFeedback),
-            (_new_ThrustVectorFeedback, ThrustVectorFeedback),
-            (_new_ThrusterAngles, ThrusterAngles),
-            (_new_ThrusterFeedback, ThrusterFeedback),
-            (_new_ThrusterRPMs, ThrusterRPMs),
-            (_new_BatteryState, BatteryState),
-            (_new_FluidPressure, FluidPressure),
-            (_new_Imu, Imu),
-            (_new_MagneticField, MagneticField),
-            (_new_NavSatFix, NavSatFix),
-            (_new_NavSatStatus, NavSatStatus),
-            (_new_Header, Header),
-        ))
+        return all(_same(new(), cls()) for new, cls in _FACTORIES)
     except Exception:  # a slot or attribute this layout does not have: not the layout they were written for
         return False
 
@@ -520,6 +774,19 @@ if not FAST_CONSTRUCTORS:
     _new_NavSatFix = NavSatFix
     _new_NavSatStatus = NavSatStatus
     _new_Header = Header
+    _new_sam_actuator_BallastAngles_0_1 = sam.actuator.BallastAngles_0_1
+    _new_sam_actuator_PercentCommand_0_1 = sam.actuator.PercentCommand_0_1
+    _new_sam_actuator_PositionFeedback_0_1 = sam.actuator.PositionFeedback_0_1
+    _new_sam_actuator_ThrustVector_0_1 = sam.actuator.ThrustVector_0_1
+    _new_sam_actuator_ThrustVectorFeedback_0_1 = sam.actuator.ThrustVectorFeedback_0_1
+    _new_sam_actuator_ThrusterFeedback_0_1 = sam.actuator.ThrusterFeedback_0_1
+    _new_sam_actuator_ThrusterRPM_0_1 = sam.actuator.ThrusterRPM_0_1
+    _new_sam_power_BatteryInfo_0_1 = sam.power.BatteryInfo_0_1
+    _new_sam_sensor_GNSSFix_0_1 = sam.sensor.GNSSFix_0_1
+    _new_sam_sensor_MagneticFieldStrength_0_1 = sam.sensor.MagneticFieldStrength_0_1
+    _new_sam_sensor_RawIMU_0_1 = sam.sensor.RawIMU_0_1
+    _new_sam_sensor_StaticPressure_0_1 = sam.sensor.StaticPressure_0_1
+    _new_uavcan_time_SynchronizedTimestamp_1_0 = uavcan.time.SynchronizedTimestamp_1_0
 
 
 def imu_to_ros(src: sam.sensor.RawIMU_0_1, receive_ns: int, stats: ConversionStats) -> Imu | None:
@@ -606,8 +873,8 @@ def imu_to_uavcan(src: Imu, stats: ConversionStats) -> sam.sensor.RawIMU_0_1 | N
     elif accelerometer_latest_2 < -65504.0:
         stats.saturate('imu.accelerometer_latest[2]')
         accelerometer_latest_2 = -65504.0
-    return sam.sensor.RawIMU_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_sensor_RawIMU_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         rate_gyro_latest=[rate_gyro_latest_0, rate_gyro_latest_1, rate_gyro_latest_2],
         accelerometer_latest=[accelerometer_latest_0, accelerometer_latest_1, accelerometer_latest_2],
     )
@@ -672,7 +939,7 @@ def magnetic_field_to_uavcan(
     )
     if magnetic_field_covariance is None:
         return None
-    return sam.sensor.MagneticFieldStrength_0_1(
+    return _new_sam_sensor_MagneticFieldStrength_0_1(
         magnetic_field_ga=[magnetic_field_ga_0, magnetic_field_ga_1, magnetic_field_ga_2],
         magnetic_field_covariance=magnetic_field_covariance,
     )
@@ -767,8 +1034,8 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> sam.sensor.GNSS
     )
     if position_covariance is None:
         return None
-    return sam.sensor.GNSSFix_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_sensor_GNSSFix_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         longitude_deg_1e8=longitude_deg_1e8,
         latitude_deg_1e8=latitude_deg_1e8,
         height_ellipsoid_mm=height_ellipsoid_mm,
@@ -813,7 +1080,7 @@ def pressure_to_uavcan(src: FluidPressure, stats: ConversionStats) -> sam.sensor
     elif static_pressure_variance < -65504.0:
         stats.saturate('pressure.static_pressure_variance')
         static_pressure_variance = -65504.0
-    return sam.sensor.StaticPressure_0_1(
+    return _new_sam_sensor_StaticPressure_0_1(
         static_pressure=static_pressure,
         static_pressure_variance=static_pressure_variance,
     )
@@ -880,7 +1147,7 @@ def battery_state_to_uavcan(src: BatteryState, stats: ConversionStats) -> sam.po
         state_of_charge_pct = 0
     else:
         state_of_charge_pct = round(state_of_charge_pct)
-    return sam.power.BatteryInfo_0_1(
+    return _new_sam_power_BatteryInfo_0_1(
         temperature=temperature,
         voltage=voltage,
         current=current,
@@ -988,7 +1255,7 @@ def battery_info_to_uavcan(src: BatteryInfo, stats: ConversionStats) -> sam.powe
         stats.saturate('battery_info.state_of_charge_pct_stdev')
         state_of_charge_pct_stdev = 127
     model_name = src.model_name.tolist()
-    return sam.power.BatteryInfo_0_1(
+    return _new_sam_power_BatteryInfo_0_1(
         temperature=temperature,
         voltage=voltage,
         current=current,
@@ -1035,7 +1302,7 @@ def thruster_1_rpm_to_uavcan(
     elif rpm < -131072:
         stats.saturate('thruster_1_rpm.rpm')
         rpm = -131072
-    return sam.actuator.ThrusterRPM_0_1(rpm=rpm)
+    return _new_sam_actuator_ThrusterRPM_0_1(rpm=rpm)
 
 
 def thruster_2_rpm_to_ros(
@@ -1067,7 +1334,7 @@ def thruster_2_rpm_to_uavcan(
     elif rpm < -131072:
         stats.saturate('thruster_2_rpm.rpm')
         rpm = -131072
-    return sam.actuator.ThrusterRPM_0_1(rpm=rpm)
+    return _new_sam_actuator_ThrusterRPM_0_1(rpm=rpm)
 
 
 def thrust_vector_to_ros(
@@ -1107,7 +1374,7 @@ def thrust_vector_to_uavcan(
     elif horizontal_radians < -65504.0:
         stats.saturate('thrust_vector.horizontal_radians')
         horizontal_radians = -65504.0
-    return sam.actuator.ThrustVector_0_1(
+    return _new_sam_actuator_ThrustVector_0_1(
         vertical_radians=vertical_radians,
         horizontal_radians=horizontal_radians,
     )
@@ -1148,7 +1415,7 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> sam.actuato
     elif weight_2_offset_radians < -65504.0:
         stats.saturate('ballast.weight_2_offset_radians')
         weight_2_offset_radians = -65504.0
-    return sam.actuator.BallastAngles_0_1(
+    return _new_sam_actuator_BallastAngles_0_1(
         weight_1_offset_radians=weight_1_offset_radians,
         weight_2_offset_radians=weight_2_offset_radians,
     )
@@ -1186,7 +1453,7 @@ def longitudinal_weight_to_uavcan(
     elif percent > 100.0:
         stats.saturate('longitudinal_weight.percent')
         percent = 100.0
-    return sam.actuator.PercentCommand_0_1(percent=percent)
+    return _new_sam_actuator_PercentCommand_0_1(percent=percent)
 
 
 def buoyancy_piston_to_ros(
@@ -1221,7 +1488,7 @@ def buoyancy_piston_to_uavcan(
     elif percent > 100.0:
         stats.saturate('buoyancy_piston.percent')
         percent = 100.0
-    return sam.actuator.PercentCommand_0_1(percent=percent)
+    return _new_sam_actuator_PercentCommand_0_1(percent=percent)
 
 
 def thruster_1_feedback_to_ros(
@@ -1280,8 +1547,8 @@ def thruster_1_feedback_to_uavcan(
     if temperature_c > 127:
         stats.saturate('thruster_1_feedback.temperature_c')
         temperature_c = 127
-    return sam.actuator.ThrusterFeedback_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_actuator_ThrusterFeedback_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         rpm=rpm,
         current=current,
         temperature_c=temperature_c,
@@ -1344,8 +1611,8 @@ def thruster_2_feedback_to_uavcan(
     if temperature_c > 127:
         stats.saturate('thruster_2_feedback.temperature_c')
         temperature_c = 127
-    return sam.actuator.ThrusterFeedback_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_actuator_ThrusterFeedback_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         rpm=rpm,
         current=current,
         temperature_c=temperature_c,
@@ -1403,8 +1670,8 @@ def thrust_vector_feedback_to_uavcan(
     elif horizontal_mrad < -4096:
         stats.saturate('thrust_vector_feedback.horizontal_mrad')
         horizontal_mrad = -4096
-    return sam.actuator.ThrustVectorFeedback_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_actuator_ThrustVectorFeedback_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         vertical_mrad=vertical_mrad,
         horizontal_mrad=horizontal_mrad,
     )
@@ -1458,8 +1725,8 @@ def longitudinal_weight_feedback_to_uavcan(
     if encoder_count > 16777215:
         stats.saturate('longitudinal_weight_feedback.encoder_count')
         encoder_count = 16777215
-    return sam.actuator.PositionFeedback_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_actuator_PositionFeedback_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         percent=percent,
         encoder_count=encoder_count,
     )
@@ -1513,8 +1780,8 @@ def buoyancy_piston_feedback_to_uavcan(
     if encoder_count > 16777215:
         stats.saturate('buoyancy_piston_feedback.encoder_count')
         encoder_count = 16777215
-    return sam.actuator.PositionFeedback_0_1(
-        timestamp=uavcan.time.SynchronizedTimestamp_1_0(microsecond=us),
+    return _new_sam_actuator_PositionFeedback_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
         percent=percent,
         encoder_count=encoder_count,
     )
