@@ -153,6 +153,23 @@ def _parse_params(items: Sequence[str]) -> dict[str, Any]:
     return out
 
 
+def _serve(prog: str, body: Any, errors: tuple[type[BaseException], ...]) -> int:
+    """Run ``body(stop)`` on a fresh loop, `stop` set by SIGINT/SIGTERM; `errors` become one line and exit 1."""
+
+    async def run() -> int:
+        stop = asyncio.Event()
+        _install_stop_handlers(asyncio.get_running_loop(), stop)
+        return int(await body(stop))
+
+    try:
+        return _run_async(run)
+    except errors as ex:
+        print(f"{prog}: {ex}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        return EXIT_OK
+
+
 # ============================================================================================ bridge
 def _bridge_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="sam-bridge", description="The UAVCAN (Cyphal) <-> ROS 2 bridge of the spec.")
@@ -183,9 +200,7 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
     from sam_runtime.genpkg import GeneratedPackageError
     from sam_runtime.transport import TransportConfigError
 
-    async def run() -> int:
-        stop = asyncio.Event()
-        _install_stop_handlers(asyncio.get_running_loop(), stop)
+    async def run(stop: asyncio.Event) -> int:
         bridge = Bridge(
             _generated(args),
             node_id=args.node_id,
@@ -216,13 +231,7 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
                 _write_json_atomic(args.stats_file, snapshot)
         return EXIT_OK
 
-    try:
-        return _run_async(run)
-    except (BridgeConfigError, GeneratedPackageError, TransportConfigError) as ex:
-        print(f"sam-bridge: {ex}", file=sys.stderr)
-        return EXIT_ERROR
-    except KeyboardInterrupt:
-        return EXIT_OK
+    return _serve("sam-bridge", run, (BridgeConfigError, GeneratedPackageError, TransportConfigError))
 
 
 # ============================================================================================ sim
@@ -250,9 +259,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
     from sam_runtime.sim import SimConfig, Simulator
     from sam_runtime.transport import TransportConfigError
 
-    async def run() -> int:
-        stop = asyncio.Event()
-        _install_stop_handlers(asyncio.get_running_loop(), stop)
+    async def run(stop: asyncio.Event) -> int:
         kind = _transport_kind(args)
         cfg = SimConfig(
             kind=kind, iface=args.iface, mtu=args.mtu, environ=dict(os.environ) if kind == "env" else None,
@@ -287,13 +294,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
         print("DONE " + json.dumps({k: v["published"] for k, v in report["devices"].items()}), flush=True)
         return EXIT_OK
 
-    try:
-        return _run_async(run)
-    except (GeneratedPackageError, TransportConfigError, ValueError) as ex:
-        print(f"sam-sim: {ex}", file=sys.stderr)
-        return EXIT_ERROR
-    except KeyboardInterrupt:
-        return EXIT_OK
+    return _serve("sam-sim", run, (GeneratedPackageError, TransportConfigError, ValueError))
 
 
 # ============================================================================================ run
