@@ -41,7 +41,7 @@ def plot(results: dict[str, Any], out: Path) -> Path:
         if sam:
             ax.axhline(sam["build_s"], color="C2", lw=0.8, ls="-.", label=f"SAM spec: {sam['build_s']:.2f} s")
         ax.set_xlabel("message types in the spec (N)")
-        ax.set_ylabel("seconds (median, fresh process)")
+        ax.set_ylabel("seconds (minimum of the runs, fresh process)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
 

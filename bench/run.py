@@ -122,7 +122,7 @@ def markdown(res: dict[str, Any], command: str) -> str:
     gen = res.get("generator")
     if gen:
         lines += ["", "## 1. Generator", "",
-                  f"Median of {gen['method']['reps']} runs, each a fresh process: "
+                  f"Minimum of {gen['method']['reps']} runs (other processes only add time), each a fresh process: "
                   "`sam-codegen build --spec S --out NEW` "
                   "(every file written) against `pycyphal.dsdl.compile` of the DSDL namespace it emitted "
                   "(nunavut 2.3; `uavcan` lookup-only). Synthetic specs: bench/synthetic.py (half derived UAVCAN->ROS "
@@ -138,11 +138,19 @@ def markdown(res: dict[str, Any], command: str) -> str:
         if g:
             lines += ["", "Growth of t(N) - t(1) with N: " + "; ".join(
                 f"{name}: fitted exponent {v['fitted_exponent']} over N = {', '.join(map(str, v['fit_sizes']))} "
-                f"(local {', '.join(f'{k}: {e}' for k, e in v['local_exponents'].items())}), "
+                f"(local {', '.join(f'{k}: {_f(e)}' for k, e in v['local_exponents'].items())}), "
                 f"fixed cost t(1) = {v['fixed_s']:.2f} s" for name, v in g.items())
-                + ". Sizes whose t(N) - t(1) is under 0.25 s (noise of a process start) are left out of the fit."]
+                + ". The fit is weighted by each margin's precision (" + gen["method"].get("fit", "")
+                + "), so the small sizes, whose margins are within a process start's noise, count for little."]
+        by_size = gen.get("stages_by_size") or {}
         st = gen.get("stages_at_largest") or {}
-        if st.get("seconds"):
+        if by_size:
+            sizes = sorted(by_size, key=int)
+            keys = list(dict.fromkeys(k for n in sizes for k in by_size[n]))
+            lines += ["", f"Where the time goes at N = {', '.join(sizes)} (in one process, imports warm):", "",
+                      table(["stage", *(f"s at N = {n}" for n in sizes)],
+                            [[k.strip(), *(_f(by_size[n].get(k)) for n in sizes)] for k in keys])]
+        elif st.get("seconds"):
             lines += ["", f"Where the time goes at N = {st['types']} (in one process, imports warm):", "",
                       table(["stage", "s"], [[k.strip(), f"{v:.2f}"] for k, v in st["seconds"].items()])]
     conv = res.get("converters")
@@ -248,21 +256,16 @@ def notes(res: dict[str, Any]) -> list[str]:
     gen = res.get("generator")
     if gen and gen.get("stages_at_largest", {}).get("seconds"):
         st = gen["stages_at_largest"]["seconds"]
-        yaml_s = next((v for k, v in st.items() if k.startswith("YAML compose (PyYAML")), None)
-        lib_s = next((v for k, v in st.items() if "libyaml" in k), None)
-        ver = next((v for k, v in st.items() if k.startswith("verify_dsdl")), None)
+        top = sorted(st.items(), key=lambda kv: -kv[1])[:3]
+        growth = gen["growth"]["sam-codegen build"]
         out.append(
-            f"- **Generator.** Growth is linear within noise (fitted exponent "
-            f"{gen['growth']['sam-codegen build']['fitted_exponent']}; pycyphal's own compile "
-            f"{gen['growth']['pycyphal compile']['fitted_exponent']}). At {gen['stages_at_largest']['types']} types "
-            f"the two largest stages are pydsdl re-reading the emitted DSDL ({ver} s; pydsdl's fixed-port-id collision "
-            "check is quadratic, the same code pycyphal's compile runs) and PyYAML's pure-Python composer "
-            f"({yaml_s} s; "
-            f"libyaml's composer, which also keeps line/column marks, takes {lib_s} s). Fix (not made: codegen/ is "
-            "not the benchmark's): in codegen/yaml_source.py `load_yaml`, compose with "
-            "`getattr(yaml, 'CSafeLoader', yaml.SafeLoader)`, after checking that tests/test_bad_specs.py's "
-            "YAML-syntax diagnostics keep their positions; `validate.resolve_mapping` scans every device port per "
-            "mapping (quadratic, small at 1000).")
+            f"- **Generator.** Fitted exponent {growth['fitted_exponent']} (local "
+            f"{', '.join(f'{k}: {_f(e)}' for k, e in growth['local_exponents'].items())}); pycyphal's own compile "
+            f"{gen['growth']['pycyphal compile']['fitted_exponent']}. At {gen['stages_at_largest']['types']} types "
+            f"the largest stages are {', '.join(f'{k.strip()} ({v:.2f} s)' for k, v in top)}. pydsdl's namespace "
+            "checks are quadratic (pairwise fixed-port-id check, a scan of every definition per type read), so the "
+            "generator has pydsdl read the emitted DSDL in batches of bounded size (codegen/build.py DSDL_BATCH); "
+            "pycyphal's compile has pydsdl read the whole namespace in one call.")
     conv = res.get("converters")
     if conv:
         s = conv["summary"]

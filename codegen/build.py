@@ -13,7 +13,9 @@ from pathlib import Path
 import pydsdl
 
 from .diagnostics import Diagnostic, Pos, SpecError
+from .model import DsdlStruct
 from .spec_loader import load_spec_file
+from .typesys import DsdlType, split_composite_name
 from .validate import Resolved, validate
 
 Emitter = Callable[[Resolved], dict[str, str]]
@@ -26,27 +28,106 @@ def emitters() -> list[Emitter]:
     return [emit_ros.emit, emit_dsdl.emit, emit_python.emit, emit_docs.emit]
 
 
-def verify_dsdl(resolved: Resolved, files: dict[str, str]) -> None:
-    """Run pydsdl, the reference DSDL front end, over the emitted DSDL; its complaints become spec errors."""
+# pydsdl reads about this many of the spec's types per call. Its namespace-wide passes are O(N^2) in the
+# definitions of one call: every type it reads filters the whole lookup list (every target and lookup
+# definition) for itself and for each type it references, and `_ensure_no_fixed_port_id_collisions` compares
+# every pair of targets. Over a whole 1000-type namespace that was 3-5 s, the largest stage of `build`; in batches
+# of bounded size the cost per type is constant. Each call also costs ~35 ms to list and resolve the lookup
+# namespaces (uavcan, reg), hence batches of 100 rather than smaller. A spec of up to 100 types (SAM has 12) is
+# still read in a single call.
+DSDL_BATCH = 100
+
+
+def verify_dsdl(resolved: Resolved, files: dict[str, str], *, batch: int | None = None) -> None:
+    """Run pydsdl, the reference DSDL front end, over the emitted DSDL; its complaints become spec errors.
+
+    pydsdl reads every emitted type (syntax, bit lengths, extents, references) in batches of about `batch`
+    types (default DSDL_BATCH). A batch reads whole groups of relatives (spec types whose full names differ
+    only by letter case or version), and its temporary tree holds its types, the spec types they reference
+    (transitively) and the relatives of those: so pydsdl's checks between related definitions (names that
+    differ only by letter case; equal extent and sealing across the minor versions of one major version) see
+    the same definitions as over the whole namespace. Its one check between unrelated types, fixed port-id
+    collisions, cannot fail here: batches are used only when every emitted file is a spec type's
+    `Name.MAJOR.MINOR.dsdl`, which carries no fixed port id; any other emitted tree is read in one call.
+    """
+    from .emit_dsdl import dsdl_path
+
     dsdl_files = {path: text for path, text in files.items() if path.startswith("dsdl/")}
     if not dsdl_files:
         return
-    with tempfile.TemporaryDirectory(prefix="sam-dsdl-") as tmp:
-        for path, text in dsdl_files.items():
-            target = Path(tmp, path)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_text(text, encoding="utf-8")
-        root = Path(tmp, "dsdl", resolved.spec.dsdl_root)
+    structs = {struct.name: struct for struct in resolved.dsdl_types}
+    path_of = {name: f"dsdl/{dsdl_path(name)}" for name in structs}
+    lookup = [str(r) for r in resolved.dsdl.roots]
+    with tempfile.TemporaryDirectory(prefix="sam-dsdl-", dir=_scratch_dir()) as tmp:
+        if set(path_of.values()) != set(dsdl_files):  # not one port-id-free file per spec type
+            _read_dsdl(resolved, Path(tmp, "all"), dsdl_files, list(dsdl_files), lookup)
+            return
+        relatives: dict[str, list[str]] = {}  # full name in lower case, without version -> spec types
+        for name in structs:
+            relatives.setdefault(split_composite_name(name)[0].lower(), []).append(name)
+        # A batch takes whole groups of relatives, so that pydsdl reads every version of a type in one call.
+        size = batch or DSDL_BATCH
+        batches: list[list[str]] = [[]]
+        for group in relatives.values():
+            if batches[-1] and len(batches[-1]) + len(group) > size:
+                batches.append([])
+            batches[-1].extend(group)
+        for k, targets in enumerate(batches):
+            needed = _closure(structs, relatives, targets)
+            _read_dsdl(resolved, Path(tmp, f"batch{k}"), {path_of[n]: dsdl_files[path_of[n]] for n in needed},
+                       [path_of[n] for n in targets], lookup)
+
+
+def _scratch_dir() -> str | None:
+    """Where the DSDL copies for pydsdl go: memory (tmpfs) when the system has it, since creating a file on a
+    disk file system cost up to 1 ms each (a second per 1000 types); else the default temporary folder."""
+    shm = "/dev/shm"
+    return shm if os.path.isdir(shm) and os.access(shm, os.W_OK | os.X_OK) else None
+
+
+def _closure(structs: dict[str, DsdlStruct], relatives: dict[str, list[str]], targets: list[str]) -> list[str]:
+    """The spec types a batch needs: its targets, the spec types they reference transitively, and with each the
+    types in `relatives` under its name; targets first, then in the order found."""
+    seen: dict[str, None] = {}
+    stack = list(reversed(targets))
+    while stack:
+        name = stack.pop()
+        if name in seen:
+            continue
+        seen[name] = None
+        stack.extend(relatives[split_composite_name(name)[0].lower()])
+        for f in structs[name].fields:
+            if isinstance(f.type, DsdlType) and f.type.kind == "composite" and f.type.composite in structs:
+                stack.append(f.type.composite)
+    return list(seen)
+
+
+def _read_dsdl(resolved: Resolved, tree: Path, files: dict[str, str], targets: list[str], lookup: list[str]) -> None:
+    """Write `files` (paths dsdl/<root>/...) under `tree` and have pydsdl read `targets` with what they use."""
+    for path, text in files.items():
+        target = tree / path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text, encoding="utf-8")
+    root = tree / "dsdl" / resolved.spec.dsdl_root
+    try:
+        pydsdl.read_files([tree / path for path in targets], [root], lookup)
+    except pydsdl.FrontendError as exc:
+        raise SpecError([_pydsdl_diagnostic(resolved, exc, tree / "dsdl")]) from None
+
+
+def _pydsdl_diagnostic(resolved: Resolved, exc: pydsdl.FrontendError, dsdl_dir: Path) -> Diagnostic:
+    """pydsdl's complaint at the spec position of the type whose file it names."""
+    name = ""
+    if exc.path:
         try:
-            pydsdl.read_namespace(root, [str(r) for r in resolved.dsdl.roots])
-        except pydsdl.FrontendError as exc:
-            name = ""
-            if exc.path:
-                relative = Path(exc.path).resolve().relative_to(Path(tmp, "dsdl").resolve())
-                name = ".".join([*relative.parent.parts, relative.name.removesuffix(".dsdl")])
-            struct = resolved.spec.dsdl_types.get(name)
-            pos = struct.pos if struct else Pos(resolved.spec.file)
-            raise SpecError([Diagnostic(pos, f"DSDL type {name or '?'} is rejected by pydsdl: {exc.text}")]) from None
+            relative = Path(exc.path).resolve().relative_to(dsdl_dir.resolve())
+        except ValueError:  # a file outside the emitted tree (a lookup namespace)
+            relative = None
+        if relative is not None:
+            name = ".".join([*relative.parent.parts, relative.name.removesuffix(".dsdl")])
+    struct = resolved.spec.dsdl_types.get(name)
+    pos = struct.pos if struct else Pos(resolved.spec.file)
+    return Diagnostic(pos, f"DSDL type {name or '?'} is rejected by pydsdl: {exc.text}")
 
 
 def generate(spec_path: Path) -> dict[str, str]:

@@ -17,6 +17,7 @@ import json
 import math
 import re
 import unicodedata
+from collections.abc import Hashable, Iterable
 from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
@@ -198,17 +199,36 @@ class Graph:
     links: list[tuple[str, list[int], int]] = field(default_factory=list)
 
 
-def mapping_devices(spec: Spec, mapping: Mapping) -> list[Device]:
+class PortIndex:
+    """Who uses each subject, built in one pass over the spec: the emitters ask per mapping, topic and subject,
+    and a scan of every device's ports per question made large specs quadratic. Lists keep spec order."""
+
+    def __init__(self, spec: Spec) -> None:
+        self.publishers: dict[int, list[Device]] = {}  # subject id -> devices publishing it, each once
+        self.subscribers: dict[int, list[Device]] = {}
+        self.rates: dict[int, set[float]] = {}  # subject id -> nominal rates of its ports
+        for d in spec.devices.values():
+            for ports, users in ((d.publishes, self.publishers), (d.subscribes, self.subscribers)):
+                for p in ports:
+                    devices = users.setdefault(p.subject_id, [])
+                    if not devices or devices[-1] is not d:
+                        devices.append(d)
+            for p in d.publishes + d.subscribes:
+                self.rates.setdefault(p.subject_id, set()).add(p.rate_hz)
+
+
+def mapping_devices(spec: Spec, mapping: Mapping, index: PortIndex | None = None) -> list[Device]:
     """The devices a mapping reads from (uavcan_to_ros) or commands (ros_to_uavcan)."""
+    index = index if index is not None else PortIndex(spec)
     if mapping.direction == UAVCAN_TO_ROS:
-        candidates = [d for d in spec.devices.values() if any(p.subject_id == mapping.subject_id for p in d.publishes)]
+        candidates = index.publishers.get(mapping.subject_id, [])
         if mapping.source_node_ids:
             return [d for d in candidates if d.node_id in mapping.source_node_ids]
-        return candidates
-    candidates = [d for d in spec.devices.values() if any(p.subject_id == mapping.subject_id for p in d.subscribes)]
+        return list(candidates)
+    candidates = index.subscribers.get(mapping.subject_id, [])
     if mapping.destination_node_id is not None:
         return [d for d in candidates if d.node_id == mapping.destination_node_id]
-    return candidates
+    return list(candidates)
 
 
 def build_graph(resolved: Resolved) -> Graph:
@@ -216,12 +236,17 @@ def build_graph(resolved: Resolved) -> Graph:
     bridge = spec.bridge
     mappings = bridge.mappings if bridge is not None else []
     device_index = {name: i for i, name in enumerate(spec.devices)}
+    ports = PortIndex(spec)
+    devices_of = [mapping_devices(spec, m, ports) for m in mappings]
+    linked_devices: dict[str, list[int]] = {}  # topic -> indexes of the devices its mappings reach
+    for m, devices in zip(mappings, devices_of, strict=True):
+        linked_devices.setdefault(m.topic, []).extend(device_index[d.name] for d in devices)
 
     # Topics: those the bridge links, in the order of the devices they come from or go to, then the rest
     # in spec order; so the bridge's lines run roughly straight across.
     def topic_key(item: tuple[int, str]) -> tuple[int, int, int]:
         index, name = item
-        linked = [device_index[d.name] for m in mappings if m.topic == name for d in mapping_devices(spec, m)]
+        linked = linked_devices.get(name)
         if linked:
             return (0, min(linked), index)
         return (1, 0, index)
@@ -239,17 +264,17 @@ def build_graph(resolved: Resolved) -> Graph:
 
     if bridge is not None:
         b = ("bridge", bridge.name)
-        for m in mappings:
+        for m, devices in zip(mappings, devices_of, strict=True):
             if m.topic not in spec.topics:
                 continue
             t = ("topic", m.topic)
             label = str(m.subject_id)
             if m.direction == UAVCAN_TO_ROS:
-                dev_edges = [add(Edge(UAVCAN_TO_ROS, ("device", d.name), b, label)) for d in mapping_devices(spec, m)]
+                dev_edges = [add(Edge(UAVCAN_TO_ROS, ("device", d.name), b, label)) for d in devices]
                 topic_edge = add(Edge(UAVCAN_TO_ROS, b, t))
             else:
                 topic_edge = add(Edge(ROS_TO_UAVCAN, t, b))
-                dev_edges = [add(Edge(ROS_TO_UAVCAN, b, ("device", d.name), label)) for d in mapping_devices(spec, m)]
+                dev_edges = [add(Edge(ROS_TO_UAVCAN, b, ("device", d.name), label)) for d in devices]
             graph.links.append((m.direction, dev_edges, topic_edge))
     for node in spec.nodes.values():
         for topic in node.subscribes:
@@ -663,26 +688,51 @@ def _field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
     return rows
 
 
+def _users(pairs: Iterable[tuple[str, Iterable[Hashable]]]) -> dict[Hashable, list[str]]:
+    """{thing: the users that name it}, users in the given order and each at most once per thing.
+
+    >>> _users([("a", ["/x", "/y", "/x"]), ("b", ["/x"])])
+    {'/x': ['a', 'b'], '/y': ['a']}
+    """
+    out: dict[Hashable, list[str]] = {}
+    for user, things in pairs:
+        for thing in things:
+            users = out.setdefault(thing, [])
+            if not users or users[-1] != user:
+                users.append(user)
+    return out
+
+
 def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     spec = resolved.spec
     bridge = spec.bridge
     mappings = bridge.mappings if bridge is not None else []
     devices_by_id = spec.devices_by_node_id()
+    # Indexes built once (spec order kept): asking every node, mapping or port per topic, message and subject
+    # made the reference quadratic in the size of the spec.
+    ports = PortIndex(spec)
+    node_publishers = _users((n.name, n.publishes) for n in spec.nodes.values())  # topic -> nodes
+    node_subscribers = _users((n.name, n.subscribes) for n in spec.nodes.values())
+    node_readers = _users((n.name, n.parameters) for n in spec.nodes.values())  # parameter -> nodes
+    topics_of_type = _users((t.name, [t.type]) for t in spec.topics.values())  # ROS type -> topics
+    mappings_of_subject = _users((m.name, [m.subject_id]) for m in mappings)
+    bridged_topics = {(m.topic, m.direction) for m in mappings}
+    bridged_subjects = {(m.subject_id, m.direction) for m in mappings}
 
     topics = []
     for name, t in spec.topics.items():
-        publishers = [n.name for n in spec.nodes.values() if name in n.publishes]
-        subscribers = [n.name for n in spec.nodes.values() if name in n.subscribes]
+        publishers = list(node_publishers.get(name, []))
+        subscribers = list(node_subscribers.get(name, []))
         if bridge is not None:
-            if any(m.topic == name and m.direction == UAVCAN_TO_ROS for m in mappings):
+            if (name, UAVCAN_TO_ROS) in bridged_topics:
                 publishers.append(bridge.name)
-            if any(m.topic == name and m.direction == ROS_TO_UAVCAN for m in mappings):
+            if (name, ROS_TO_UAVCAN) in bridged_topics:
                 subscribers.append(bridge.name)
         topics.append({"name": name, "type": t.type, "section": t.section, "description": t.description,
                        "publishers": publishers, "subscribers": subscribers})
 
     def used_by(full_name: str) -> list[str]:
-        return [t.name for t in spec.topics.values() if t.type == full_name]
+        return list(topics_of_type.get(full_name, []))
 
     messages = []
     for msg in resolved.messages:
@@ -705,7 +755,7 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         parameters.append({
             "name": p.name, "type": p.type, "unit": p.unit, "default": fmt_number(p.default),
             "range": _range(p.minimum, p.maximum), "section": p.section, "description": p.description,
-            "nodes": [n.name for n in spec.nodes.values() if p.name in n.parameters],
+            "nodes": list(node_readers.get(p.name, [])),
         })
     rules = [{"left": r.left, "op": r.op, "right": r.right, "description": r.description,
               "defaults": f"{fmt_number(spec.parameters[r.left].default)} {r.op} "
@@ -718,7 +768,7 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
                   for t in spec.transforms]
 
     def port_mappings(subject_id: int) -> list[str]:
-        return [m.name for m in mappings if m.subject_id == subject_id]
+        return list(mappings_of_subject.get(subject_id, []))
 
     def port_text(port: Port) -> dict[str, object]:
         return {"subject_id": port.subject_id, "type": port.type, "rate": fmt_rate(port.rate_hz)}
@@ -732,15 +782,13 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     subject_types = spec.subject_types()
     subjects = []
     for subject_id in sorted(subject_types):
-        rates = sorted({p.rate_hz for d in spec.devices.values() for p in d.publishes + d.subscribes
-                        if p.subject_id == subject_id})
-        publishers = [d.name for d in spec.devices.values() if any(p.subject_id == subject_id for p in d.publishes)]
-        subscribers = [d.name for d in spec.devices.values()
-                       if any(p.subject_id == subject_id for p in d.subscribes)]
+        rates = sorted(ports.rates.get(subject_id, ()))
+        publishers = [d.name for d in ports.publishers.get(subject_id, [])]
+        subscribers = [d.name for d in ports.subscribers.get(subject_id, [])]
         if bridge is not None:
-            if any(m.subject_id == subject_id and m.direction == ROS_TO_UAVCAN for m in mappings):
+            if (subject_id, ROS_TO_UAVCAN) in bridged_subjects:
                 publishers.append(bridge.name)
-            if any(m.subject_id == subject_id and m.direction == UAVCAN_TO_ROS for m in mappings):
+            if (subject_id, UAVCAN_TO_ROS) in bridged_subjects:
                 subscribers.append(bridge.name)
         subjects.append({"subject_id": subject_id, "type": subject_types[subject_id],
                          "rate": ", ".join(fmt_rate(r) for r in rates), "publishers": publishers,
@@ -753,19 +801,18 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
                 seen[m.subject_id] = {"subject_id": m.subject_id, "type": subject_types.get(m.subject_id, "")}
         return list(seen.values())
 
-    dsdl_users: dict[str, list[str]] = {}
+    dsdl_users: dict[str, dict[str, None]] = {}  # DSDL type -> its subject ids, in order (a dict as ordered set)
     for d in spec.devices.values():
         for p in d.publishes + d.subscribes:
-            dsdl_users.setdefault(p.type, [])
-            if str(p.subject_id) not in dsdl_users[p.type]:
-                dsdl_users[p.type].append(str(p.subject_id))
+            dsdl_users.setdefault(p.type, {})[str(p.subject_id)] = None
+    derived_messages = _users((m.full_name, [m.derived_from]) for m in resolved.messages if m.derived_from)
     dsdl_types = []
     for s in resolved.dsdl_types:
         dsdl_types.append({
             "name": s.name, "description": s.description,
             "layout": "Sealed" if s.sealed else f"Delimited, extent {s.extent} bytes" if s.extent else "Delimited",
-            "subjects": dsdl_users.get(s.name, []),
-            "derived": [m.full_name for m in resolved.messages if m.derived_from == s.name],
+            "subjects": list(dsdl_users.get(s.name, {})),
+            "derived": list(derived_messages.get(s.name, [])),
             "fields": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in s.fields],
             "constants": [{"name": c.name, "type": str(c.type), "value": fmt_number(c.value), "comment": c.comment}
                           for c in s.constants],
@@ -790,7 +837,7 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
             "name": m.name,
             "direction": "UAVCAN → ROS" if m.direction == UAVCAN_TO_ROS else "ROS → UAVCAN",
             "uavcan_to_ros": m.direction == UAVCAN_TO_ROS,
-            "dsdl_type": rm.dsdl_struct.name if rm is not None else spec.subject_types().get(m.subject_id, ""),
+            "dsdl_type": rm.dsdl_struct.name if rm is not None else subject_types.get(m.subject_id, ""),
             "subject_id": m.subject_id,
             "topic": m.topic,
             "ros_type": topic.type if topic is not None else "",
