@@ -116,12 +116,13 @@ class _Names:
     """Local variable names of one function: readable, unique, never shadowing a module name or builtin."""
 
     def __init__(self, reserved: set[str]) -> None:
-        self.taken = set(reserved) | _LOCAL_RESERVED
+        self.reserved = reserved  # the module's names: shared, not copied (one _Names per function)
+        self.taken = set(_LOCAL_RESERVED)
 
     def new(self, hint: str) -> str:
         base = _identifier(hint)
         name, n = base, 2
-        while name in self.taken:
+        while name in self.taken or name in self.reserved:
             name, n = f"{base}_{n}", n + 1
         self.taken.add(name)
         return name
