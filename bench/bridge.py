@@ -647,8 +647,12 @@ def per_message_costs(rig: Rig, n: int = 2000) -> dict[str, float]:
         "generated imu_to_ros": t(lambda: conv.imu_to_ros(src, 1, stats)),
         "  of which sensor_msgs/Imu() construction": t(type(msg)),
     }
+    receive_ns = getattr(rig.bridge, "_receive_ns", None)
+    if receive_ns is not None:
+        out["bridge: receive stamp per message (system clock unless use_sim_time)"] = t(receive_ns)
     if clock is not None:
-        out["bridge: ROS clock now() per message"] = t(lambda: clock.now().nanoseconds)
+        out["  for comparison: rclpy Clock.now() (read only under use_sim_time)"] = t(
+            lambda: clock.now().nanoseconds)
     if pub is not None:
         out["rclpy publish of the Imu (1 subscriber)"] = t(lambda: pub.publish(msg))
     return out
