@@ -292,28 +292,38 @@ def notes(res: dict[str, Any]) -> list[str]:
     udp = br.get("udp") or {}
     if udp.get("throughput"):
         tp = udp["throughput"]
+        steps = udp.get("per_message_us") or {}
+
+        def cpu(run: str, key: str) -> float:
+            return float(tp[run]["cpu_ms_per_1000"].get(key, math.nan))
+
+        def split(direction: str) -> str:
+            b, r = f"{direction}_bridge", f"{direction}_raw"
+            return (f"per message, this process {cpu(b, 'process'):.0f} us against {cpu(r, 'process'):.0f} us raw "
+                    f"(asyncio loop {cpu(b, 'main (asyncio loop)'):.0f} vs {cpu(r, 'main (asyncio loop)'):.0f}, "
+                    f"the bridge's rclpy thread {cpu(b, 'bridge rclpy thread'):.0f}, DDS and I/O threads "
+                    f"{cpu(b, 'other threads'):.0f} vs {cpu(r, 'other threads'):.0f}) plus "
+                    f"{cpu(b, 'ROS process'):.0f} us in the ROS process, which raw does not have")
+
+        publish = steps.get("rclpy publish of the Imu (1 subscriber)", math.nan)
+        convert = steps.get("generated imu_to_ros", math.nan)
         out.append(
-            f"- **Bridge UAVCAN->ROS** ({tp['u2r_ratio']:.2f}x raw on UDP). The bridge's half runs on the asyncio "
-            "loop, which also serves the device publisher here: the loop is the bottleneck (see the CPU split). Per "
-            "message the bridge adds the converter (mostly the Imu constructor), rclpy's publish (C: conversion, CDR, "
-            "Fast DDS write) and the ROS clock read (see the per-message table); the raw path has none of these. "
-            "Small fixes in runtime/bridge.py `_bridge_transfer`: take the receive time with `time.time_ns()` "
-            "instead of `self._clock.now().nanoseconds` (the same value without sim time; ~3 us of object "
-            "creation), and in `_track_transfer_id` use `transfer.timestamp.monotonic_ns * 1e-9` instead of "
-            "`float(transfer.timestamp.monotonic)` (a Decimal).")
-        out.append(
-            f"- **Bridge ROS->UAVCAN** ({tp['r2u_ratio']:.2f}x raw on UDP) is limited by rclpy's Python "
-            "SingleThreadedExecutor in the bridge's rclpy thread (see `bridge rclpy thread` in the CPU split): every "
-            "wake-up rebuilds the wait set from all of the node's entities, including ~36 QoS-event waitables (one "
-            "per publisher/subscription for rclpy's default incompatible-QoS callbacks), and takes one message. "
-            "Profiled fix, sized with `python -m bench.profile_bridge r2u_bridge udp 3 events_executor "
-            "no_qos_events` (monkeypatched in the benchmark process only): in runtime/bridge.py `_start_ros`, "
-            "create the executor as `rclpy.experimental.EventsExecutor(context=self._ros_ctx)` (in this rclpy, "
-            "C++ event queue) and pass `event_callbacks=PublisherEventCallbacks(use_default_callbacks=False)` / "
-            "`SubscriptionEventCallbacks(use_default_callbacks=False)` to create_publisher/create_subscription (or "
-            "keep them and put the sensor publishers on a second node that is never spun): measured 1,250 -> 3,785 "
-            "msg/s on UDP, 0.25x -> ~0.76x raw. Then `_on_ros` -> `call_soon_threadsafe` per message (a self-pipe "
-            "write and a GIL hand-over each) is next: batch through a deque and wake the loop only when it was empty.")
+            f"- **Bridge throughput** (UDP: {tp['u2r_ratio']:.2f}x raw UAVCAN->ROS, {tp['r2u_ratio']:.2f}x "
+            "ROS->UAVCAN). The runs are CPU-bound on the 2 cores, and the ratio follows the CPU each message costs "
+            f"across both processes. UAVCAN->ROS: {split('u2r')}. ROS->UAVCAN: {split('r2u')}. The bridge's own "
+            f"Python per message is small: the converter {convert:.1f} us, the receive stamp "
+            f"{steps.get('bridge: receive stamp per message (system clock unless use_sim_time)', math.nan):.1f} us, "
+            f"its bookkeeping a few us; rclpy's publish alone is {publish:.1f} us, and under load it and Fast DDS's "
+            "threads take several times that (GIL hand-overs between the asyncio loop, the rclpy thread and DDS "
+            "callbacks). What the profiles (`python -m bench.profile_bridge`, `... ab udp` for A/B of the bridge's "
+            "own options) showed and was fixed: the Python executor (now rclpy's EventsExecutor, spinning in 0.1 s "
+            "slices), one loop wake-up per ROS message (now one per batch), the ROS clock read per message (now "
+            "`time.time_ns()` unless use_sim_time), the message constructors (now convert.py's own). What is left "
+            "is the cost of a DDS publication and its delivery to another process, which the raw reference does "
+            "not pay; reaching 0.8x would need the bridge path to cost at most 1.25x the raw pycyphal path, "
+            "i.e. a ROS publish plus delivery in ~25% of what one pycyphal transfer costs in Python. Tried and "
+            "not kept: rclpy without its QoS-event handlers (no gain with the EventsExecutor), Fast DDS "
+            "asynchronous publication mode (slower).")
     can = br.get("can") or {}
     mixes = [b["sensor_mix"] for b in (udp, can) if b.get("sensor_mix")]
     if mixes:
@@ -369,7 +379,7 @@ def main(argv: list[str] | None = None) -> int:
         from bench import generator
 
         log("part 1: generator")
-        res["generator"] = generator.run(reps=1 if args.quick else 3, sizes=(1, 10, 100) if args.quick
+        res["generator"] = generator.run(reps=1 if args.quick else 5, sizes=(1, 10, 100) if args.quick
                                          else generator.SIZES)
     gen = generated_package() if {"converters", "bridge"} & set(parts) else None
     if "converters" in parts:
