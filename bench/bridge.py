@@ -732,7 +732,11 @@ def _summarize_tp(tp: dict[str, list[dict[str, Any]]]) -> dict[str, Any]:
         }
     for d in ("u2r", "r2u"):
         b, r = out[f"{d}_bridge"], out[f"{d}_raw"]
-        out[f"{d}_ratio"] = round(ratio(b["msg_per_s"], r["msg_per_s"]), 3)
+        # Each repetition runs bridge and raw back to back: the ratio of a pair is taken under the same load, and
+        # the median over the pairs is the figure (the machine's load drifts between repetitions).
+        pairs = [ratio(x["msg_per_s"], y["msg_per_s"]) for x, y in zip(tp[f"{d}_bridge"], tp[f"{d}_raw"], strict=True)]
+        out[f"{d}_ratio"] = round(median(pairs), 3)
+        out[f"{d}_ratio_runs"] = [round(x, 3) for x in pairs]
         out[f"{d}_cpu_ratio"] = round(ratio(b["cpu_ms_per_1000"].get("process", 0),
                                             r["cpu_ms_per_1000"].get("process", 0)), 2)
     return out
