@@ -1111,7 +1111,18 @@ class Bridge:
 
     # ------------------------------------------------------------------------------------------ ROS -> UAVCAN
     def _on_ros(self, oms: list[_OutMapping], msg: Any) -> None:
-        """Runs in the rclpy executor thread for every message of a command topic."""
+        """Runs in the rclpy executor thread for every message of a command topic. Never raises: an exception
+        out of a callback would also leave the EventsExecutor's queued messages waiting for the next one."""
+        try:
+            self._hand_off_ros(oms, msg)
+        except Exception as ex:  # a bug: counted and logged, the executor goes on
+            for om in oms:
+                om.stats.drop("handler_error")
+            self._errors["handler_error"] += 1
+            self.log.note((f"topic {oms[0].info.topic.name if oms else '?'}", "handler_error"), logging.ERROR, "%s: %s",
+                          type(ex).__name__, ex)
+
+    def _hand_off_ros(self, oms: list[_OutMapping], msg: Any) -> None:
         loop = self._loop
         for om in oms:
             st = om.stats
@@ -1132,8 +1143,8 @@ class Bridge:
             # flag before it empties the deque, so an object appended after its last look finds the flag clear
             # and schedules the next drain: nothing stays behind. Each object then meets the bounded queue in
             # _enqueue exactly as one call_soon_threadsafe per object did (same order, same drops).
+            assert loop is not None  # (before the append: what fails here is counted, never also delivered)
             self._handoff.append((om, obj))
-            assert loop is not None
             if not self._handoff_scheduled or loop.is_closed():
                 self._handoff_scheduled = True
                 try:

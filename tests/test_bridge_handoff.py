@@ -134,6 +134,25 @@ def test_handoff_after_the_loop_closed_counts_shutdown() -> None:
     assert om.stats.snapshot()["received"] == 3 and _drops(om) == {"shutdown": 3}
 
 
+def test_a_failing_ros_callback_is_counted_and_never_raises() -> None:
+    """A bug inside the hand-off (here: no loop to hand to) must not escape into the rclpy executor, where it
+    would also hold back the messages it has queued: counted as handler_error, and the next message goes on."""
+    bridge, om = _bridge(queue_size=8)
+    bridge._loop = None  # _hand_off_ros asserts a loop
+    bridge._on_ros([om], 1)
+    assert _drops(om) == {"handler_error": 1} and bridge._errors["handler_error"] == 1
+    loop = asyncio.new_event_loop()
+    try:
+        bridge._loop = loop
+        om.queue = asyncio.Queue(maxsize=8)
+        bridge._on_ros([om], 2)
+        loop.run_until_complete(asyncio.sleep(0))
+        assert om.queue.get_nowait() == 2
+    finally:
+        loop.close()
+    assert om.stats.snapshot()["received"] == 2
+
+
 def test_handoff_drained_at_close_counts_shutdown() -> None:
     """What the rclpy thread handed off last, still in the deque when the bridge closes: shutdown."""
     bridge, om = _bridge(queue_size=8)
