@@ -310,7 +310,10 @@ def test_heartbeat_timeout_and_recovery_on_diagnostics(can_run: dict[str, Any]) 
         "device": {k: ph["device"][k] for k in ("alive", "lost_events", "restarts", "uptime_s")}})
     # ERROR on /diagnostics once the last heartbeat is 3 s old (the Cyphal offline timeout), published at once.
     assert 3.0 <= ph["heartbeat_age_when_reported_s"] < 3.6
-    assert 2.0 <= ph["error_after_power_off_s"] <= 3.0 - ph["heartbeat_age_at_power_off_s"] + 0.8
+    # Heartbeats come every 1 s, so the last one was 0-1 s old at power-off: ERROR 2-3 s later, plus latency. (The
+    # probe's own reading of that age comes from a /diagnostics message that may be a publish period old under
+    # load, so it does not tighten this bound; the bridge's own age when it reported, above, is the exact check.)
+    assert 2.0 <= ph["error_after_power_off_s"] <= 3.0 + 0.8
     assert "heartbeat lost" in ph["message_when_lost"]
     assert ph["ok_after_power_on_s"] < 2.0
     assert ph["device"]["alive"] and ph["device"]["restarts"] == 1 and ph["device"]["lost_events"] >= 1
