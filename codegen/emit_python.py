@@ -329,10 +329,6 @@ class _Module:
             return f"{ros_factory_name(self.ros_aliases[t.base])}()"
         return _typed_literal(0, t.base)
 
-    @staticmethod
-    def is_composite(t: DsdlType | RosType) -> bool:
-        return bool(t.composite) if isinstance(t, DsdlType) else not t.is_primitive
-
     def insert(self, root: _Ctor, path: tuple, value: str) -> None:
         """Set the field at `path` (segments (name, index or None)) of the tree under root to `value`."""
         node: Any = root

@@ -948,11 +948,14 @@ class Bridge:
         try:
             self._bridge_transfer(group, msg, transfer)
         except Exception as ex:  # a bug: counted and logged, the receive loop goes on
-            for im in group.mappings:
-                im.stats.drop("handler_error")
-            self._errors["handler_error"] += 1
-            self.log.note((f"subject {group.subject_id}", "handler_error"), logging.ERROR, "%s: %s",
-                          type(ex).__name__, ex)
+            self._handler_failed([im.stats for im in group.mappings], f"subject {group.subject_id}", ex)
+
+    def _handler_failed(self, stats: list[Any], where: str, ex: Exception) -> None:
+        """A receive handler raised (a bug): one handler_error per mapping it serves, and a rate-bounded log line."""
+        for st in stats:
+            st.drop("handler_error")
+        self._errors["handler_error"] += 1
+        self.log.note((where, "handler_error"), logging.ERROR, "%s: %s", type(ex).__name__, ex)
 
     def _track_transfer_id(self, group: _SubjectGroup, src: int, transfer: Any) -> tuple[int, int]:
         """(lost, estimated): transfers lost before this one from ``src`` (a gap in its transfer ids), and, on
@@ -1116,11 +1119,7 @@ class Bridge:
         try:
             self._hand_off_ros(oms, msg)
         except Exception as ex:  # a bug: counted and logged, the executor goes on
-            for om in oms:
-                om.stats.drop("handler_error")
-            self._errors["handler_error"] += 1
-            self.log.note((f"topic {oms[0].info.topic.name if oms else '?'}", "handler_error"), logging.ERROR, "%s: %s",
-                          type(ex).__name__, ex)
+            self._handler_failed([om.stats for om in oms], f"topic {oms[0].info.topic.name if oms else '?'}", ex)
 
     def _hand_off_ros(self, oms: list[_OutMapping], msg: Any) -> None:
         loop = self._loop
