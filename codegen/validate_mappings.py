@@ -1,0 +1,274 @@
+"""Bridge mappings: each `ros_field: uavcan_field` line resolved against both types and the conversion rules,
+and the check that every UAVCAN field of a mapping is mapped, ignored or given a value."""
+
+from __future__ import annotations
+
+import re
+from typing import TypeVar
+
+from .diagnostics import Diagnostics, Pos
+from .dsdl_catalog import DsdlCatalog
+from .mapping_rules import (
+    HEADER,
+    SYNC_TIMESTAMP,
+    TIME,
+    ResolvedMapping,
+    RuleError,
+    Step,
+    auto_links,
+    check_arrays,
+    check_scalar,
+    check_string,
+    format_path,
+    parse_path,
+)
+from .model import Device, DsdlStruct, FieldLink, Mapping, Port, RosMessage, Spec
+from .ros_catalog import RosCatalog
+from .typesys import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from .validate_values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
+
+T = TypeVar("T", RosType, DsdlType)
+
+
+def _indexed(leaf: T, name: str, index: int | None) -> T:
+    """The element type for `name[index]`, which only a fixed-size array allows."""
+    if index is None:
+        return leaf
+    if leaf.array != "fixed":
+        raise RuleError(f"{name}[{index}]: only fixed-size arrays take an index, {name} is {leaf}")
+    if index >= (leaf.capacity or 0):
+        raise RuleError(f"{name}[{index}]: index out of range, {name} has {leaf.capacity} elements")
+    return leaf.element
+
+
+class MappingValidator:
+    """Resolves the bridge's mappings; reports into the run's Diagnostics."""
+
+    def __init__(self, spec: Spec, ros: RosCatalog, dsdl: DsdlCatalog, diag: Diagnostics,
+                 publishers: dict[int, str]) -> None:
+        self.spec, self.ros, self.dsdl, self.diag = spec, ros, dsdl, diag
+        self.publishers = publishers  # subject id -> who publishes it (devices; mappings are added)
+
+    def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
+        self.diag.error(pos, message, expected)
+
+    def resolve_mappings(self) -> list[ResolvedMapping]:
+        s = self.spec
+        if s.bridge is None:
+            return []
+        devices_by_id = s.devices_by_node_id()
+        self.ports_by_subject: dict[int, list[tuple[Device, Port, bool]]] = {}
+        for d in s.devices.values():
+            for p, publishing in [(p, True) for p in d.publishes] + [(p, False) for p in d.subscribes]:
+                self.ports_by_subject.setdefault(p.subject_id, []).append((d, p, publishing))
+        result = []
+        for mapping in s.bridge.mappings:
+            resolved = self.resolve_mapping(mapping, devices_by_id)
+            if resolved is not None:
+                result.append(resolved)
+        return result
+
+    def resolve_mapping(self, mapping: Mapping, devices_by_id: dict) -> ResolvedMapping | None:
+        s, what = self.spec, f"mapping {mapping.name!r}"
+        if not re.fullmatch(r"[a-z][a-z0-9_]*", mapping.name) or not python_safe(mapping.name):
+            self.error(mapping.pos, f"mapping name {mapping.name!r} is not valid", "lower_case identifier")
+        topic = s.topics.get(mapping.topic)
+        if topic is None:
+            self.error(mapping.pos, f"{what} uses undeclared topic {mapping.topic!r}", "a topic of `topics`")
+        if mapping.subject_id not in SUBJECT_IDS:
+            self.error(mapping.pos, f"subject id {mapping.subject_id} of {what} is out of range", "0..8191")
+        ports = self.ports_by_subject.get(mapping.subject_id, [])
+        if not ports:
+            self.error(mapping.pos, f"subject id {mapping.subject_id} of {what} is used by no device",
+                       "a subject a device publishes or subscribes")
+            return None
+        port = ports[0][1]
+        if mapping.direction == "uavcan_to_ros":
+            publishers = {d.node_id for d, _, pub in ports if pub}
+            for node_id in mapping.source_node_ids:
+                if node_id not in CAN_NODE_IDS:
+                    self.error(mapping.pos, f"source node id {node_id} of {what} is out of range", "0..127")
+                elif node_id not in publishers:
+                    owner = devices_by_id.get(node_id)
+                    self.error(mapping.pos, f"source node id {node_id} of {what} does not publish subject "
+                               f"{mapping.subject_id}" + (f" (it is device {owner.name})" if owner else ""),
+                               "the node id of a device that publishes it: " + ", ".join(map(str, sorted(publishers)))
+                               if publishers else "a publishing device")
+        else:
+            dest = mapping.destination_node_id
+            subscribers = {d.node_id for d, _, pub in ports if not pub}
+            if dest is not None and dest not in CAN_NODE_IDS:
+                self.error(mapping.pos, f"destination node id {dest} of {what} is out of range", "0..127")
+            elif dest is not None and dest not in subscribers:
+                self.error(mapping.pos, f"destination node id {dest} of {what} does not subscribe to subject "
+                           f"{mapping.subject_id}", "the node id of a device that subscribes to it")
+            owner = self.publishers.get(mapping.subject_id)
+            if owner is not None:
+                self.error(mapping.pos, f"duplicate subject id {mapping.subject_id}: {what} publishes it but "
+                           f"{owner} does too", "one publisher per subject")
+            self.publishers[mapping.subject_id] = what
+        struct = self.dsdl.get(port.type)
+        ros_message = self.ros.get(topic.type) if topic is not None else None
+        if struct is None or ros_message is None:
+            return None
+        if struct.union:
+            self.error(mapping.pos, f"{what}: union types ({struct.name}) cannot be mapped")
+            return None
+        has_header = any(f.name == "header" and isinstance(f.type, RosType) and f.type.base == HEADER
+                         for f in ros_message.fields)
+        if mapping.frame_id is not None and mapping.frame_id not in s.frames:
+            self.error(mapping.pos, f"frame_id {mapping.frame_id!r} of {what} is not a declared frame",
+                       "one of " + ", ".join(s.frames))
+        if mapping.direction == "uavcan_to_ros" and has_header and mapping.frame_id is None:
+            self.error(mapping.pos, f"{what} publishes {ros_message.full_name}, which has a header: it needs "
+                       "a frame_id")
+        links = auto_links(struct, mapping.pos) if mapping.auto else mapping.links
+        if mapping.auto and ros_message.derived_from != struct.name:
+            self.error(mapping.pos, f"{what} uses `fields: auto`, which needs a ROS message derived from "
+                       f"{struct.name} (topic type is {ros_message.full_name})")
+            return None
+        resolved = ResolvedMapping(mapping, ros_message, struct, has_header=has_header, rate_hz=port.rate_hz)
+        ros_targets: dict[str, Pos] = {}
+        self.failed_paths: set[str] = set()
+        for link in links:
+            step = self.resolve_link(link, ros_message, struct, mapping, what)
+            if step is None:
+                # Its UAVCAN side is reported already; do not report it again as unmapped.
+                if link.uavcan_path:
+                    self.failed_paths.add(link.uavcan_path.split("[")[0].split(".")[0])
+                continue
+            if step.ros in ros_targets:
+                self.error(link.pos, f"ROS field {step.ros!r} is set twice in {what}")
+            ros_targets[step.ros] = link.pos
+            resolved.steps.append(step)
+        for path_text, value in mapping.uavcan_values.items():
+            try:
+                path = parse_path(path_text)
+                leaf = self.dsdl_leaf(struct, path)
+            except RuleError as exc:
+                self.error(mapping.pos, f"uavcan_values of {what}: {exc}")
+                continue
+            check_dsdl_value(self.diag, leaf, value, mapping.pos, f"uavcan value {path_text!r} of {what}")
+            resolved.uavcan_values.append((tuple(path), leaf, value))
+        for ignored in mapping.ignore:
+            try:
+                self.dsdl_leaf(struct, parse_path(ignored), allow_composite=True)
+            except RuleError as exc:
+                self.error(mapping.pos, f"ignore of {what}: {exc}")
+        self.check_coverage(resolved, what)
+        return resolved
+
+    def ros_leaf(self, message: RosMessage, path: list) -> RosType:
+        current: RosMessage | None = message
+        leaf: RosType | None = None
+        for i, (name, index) in enumerate(path):
+            if current is None:
+                raise RuleError(f"{format_path(path[:i])} is a {leaf}, it has no field {name!r}")
+            f = current.field(name)
+            if f is None:
+                raise RuleError(f"{current.full_name} has no field {name!r}")
+            assert isinstance(f.type, RosType)
+            leaf = f.type
+            leaf = _indexed(leaf, name, index)
+            current = None if leaf.is_primitive or leaf.array or leaf.base == TIME else self.ros.get(leaf.base)
+        assert leaf is not None
+        return leaf
+
+    def dsdl_leaf(self, struct: DsdlStruct, path: list, allow_composite: bool = False) -> DsdlType:
+        current: DsdlStruct | None = struct
+        leaf: DsdlType | None = None
+        for i, (name, index) in enumerate(path):
+            if current is None:
+                raise RuleError(f"{format_path(path[:i])} is a {leaf}, it has no field {name!r}")
+            f = current.field(name)
+            if f is None:
+                raise RuleError(f"{current.name} has no field {name!r}")
+            assert isinstance(f.type, DsdlType)
+            leaf = f.type
+            leaf = _indexed(leaf, name, index)
+            current = self.dsdl.get(leaf.composite) if leaf.kind == "composite" and not leaf.array else None
+            if current is not None and current.union:
+                raise RuleError(f"{name} is a union ({current.name}); unions cannot be mapped")
+        assert leaf is not None
+        if leaf.kind == "composite" and not leaf.array and not allow_composite and leaf.composite != SYNC_TIMESTAMP:
+            raise RuleError(f"{format_path(path)} is a composite ({leaf.composite}); map its fields one by one")
+        return leaf
+
+    def resolve_link(self, link: FieldLink, ros_message: RosMessage, struct: DsdlStruct, mapping: Mapping,
+                     what: str) -> Step | None:
+        try:
+            ros_path = parse_path(link.ros_path)
+            ros_type = self.ros_leaf(ros_message, ros_path)
+            if link.value is not None:
+                if mapping.direction == "ros_to_uavcan":
+                    raise RuleError("a `value` sets a ROS field; a ROS->UAVCAN mapping sets UAVCAN fields with "
+                                    "uavcan_values")
+                if ros_type.array or not ros_type.is_primitive:
+                    raise RuleError(f"a `value` sets a primitive field, {link.ros_path} is {ros_type}")
+                check_ros_value(self.diag, ros_type, link.value, link.pos, f"value of {link.ros_path!r}")
+                return Step("value", tuple(ros_path), ros_type, value=link.value, pos=link.pos)
+            assert link.uavcan_path is not None
+            uav_path = parse_path(link.uavcan_path)
+            uav_type = self.dsdl_leaf(struct, uav_path)
+            if uav_type.kind == "composite" and uav_type.composite == SYNC_TIMESTAMP:
+                uav_path.append(("microsecond", None))
+                uav_type = DsdlType("uint", 56, truncated=True)
+            if not ros_type.is_primitive and ros_type.base == TIME and not ros_type.array:
+                if uav_type.kind not in ("uint", "int") or uav_type.array or link.scale or link.table:
+                    raise RuleError(f"builtin_interfaces/Time receives a microsecond integer, not {uav_type}")
+                return Step("time", tuple(ros_path), ros_type, tuple(uav_path), uav_type, pos=link.pos)
+            if not ros_type.is_primitive:
+                raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one")
+            if link.limits is not None and (ros_type.array or ros_type.base not in {*ROS_INT_RANGES, *ROS_FLOAT_BITS}):
+                raise RuleError("limits apply to numeric scalar fields")
+            if uav_type.kind == "utf8" or ros_type.base == "string":
+                exact = check_string(ros_type, uav_type, link)
+                kind = "string"
+            elif uav_type.array or ros_type.array:
+                exact = check_arrays(ros_type, uav_type, link)
+                kind = "array"
+            else:
+                kind, exact = check_scalar(ros_type, uav_type, link)
+            return Step(kind, tuple(ros_path), ros_type, tuple(uav_path), uav_type, link.scale, link.offset,
+                        tuple(sorted((link.table or {}).items())), None, link.limits, exact, link.pos)
+        except RuleError as exc:
+            self.error(link.pos, f"{what}, field {link.ros_path!r}: {exc}")
+            return None
+
+    def dsdl_leaves(self, struct: DsdlStruct, prefix: str = "") -> list[tuple[str, DsdlType]]:
+        leaves: list[tuple[str, DsdlType]] = []
+        for f in struct.fields:
+            assert isinstance(f.type, DsdlType)
+            path = f"{prefix}{f.name}"
+            nested = self.dsdl.get(f.type.composite) if f.type.kind == "composite" and not f.type.array \
+                and f.type.composite else None
+            if nested is not None and not nested.union:
+                leaves.extend(self.dsdl_leaves(nested, path + "."))
+            else:
+                leaves.append((path, f.type))
+        return leaves
+
+    def check_coverage(self, resolved: ResolvedMapping, what: str) -> None:
+        mapping = resolved.mapping
+        linked = {s.uavcan for s in resolved.steps if s.uavcan_path} | self.failed_paths
+        valued = {format_path(list(p)) for p, _, _ in resolved.uavcan_values}
+        ignored = set(mapping.ignore)
+
+        def covered(path: str, t: DsdlType, pool: set[str]) -> bool:
+            if path in pool or any(path.startswith(p + ".") for p in pool):
+                return True
+            return t.array == "fixed" and all(f"{path}[{i}]" in pool for i in range(t.capacity or 0))
+
+        for path, t in self.dsdl_leaves(resolved.dsdl_struct):
+            if mapping.direction == "uavcan_to_ros":
+                if not covered(path, t, linked | ignored):
+                    self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
+                               f"{resolved.dsdl_struct.name} is neither mapped nor ignored in {what}",
+                               f"a `ros_field: {path}` line or `{path}` in ignore")
+            elif not covered(path, t, linked | valued):
+                self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
+                           f"{resolved.dsdl_struct.name} gets no value in {what}",
+                           f"a `ros_field: {path}` line or an entry in uavcan_values")
+        if mapping.direction == "ros_to_uavcan":
+            for path in linked & valued:
+                self.error(mapping.pos, f"UAVCAN field {path!r} is both mapped and in uavcan_values in {what}")
