@@ -29,6 +29,8 @@ from pathlib import Path
 
 from sam_codegen.cyphal_path import CyphalPathError, dsdl_lookup_roots, repo_root
 
+from .nunavut_fix import FIX_VERSION, fix_support
+
 __all__ = [
     "CACHE_ENV_VAR",
     "DsdlCompileError",
@@ -40,7 +42,7 @@ __all__ = [
 
 CACHE_ENV_VAR = "SAM_DSDL_CACHE"
 # Bump when the layout or the compile rule of a cache entry changes.
-_CACHE_FORMAT = "sam-dsdl-cache-1"
+_CACHE_FORMAT = f"sam-dsdl-cache-1;nunavut-fix-{FIX_VERSION}"
 _COMPLETE_MARKER = ".complete"
 _STALE_TMP_AGE_S = 3600.0
 try:
@@ -185,6 +187,7 @@ def _compile_into(out_dir: Path, targets: Sequence[Path], lookups: Sequence[Path
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             pycyphal.dsdl.compile(None, output_directory=out_dir)
+    fix_support(out_dir / "nunavut_support.py")  # narrow signed integer arrays under numpy 2
     return done
 
 
