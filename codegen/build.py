@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import os
 import shutil
@@ -20,6 +21,10 @@ from .validate import Resolved, validate
 
 Emitter = Callable[[Resolved], dict[str, str]]
 MARKER = ".sam-codegen"  # marks a directory as ours, so that a rebuild never replaces someone else's folder
+
+
+class OutputError(Exception):
+    """The output folder cannot be written (not ours, or a file system error); the spec may well be valid."""
 
 
 def emitters() -> list[Emitter]:
@@ -190,31 +195,46 @@ def compare(files: dict[str, str], out_dir: Path) -> Staleness:
 
 def write_atomically(files: dict[str, str], out_dir: Path) -> None:
     """Write the whole tree beside out_dir, then swap it in: a failure leaves the old tree as it was."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OutputError(f"{out_dir} is not a folder; choose an empty or generated output folder")
     if out_dir.exists() and any(out_dir.iterdir()) and not (out_dir / MARKER).exists():
-        raise SpecError([Diagnostic(Pos(str(out_dir)), "refusing to replace a folder that sam-codegen did not "
-                                    f"generate (no {MARKER} marker); choose an empty or generated output folder")])
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}-new-", dir=out_dir.parent))
+        raise OutputError(f"refusing to replace {out_dir}: sam-codegen did not generate it (no {MARKER} "
+                          "marker); choose an empty or generated output folder")
+    try:
+        out_dir.parent.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}-new-", dir=out_dir.parent))
+    except OSError as exc:
+        raise OutputError(f"cannot write {out_dir}: {exc}") from None
+    old = out_dir.with_name(f".{out_dir.name}-old-{os.getpid()}")
+    moved = False
     try:
         for path, text in files.items():
             target = staging / path
             target.parent.mkdir(parents=True, exist_ok=True)
             with open(target, "w", encoding="utf-8", newline="\n") as handle:
                 handle.write(text)
-        old = out_dir.with_name(f".{out_dir.name}-old-{os.getpid()}")
         if out_dir.exists():
             os.rename(out_dir, old)
+            moved = True
         os.rename(staging, out_dir)
-        shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
+    except BaseException as exc:
+        if moved and not out_dir.exists():
+            with contextlib.suppress(OSError):
+                os.rename(old, out_dir)  # the old tree back in place
         shutil.rmtree(staging, ignore_errors=True)
+        if isinstance(exc, OSError):
+            raise OutputError(f"cannot write {out_dir}: {exc}") from None
         raise
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def build(spec_path: Path, out_dir: Path, *, check: bool = False) -> Staleness:
     """Generate from spec_path. With check, compare only; otherwise write when anything differs."""
     files = generate(spec_path)
-    stale = compare(files, out_dir)
+    try:
+        stale = compare(files, out_dir)
+    except OSError as exc:
+        raise OutputError(f"cannot read {out_dir}: {exc}") from None
     if stale and not check:
         write_atomically(files, out_dir)
     return stale

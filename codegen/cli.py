@@ -14,10 +14,13 @@ DEFAULT_OUT = REPO_ROOT / "generated"
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    from .build import build
+    from .build import OutputError, build
 
     try:
         stale = build(Path(args.spec), Path(args.out), check=args.check)
+    except OutputError as exc:
+        print(f"sam-codegen: {exc}", file=sys.stderr)
+        return 1
     except SpecError as exc:
         for diagnostic in exc.diagnostics:
             print(diagnostic, file=sys.stderr)

@@ -153,6 +153,8 @@ def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
     notes: list[str] = []
     if step.kind == "table":
         pairs = ", ".join(f"{k}: {v}" for k, v in step.table)
+        if to_ros and step.table_default is not None:  # the inverse rejects what has no key
+            pairs += f", default: {step.table_default}"
         text += f" table {{{pairs}}}" if to_ros else f" inverse of table {{{pairs}}}"
         if not step.exact:
             notes.append("not one to one")
@@ -813,7 +815,8 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
             "layout": "Sealed" if s.sealed else f"Delimited, extent {s.extent} bytes" if s.extent else "Delimited",
             "subjects": list(dsdl_users.get(s.name, {})),
             "derived": list(derived_messages.get(s.name, [])),
-            "fields": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in s.fields],
+            "fields": [{"name": f.name, "type": str(f.type), "comment": f.comment or ("padding" if not f.name else "")}
+                       for f in s.declared_fields],
             "constants": [{"name": c.name, "type": str(c.type), "value": fmt_number(c.value), "comment": c.comment}
                           for c in s.constants],
         })

@@ -465,7 +465,8 @@ class _MappingEmitter:
         if s.kind == "table":
             var = names.new(s.ros)
             table = self.module_table(s, "to_ros")
-            statements.append(_st("table", var=var, table=table, read=read, key=pol.key))
+            default = None if s.table_default is None else py_literal(s.table_default)
+            statements.append(_st("table", var=var, table=table, read=read, key=pol.key, default=default))
             return [(s.ros_path, var)]
         if s.kind == "string":
             return [(s.ros_path, f"{read}.tobytes().decode(errors='replace')")]
@@ -633,7 +634,7 @@ class _MappingEmitter:
         if s.kind == "table":
             var = names.new(s.uavcan)
             table = self.module_table(s, "to_uavcan")
-            statements.append(_st("table", var=var, table=table, read=read, key=pol.key))
+            statements.append(_st("table", var=var, table=table, read=read, key=pol.key, default=None))
             return var
         if s.kind == "string":
             var = names.new(s.uavcan)

@@ -142,6 +142,7 @@ class Step:
     scale: float | None = None
     offset: float | None = None
     table: tuple[tuple[int, int], ...] = ()
+    table_default: int | None = None  # UAVCAN -> ROS: the ROS value of every key the table does not list
     value: Scalar | None = None
     limits: tuple[float, float] | None = None
     exact: bool = True  # UAVCAN -> ROS -> UAVCAN gives the value back
@@ -190,6 +191,8 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
                 raise RuleError(f"table key {key} is outside the range of {uav} [{lo}, {hi}]")
             if not ros_lo <= value <= ros_hi:
                 raise RuleError(f"table value {value} is outside the range of {ros_base}")
+        if link.table_default is not None and not ros_lo <= link.table_default <= ros_hi:
+            raise RuleError(f"table default {link.table_default} is outside the range of {ros_base}")
         injective = len(set(link.table.values())) == len(link.table)
         return "table", injective and len(link.table) == hi - lo + 1
     if uav.kind == "bool":
@@ -236,6 +239,25 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
             link.scale is None or mantissa[ROS_FLOAT_BITS[ros_base]] >= mantissa.get(uav.bits, 53) + 2)
         return "number", exact
     raise RuleError(f"UAVCAN {uav} cannot be linked to a ROS field")
+
+
+def missing_table_keys(uav: DsdlType, keys: set[int], shown: int = 5) -> tuple[int, list[int]]:
+    """How many values of the integer type `uav` are not among `keys`, and the first `shown` of them.
+
+    >>> missing_table_keys(DsdlType("uint", 2), {0, 1})
+    (2, [2, 3])
+    >>> missing_table_keys(DsdlType("int", 16), {0}, 3)
+    (65535, [-32768, -32767, -32766])
+    """
+    lo, hi = uav.range
+    count = hi - lo + 1 - sum(1 for k in keys if lo <= k <= hi)
+    first: list[int] = []
+    value = lo
+    while len(first) < min(shown, count):
+        if value not in keys:
+            first.append(value)
+        value += 1
+    return count, first
 
 
 def check_string(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:

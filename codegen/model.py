@@ -58,7 +58,7 @@ class DsdlStruct:
     """A DSDL composite type: one of the spec's own, or a standard one read from CYPHAL_PATH."""
 
     name: str  # full name with version: sam.sensor.RawIMU.0.1
-    fields: list[Field]
+    fields: list[Field]  # the data fields: void padding left out, as pydsdl's fields_except_padding
     constants: list[Constant] = field(default_factory=list)
     description: str = ""
     sealed: bool = True
@@ -66,6 +66,13 @@ class DsdlStruct:
     standard: bool = False
     union: bool = False
     pos: Pos = NOWHERE
+    # Every field as declared, void padding (no name) included; empty when the type has no padding.
+    layout: list[Field] = field(default_factory=list)
+
+    @property
+    def declared_fields(self) -> list[Field]:
+        """The fields in declaration order with the padding between them: what the DSDL definition lists."""
+        return self.layout or self.fields
 
     @property
     def full_name(self) -> str:
@@ -163,6 +170,7 @@ class FieldLink:
     scale: float | None = None
     offset: float | None = None
     table: dict[int, int] | None = None
+    table_default: int | None = None  # the ROS value of every UAVCAN value the table does not list
     value: Scalar | None = None
     limits: tuple[float, float] | None = None
     pos: Pos = NOWHERE

@@ -28,7 +28,7 @@ from .model import (
     Topic,
     Transform,
 )
-from .typesys import parse_dsdl_type, parse_ros_type
+from .typesys import DsdlType, parse_dsdl_type, parse_ros_type
 from .yaml_source import YMap, YNode, YScalar, YSeq, load_yaml
 
 T = TypeVar("T")
@@ -147,11 +147,24 @@ _CONST_KEYS = ("name", "type", "value", "comment")
 
 
 def _fields(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics) -> list[Field]:
+    """The fields of a message or DSDL type; DSDL void padding comes as a Field without a name."""
     result = []
     for item in _list(node, f"the fields of {what}", diag):
         r = _Reader(item, f"a field of {what}", diag, _FIELD_KEYS)
-        name, type_text = r.get("name", str), r.get("type", str)
+        type_text = r.get("type", str)
         type_ = _parse_type(type_text, r.key_pos("type"), parse, diag)
+        if type_ is None and parse is parse_dsdl_type and str(type_text).strip().startswith("void"):
+            continue  # padding with a bad type (reported): it has no name to miss
+        if isinstance(type_, DsdlType) and type_.kind == "void":
+            # DSDL padding has no name (`void3`); it is kept for the layout and mapped by no one.
+            if r.node("name") is not None:
+                diag.error(r.key_pos("name"), f"void padding in {what} has no name in DSDL",
+                           f"{{type: {type_}}} without a name")
+            if r.node("default") is not None:
+                diag.error(r.key_pos("default"), f"void padding in {what} has no value")
+            result.append(Field("", type_, _text(r, "comment"), item.pos))
+            continue
+        name = r.get("name", str)
         default = r.get("default", (bool, int, float, str), None)
         if name is not None and type_ is not None:
             result.append(Field(name, type_, _text(r, "comment"), item.pos, default))
@@ -200,10 +213,11 @@ def _dsdl_struct(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> DsdlStru
         diag.error(pos, f"{what} needs `sealed: true` or `extent: <bytes>`", "sealed or extent (DSDL requires one)")
     if sealed and extent is not None:
         diag.error(r.key_pos("extent"), f"{what} cannot be both sealed and have an extent")
-    fields = _fields(r.node("fields"), what, parse_dsdl_type, diag)
+    layout = _fields(r.node("fields"), what, parse_dsdl_type, diag)
+    fields = [f for f in layout if f.name]
     return DsdlStruct(
         key, fields, _constants(r.node("constants"), what, parse_dsdl_type, diag),
-        _text(r, "description"), bool(sealed), extent, pos=pos,
+        _text(r, "description"), bool(sealed), extent, pos=pos, layout=layout if len(fields) < len(layout) else [],
     )
 
 
@@ -240,10 +254,13 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
     if table_node is not None:
         table: dict[int, int] = {}
         for key, key_pos, value_node in _items(table_node, f"'table' of {what}", diag):
+            if key == "default":  # every UAVCAN value the table does not list
+                link.table_default = scalar(value_node, int, f"table default of {what}", diag)
+                continue
             try:
                 source = int(key)
             except ValueError:
-                diag.error(key_pos, f"table key {key!r} of {what} is not an integer")
+                diag.error(key_pos, f"table key {key!r} of {what} is not an integer", "an integer or `default`")
                 continue
             target = scalar(value_node, int, f"table value of {what}", diag)
             if target is not None:

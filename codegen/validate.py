@@ -49,6 +49,9 @@ class _Validator:
     def __init__(self, spec: Spec, ros: RosCatalog, dsdl: DsdlCatalog) -> None:
         self.spec, self.ros, self.dsdl = spec, ros, dsdl
         self.diag = Diagnostics()
+        # What is reported broken already, so that the checks which use it add no follow-on errors:
+        self.bad_dsdl_fields: set[tuple[str, str]] = set()  # (DSDL type, field)
+        self.failed_messages: set[str] = set()  # derived ROS messages that could not be derived
 
     def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
         self.diag.error(pos, message, expected)
@@ -129,22 +132,26 @@ class _Validator:
         if struct.extent is not None and not 0 < struct.extent <= 65535:
             self.error(struct.pos, f"extent of {what} must be 1..65535 bytes")
         seen: set[str] = set()
+        fields = {id(f) for f in struct.fields}
         for f in [*struct.fields, *struct.constants]:
+            bad = False
             if not is_dsdl_identifier(f.name) or not _python_safe(f.name):
                 self.error(f.pos, f"{f.name!r} is not a valid DSDL identifier in {what}",
                            "letters, digits and underscores, not reserved (e.g. uint8, bool, saturated) "
                            "nor a Python keyword")
+                bad = True
             if f.name in seen:
                 self.error(f.pos, f"{f.name!r} appears twice in {what}")
+                bad = True
             seen.add(f.name)
-        for f in struct.fields:
+            if bad and id(f) in fields:
+                self.bad_dsdl_fields.add((struct.name, f.name))
+        for f in struct.fields:  # void padding is not among them: it is only emitted
             assert isinstance(f.type, DsdlType)
-            if f.type.kind == "void":
-                self.error(f.pos, f"field {f.name!r} of {what}: void padding is not supported",
-                           "a named field; sealed types are bit-packed")
             if f.type.kind == "composite" and f.type.composite and self.dsdl.get(f.type.composite) is None:
                 self.error(f.pos, f"unknown DSDL type {f.type.composite!r} in {what}",
                            "a type of this spec or of CYPHAL_PATH (uavcan.*, reg.*)")
+                self.bad_dsdl_fields.add((struct.name, f.name))
         for c in struct.constants:
             assert isinstance(c.type, DsdlType)
             check_dsdl_value(self.diag, c.type, c.value, c.pos, f"constant {c.name} of {what}")
@@ -158,11 +165,13 @@ class _Validator:
             if struct is None:
                 self.error(message.pos, f"message {message.full_name} derives from unknown DSDL type "
                            f"{message.derived_from!r}")
+                self.failed_messages.add(message.full_name)
                 continue
             try:
                 derived = derive_message(struct, message.package, message.name, message.description, message.pos)
             except RuleError as exc:
                 self.error(message.pos, str(exc))
+                self.failed_messages.add(message.full_name)
                 continue
             self.spec.messages[message.full_name] = derived
         for message in self.spec.external_messages.values():
@@ -299,7 +308,8 @@ class _Validator:
         self.publishers = publishers
 
     def resolve_mappings(self) -> list[ResolvedMapping]:
-        return MappingValidator(self.spec, self.ros, self.dsdl, self.diag, self.publishers).resolve_mappings()
+        return MappingValidator(self.spec, self.ros, self.dsdl, self.diag, self.publishers,
+                                self.bad_dsdl_fields, self.failed_messages).resolve_mappings()
 
 
 def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots: list[Path] | None = None

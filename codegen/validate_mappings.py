@@ -20,6 +20,7 @@ from .mapping_rules import (
     check_scalar,
     check_string,
     format_path,
+    missing_table_keys,
     parse_path,
 )
 from .model import Device, DsdlStruct, FieldLink, Mapping, Port, RosMessage, Spec
@@ -28,6 +29,10 @@ from .typesys import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from .validate_values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
 T = TypeVar("T", RosType, DsdlType)
+
+
+class _Reported(RuleError):
+    """The path runs into a type that is reported broken already: the link adds no error of its own."""
 
 
 def _indexed(leaf: T, name: str, index: int | None) -> T:
@@ -45,9 +50,13 @@ class MappingValidator:
     """Resolves the bridge's mappings; reports into the run's Diagnostics."""
 
     def __init__(self, spec: Spec, ros: RosCatalog, dsdl: DsdlCatalog, diag: Diagnostics,
-                 publishers: dict[int, str]) -> None:
+                 publishers: dict[int, str], bad_dsdl_fields: set[tuple[str, str]] | None = None,
+                 failed_messages: set[str] | None = None) -> None:
         self.spec, self.ros, self.dsdl, self.diag = spec, ros, dsdl, diag
         self.publishers = publishers  # subject id -> who publishes it (devices; mappings are added)
+        # Reported already (with their declarations): no follow-on errors about them.
+        self.bad_dsdl_fields = bad_dsdl_fields or set()  # (DSDL type, field)
+        self.failed_messages = failed_messages or set()  # ROS messages whose derive_from failed
 
     def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
         self.diag.error(pos, message, expected)
@@ -111,6 +120,8 @@ class MappingValidator:
         ros_message = self.ros.get(topic.type) if topic is not None else None
         if struct is None or ros_message is None:
             return None
+        if ros_message.full_name in self.failed_messages:
+            return None  # its fields are unknown: every line would be a follow-on error
         if struct.union:
             self.error(mapping.pos, f"{what}: union types ({struct.name}) cannot be mapped")
             return None
@@ -145,16 +156,25 @@ class MappingValidator:
             try:
                 path = parse_path(path_text)
                 leaf = self.dsdl_leaf(struct, path)
+            except _Reported:
+                self.failed_paths.add(path_text.split("[")[0].split(".")[0])
+                continue
             except RuleError as exc:
                 self.error(mapping.pos, f"uavcan_values of {what}: {exc}")
                 continue
             check_dsdl_value(self.diag, leaf, value, mapping.pos, f"uavcan value {path_text!r} of {what}")
             resolved.uavcan_values.append((tuple(path), leaf, value))
+        self.ignored: set[str] = set()
         for ignored in mapping.ignore:
             try:
-                self.dsdl_leaf(struct, parse_path(ignored), allow_composite=True)
+                path = parse_path(ignored)
+                self.dsdl_leaf(struct, path, allow_composite=True)
+            except _Reported:
+                self.ignored.add(ignored.split("[")[0].split(".")[0])
             except RuleError as exc:
                 self.error(mapping.pos, f"ignore of {what}: {exc}")
+            else:
+                self.ignored.add(format_path(path))
         self.check_coverage(resolved, what)
         return resolved
 
@@ -170,7 +190,10 @@ class MappingValidator:
             assert isinstance(f.type, RosType)
             leaf = f.type
             leaf = _indexed(leaf, name, index)
-            current = None if leaf.is_primitive or leaf.array or leaf.base == TIME else self.ros.get(leaf.base)
+            nested = not (leaf.is_primitive or leaf.array or leaf.base == TIME)
+            current = self.ros.get(leaf.base) if nested else None
+            if nested and (current is None or current.full_name in self.failed_messages):
+                raise _Reported(f"{leaf.base} is unknown or could not be derived")  # reported with the type
         assert leaf is not None
         return leaf
 
@@ -187,6 +210,8 @@ class MappingValidator:
             leaf = f.type
             leaf = _indexed(leaf, name, index)
             current = self.dsdl.get(leaf.composite) if leaf.kind == "composite" and not leaf.array else None
+            if current is None and leaf.kind == "composite" and not leaf.array:
+                raise _Reported(f"unknown DSDL type {leaf.composite}")  # reported with the field's declaration
             if current is not None and current.union:
                 raise RuleError(f"{name} is a union ({current.name}); unions cannot be mapped")
         assert leaf is not None
@@ -229,46 +254,64 @@ class MappingValidator:
                 kind = "array"
             else:
                 kind, exact = check_scalar(ros_type, uav_type, link)
+            if kind == "table" and mapping.direction == "uavcan_to_ros" and link.table_default is None:
+                self.check_table_covers(uav_type, link, what)
             return Step(kind, tuple(ros_path), ros_type, tuple(uav_path), uav_type, link.scale, link.offset,
-                        tuple(sorted((link.table or {}).items())), None, link.limits, exact, link.pos)
+                        tuple(sorted((link.table or {}).items())), link.table_default, None, link.limits, exact,
+                        link.pos)
+        except _Reported:
+            return None
         except RuleError as exc:
             self.error(link.pos, f"{what}, field {link.ros_path!r}: {exc}")
             return None
 
-    def dsdl_leaves(self, struct: DsdlStruct, prefix: str = "") -> list[tuple[str, DsdlType]]:
-        leaves: list[tuple[str, DsdlType]] = []
+    def check_table_covers(self, uav: DsdlType, link: FieldLink, what: str) -> None:
+        """A UAVCAN -> ROS table must say what every value the device may send becomes; a value it misses
+        would drop the whole message at run time."""
+        count, first = missing_table_keys(uav, set(link.table or {}))
+        if count:
+            listed = ", ".join(map(str, first)) + (", ..." if count > len(first) else "")
+            total = uav.range[1] - uav.range[0] + 1
+            self.error(link.pos, f"{what}, field {link.ros_path!r}: the table has no entry for {count} of the "
+                       f"{total} values of {uav} ({listed}); a message carrying one would be dropped",
+                       "an entry for each value, or `default: <ROS value>` for the values it does not list")
+
+    def uncovered(self, struct: DsdlStruct, prefix: str, pool: set[str]) -> list[tuple[str, DsdlType]]:
+        """The fields of `struct` (paths under `prefix`) that `pool` leaves without a value, each as large as
+        possible: a field or array element under which the pool has no path is one entry, whole."""
+        result: list[tuple[str, DsdlType]] = []
         for f in struct.fields:
             assert isinstance(f.type, DsdlType)
-            path = f"{prefix}{f.name}"
-            nested = self.dsdl.get(f.type.composite) if f.type.kind == "composite" and not f.type.array \
-                and f.type.composite else None
-            if nested is not None and not nested.union:
-                leaves.extend(self.dsdl_leaves(nested, path + "."))
-            else:
-                leaves.append((path, f.type))
-        return leaves
+            if (struct.name, f.name) not in self.bad_dsdl_fields:  # reported with its declaration
+                result.extend(self.uncovered_at(prefix + f.name, f.type, pool))
+        return result
+
+    def uncovered_at(self, path: str, t: DsdlType, pool: set[str]) -> list[tuple[str, DsdlType]]:
+        if path in pool:
+            return []
+        if not any(p.startswith((path + ".", path + "[")) for p in pool):
+            return [(path, t)]
+        if t.array == "fixed":  # some elements (or their fields) are covered: look at each
+            return [u for i in range(t.capacity or 0) for u in self.uncovered_at(f"{path}[{i}]", t.element, pool)]
+        nested = self.dsdl.get(t.composite) if t.kind == "composite" and not t.array and t.composite else None
+        if nested is not None:
+            return self.uncovered(nested, path + ".", pool)
+        return [(path, t)]
 
     def check_coverage(self, resolved: ResolvedMapping, what: str) -> None:
         mapping = resolved.mapping
         linked = {s.uavcan for s in resolved.steps if s.uavcan_path} | self.failed_paths
         valued = {format_path(list(p)) for p, _, _ in resolved.uavcan_values}
-        ignored = set(mapping.ignore)
-
-        def covered(path: str, t: DsdlType, pool: set[str]) -> bool:
-            if path in pool or any(path.startswith(p + ".") for p in pool):
-                return True
-            return t.array == "fixed" and all(f"{path}[{i}]" in pool for i in range(t.capacity or 0))
-
-        for path, t in self.dsdl_leaves(resolved.dsdl_struct):
-            if mapping.direction == "uavcan_to_ros":
-                if not covered(path, t, linked | ignored):
-                    self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
-                               f"{resolved.dsdl_struct.name} is neither mapped nor ignored in {what}",
-                               f"a `ros_field: {path}` line or `{path}` in ignore")
-            elif not covered(path, t, linked | valued):
+        struct = resolved.dsdl_struct
+        if mapping.direction == "uavcan_to_ros":
+            for path, t in self.uncovered(struct, "", linked | self.ignored):
                 self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
-                           f"{resolved.dsdl_struct.name} gets no value in {what}",
+                           f"{struct.name} is neither mapped nor ignored in {what}",
+                           f"a `ros_field: {path}` line or `{path}` in ignore")
+        else:
+            for path, t in self.uncovered(struct, "", linked | valued):
+                self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
+                           f"{struct.name} gets no value in {what}",
                            f"a `ros_field: {path}` line or an entry in uavcan_values")
-        if mapping.direction == "ros_to_uavcan":
-            for path in linked & valued:
+            for path in sorted(linked & valued):
                 self.error(mapping.pos, f"UAVCAN field {path!r} is both mapped and in uavcan_values in {what}")

@@ -12,8 +12,9 @@ A ROS package installed outside the venv is only usable by a process started wit
 started with ``ros_runtime_env(prefix)`` and ``SAM_CONVERTERS_WORKER`` set to the build's description. In
 worker mode the module defines the round-trip tests (hypothesis) and the spec-specific checks; in the parent
 they do not exist and one test per spec starts the child and shows its report when it fails.
-Two specs are exercised: the SAM spec and tests/specs/rover.yaml (other widths, utf8/byte arrays, a nested
-composite, a derived message, both out-of-range policies, uavcan_values).
+Three specs are exercised: the SAM spec, tests/specs/rover.yaml (other widths, utf8/byte arrays, a nested
+composite, a derived message, both out-of-range policies, uavcan_values) and tests/specs/tractor.yaml (void
+padding, int3/int5/int7 arrays, per-element links into fixed arrays of composites, a table with a default).
 """
 
 from __future__ import annotations
@@ -39,7 +40,8 @@ from sam_codegen.spec_loader import load_spec_file
 from sam_codegen.validate import Resolved, validate
 
 ROOT = Path(__file__).resolve().parents[1]
-SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "rover": Path(__file__).resolve().parent / "specs" / "rover.yaml"}
+SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "rover": Path(__file__).resolve().parent / "specs" / "rover.yaml",
+         "tractor": Path(__file__).resolve().parent / "specs" / "tractor.yaml"}
 WORKER_ENV = "SAM_CONVERTERS_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
 
@@ -380,7 +382,8 @@ if WORKER:
         scale = abs(s.scale) if s.scale is not None else 1.0
         v = abs(x - (s.offset or 0.0)) / scale
         if uav.kind in ("int", "uint", "byte"):
-            q = 0.5 if (s.scale is not None or s.offset is not None) else 0.0
+            # a fraction (scaled, or a ROS float) is rounded to the nearest integer
+            q = 0.5 if (s.scale is not None or s.offset is not None or s.ros_type.base.startswith("float")) else 0.0
         else:
             q = {16: v * 2**-11 + 2**-25, 32: v * 2**-24 + 2**-150}.get(uav.bits, v * 2**-53)
         ros_rounding = abs(x) * 2**-24 if s.ros_type.base == "float32" else abs(x) * 2**-52
@@ -715,3 +718,48 @@ if WORKER:
             thermo = convert.temperature_to_ros(rover.sensor.Thermo_1_0(temperature_dk=2981), RECEIVE_NS, stats)
             assert thermo.temperature == pytest.approx(24.95)
             assert convert.temperature_to_uavcan(thermo, stats).temperature_dk == 2981
+
+    # ---------------------------------------------------------------------------------------- tractor checks
+
+    if SPEC_NAME == "tractor":
+        import tractor.hitch
+        from tractor_msgs.msg import HitchCommand, Section
+
+        def hitch_status(**fields: Any) -> Any:
+            sections = [tractor.hitch.Section_1_0(rate=100 * (i + 1), open_=i != 1) for i in range(3)]
+            values = {"state": 1, "tilt": [-16, -1, 0, 15], "trim": [-4, 3, 0, -1], "sections": sections, **fields}
+            return dsdl_wire(tractor.hitch.Status_1_0(**values))
+
+        def test_table_default_takes_the_values_the_table_does_not_list() -> None:
+            stats = convert.ConversionStats()
+            got = {state: convert.hitch_status_to_ros(hitch_status(state=state), RECEIVE_NS, stats).state
+                   for state in range(8)}
+            assert got == {0: 0, 1: 1, 2: 2, 3: 3, 4: -1, 5: -1, 6: -1, 7: -1}
+            assert not stats.rejected and not stats.saturated  # nothing dropped: the default says what they are
+            msg = convert.hitch_status_to_ros(hitch_status(state=5), RECEIVE_NS, stats)
+            assert dsdl_wire(convert.hitch_status_to_uavcan(msg, stats)).state == 7  # -1: its first key
+
+        def test_narrow_signed_arrays_and_elements_of_composite_arrays() -> None:
+            stats = convert.ConversionStats()
+            msg = ros_wire(convert.hitch_status_to_ros(hitch_status(), RECEIVE_NS, stats))
+            assert list(msg.tilt) == [-16, -1, 0, 15] and list(msg.trim) == [-4, 3, 0, -1]
+            assert (msg.left.rate, msg.left.open, msg.right_rate) == (100, True, 300)
+            back = dsdl_wire(convert.hitch_status_to_uavcan(msg, stats))
+            assert back.tilt.tolist() == [-16, -1, 0, 15] and back.trim.tolist() == [-4, 3, 0, -1]
+            assert [(s.rate, s.open_) for s in back.sections] == [(100, True), (0, False), (300, False)]
+            assert not stats.rejected and not stats.saturated
+
+        def test_command_per_element_links_values_and_saturation() -> None:
+            stats = convert.ConversionStats()
+            cmd = HitchCommand(lift_pct=42.4, offsets=[-64, -1, 63], mode=-1,
+                               sections=[Section(rate=4000, open=True), Section(rate=5000, open=False)])
+            out = dsdl_wire(convert.hitch_command_to_uavcan(cmd, stats))
+            assert (out.lift_pct, out.offsets.tolist(), out.mode) == (42, [-64, -1, 63], 3)
+            assert [(s.rate, s.open_) for s in out.sections] == [(4000, True), (4095, True)]  # uavcan_values
+            assert stats.saturated == {"hitch_command.sections[1].rate": 1} and not stats.rejected
+            cmd.offsets = [-100, 100]
+            out = dsdl_wire(convert.hitch_command_to_uavcan(cmd, stats))
+            assert out.offsets.tolist() == [-64, 63] and stats.saturated["hitch_command.offsets"] == 1
+            cmd.mode = 5  # no key gives ROS 5: the command is rejected, not guessed
+            assert convert.hitch_command_to_uavcan(cmd, stats) is None
+            assert stats.rejected == {"hitch_command.mode": 1}
