@@ -5,14 +5,20 @@
 - Values: a generic generator fills every field of any DSDL type from its pydsdl model (slow sines within
   the field's range, timestamps in microseconds, composites recursively), so any spec gets plausible,
   changing data. Where the type is known, a small physics table (:data:`PHYSICS`, keyed by the type name
-  without its root namespace, e.g. ``sensor.RawIMU``) overrides the fields with the SAM models: IMU at rest
-  with gravity and noise, a slowly rotating ~0.5 G magnetic field, a GNSS fix at the surface near KTH, the
-  pressure at a depth that oscillates 0..10 m, a discharging battery, actuators moving toward their
-  commanded values at a finite rate.
+  without its root namespace, e.g. ``sensor.RawIMU``) overrides the fields with measurements of one shared
+  simulated vehicle (:mod:`sam_runtime.vehicle`): IMU, magnetometer, pressure, altimeter, GNSS (a fix only at
+  the surface), battery, and the actuators' feedback.
+- One vehicle: the SAM actuator devices (:data:`SAM_ACTUATORS`, by device name) drive the model's inputs; the
+  model moves toward them at finite rates and integrates in fixed 10 ms steps up to the time a device reads it,
+  so a seed and a command sequence give one trajectory. Devices of other specs keep their own simple feedback
+  model (moving toward the last command at a finite rate).
 - Actuators accept commands only from the bridge's node id; commands from any other node are counted and
-  ignored. The last accepted command drives the device's feedback model.
+  ignored.
 - Timestamps: microseconds on a monotonic clock whose epoch is the wall-clock time at start (realistic
-  ROS stamps, never jumping).
+  ROS stamps, never jumping); with ``time_scale`` the vehicle's clock (and the stamps) run that many times
+  faster than the wall clock, and so do the publication rates.
+- Ground truth: ``Simulator.truth()`` in process, and ``truth_file`` (JSON lines when it ends in ``.jsonl``,
+  else one JSON object replaced atomically) at ``truth_rate_hz`` of vehicle time.
 
 ``Simulator.report()`` gives counts per device and subject (published, commands accepted/rejected, the
 last command); ``record`` writes every transmitted and received message (as transmitted) as JSON lines.
@@ -26,6 +32,7 @@ import asyncio
 import json
 import logging
 import math
+import os
 import random
 import time
 from collections import Counter
@@ -35,42 +42,53 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, Vehicle, VehicleParams
 
-__all__ = ["PHYSICS", "DeviceState", "SimConfig", "Simulator", "VehicleState"]
+__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState"]
 
 _log = logging.getLogger("sam_runtime.sim")
 
 SYNC_TIMESTAMP = "uavcan.time.SynchronizedTimestamp"
-G = 9.80665
-RHO_SEAWATER = 1025.0
-P_ATM = 101325.0
+GEOID_HEIGHT_M = 23.0  # the geoid above the WGS 84 ellipsoid near Stockholm
+
+# SAM's actuator devices (by the spec's device name): command field -> the vehicle model's input.
+SAM_ACTUATORS: dict[str, dict[str, str]] = {
+    "thruster_1": {"rpm": "rpm_1"},
+    "thruster_2": {"rpm": "rpm_2"},
+    "thrust_vector": {"vertical_radians": "vertical_rad", "horizontal_radians": "horizontal_rad"},
+    "ballast": {"weight_1_offset_radians": "ballast_1_rad", "weight_2_offset_radians": "ballast_2_rad"},
+    "longitudinal_weight": {"percent": "longitudinal_weight_pct"},
+    "buoyancy_piston": {"percent": "buoyancy_pct"},
+}
 
 
 # ============================================================================================ state
 @dataclass
 class VehicleState:
-    """What the devices of one vehicle share: time and the vehicle's motion."""
+    """What the devices of one vehicle share: the clock and the simulated vehicle (model and sensors)."""
 
     epoch_us: int = field(default_factory=lambda: time.time_ns() // 1000)
     mono0_ns: int = field(default_factory=time.monotonic_ns)
     rng: random.Random = field(default_factory=lambda: random.Random(0x5A3))
-    depth_period_s: float = 120.0
-    max_depth_m: float = 10.0
+    time_scale: float = 1.0  # vehicle seconds per wall second
+    model: SimulatedVehicle = field(default_factory=SimulatedVehicle)
 
     def t(self) -> float:
-        """Seconds since start."""
-        return (time.monotonic_ns() - self.mono0_ns) * 1e-9
+        """Vehicle seconds since start."""
+        return (time.monotonic_ns() - self.mono0_ns) * 1e-9 * self.time_scale
 
     def now_us(self) -> int:
-        """Monotonic microseconds since the Unix epoch of the start time."""
-        return self.epoch_us + (time.monotonic_ns() - self.mono0_ns) // 1000
+        """Monotonic microseconds since the Unix epoch of the start time (in vehicle time)."""
+        return self.epoch_us + int((time.monotonic_ns() - self.mono0_ns) * self.time_scale) // 1000
 
-    def depth(self, t: float) -> float:
-        """Depth [m], a slow oscillation between the surface and max_depth_m."""
-        return self.max_depth_m * 0.5 * (1.0 - math.cos(2.0 * math.pi * t / self.depth_period_s))
+    @property
+    def vehicle(self) -> Vehicle:
+        return self.model.vehicle
 
-    def heading(self, t: float) -> float:
-        return (0.05 * t) % (2.0 * math.pi)
+    def sync(self, t: float) -> Vehicle:
+        """The vehicle integrated up to ``t`` (never backwards)."""
+        self.model.vehicle.advance_to(t)
+        return self.model.vehicle
 
 
 @dataclass
@@ -180,76 +198,95 @@ PhysicsFn = Callable[[Any, DeviceState, VehicleState, float, float, random.Rando
 
 
 def _imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    n = rng.gauss
-    gyro = [0.05 * math.sin(0.5 * t), 0.04 * math.sin(0.3 * t + 1.0), 0.05]  # yaw rate = d(heading)/dt
-    acc = [0.02 * n(0, 1), 0.02 * n(0, 1), G + 0.02 * n(0, 1)]
+    veh.sync(t)
+    m = veh.model.sensors.imu()
     _stamp(obj, "timestamp", veh.now_us())
     _set(obj, "integration_interval", dt)
-    _set(obj, "rate_gyro_latest", gyro)
-    _set(obj, "rate_gyro_integral", [g * dt for g in gyro])
-    _set(obj, "accelerometer_latest", acc)
-    _set(obj, "accelerometer_integral", [a * dt for a in acc])
+    _set(obj, "rate_gyro_latest", list(m.gyro))
+    _set(obj, "rate_gyro_integral", [g * dt for g in m.gyro])
+    _set(obj, "accelerometer_latest", list(m.accel))
+    _set(obj, "accelerometer_integral", [a * dt for a in m.accel])
     # Full 6x6 covariance of [gyro, accel], row major: makes the transfer multi-frame on CAN FD too.
-    _set(obj, "covariance", [(1e-4 if i < 3 else 4e-4) if i == j else 0.0 for i in range(6) for j in range(6)])
+    n = veh.model.sensors.noise
+    _set(obj, "covariance", [(n.gyro ** 2 if i < 3 else n.accel ** 2) if i == j else 0.0
+                             for i in range(6) for j in range(6)])
 
 
 def _magnetometer(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    # Stockholm: ~0.52 G total, inclination ~73 deg: 0.15 G horizontal, 0.49 G down; body frame rotates.
-    h = veh.heading(t)
-    field_ga = [0.15 * math.cos(h) + 0.002 * rng.gauss(0, 1), -0.15 * math.sin(h) + 0.002 * rng.gauss(0, 1),
-                0.49 + 0.002 * rng.gauss(0, 1)]
-    _set(obj, "magnetic_field_ga", field_ga)
-    _set(obj, "magnetic_field_covariance", [4e-6 if i == j else 0.0 for i in range(3) for j in range(3)])
+    veh.sync(t)
+    _set(obj, "magnetic_field_ga", list(veh.model.sensors.magnetometer()))
+    var = veh.model.sensors.noise.mag ** 2
+    _set(obj, "magnetic_field_covariance", [var if i == j else 0.0 for i in range(3) for j in range(3)])
 
 
 def _gnss(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    # At the surface near KTH, Stockholm (59.35 N, 18.07 E), drifting slowly east-north-east at ~0.5 m/s.
-    lat = 59.3500 + 0.5 * math.sin(0.3) * t / 111_320.0
-    lon = 18.0700 + 0.5 * math.cos(0.3) * t / (111_320.0 * math.cos(math.radians(59.35)))
+    veh.sync(t)
+    fix = veh.model.sensors.gps()
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "latitude_deg_1e8", round(lat * 1e8))
-    _set(obj, "longitude_deg_1e8", round(lon * 1e8))
-    wave = 0.2 * math.sin(2 * math.pi * t / 8.0)
-    _set(obj, "height_ellipsoid_mm", round((23.0 + wave) * 1000))  # geoid ~23 m above the ellipsoid
-    _set(obj, "height_msl_mm", round(wave * 1000))
-    _set(obj, "ned_velocity", [0.5 * math.sin(0.3), 0.5 * math.cos(0.3), 0.0])
-    _set(obj, "sats_used", 9 + int(2 * (1 + math.sin(t / 30.0))))
-    _set(obj, "status", 3)
-    _set(obj, "pdop", 1.2 + 0.1 * math.sin(t / 10.0))
-    _set(obj, "position_covariance", [2.25 if i == j else 0.0 for i in range(3) for j in range(3)])
+    _set(obj, "latitude_deg_1e8", round(fix.lat * 1e8))
+    _set(obj, "longitude_deg_1e8", round(fix.lon * 1e8))
+    _set(obj, "status", fix.status)
+    _set(obj, "sats_used", fix.sats)
+    if fix.status == veh.model.sensors.GPS_STATUS_NO_FIX:
+        _set(obj, "height_ellipsoid_mm", 0)
+        _set(obj, "height_msl_mm", 0)
+        _set(obj, "ned_velocity", [0.0, 0.0, 0.0])
+        _set(obj, "pdop", 99.0)
+        _set(obj, "position_covariance", [])  # unknown
+        return
+    _set(obj, "height_ellipsoid_mm", round((GEOID_HEIGHT_M + fix.height_msl) * 1000))
+    _set(obj, "height_msl_mm", round(fix.height_msl * 1000))
+    _set(obj, "ned_velocity", list(fix.ned_velocity))
+    _set(obj, "pdop", 1.2)
+    var = fix.std_m ** 2
+    _set(obj, "position_covariance", [var if i == j else 0.0 for i in range(3) for j in range(3)])
 
 
 def _pressure(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    depth = veh.depth(t)
-    _set(obj, "static_pressure", P_ATM + RHO_SEAWATER * G * depth + 5.0 * rng.gauss(0, 1))
-    _set(obj, "static_pressure_variance", 25.0)
+    veh.sync(t)
+    _set(obj, "static_pressure", veh.model.sensors.pressure())
+    _set(obj, "static_pressure_variance", veh.model.sensors.noise.pressure ** 2)
+
+
+def _altitude(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+    veh.sync(t)
+    _stamp(obj, "timestamp", veh.now_us())
+    _set(obj, "altitude", veh.model.sensors.altitude())
+    _set(obj, "altitude_variance", veh.model.sensors.noise.altitude ** 2)
 
 
 def _battery(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    full_wh = 800.0
-    soc = max(0.0, 0.95 - 0.0005 * t)  # 0.05 %/s: visible in a demo
-    current = -(12.0 + 0.5 * math.sin(t / 5.0))
-    voltage = 6 * (3.4 + 0.8 * soc)  # a 6S pack
-    _set(obj, "temperature", 298.15 + 2.0 * math.sin(t / 60.0))
-    _set(obj, "voltage", voltage)
-    _set(obj, "current", current)
-    _set(obj, "average_power_10sec", -voltage * current)
-    _set(obj, "remaining_capacity_wh", full_wh * soc)
-    _set(obj, "full_charge_capacity_wh", full_wh)
+    veh.sync(t)
+    b = veh.model.sensors.battery()
+    _set(obj, "temperature", b.temperature_k)
+    _set(obj, "voltage", b.voltage)
+    _set(obj, "current", b.current)
+    _set(obj, "average_power_10sec", b.power_w)
+    _set(obj, "remaining_capacity_wh", b.remaining_wh)
+    _set(obj, "full_charge_capacity_wh", b.full_wh)
     _set(obj, "hours_to_full_charge", 0.0)
-    _set(obj, "status_flags", 1)  # IN_USE
-    _set(obj, "state_of_health_pct", 98)
-    _set(obj, "state_of_charge_pct", round(soc * 100))
+    _set(obj, "status_flags", b.status_flags)
+    _set(obj, "state_of_health_pct", b.health_pct)
+    _set(obj, "state_of_charge_pct", round(b.soc * 100))
     _set(obj, "state_of_charge_pct_stdev", 2)
     _set(obj, "battery_id", 0)
     _set(obj, "model_instance_id", 0x5A3_0001)
     _set(obj, "model_name", b"SAM 6S Li-ion")
 
 
+def _vehicle_actuator(dev: DeviceState, veh: VehicleState, t: float, command_field: str) -> float | None:
+    """The vehicle model's actuator position for a SAM device's command field, or None for other devices."""
+    name = SAM_ACTUATORS.get(dev.name, {}).get(command_field)
+    if name is None:
+        return None
+    return float(getattr(veh.sync(t).actuators, name))
+
+
 def _thruster_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
                        rng: random.Random) -> None:
-    target = float(dev.command.get("rpm", 0))
-    rpm = dev.approach("rpm", target, 2000.0, t)  # spins up at 2000 rpm/s
+    rpm = _vehicle_actuator(dev, veh, t, "rpm")
+    if rpm is None:
+        rpm = dev.approach("rpm", float(dev.command.get("rpm", 0)), 2000.0, t)  # spins up at 2000 rpm/s
     _stamp(obj, "timestamp", veh.now_us())
     _set(obj, "rpm", round(max(-131072, min(131071, rpm))))
     _set(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
@@ -258,8 +295,11 @@ def _thruster_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, 
 
 def _thrust_vector_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
                             rng: random.Random) -> None:
-    v = dev.approach("vertical", float(dev.command.get("vertical_radians", 0.0)), 0.5, t)  # 0.5 rad/s servos
-    h = dev.approach("horizontal", float(dev.command.get("horizontal_radians", 0.0)), 0.5, t)
+    v = _vehicle_actuator(dev, veh, t, "vertical_radians")
+    h = _vehicle_actuator(dev, veh, t, "horizontal_radians")
+    if v is None or h is None:  # 0.5 rad/s servos
+        v = dev.approach("vertical", float(dev.command.get("vertical_radians", 0.0)), 0.5, t)
+        h = dev.approach("horizontal", float(dev.command.get("horizontal_radians", 0.0)), 0.5, t)
     _stamp(obj, "timestamp", veh.now_us())
     _set(obj, "vertical_mrad", int(max(-4096, min(4095, round(v * 1000)))))
     _set(obj, "horizontal_mrad", int(max(-4096, min(4095, round(h * 1000)))))
@@ -267,8 +307,10 @@ def _thrust_vector_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: fl
 
 def _position_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
                        rng: random.Random) -> None:
-    target = float(dev.command.get("percent", 50.0))
-    pct = dev.approach("percent", max(0.0, min(100.0, target)), 10.0, t, initial=50.0)  # 10 %/s
+    pct = _vehicle_actuator(dev, veh, t, "percent")
+    if pct is None:
+        target = float(dev.command.get("percent", 50.0))
+        pct = dev.approach("percent", max(0.0, min(100.0, target)), 10.0, t, initial=50.0)  # 10 %/s
     _stamp(obj, "timestamp", veh.now_us())
     _set(obj, "percent", pct)
     _set(obj, "encoder_count", round(pct * 100))  # 10 000 counts over the full travel
@@ -280,6 +322,7 @@ PHYSICS: dict[str, PhysicsFn] = {
     "sensor.MagneticFieldStrength": _magnetometer,
     "sensor.GNSSFix": _gnss,
     "sensor.StaticPressure": _pressure,
+    "sensor.Altitude": _altitude,
     "power.BatteryInfo": _battery,
     "actuator.ThrusterFeedback": _thruster_feedback,
     "actuator.ThrustVectorFeedback": _thrust_vector_feedback,
@@ -309,6 +352,27 @@ class SimConfig:
     devices: Iterable[str] | None = None  # subset of device names; default all
     rate_scale: float = 1.0
     record: Path | None = None  # JSON lines of every transmitted/received message
+    # The simulated vehicle (see sam_runtime.vehicle): noise seed, sea floor, start pose in the sim's world frame
+    # (ENU metres around gps_origin; yaw counter-clockwise from east), battery, time.
+    seed: int = 0
+    sea_floor: SeaFloor = field(default_factory=SeaFloor)
+    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw
+    battery_percent: float = 95.0
+    battery_drain_factor: float = 1.0  # multiplies the power drawn (a scenario can drain the battery quickly)
+    battery_health_pct: int = 98
+    gps_origin: tuple[float, float] = (59.35, 18.07)  # lat, lon of the sim's world origin (KTH, Stockholm)
+    vehicle_params: VehicleParams = field(default_factory=VehicleParams)
+    noise: SensorNoise = field(default_factory=SensorNoise)
+    time_scale: float = 1.0  # vehicle seconds per wall second (rates and stamps follow)
+    truth_file: Path | None = None  # the true state: JSON lines if it ends in .jsonl, else an atomic JSON file
+    truth_rate_hz: float = 5.0  # of vehicle time
+
+    def make_vehicle(self) -> SimulatedVehicle:
+        """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""
+        return SimulatedVehicle(seed=self.seed, sea_floor=self.sea_floor, start=self.start,
+                                battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
+                                battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
+                                params=self.vehicle_params, noise=self.noise)
 
 
 @dataclass
@@ -354,7 +418,13 @@ class Simulator:
         self.gen = gen
         self.tables = gen.tables()
         self.config = config or SimConfig()
-        self.vehicle = VehicleState()
+        if not (math.isfinite(self.config.time_scale) and self.config.time_scale > 0):
+            raise ValueError(f"time_scale must be > 0, got {self.config.time_scale}")
+        if not (math.isfinite(self.config.truth_rate_hz) and self.config.truth_rate_hz > 0):
+            raise ValueError(f"truth_rate_hz must be > 0, got {self.config.truth_rate_hz}")
+        self.vehicle = VehicleState(time_scale=self.config.time_scale, model=self.config.make_vehicle())
+        self._truth_task: asyncio.Task[None] | None = None
+        self.truth_written = 0
         self.bridge_node_id = int(self.config.bridge_node_id if self.config.bridge_node_id is not None
                                   else self.tables.BRIDGE_NODE_ID)
         wanted = None if self.config.devices is None else set(self.config.devices)
@@ -395,6 +465,8 @@ class Simulator:
                 self._open_device(dev)
             for dev in self.devices:
                 self._start_device_tasks(dev)
+            if self.config.truth_file is not None:
+                self._truth_task = asyncio.create_task(self._truth_loop(), name="sim-truth")
         except BaseException:
             await self.close()
             raise
@@ -445,6 +517,9 @@ class Simulator:
         if not dev.powered:
             return
         dev.powered = False
+        if "rpm" in SAM_ACTUATORS.get(name, {}):  # a motor without power stops; servos hold their position
+            self.vehicle.sync(self.vehicle.t())
+            self.vehicle.vehicle.command(**{SAM_ACTUATORS[name]["rpm"]: 0.0})
         await cancel_and_wait([pp.task for pp in dev.pubs if pp.task is not None])
         ports = [pp.publisher for pp in dev.pubs] + [sp.subscriber for sp in dev.subs]
         for pp in dev.pubs:
@@ -505,7 +580,10 @@ class Simulator:
         from sam_runtime.bridge import cancel_and_wait
         from sam_runtime.transport import aclose
 
-        stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None])
+        stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None]
+                                      + ([self._truth_task] if self._truth_task is not None else []))
+        if self.config.truth_file is not None:
+            self._write_truth()
         if stuck:
             _log.warning("%d publish tasks did not stop", len(stuck))
         ports = [p.publisher for d in self.devices for p in d.pubs] + [s.subscriber for d in self.devices
@@ -526,14 +604,14 @@ class Simulator:
         obj = pp.dtype()
         generic_fill(obj, t, self.vehicle.now_us(), seed=pp.port.subject_id)
         if pp.physics is not None:
-            pp.physics(obj, dev.state, self.vehicle, t, dt, self.vehicle.rng)
+            pp.physics(obj, dev.state, self.vehicle, t, dt * self.vehicle.time_scale, self.vehicle.rng)
         dev.state.last_update = t
         return obj
 
     async def _publish_loop(self, dev: _SimDevice, pp: _PubPort, restart: bool = False) -> None:
         assert self._go is not None
         await self._go.wait()
-        rate = float(pp.port.rate_hz) * float(self.config.rate_scale)
+        rate = float(pp.port.rate_hz) * float(self.config.rate_scale) * self.vehicle.time_scale  # per wall second
         if rate <= 0:
             return
         period = 1.0 / rate
@@ -597,12 +675,51 @@ class Simulator:
             values = pycyphal.dsdl.to_builtin(msg)
             sp.last = values
             dev.state.command.update(values)
+            inputs = SAM_ACTUATORS.get(dev.info.name)
+            if inputs:  # from now on (the model first catches up with the time of arrival)
+                self.vehicle.sync(self.vehicle.t())
+                self.vehicle.vehicle.command(**{inputs[k]: float(v) for k, v in values.items() if k in inputs})
         else:
             sp.rejected += 1
             sp.rejected_sources[-1 if src is None else int(src)] += 1
         if self._record is not None:
             self._write_record("rx", dev, sp.port.subject_id, msg, source=src, accepted=accepted,
                                seq=sp.accepted if accepted else sp.rejected)
+
+    # ---------------------------------------------------------------------------------- truth
+    def truth(self) -> dict[str, Any]:
+        """The vehicle's true state now (see :meth:`sam_runtime.vehicle.Vehicle.truth`), with the sim's stamp
+        clock (``stamp_us``, as in the devices' timestamps), the wall clock and the GPS origin."""
+        veh = self.vehicle.sync(self.vehicle.t())
+        return {**veh.truth(), "stamp_us": self.vehicle.epoch_us + round(veh.t * 1e6), "wall_ns": time.time_ns(),
+                "gps_origin": list(self.config.gps_origin), "time_scale": self.vehicle.time_scale}
+
+    def _write_truth(self) -> None:
+        path = self.config.truth_file
+        assert path is not None
+        line = json.dumps(self.truth(), default=_json_default)
+        try:
+            if path.suffix == ".jsonl":
+                with open(path, "a") as f:
+                    f.write(line + "\n")
+            else:
+                tmp = path.with_name(f"{path.name}.tmp{os.getpid()}")
+                tmp.write_text(line + "\n")
+                os.replace(tmp, path)
+            self.truth_written += 1
+        except OSError as ex:
+            _log.warning("truth file %s: %s", path, ex)
+
+    async def _truth_loop(self) -> None:
+        if self.config.truth_file is not None and self.config.truth_file.suffix == ".jsonl":
+            self.config.truth_file.write_text("")  # a new run
+        period = 1.0 / (self.config.truth_rate_hz * self.vehicle.time_scale)  # wall seconds
+        start = time.monotonic()
+        k = 0
+        while not self._closed:
+            self._write_truth()
+            k += 1
+            await asyncio.sleep(max(0.0, start + k * period - time.monotonic()))
 
     # ---------------------------------------------------------------------------------- reporting
     def _write_record(self, direction: str, dev: _SimDevice, subject: int, obj: Any, **extra: Any) -> None:
@@ -634,12 +751,15 @@ class Simulator:
                 },
                 "position": dict(d.state.position),
             }
+        truth = self.truth()
         since = self._publishing_since
         return {
             "bridge_node_id": self.bridge_node_id,
             "publishing_s": None if since is None else round(
                 (min(time.monotonic(), self._publishing_until or math.inf)) - since, 3),
             "devices": devices,
+            "vehicle": truth,
+            "rejected_vehicle_commands": self.vehicle.vehicle.rejected_commands,
         }
 
 

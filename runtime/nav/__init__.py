@@ -1,0 +1,39 @@
+"""The pure logic of the document's five nodes (sections IV.E-IV.H), without ROS: plain numbers in, plain numbers
+out, times in seconds passed in by the caller. The ROS nodes (sam_runtime.nodes) feed these from their callbacks.
+
+- :mod:`.dead_reckoning` - odom -> base_link from IMU, magnetometer, pressure and thruster feedback (IV.E.1)
+- :mod:`.slam` - world -> odom from GPS fixes at the surface (IV.E.2)
+- :mod:`.planner` - goals, the z convention, safety clamps and the path (IV.F)
+- :mod:`.controller` - path following to actuator commands (IV.G)
+- :mod:`.monitor` - the emergency state machine (IV.H)
+- :mod:`.geo` - frames, angles, quaternions, the local metric frame, depth from pressure
+- :mod:`.closed_loop` - all of them on the simulated vehicle in one process, in simulated time (tests, tuning)
+"""
+
+from sam_runtime.nav.controller import Commands, Controller, ControllerConfig, ControllerPose
+from sam_runtime.nav.dead_reckoning import DeadReckoning, DeadReckoningConfig, DrPose
+from sam_runtime.nav.monitor import MonitorLimits, MonitorOutput, PerformanceMonitor
+from sam_runtime.nav.planner import GOAL_FRAME, Goal, GoalDecision, Plan, Planner, PlannerConfig, PlanResult
+from sam_runtime.nav.slam import SlamConfig, SlamCorrector
+
+__all__ = [
+    "GOAL_FRAME",
+    "Commands",
+    "Controller",
+    "ControllerConfig",
+    "ControllerPose",
+    "DeadReckoning",
+    "DeadReckoningConfig",
+    "DrPose",
+    "Goal",
+    "GoalDecision",
+    "MonitorLimits",
+    "MonitorOutput",
+    "PerformanceMonitor",
+    "Plan",
+    "PlanResult",
+    "Planner",
+    "PlannerConfig",
+    "SlamConfig",
+    "SlamCorrector",
+]
