@@ -509,8 +509,8 @@ class Sensors:
         lat, lon = latlon_from_local(e, n, *self.gps_origin)
         self._last_fix = (lat, lon)
         vel = (s.velocity[1] + rng.gauss(0, 0.05), s.velocity[0] + rng.gauss(0, 0.05), -s.velocity[2])
-        return GpsReading(self.GPS_STATUS_3D_FIX, lat, lon, rng.gauss(0.0, self.noise.gps), vel,
-                          9 + rng.randrange(3), self.noise.gps)
+        height = max(-0.6, min(0.6, rng.gauss(0.0, 0.2)))  # the antenna floats at sea level
+        return GpsReading(self.GPS_STATUS_3D_FIX, lat, lon, height, vel, 9 + rng.randrange(3), self.noise.gps)
 
     def battery(self) -> BatteryReading:
         v, p = self.vehicle, self.vehicle.params

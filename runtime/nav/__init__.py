@@ -10,30 +10,27 @@ out, times in seconds passed in by the caller. The ROS nodes (sam_runtime.nodes)
 - :mod:`.closed_loop` - all of them on the simulated vehicle in one process, in simulated time (tests, tuning)
 """
 
-from sam_runtime.nav.controller import Commands, Controller, ControllerConfig, ControllerPose
-from sam_runtime.nav.dead_reckoning import DeadReckoning, DeadReckoningConfig, DrPose
-from sam_runtime.nav.monitor import MonitorLimits, MonitorOutput, PerformanceMonitor
-from sam_runtime.nav.planner import GOAL_FRAME, Goal, GoalDecision, Plan, Planner, PlannerConfig, PlanResult
-from sam_runtime.nav.slam import SlamConfig, SlamCorrector
+from __future__ import annotations
 
-__all__ = [
-    "GOAL_FRAME",
-    "Commands",
-    "Controller",
-    "ControllerConfig",
-    "ControllerPose",
-    "DeadReckoning",
-    "DeadReckoningConfig",
-    "DrPose",
-    "Goal",
-    "GoalDecision",
-    "MonitorLimits",
-    "MonitorOutput",
-    "PerformanceMonitor",
-    "Plan",
-    "PlanResult",
-    "Planner",
-    "PlannerConfig",
-    "SlamConfig",
-    "SlamCorrector",
-]
+import importlib
+from typing import Any
+
+# Lazy: sam_runtime.vehicle imports sam_runtime.nav.geo, and the estimator imports the vehicle's nominal model.
+_EXPORTS = {
+    "Commands": "controller", "Controller": "controller", "ControllerConfig": "controller",
+    "ControllerPose": "controller",
+    "DeadReckoning": "dead_reckoning", "DeadReckoningConfig": "dead_reckoning", "DrPose": "dead_reckoning",
+    "MonitorLimits": "monitor", "MonitorOutput": "monitor", "PerformanceMonitor": "monitor",
+    "GOAL_FRAME": "planner", "Goal": "planner", "GoalDecision": "planner", "Plan": "planner", "PlanResult": "planner",
+    "Planner": "planner", "PlannerConfig": "planner",
+    "SlamConfig": "slam", "SlamCorrector": "slam",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f"{__name__}.{module}"), name)
