@@ -131,7 +131,7 @@ def steady_surge_speed(rpm_1: float, rpm_2: float, p: VehicleParams | None = Non
     relation; negative for reverse thrust).
 
     >>> round(steady_surge_speed(2000, 2000), 2), steady_surge_speed(0, 0), round(steady_surge_speed(-500, -500), 3)
-    (1.76, 0.0, -0.2)
+    (1.76, 0.0, -0.281)
     """
     p = p or VehicleParams()
     thrust = _thrust(rpm_1, p) + _thrust(rpm_2, p)

@@ -117,8 +117,9 @@ class DeadReckoning:
         n = max(1, math.ceil(span / self.config.max_step))
         h = span / n
         p, q, r = self.rates
-        for _ in range(n):
-            rpm_1, rpm_2 = self._rpm_at(0, self.t), self._rpm_at(1, self.t)
+        for i in range(n):
+            tk = self.t + i * h
+            rpm_1, rpm_2 = self._rpm_at(0, tk), self._rpm_at(1, tk)
             self.u += surge_acceleration(self.u, rpm_1, rpm_2, self.config.vehicle) * h
             sr, cr = math.sin(self.roll), math.cos(self.roll)
             cp = max(math.cos(self.pitch), 0.05)
