@@ -311,7 +311,60 @@ def test_sim_command_line_vehicle_options_and_truth_file(gen: Any, tmp_path: Pat
     assert first["battery_percent"] == pytest.approx(40.0, abs=0.01) and first["gps_origin"] == [10.5, 20.25]
     assert last["t"] >= 1.4 and all(b["t"] >= a["t"] for a, b in itertools.pairwise(lines))
     assert last["depth"] == pytest.approx(2.0, abs=0.01)  # neutral buoyancy, no thrust: it stays
+    # Four times faster than the wall clock: the vehicle's time, the rates and the stamps.
+    fast = tmp_path / "fast.json"
+    report = tmp_path / "report.json"
+    proc = subprocess.run([*base, "--duration", "1.0", "--time-scale", "4", "--truth-file", str(fast), "--report",
+                           str(report)], env=env, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert json.loads(fast.read_text())["t"] >= 3.6  # at exit: 4 x (start-up + 1 s of publishing)
+    assert json.loads(report.read_text())["devices"]["pressure"]["published"]["1103"] == pytest.approx(80, abs=3)
     for bad, message in ((["--start", "0,0,30,0"], "the sea floor there"), (["--sea-floor", "deep"], "sea floor"),
                          (["--gps-origin", "95,0"], "GPS origin")):
         proc = subprocess.run([*base, "--duration", "0.1", *bad], env=env, capture_output=True, text=True, timeout=60)
         assert proc.returncode == 1 and "Traceback" not in proc.stderr and message in proc.stderr, proc.stderr
+
+
+@pytest.mark.slow
+def test_a_non_sam_spec_gets_generic_values_and_its_own_actuator_model(tmp_path: Path) -> None:
+    """tests/specs/rover.yaml has none of SAM's devices: every port publishes generic in-range values, the vehicle
+    model is there but drives nothing, commands are accepted from the bridge only."""
+    import pycyphal.dsdl
+
+    from sam_runtime.genpkg import GeneratedPackage
+
+    out = tmp_path / "generated"
+    spec = Path(__file__).resolve().parent / "specs" / "rover.yaml"
+    proc = subprocess.run([sys.executable, "-m", "sam_codegen.cli", "build", "--spec", str(spec), "--out", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    rover = GeneratedPackage(out)
+
+    async def scenario() -> dict[str, Any]:
+        sim = Simulator(rover, SimConfig("can", f"virtual:rover{os.getpid()}", 64, truth_file=tmp_path / "t.json"))
+        await sim.start(publish_now=True)
+        try:
+            await asyncio.sleep(1.0)
+            samples = {}
+            for dev in sim.devices:
+                for pp in dev.pubs:
+                    a, b = sim.make_sample(dev, pp, 0.1), sim.make_sample(dev, pp, 0.1)
+                    wire = pycyphal.dsdl.deserialize(pp.dtype, list(pycyphal.dsdl.serialize(a)))
+                    samples[pp.port.subject_id] = (pycyphal.dsdl.to_builtin(wire), pycyphal.dsdl.to_builtin(b))
+            drive = sim.device("drive")
+            sp = drive.subs[0]
+            sim._on_command(drive, sp, sp.dtype(), _Transfer(sim.bridge_node_id))
+            sim._on_command(drive, sp, sp.dtype(), _Transfer(3))
+            return {"report": sim.report(), "samples": samples}
+        finally:
+            await sim.close()
+
+    res = _run(scenario())
+    report = res["report"]
+    assert set(report["devices"]) == {"drive", "thermo", "air", "nav", "lights"}
+    assert report["devices"]["nav"]["published"]["520"] >= 20  # 50 Hz for a second, on a loaded machine too
+    assert report["devices"]["drive"]["commands"]["501"]["accepted"] == 1
+    assert report["devices"]["drive"]["commands"]["501"]["rejected"] == 1
+    assert report["vehicle"]["depth"] == 0.0 and report["vehicle"]["speed"] == 0.0  # nothing drives it
+    assert set(res["samples"]) == {500, 510, 511, 520}
+    assert json.loads((tmp_path / "t.json").read_text())["t"] >= 0.9  # the atomic truth file, rewritten

@@ -84,6 +84,7 @@ class ClosedLoop:
         self.history: list[dict[str, Any]] = []
         self.events: list[tuple[float, str]] = []  # (t, what): goals, plans refused, monitor transitions
         self._next_replan = 0.0
+        self.replanning = True  # False: the planner has died (no new plans; the controller's plan goes stale)
 
     @property
     def t(self) -> float:
@@ -172,7 +173,7 @@ class ClosedLoop:
             if tr is not None:
                 self.world_odom = (tr[0][0], tr[0][1])
         world = self.world_pose()
-        if t >= self._next_replan and self.planner.goal is not None:
+        if self.replanning and t >= self._next_replan and self.planner.goal is not None:
             self._next_replan = t + self.options.replan_period
             self.planner.safe_depth, self.planner.safe_altitude = self.options.safe_depth, self.options.safe_altitude
             if world is None:
