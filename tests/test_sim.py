@@ -178,11 +178,6 @@ def test_actuators_drive_the_shared_vehicle_and_its_sensors_measure_it(gen: Any)
     assert veh.rejected_commands == 1
     truth = sim.truth()
     assert truth["max_depth"] == veh.state.max_depth and truth["gps_origin"] == [59.35, 18.07]
-    # A thruster that loses power stops; a servo without power holds its position.
-    _command(sim, "thruster_1", sim.bridge_node_id, rpm=1000)
-    _run(sim.power_off("thruster_1"))
-    _run(sim.power_off("thrust_vector"))
-    assert veh.commands.rpm_1 == 0.0 and veh.commands.vertical_rad == pytest.approx(0.12)
 
 
 def test_altimeter_physics_measures_the_range_to_the_sea_floor() -> None:
@@ -246,12 +241,24 @@ async def _network_scenario(gen: Any, channel: str) -> dict[str, Any]:
                 t > t_cmd + 1.0 for t, _ in feedback[fb_sid]):
             await asyncio.sleep(0.05)
         after = [(t - t_cmd, float(m.percent)) for t, m in feedback[fb_sid] if t > t_cmd]
+        # The thruster spins up the shared vehicle; without power it stops (its command is gone).
+        thruster = next(d for d in tables.DEVICES if d.name == "thruster_1")
+        rpm_cls = gen.dsdl_class(thruster.subscribes[0])
+        pub_rpm = bridge_like.make_publisher(rpm_cls, thruster.subscribes[0].subject_id)
+        assert await pub_rpm.publish(rpm_cls(rpm=1000))
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline and sim.vehicle.vehicle.commands.rpm_1 != 1000.0:
+            await asyncio.sleep(0.02)
+        spun_up = sim.vehicle.vehicle.commands.rpm_1
+        await sim.power_off("thruster_1")
+        stopped = sim.vehicle.vehicle.commands.rpm_1
         report = sim.report()
-        await aclose(pub_ok, pub_bad, hb, *subs)
+        await aclose(pub_ok, pub_bad, pub_rpm, hb, *subs)
     finally:
         await sim.close()
         await aclose(bridge_like, other)
-    return {"rates": rates, "heartbeats": heartbeats, "after": after, "report": report}
+    return {"rates": rates, "heartbeats": heartbeats, "after": after, "report": report, "spun_up": spun_up,
+            "stopped": stopped}
 
 
 @pytest.mark.slow
@@ -274,6 +281,8 @@ def test_devices_publish_at_nominal_rates_with_heartbeats_and_obey_only_the_brid
     for dt, pct in res["after"]:
         assert 50.0 <= pct <= 50.0 + 10.0 * dt + 1.5, (dt, pct)
     assert any(dt > 0.9 and pct > 57.0 for dt, pct in res["after"]), res["after"]
+    assert res["spun_up"] == 1000.0 and res["stopped"] == 0.0
+    assert res["report"]["devices"]["thruster_1"]["powered"] is False
 
 
 @pytest.mark.slow
