@@ -96,6 +96,17 @@ def test_an_altitude_goal_keeps_its_height_above_the_sea_floor() -> None:
     assert loop.vehicle.altitude() == pytest.approx(6.0, abs=0.3)
 
 
+@pytest.mark.parametrize("offset", [(0.0, 3.0), (-2.0, 0.0), (0.0, -6.0)])
+def test_a_goal_inside_the_turning_circles_is_reached(offset: tuple[float, float]) -> None:
+    loop = _start(seed=11)
+    here = loop.world_pose()
+    assert here is not None
+    goal = (here.x + offset[0], here.y + offset[1], -2.0)
+    loop.goal_pose(*goal)
+    arrived = _first(loop, lambda lp: lp.commands is not None and lp.commands.mode == "arrived", 120.0)
+    assert arrived is not None and _horizontal_error(loop, goal[0], goal[1]) < 3.0
+
+
 def _emergency_figures(loop: ClosedLoop, crossing: float) -> tuple[float, float]:
     abort = _first(loop, lambda lp: lp.monitor.state == "emergency", 60.0)
     assert abort is not None, loop.events

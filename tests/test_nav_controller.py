@@ -129,3 +129,21 @@ def test_bad_controller_config_is_refused() -> None:
         ControllerConfig(plan_timeout=0.0)
     with pytest.raises(ValueError, match="cruise_rpm must be finite"):
         ControllerConfig(cruise_rpm=math.nan)
+
+
+def test_a_goal_close_behind_is_first_left_behind() -> None:
+    """Inside the turning circles a torpedo never reaches it by turning: run straight, then come back."""
+    cfg = ControllerConfig(turn_radius=6.0)
+    c = Controller(cfg)
+    c.set_plan(0.0, _line(0, 0, -4.0, 3.0, -5.0))  # 5 m behind, to port
+    out = c.step(0.1, LEVEL)
+    assert out.mode == "follow" and out.horizontal_rad == 0.0 and out.rpm_1 == cfg.cruise_rpm
+    assert out.reason == "running straight to open the distance to a goal 5.0 m behind"
+    out = c.step(0.2, ControllerPose(7.0, 0.0, -5.0, 0.0, 0.0, 0.0))  # 11.4 m away: still opening
+    assert out.horizontal_rad == 0.0
+    c.set_plan(1.0, _line(8.5, 0, -4.0, 3.0, -5.0))  # replanned from 12.9 m away: turn back now
+    out = c.step(1.1, ControllerPose(8.5, 0.0, -5.0, 0.0, 0.0, 0.0))
+    assert out.horizontal_rad == pytest.approx(0.12) and out.reason.startswith("following")
+    ahead = Controller(cfg)
+    ahead.set_plan(0.0, _line(0, 0, 4.0, 3.0, -5.0))  # close but ahead: just steer
+    assert ahead.step(0.1, LEVEL).horizontal_rad > 0.0

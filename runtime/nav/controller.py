@@ -8,6 +8,8 @@
   moving, also the pitch: a desired pitch toward the target depth, reached with the vertical thrust-vector angle
   (> 0 pitches the nose up) and held with the longitudinal weight (a feed-forward of the trim moment the desired
   pitch needs).
+- A goal behind the vehicle and closer than two turning radii lies inside its turning circles (SAM cannot turn on
+  the spot): the vehicle first runs straight until it is that far, then turns back toward it.
 - Speed: both thrusters at ``cruise_rpm``, slowing within ``slow_radius`` of the path's end, zero within
   ``goal_tolerance`` (arrived; the depth is still held).
 - No pose, no plan, an empty plan, a plan older than ``plan_timeout``: zero RPM, neutral angles and weights,
@@ -38,6 +40,8 @@ class ControllerConfig:
     slow_radius: float = 8.0  # [m] from the end of the path
     goal_tolerance: float = 1.5  # [m], horizontal
     rearm_distance: float = 5.0  # [m] once arrived, drifting this far from the same goal resumes following
+    turn_radius: float = 6.0  # [m] about SAM's at cruise; a goal behind closer than twice this is approached
+    #                           after running straight to open the distance (it is inside the turning circles)
     plan_timeout: float = 10.0  # [s] a plan older than this is stale
     max_vector_angle: float = 0.12  # [rad]
     heading_gain: float = 0.4  # [rad of nozzle per rad of heading error]
@@ -117,6 +121,7 @@ class Controller:
         self._integral = 0.0
         self._last_integral_t: float | None = None
         self._arrived_at: tuple[float, float] | None = None  # the goal reached (kept over replans of it)
+        self._opening = False  # running straight away from a goal inside the turning circles
 
     # ---------------------------------------------------------------------------------- inputs
     def set_plan(self, stamp: float, poses: list[PathPose] | tuple[PathPose, ...]) -> None:
@@ -216,23 +221,29 @@ class Controller:
             return Commands(0, 0, 0.0, 0.0, 0.0, 0.0, 50.0, buoyancy, "arrived",
                             f"within {cfg.goal_tolerance:g} m of the goal", (end[0], end[1], end[2]), to_goal)
 
-        # Speed: cruise, slowing toward the end of the path.
-        frac = min(1.0, remaining / cfg.slow_radius) if cfg.slow_radius > 0 else 1.0
+        # Heading: pure pursuit of the lookahead point; a goal close behind is first left behind.
+        desired_yaw = math.atan2(target[1] - pose.y, target[0] - pose.x)
+        goal_bearing = wrap_angle(math.atan2(end[1] - pose.y, end[0] - pose.x) - pose.yaw)
+        opening = self._opening if to_goal < 2.0 * cfg.turn_radius else False
+        if not opening and to_goal < 2.0 * cfg.turn_radius and abs(goal_bearing) > math.pi / 2:
+            opening = True
+        self._opening = opening
+        yaw_err = 0.0 if opening else wrap_angle(desired_yaw - pose.yaw)
+        horizontal = _clamp(cfg.heading_gain * yaw_err - cfg.yaw_rate_gain * yaw_rate, cfg.max_vector_angle)
+
+        # Speed: cruise, slowing toward the end of the path (not while opening the distance).
+        frac = 1.0 if opening or cfg.slow_radius <= 0 else min(1.0, remaining / cfg.slow_radius)
         rpm = max(cfg.min_rpm, cfg.cruise_rpm * frac)
         rpm = round(max(-cfg.max_rpm, min(cfg.max_rpm, rpm)))
-
-        # Heading: pure pursuit of the lookahead point.
-        desired_yaw = math.atan2(target[1] - pose.y, target[0] - pose.x)
-        yaw_err = wrap_angle(desired_yaw - pose.yaw)
-        horizontal = _clamp(cfg.heading_gain * yaw_err - cfg.yaw_rate_gain * yaw_rate, cfg.max_vector_angle)
 
         # Pitch toward the target depth (REP-103: > 0 nose down), held by the trim weight, steered by the nozzle.
         desired_pitch = _clamp(cfg.pitch_per_depth_error * err, cfg.max_pitch)
         vertical = _clamp(-cfg.pitch_gain * (desired_pitch - pose.pitch) + cfg.pitch_rate_gain * pitch_rate,
                           cfg.max_vector_angle)
         weight = max(0.0, min(100.0, 50.0 + cfg.trim_feedforward * math.sin(desired_pitch)))
-        return Commands(rpm, rpm, vertical, horizontal, 0.0, 0.0, weight, buoyancy, "follow",
-                        f"following a path of {len(self.path)} poses", target, to_goal)
+        why = (f"running straight to open the distance to a goal {to_goal:.1f} m behind" if opening
+               else f"following a path of {len(self.path)} poses")
+        return Commands(rpm, rpm, vertical, horizontal, 0.0, 0.0, weight, buoyancy, "follow", why, target, to_goal)
 
     def _dt(self, t: float) -> float:
         last, self._last_integral_t = self._last_integral_t, t
