@@ -148,3 +148,16 @@ def test_speed_from_the_feedback_rpm_and_stale_feedback_counts_as_stopped() -> N
     x = p.x
     p = dr.pose(1000.0)  # a jump of the clock: at most max_gap (1 s) is integrated
     assert p is not None and p.t == 1000.0 and p.x - x < 0.05
+
+
+def test_a_lost_imu_does_not_spin_the_estimate_and_input_ages_show_it() -> None:
+    dr = DeadReckoning()
+    dr.on_imu(0.0, (0.0, 0.0, 0.5), (0.0, 0.0, 9.80665))  # turning at 0.5 rad/s when the IMU goes silent
+    dr.on_magnetometer(0.0, (0.0, 0.15, -0.49))
+    dr.on_pressure(0.0, pressure_at_depth(2.0))
+    for k in range(1, 41):
+        p = dr.pose(k * 0.05)
+    assert p is not None and 0.2 < p.yaw < 0.3  # integrated for imu_timeout (0.5 s), then held
+    ages = dr.input_ages(2.0)
+    assert ages["imu"] == ages["mag"] == ages["pressure"] == 2.0
+    assert ages["thruster_1"] is None and ages["thruster_2"] is None

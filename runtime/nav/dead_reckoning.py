@@ -48,6 +48,7 @@ class DeadReckoningConfig:
     max_step: float = 0.05  # integration sub-step [s]
     max_gap: float = 1.0  # a longer gap between two updates is integrated as this long (a stalled clock)
     feedback_timeout: float = 1.0  # thruster feedback older than this counts as 0 rpm [s]
+    imu_timeout: float = 0.5  # gyro rates older than this count as 0 (a lost IMU does not spin the estimate) [s]
     p_atm: float = P_ATM
     rho: float = RHO_SEAWATER
     vehicle: VehicleParams = field(default_factory=VehicleParams)  # nominal: the speed model
@@ -116,9 +117,10 @@ class DeadReckoning:
         span = min(gap, self.config.max_gap)
         n = max(1, math.ceil(span / self.config.max_step))
         h = span / n
-        p, q, r = self.rates
+        imu_t = self._prev.get("imu", -math.inf)
         for i in range(n):
             tk = self.t + i * h
+            p, q, r = self.rates if tk - imu_t <= self.config.imu_timeout else (0.0, 0.0, 0.0)
             rpm_1, rpm_2 = self._rpm_at(0, tk), self._rpm_at(1, tk)
             self.u += surge_acceleration(self.u, rpm_1, rpm_2, self.config.vehicle) * h
             sr, cr = math.sin(self.roll), math.cos(self.roll)
@@ -141,6 +143,7 @@ class DeadReckoning:
             self._refuse("imu_not_finite")
             return False
         self.advance(t)
+        dt = self._last_dt("imu", t)
         self.rates = (float(gyro[0]), float(gyro[1]), float(gyro[2]))
         # Gravity = specific force minus the vehicle's own acceleration (surge change, and the centripetal terms
         # of moving forward at u while rotating: w x (u, 0, 0) = (0, r u, -q u)).
@@ -155,7 +158,7 @@ class DeadReckoning:
             if not self._have_tilt:
                 self.roll, self.pitch, self._have_tilt = roll_m, pitch_m, True
             else:
-                k = min(1.0, self.config.attitude_gain * self._last_dt("imu", t))
+                k = min(1.0, self.config.attitude_gain * dt)
                 self.roll += k * wrap_angle(roll_m - self.roll)
                 self.pitch += k * wrap_angle(pitch_m - self.pitch)
         else:
@@ -181,10 +184,11 @@ class DeadReckoning:
             self._refuse("magnetometer_vertical")
             return False
         yaw_m = math.atan2(lx, ly)
+        dt = self._last_dt("mag", t)
         if not self._have_heading:
             self.yaw, self._have_heading = yaw_m, True
         else:
-            k = min(1.0, self.config.heading_gain * self._last_dt("mag", t))
+            k = min(1.0, self.config.heading_gain * dt)
             self.yaw = wrap_angle(self.yaw + k * wrap_angle(yaw_m - self.yaw))
         self.counts["magnetometer"] += 1
         return True
@@ -196,6 +200,7 @@ class DeadReckoning:
             return False
         self.advance(t)
         self.depth = max(0.0, depth_from_pressure(pressure_pa, self.config.p_atm, self.config.rho))
+        self._prev["pressure"] = t
         self.counts["pressure"] += 1
         return True
 
@@ -216,6 +221,14 @@ class DeadReckoning:
         prev = self._prev.get(key)
         self._prev[key] = t
         return 0.0 if prev is None else min(max(t - prev, 0.0), self.config.max_gap)
+
+    def input_ages(self, t: float) -> dict[str, float | None]:
+        """Seconds since the last accepted reading of each input at ``t`` (None: never), for diagnostics."""
+        ages: dict[str, float | None] = {k: None if k not in self._prev else t - self._prev[k]
+                                         for k in ("imu", "mag", "pressure")}
+        for i, (_, stamp) in enumerate(self._rpm):
+            ages[f"thruster_{i + 1}"] = None if stamp == -math.inf else t - stamp
+        return ages
 
     # ---------------------------------------------------------------------------------- output
     def pose(self, t: float | None = None) -> DrPose | None:
