@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from sam_runtime.nav.geo import wrap_angle
+from sam_runtime.nav.geo import euler_from_quaternion, wrap_angle
 
 __all__ = ["Commands", "Controller", "ControllerConfig", "ControllerPose"]
 
@@ -78,6 +78,17 @@ class ControllerPose:
     roll: float
     pitch: float
     yaw: float
+
+    @classmethod
+    def from_transform(cls, translation: tuple[float, float, float],
+                       rotation: tuple[float, float, float, float]) -> ControllerPose:
+        """From a TF lookup of world -> base_link (translation, quaternion (x, y, z, w)).
+
+        >>> ControllerPose.from_transform((1.0, 2.0, -3.0), (0.0, 0.0, 0.0, 1.0))
+        ControllerPose(x=1.0, y=2.0, z=-3.0, roll=0.0, pitch=0.0, yaw=0.0)
+        """
+        roll, pitch, yaw = euler_from_quaternion(rotation)
+        return cls(float(translation[0]), float(translation[1]), float(translation[2]), roll, pitch, yaw)
 
 
 @dataclass(frozen=True)
