@@ -333,8 +333,10 @@ def test_sim_command_line_vehicle_options_and_truth_file(gen: Any, tmp_path: Pat
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert json.loads(fast.read_text())["t"] >= 3.6  # at exit: 4 x (start-up + 1 s of publishing)
     pressure = json.loads(report.read_text())["devices"]["pressure"]
-    published, late = pressure["published"]["1103"], pressure["late"].get("1103", 0)  # late ticks: skipped
-    assert published + late == pytest.approx(4 * 20 * 1.0, abs=3) and published >= 40  # 20 Hz of vehicle time
+    # 20 Hz of vehicle time = 80 per wall second; ticks the loaded process was too late for are skipped and counted
+    # (a stall near the end may count a few beyond the window).
+    published, late = pressure["published"]["1103"], pressure["late"].get("1103", 0)
+    assert 40 <= published <= 83 and published + late >= 77, pressure
     for bad, message in ((["--start", "0,0,30,0"], "the sea floor there"), (["--sea-floor", "deep"], "sea floor"),
                          (["--gps-origin", "95,0"], "GPS origin")):
         proc = subprocess.run([*base, "--duration", "0.1", *bad], env=env, capture_output=True, text=True, timeout=60)
