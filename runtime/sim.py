@@ -2,17 +2,20 @@
 
 - Every published port runs at its nominal rate (``rate_hz`` of the spec, optionally scaled), on an
   absolute schedule (no drift; a late tick is published late, never twice).
-- Values: a generic generator fills every field of any DSDL type from its pydsdl model (slow sines within
-  the field's range, timestamps in microseconds, composites recursively), so any spec gets plausible,
-  changing data. Where the type is known, a small physics table (:data:`PHYSICS`, keyed by the type name
-  without its root namespace, e.g. ``sensor.RawIMU``) overrides the fields with the SAM models: IMU at rest
-  with gravity and noise, a slowly rotating ~0.5 G magnetic field, a GNSS fix at the surface near KTH, the
-  pressure at a depth that oscillates 0..10 m, a discharging battery, actuators moving toward their
-  commanded values at a finite rate.
+- Values (:mod:`sam_runtime.device_models`): generic in-range values for any DSDL type; where the type is
+  known, measurements of one shared simulated vehicle (:mod:`sam_runtime.vehicle`): IMU, magnetometer,
+  pressure, altimeter, GNSS (a fix only at the surface), battery, and the actuators' feedback.
+- One vehicle: the SAM actuator devices (:data:`SAM_ACTUATORS`, by device name) drive the model's inputs; the
+  model moves toward them at finite rates and integrates in fixed 10 ms steps up to the time a device reads it,
+  so a seed and a command sequence give one trajectory. Devices of other specs keep their own simple feedback
+  model (moving toward the last command at a finite rate).
 - Actuators accept commands only from the bridge's node id; commands from any other node are counted and
-  ignored. The last accepted command drives the device's feedback model.
+  ignored.
 - Timestamps: microseconds on a monotonic clock whose epoch is the wall-clock time at start (realistic
-  ROS stamps, never jumping).
+  ROS stamps, never jumping); with ``time_scale`` the vehicle's clock (and the stamps) run that many times
+  faster than the wall clock, and so do the publication rates.
+- Ground truth: ``Simulator.truth()`` in process, and ``truth_file`` (JSON lines when it ends in ``.jsonl``,
+  else one JSON object replaced atomically) at ``truth_rate_hz`` of vehicle time.
 
 ``Simulator.report()`` gives counts per device and subject (published, commands accepted/rejected, the
 last command); ``record`` writes every transmitted and received message (as transmitted) as JSON lines.
@@ -26,273 +29,31 @@ import asyncio
 import json
 import logging
 import math
-import random
+import os
 import time
 from collections import Counter
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
+from sam_runtime.device_models import (
+    PHYSICS,
+    SAM_ACTUATORS,
+    DeviceState,
+    PhysicsFn,
+    VehicleState,
+    generic_fill,
+    physics_key,
+)
 from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, VehicleParams
 
-__all__ = ["PHYSICS", "DeviceState", "SimConfig", "Simulator", "VehicleState"]
+# The device models live in sam_runtime.device_models; re-exported here, where the tests and benchmarks import them.
+__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState", "generic_fill",
+           "physics_key"]
 
 _log = logging.getLogger("sam_runtime.sim")
-
-SYNC_TIMESTAMP = "uavcan.time.SynchronizedTimestamp"
-G = 9.80665
-RHO_SEAWATER = 1025.0
-P_ATM = 101325.0
-
-
-# ============================================================================================ state
-@dataclass
-class VehicleState:
-    """What the devices of one vehicle share: time and the vehicle's motion."""
-
-    epoch_us: int = field(default_factory=lambda: time.time_ns() // 1000)
-    mono0_ns: int = field(default_factory=time.monotonic_ns)
-    rng: random.Random = field(default_factory=lambda: random.Random(0x5A3))
-    depth_period_s: float = 120.0
-    max_depth_m: float = 10.0
-
-    def t(self) -> float:
-        """Seconds since start."""
-        return (time.monotonic_ns() - self.mono0_ns) * 1e-9
-
-    def now_us(self) -> int:
-        """Monotonic microseconds since the Unix epoch of the start time."""
-        return self.epoch_us + (time.monotonic_ns() - self.mono0_ns) // 1000
-
-    def depth(self, t: float) -> float:
-        """Depth [m], a slow oscillation between the surface and max_depth_m."""
-        return self.max_depth_m * 0.5 * (1.0 - math.cos(2.0 * math.pi * t / self.depth_period_s))
-
-    def heading(self, t: float) -> float:
-        return (0.05 * t) % (2.0 * math.pi)
-
-
-@dataclass
-class DeviceState:
-    """One simulated device's own state: its last accepted command and its actuator positions."""
-
-    name: str
-    node_id: int
-    command: dict[str, Any] = field(default_factory=dict)  # field name -> value of the last accepted command
-    position: dict[str, float] = field(default_factory=dict)  # model state, e.g. percent, rpm
-    last_update: float | None = None  # VehicleState.t() of the last model step
-    extra: dict[str, Any] = field(default_factory=dict)
-
-    def approach(self, key: str, target: float, rate_per_s: float, t: float, initial: float = 0.0) -> float:
-        """Move position[key] toward target at rate_per_s since the last call; returns the new value."""
-        cur = self.position.get(key, initial)
-        dt = 0.0 if self.last_update is None else max(0.0, t - self.last_update)
-        step = rate_per_s * dt
-        cur = min(cur + step, target) if target >= cur else max(cur - step, target)
-        self.position[key] = cur
-        return cur
-
-
-# ============================================================================================ generic values
-def _clip_float(bits: int, v: float) -> float:
-    lim = {16: 65504.0, 32: 3.4028234e38}.get(bits, 1.7976931348623157e308)
-    return max(-lim, min(lim, v))
-
-
-def _int_range(t: Any) -> tuple[int, int]:
-    import pydsdl
-
-    if isinstance(t, pydsdl.BooleanType):
-        return 0, 1
-    r = t.inclusive_value_range
-    return int(r.min), int(r.max)
-
-
-def _generic_scalar(t: Any, phase: float, tt: float, now_us: int) -> Any:
-    import pydsdl
-
-    s = math.sin(2.0 * math.pi * tt / 20.0 + phase)
-    if isinstance(t, pydsdl.BooleanType):
-        return s > 0
-    if isinstance(t, pydsdl.FloatType):
-        return _clip_float(t.bit_length, round(10.0 * s, 3))
-    if isinstance(t, pydsdl.IntegerType):
-        lo, hi = _int_range(t)
-        mid = (lo + hi) // 2 if lo < 0 else min(hi, 100)
-        amp = min(1000, (hi - lo) // 4)
-        return max(lo, min(hi, round(mid + amp * s)))
-    return None
-
-
-def generic_fill(obj: Any, tt: float, now_us: int, seed: int = 0) -> Any:
-    """Fill every field of a pycyphal object with a slowly changing in-range value (any DSDL type)."""
-    import pycyphal.dsdl
-    import pydsdl
-
-    model = pycyphal.dsdl.get_model(obj)
-    if isinstance(model, pydsdl.DelimitedType):
-        model = model.inner_type
-    if isinstance(model, pydsdl.UnionType):
-        return obj  # unions keep their default (first) variant
-    for i, f in enumerate(model.fields_except_padding):
-        t, phase = f.data_type, 0.7 * (i + seed)
-        try:
-            if isinstance(t, pydsdl.PrimitiveType):
-                setattr(obj, f.name, _generic_scalar(t, phase, tt, now_us))
-            elif isinstance(t, pydsdl.CompositeType):
-                sub = getattr(obj, f.name)
-                if str(t.full_name) == SYNC_TIMESTAMP or t.full_name.endswith(".SynchronizedTimestamp"):
-                    sub.microsecond = now_us
-                else:
-                    generic_fill(sub, tt, now_us, seed + i + 1)
-            elif isinstance(t, pydsdl.ArrayType) and isinstance(t.element_type, pydsdl.PrimitiveType):
-                n = t.capacity if isinstance(t, pydsdl.FixedLengthArrayType) else min(t.capacity, 3)
-                if isinstance(t.element_type, pydsdl.UnsignedIntegerType) and t.element_type.bit_length == 8 \
-                        and "name" in f.name:
-                    setattr(obj, f.name, b"sim"[: t.capacity])
-                else:
-                    setattr(obj, f.name, [_generic_scalar(t.element_type, phase + 0.3 * k, tt, now_us)
-                                          for k in range(n)])
-        except (ValueError, TypeError) as ex:  # a value the type refuses: keep the default
-            _log.debug("generic value for %s.%s refused: %s", type(obj).__name__, f.name, ex)
-    return obj
-
-
-def _set(obj: Any, name: str, value: Any) -> None:
-    """Set a field if the type has it (a spec may differ from SAM's); out-of-range values are clipped by the
-    caller or left at the generic value."""
-    if hasattr(obj, name):
-        try:
-            setattr(obj, name, value)
-        except (ValueError, TypeError) as ex:
-            _log.debug("%s.%s = %r refused: %s", type(obj).__name__, name, value, ex)
-
-
-def _stamp(obj: Any, name: str, us: int) -> None:
-    sub = getattr(obj, name, None)
-    if sub is not None and hasattr(sub, "microsecond"):
-        sub.microsecond = us
-
-
-# ============================================================================================ SAM physics
-PhysicsFn = Callable[[Any, DeviceState, VehicleState, float, float, random.Random], None]
-
-
-def _imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    n = rng.gauss
-    gyro = [0.05 * math.sin(0.5 * t), 0.04 * math.sin(0.3 * t + 1.0), 0.05]  # yaw rate = d(heading)/dt
-    acc = [0.02 * n(0, 1), 0.02 * n(0, 1), G + 0.02 * n(0, 1)]
-    _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "integration_interval", dt)
-    _set(obj, "rate_gyro_latest", gyro)
-    _set(obj, "rate_gyro_integral", [g * dt for g in gyro])
-    _set(obj, "accelerometer_latest", acc)
-    _set(obj, "accelerometer_integral", [a * dt for a in acc])
-    # Full 6x6 covariance of [gyro, accel], row major: makes the transfer multi-frame on CAN FD too.
-    _set(obj, "covariance", [(1e-4 if i < 3 else 4e-4) if i == j else 0.0 for i in range(6) for j in range(6)])
-
-
-def _magnetometer(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    # Stockholm: ~0.52 G total, inclination ~73 deg: 0.15 G horizontal, 0.49 G down; body frame rotates.
-    h = veh.heading(t)
-    field_ga = [0.15 * math.cos(h) + 0.002 * rng.gauss(0, 1), -0.15 * math.sin(h) + 0.002 * rng.gauss(0, 1),
-                0.49 + 0.002 * rng.gauss(0, 1)]
-    _set(obj, "magnetic_field_ga", field_ga)
-    _set(obj, "magnetic_field_covariance", [4e-6 if i == j else 0.0 for i in range(3) for j in range(3)])
-
-
-def _gnss(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    # At the surface near KTH, Stockholm (59.35 N, 18.07 E), drifting slowly east-north-east at ~0.5 m/s.
-    lat = 59.3500 + 0.5 * math.sin(0.3) * t / 111_320.0
-    lon = 18.0700 + 0.5 * math.cos(0.3) * t / (111_320.0 * math.cos(math.radians(59.35)))
-    _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "latitude_deg_1e8", round(lat * 1e8))
-    _set(obj, "longitude_deg_1e8", round(lon * 1e8))
-    wave = 0.2 * math.sin(2 * math.pi * t / 8.0)
-    _set(obj, "height_ellipsoid_mm", round((23.0 + wave) * 1000))  # geoid ~23 m above the ellipsoid
-    _set(obj, "height_msl_mm", round(wave * 1000))
-    _set(obj, "ned_velocity", [0.5 * math.sin(0.3), 0.5 * math.cos(0.3), 0.0])
-    _set(obj, "sats_used", 9 + int(2 * (1 + math.sin(t / 30.0))))
-    _set(obj, "status", 3)
-    _set(obj, "pdop", 1.2 + 0.1 * math.sin(t / 10.0))
-    _set(obj, "position_covariance", [2.25 if i == j else 0.0 for i in range(3) for j in range(3)])
-
-
-def _pressure(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    depth = veh.depth(t)
-    _set(obj, "static_pressure", P_ATM + RHO_SEAWATER * G * depth + 5.0 * rng.gauss(0, 1))
-    _set(obj, "static_pressure_variance", 25.0)
-
-
-def _battery(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
-    full_wh = 800.0
-    soc = max(0.0, 0.95 - 0.0005 * t)  # 0.05 %/s: visible in a demo
-    current = -(12.0 + 0.5 * math.sin(t / 5.0))
-    voltage = 6 * (3.4 + 0.8 * soc)  # a 6S pack
-    _set(obj, "temperature", 298.15 + 2.0 * math.sin(t / 60.0))
-    _set(obj, "voltage", voltage)
-    _set(obj, "current", current)
-    _set(obj, "average_power_10sec", -voltage * current)
-    _set(obj, "remaining_capacity_wh", full_wh * soc)
-    _set(obj, "full_charge_capacity_wh", full_wh)
-    _set(obj, "hours_to_full_charge", 0.0)
-    _set(obj, "status_flags", 1)  # IN_USE
-    _set(obj, "state_of_health_pct", 98)
-    _set(obj, "state_of_charge_pct", round(soc * 100))
-    _set(obj, "state_of_charge_pct_stdev", 2)
-    _set(obj, "battery_id", 0)
-    _set(obj, "model_instance_id", 0x5A3_0001)
-    _set(obj, "model_name", b"SAM 6S Li-ion")
-
-
-def _thruster_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
-                       rng: random.Random) -> None:
-    target = float(dev.command.get("rpm", 0))
-    rpm = dev.approach("rpm", target, 2000.0, t)  # spins up at 2000 rpm/s
-    _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "rpm", round(max(-131072, min(131071, rpm))))
-    _set(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
-    _set(obj, "temperature_c", int(min(127, 25 + abs(rpm) / 200.0)))
-
-
-def _thrust_vector_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
-                            rng: random.Random) -> None:
-    v = dev.approach("vertical", float(dev.command.get("vertical_radians", 0.0)), 0.5, t)  # 0.5 rad/s servos
-    h = dev.approach("horizontal", float(dev.command.get("horizontal_radians", 0.0)), 0.5, t)
-    _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "vertical_mrad", int(max(-4096, min(4095, round(v * 1000)))))
-    _set(obj, "horizontal_mrad", int(max(-4096, min(4095, round(h * 1000)))))
-
-
-def _position_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
-                       rng: random.Random) -> None:
-    target = float(dev.command.get("percent", 50.0))
-    pct = dev.approach("percent", max(0.0, min(100.0, target)), 10.0, t, initial=50.0)  # 10 %/s
-    _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "percent", pct)
-    _set(obj, "encoder_count", round(pct * 100))  # 10 000 counts over the full travel
-
-
-# Keyed by the DSDL type's full name without the root namespace and version.
-PHYSICS: dict[str, PhysicsFn] = {
-    "sensor.RawIMU": _imu,
-    "sensor.MagneticFieldStrength": _magnetometer,
-    "sensor.GNSSFix": _gnss,
-    "sensor.StaticPressure": _pressure,
-    "power.BatteryInfo": _battery,
-    "actuator.ThrusterFeedback": _thruster_feedback,
-    "actuator.ThrustVectorFeedback": _thrust_vector_feedback,
-    "actuator.PositionFeedback": _position_feedback,
-}
-
-
-def physics_key(dsdl_type: str) -> str:
-    """``sam.sensor.RawIMU.0.1`` -> ``sensor.RawIMU``."""
-    parts = dsdl_type.split(".")
-    if len(parts) >= 3 and parts[-1].isdigit() and parts[-2].isdigit():
-        parts = parts[:-2]
-    return ".".join(parts[1:])
 
 
 # ============================================================================================ simulator
@@ -309,6 +70,27 @@ class SimConfig:
     devices: Iterable[str] | None = None  # subset of device names; default all
     rate_scale: float = 1.0
     record: Path | None = None  # JSON lines of every transmitted/received message
+    # The simulated vehicle (see sam_runtime.vehicle): noise seed, sea floor, start pose in the sim's world frame
+    # (ENU metres around gps_origin; yaw counter-clockwise from east), battery, time.
+    seed: int = 0
+    sea_floor: SeaFloor = field(default_factory=SeaFloor)
+    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw
+    battery_percent: float = 95.0
+    battery_drain_factor: float = 1.0  # multiplies the power drawn (a scenario can drain the battery quickly)
+    battery_health_pct: int = 98
+    gps_origin: tuple[float, float] = (59.35, 18.07)  # lat, lon of the sim's world origin (KTH, Stockholm)
+    vehicle_params: VehicleParams = field(default_factory=VehicleParams)
+    noise: SensorNoise = field(default_factory=SensorNoise)
+    time_scale: float = 1.0  # vehicle seconds per wall second (rates and stamps follow)
+    truth_file: Path | None = None  # the true state: JSON lines if it ends in .jsonl, else an atomic JSON file
+    truth_rate_hz: float = 5.0  # of vehicle time
+
+    def make_vehicle(self) -> SimulatedVehicle:
+        """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""
+        return SimulatedVehicle(seed=self.seed, sea_floor=self.sea_floor, start=self.start,
+                                battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
+                                battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
+                                params=self.vehicle_params, noise=self.noise)
 
 
 @dataclass
@@ -354,7 +136,13 @@ class Simulator:
         self.gen = gen
         self.tables = gen.tables()
         self.config = config or SimConfig()
-        self.vehicle = VehicleState()
+        if not (math.isfinite(self.config.time_scale) and self.config.time_scale > 0):
+            raise ValueError(f"time_scale must be > 0, got {self.config.time_scale}")
+        if not (math.isfinite(self.config.truth_rate_hz) and self.config.truth_rate_hz > 0):
+            raise ValueError(f"truth_rate_hz must be > 0, got {self.config.truth_rate_hz}")
+        self.vehicle = VehicleState(time_scale=self.config.time_scale, model=self.config.make_vehicle())
+        self._truth_task: asyncio.Task[None] | None = None
+        self.truth_written = 0
         self.bridge_node_id = int(self.config.bridge_node_id if self.config.bridge_node_id is not None
                                   else self.tables.BRIDGE_NODE_ID)
         wanted = None if self.config.devices is None else set(self.config.devices)
@@ -395,6 +183,8 @@ class Simulator:
                 self._open_device(dev)
             for dev in self.devices:
                 self._start_device_tasks(dev)
+            if self.config.truth_file is not None:
+                self._truth_task = asyncio.create_task(self._truth_loop(), name="sim-truth")
         except BaseException:
             await self.close()
             raise
@@ -445,6 +235,9 @@ class Simulator:
         if not dev.powered:
             return
         dev.powered = False
+        if "rpm" in SAM_ACTUATORS.get(name, {}):  # a motor without power stops; servos hold their position
+            self.vehicle.sync(self.vehicle.t())
+            self.vehicle.vehicle.command(**{SAM_ACTUATORS[name]["rpm"]: 0.0})
         await cancel_and_wait([pp.task for pp in dev.pubs if pp.task is not None])
         ports = [pp.publisher for pp in dev.pubs] + [sp.subscriber for sp in dev.subs]
         for pp in dev.pubs:
@@ -505,7 +298,10 @@ class Simulator:
         from sam_runtime.bridge import cancel_and_wait
         from sam_runtime.transport import aclose
 
-        stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None])
+        stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None]
+                                      + ([self._truth_task] if self._truth_task is not None else []))
+        if self.config.truth_file is not None:
+            self._write_truth()
         if stuck:
             _log.warning("%d publish tasks did not stop", len(stuck))
         ports = [p.publisher for d in self.devices for p in d.pubs] + [s.subscriber for d in self.devices
@@ -526,14 +322,14 @@ class Simulator:
         obj = pp.dtype()
         generic_fill(obj, t, self.vehicle.now_us(), seed=pp.port.subject_id)
         if pp.physics is not None:
-            pp.physics(obj, dev.state, self.vehicle, t, dt, self.vehicle.rng)
+            pp.physics(obj, dev.state, self.vehicle, t, dt * self.vehicle.time_scale, self.vehicle.rng)
         dev.state.last_update = t
         return obj
 
     async def _publish_loop(self, dev: _SimDevice, pp: _PubPort, restart: bool = False) -> None:
         assert self._go is not None
         await self._go.wait()
-        rate = float(pp.port.rate_hz) * float(self.config.rate_scale)
+        rate = float(pp.port.rate_hz) * float(self.config.rate_scale) * self.vehicle.time_scale  # per wall second
         if rate <= 0:
             return
         period = 1.0 / rate
@@ -597,12 +393,51 @@ class Simulator:
             values = pycyphal.dsdl.to_builtin(msg)
             sp.last = values
             dev.state.command.update(values)
+            inputs = SAM_ACTUATORS.get(dev.info.name)
+            if inputs:  # from now on (the model first catches up with the time of arrival)
+                self.vehicle.sync(self.vehicle.t())
+                self.vehicle.vehicle.command(**{inputs[k]: float(v) for k, v in values.items() if k in inputs})
         else:
             sp.rejected += 1
             sp.rejected_sources[-1 if src is None else int(src)] += 1
         if self._record is not None:
             self._write_record("rx", dev, sp.port.subject_id, msg, source=src, accepted=accepted,
                                seq=sp.accepted if accepted else sp.rejected)
+
+    # ---------------------------------------------------------------------------------- truth
+    def truth(self) -> dict[str, Any]:
+        """The vehicle's true state now (see :meth:`sam_runtime.vehicle.Vehicle.truth`), with the sim's stamp
+        clock (``stamp_us``, as in the devices' timestamps), the wall clock and the GPS origin."""
+        veh = self.vehicle.sync(self.vehicle.t())
+        return {**veh.truth(), "stamp_us": self.vehicle.epoch_us + round(veh.t * 1e6), "wall_ns": time.time_ns(),
+                "gps_origin": list(self.config.gps_origin), "time_scale": self.vehicle.time_scale}
+
+    def _write_truth(self) -> None:
+        path = self.config.truth_file
+        assert path is not None
+        line = json.dumps(self.truth(), default=_json_default)
+        try:
+            if path.suffix == ".jsonl":
+                with open(path, "a") as f:
+                    f.write(line + "\n")
+            else:
+                tmp = path.with_name(f"{path.name}.tmp{os.getpid()}")
+                tmp.write_text(line + "\n")
+                os.replace(tmp, path)
+            self.truth_written += 1
+        except OSError as ex:
+            _log.warning("truth file %s: %s", path, ex)
+
+    async def _truth_loop(self) -> None:
+        if self.config.truth_file is not None and self.config.truth_file.suffix == ".jsonl":
+            self.config.truth_file.write_text("")  # a new run
+        period = 1.0 / (self.config.truth_rate_hz * self.vehicle.time_scale)  # wall seconds
+        start = time.monotonic()
+        k = 0
+        while not self._closed:
+            self._write_truth()
+            k += 1
+            await asyncio.sleep(max(0.0, start + k * period - time.monotonic()))
 
     # ---------------------------------------------------------------------------------- reporting
     def _write_record(self, direction: str, dev: _SimDevice, subject: int, obj: Any, **extra: Any) -> None:
@@ -634,12 +469,15 @@ class Simulator:
                 },
                 "position": dict(d.state.position),
             }
+        truth = self.truth()
         since = self._publishing_since
         return {
             "bridge_node_id": self.bridge_node_id,
             "publishing_s": None if since is None else round(
                 (min(time.monotonic(), self._publishing_until or math.inf)) - since, 3),
             "devices": devices,
+            "vehicle": truth,
+            "rejected_vehicle_commands": self.vehicle.vehicle.rejected_commands,
         }
 
 

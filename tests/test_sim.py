@@ -1,5 +1,6 @@
 """The simulated devices (runtime/sim.py): one Cyphal node per device of the spec, plausible changing values at
-the nominal rates, actuators that accept only the bridge's commands and move at a finite rate.
+the nominal rates, actuators that accept only the bridge's commands and move at a finite rate; the SAM devices
+measure one shared vehicle that their actuators drive.
 
 The network tests run over python-can ``virtual`` CAN FD in this process (a channel name per test), so they
 cannot see, or be seen by, any other run on the machine.
@@ -8,6 +9,7 @@ cannot see, or be seen by, any other run on the machine.
 from __future__ import annotations
 
 import asyncio
+import itertools
 import json
 import math
 import os
@@ -25,7 +27,8 @@ pytest.importorskip("can")
 
 from helpers.runtime_support import generated_or_skip
 
-from sam_runtime.sim import DeviceState, SimConfig, Simulator, VehicleState, generic_fill, physics_key
+from sam_runtime.sim import PHYSICS, DeviceState, SimConfig, Simulator, VehicleState, generic_fill, physics_key
+from sam_runtime.vehicle import SeaFloor, SimulatedVehicle
 
 # pycyphal.dsdl.to_builtin/serialize call a pydsdl API that pydsdl 1.25 deprecates: noise only.
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning:pydsdl")
@@ -56,12 +59,18 @@ def test_actuator_moves_toward_its_command_at_a_finite_rate() -> None:
     assert dev.approach("percent", 0.0, 10.0, t=12.0) == pytest.approx(60.0)  # and back down
 
 
-def test_vehicle_depth_oscillates_between_surface_and_10_m() -> None:
+def test_vehicle_clock_and_model_time() -> None:
     veh = VehicleState()
-    depths = [veh.depth(t) for t in range(0, 121)]
-    assert min(depths) == pytest.approx(0.0, abs=1e-9) and max(depths) == pytest.approx(10.0, abs=1e-3)
     a, b = veh.now_us(), veh.now_us()
     assert b >= a and abs(a / 1e6 - time.time()) < 5  # microseconds, epoch = the wall clock at start
+    # The model follows the device reads in whole 10 ms steps, never backwards.
+    assert veh.sync(1.234).t == pytest.approx(1.23)
+    assert veh.sync(0.5).t == pytest.approx(1.23)
+    fast = VehicleState(time_scale=4.0)
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 0.05:
+        pass
+    assert fast.t() >= 4 * 0.05 - 1e-6  # vehicle seconds run 4x the wall clock
 
 
 @pytest.fixture(scope="module")
@@ -91,8 +100,6 @@ def test_generic_values_for_any_type(gen: Any) -> None:
 def _sample(sim: Simulator, device: str, t: float) -> Any:
     dev = next(d for d in sim.devices if d.info.name == device)
     port = dev.info.publishes[0]
-    from sam_runtime.sim import PHYSICS
-
     obj = sim.gen.dsdl_class(port)()
     generic_fill(obj, t, sim.vehicle.now_us())
     PHYSICS[physics_key(port.dsdl_type)](obj, dev.state, sim.vehicle, t, 1.0 / port.rate_hz, sim.vehicle.rng)
@@ -100,26 +107,95 @@ def _sample(sim: Simulator, device: str, t: float) -> Any:
     return obj
 
 
+class _Transfer:
+    def __init__(self, source_node_id: int | None) -> None:
+        self.source_node_id = source_node_id
+
+
+def _command(sim: Simulator, device: str, source: int, **values: Any) -> None:
+    """A command as the device receives it (no network): through the simulator's command handler."""
+    dev = next(d for d in sim.devices if d.info.name == device)
+    if not dev.subs:
+        port = dev.info.subscribes[0]
+        from sam_runtime.sim import _SubPort
+
+        dev.subs.append(_SubPort(port, sim.gen.dsdl_class(port)))
+    sp = dev.subs[0]
+    sim._on_command(dev, sp, sp.dtype(**values), _Transfer(source))
+
+
 def test_sam_physics_values_are_plausible(gen: Any) -> None:
     if gen.tables().VEHICLE != "sam":
         pytest.skip("SAM's devices")
-    sim = Simulator(gen)
+    sim = Simulator(gen, SimConfig(battery_drain_factor=20.0))
     imu = _sample(sim, "imu", 1.0)
     assert imu.accelerometer_latest[2] == pytest.approx(9.81, abs=0.2) and abs(imu.accelerometer_latest[0]) < 0.2
     assert len(imu.covariance) == 36 and imu.timestamp.microsecond > 0
     mag = _sample(sim, "magnetometer", 1.0)
     assert 0.45 < math.dist((0, 0, 0), [float(x) for x in mag.magnetic_field_ga]) < 0.6  # Gauss, Stockholm
-    h0 = [float(x) for x in _sample(sim, "magnetometer", 0.0).magnetic_field_ga]
-    h1 = [float(x) for x in _sample(sim, "magnetometer", 20.0).magnetic_field_ga]
-    assert math.dist(h0[:2], h1[:2]) > 0.05  # the field rotates with the heading
     gps = _sample(sim, "gps", 1.0)
     assert abs(gps.latitude_deg_1e8 * 1e-8 - 59.35) < 0.01 and abs(gps.longitude_deg_1e8 * 1e-8 - 18.07) < 0.01
     assert gps.status == 3 and abs(gps.height_msl_mm) < 1000  # a 3D fix at the surface
-    for t, depth in ((0.0, 0.0), (30.0, 5.0), (60.0, 10.0)):
-        p = _sample(sim, "pressure", t).static_pressure
-        assert p == pytest.approx(101325 + 1025 * 9.80665 * depth, abs=30), t
-    b0, b1 = _sample(sim, "battery", 0.0), _sample(sim, "battery", 200.0)
+    p = _sample(sim, "pressure", 2.0).static_pressure
+    assert p == pytest.approx(101325, abs=30)  # at the surface
+    # The field rotates with the heading: the bridge's commands turn the vehicle.
+    bridge = sim.bridge_node_id
+    h0 = [float(x) for x in _sample(sim, "magnetometer", 2.0).magnetic_field_ga]
+    _command(sim, "thruster_1", bridge, rpm=1500)
+    _command(sim, "thruster_2", bridge, rpm=1500)
+    _command(sim, "thrust_vector", bridge, vertical_radians=0.0, horizontal_radians=0.12)
+    h1 = [float(x) for x in _sample(sim, "magnetometer", 22.0).magnetic_field_ga]
+    assert math.dist(h0[:2], h1[:2]) > 0.05
+    assert sim.vehicle.vehicle.state.r > 0.1  # to port: a counter-clockwise yaw rate
+    b0, b1 = _sample(sim, "battery", 22.0), _sample(sim, "battery", 222.0)
     assert b1.state_of_charge_pct < b0.state_of_charge_pct and b1.voltage < b0.voltage and b0.current < 0
+
+
+def test_actuators_drive_the_shared_vehicle_and_its_sensors_measure_it(gen: Any) -> None:
+    if gen.tables().VEHICLE != "sam":
+        pytest.skip("SAM's devices")
+    sim = Simulator(gen, SimConfig(seed=3, sea_floor=SeaFloor(20.0)))
+    veh = sim.vehicle.vehicle
+    _command(sim, "buoyancy_piston", 42, percent=0.0)  # not the bridge: ignored
+    assert _sample(sim, "buoyancy_piston", 5.0).percent == 50.0 and veh.state.depth == 0.0
+    _command(sim, "buoyancy_piston", sim.bridge_node_id, percent=0.0)  # sink
+    fb = [float(_sample(sim, "buoyancy_piston", 5.0 + k).percent) for k in (1, 2, 5, 6)]
+    assert fb == pytest.approx([40.0, 30.0, 0.0, 0.0], abs=0.6)  # 10 %/s
+    p = float(_sample(sim, "pressure", 40.0).static_pressure)
+    assert veh.state.depth > 3.0 and p == pytest.approx(101325 + 1025 * 9.80665 * veh.state.depth, abs=30)
+    gps = _sample(sim, "gps", 40.0)
+    assert gps.status == 0 and list(gps.position_covariance) == []  # no fix under water
+    gps_thruster = _sample(sim, "thruster_1", 40.0)
+    assert gps_thruster.rpm == 0
+    _command(sim, "buoyancy_piston", sim.bridge_node_id, percent=100.0)  # back up
+    _sample(sim, "pressure", 120.0)
+    assert veh.state.depth == 0.0 and veh.state.max_depth > 3.0
+    assert _sample(sim, "gps", 121.0).status == 3
+    # Out-of-range commands are clamped by the mechanism; NaN is refused and counted.
+    _command(sim, "thrust_vector", sim.bridge_node_id, vertical_radians=1.0, horizontal_radians=float("nan"))
+    fb = _sample(sim, "thrust_vector", 125.0)
+    assert fb.vertical_mrad == 120 and fb.horizontal_mrad == 0
+    assert veh.rejected_commands == 1
+    truth = sim.truth()
+    assert truth["max_depth"] == veh.state.max_depth and truth["gps_origin"] == [59.35, 18.07]
+
+
+def test_altimeter_physics_measures_the_range_to_the_sea_floor() -> None:
+    """The altimeter's DSDL type (sam.sensor.Altitude.0.1: timestamp, altitude, altitude_variance) on any object
+    with those fields: the range to the floor, NaN beyond the altimeter's range."""
+    from types import SimpleNamespace
+
+    def sample(veh: VehicleState, t: float) -> Any:
+        obj = SimpleNamespace(timestamp=SimpleNamespace(microsecond=0), altitude=0.0, altitude_variance=0.0)
+        PHYSICS["sensor.Altitude"](obj, DeviceState("altimeter", 16), veh, t, 0.1, veh.rng)
+        return obj
+
+    shallow = VehicleState(model=SimulatedVehicle(sea_floor=SeaFloor(12.0), start=(0.0, 0.0, 2.0, 0.0)))
+    obj = sample(shallow, 1.0)
+    assert obj.altitude == pytest.approx(10.0, abs=0.3) and obj.altitude_variance > 0
+    assert obj.timestamp.microsecond > 0
+    deep = VehicleState(model=SimulatedVehicle(sea_floor=SeaFloor(80.0)))
+    assert math.isnan(sample(deep, 1.0).altitude)  # no bottom lock beyond 30 m
 
 
 async def _network_scenario(gen: Any, channel: str) -> dict[str, Any]:
@@ -165,12 +241,24 @@ async def _network_scenario(gen: Any, channel: str) -> dict[str, Any]:
                 t > t_cmd + 1.0 for t, _ in feedback[fb_sid]):
             await asyncio.sleep(0.05)
         after = [(t - t_cmd, float(m.percent)) for t, m in feedback[fb_sid] if t > t_cmd]
+        # The thruster spins up the shared vehicle; without power it stops (its command is gone).
+        thruster = next(d for d in tables.DEVICES if d.name == "thruster_1")
+        rpm_cls = gen.dsdl_class(thruster.subscribes[0])
+        pub_rpm = bridge_like.make_publisher(rpm_cls, thruster.subscribes[0].subject_id)
+        assert await pub_rpm.publish(rpm_cls(rpm=1000))
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline and sim.vehicle.vehicle.commands.rpm_1 != 1000.0:
+            await asyncio.sleep(0.02)
+        spun_up = sim.vehicle.vehicle.commands.rpm_1
+        await sim.power_off("thruster_1")
+        stopped = sim.vehicle.vehicle.commands.rpm_1
         report = sim.report()
-        await aclose(pub_ok, pub_bad, hb, *subs)
+        await aclose(pub_ok, pub_bad, pub_rpm, hb, *subs)
     finally:
         await sim.close()
         await aclose(bridge_like, other)
-    return {"rates": rates, "heartbeats": heartbeats, "after": after, "report": report}
+    return {"rates": rates, "heartbeats": heartbeats, "after": after, "report": report, "spun_up": spun_up,
+            "stopped": stopped}
 
 
 @pytest.mark.slow
@@ -193,6 +281,8 @@ def test_devices_publish_at_nominal_rates_with_heartbeats_and_obey_only_the_brid
     for dt, pct in res["after"]:
         assert 50.0 <= pct <= 50.0 + 10.0 * dt + 1.5, (dt, pct)
     assert any(dt > 0.9 and pct > 57.0 for dt, pct in res["after"]), res["after"]
+    assert res["spun_up"] == 1000.0 and res["stopped"] == 0.0
+    assert res["report"]["devices"]["thruster_1"]["powered"] is False
 
 
 @pytest.mark.slow
@@ -213,3 +303,86 @@ def test_sim_command_line_runs_for_a_duration_and_reports(gen: Any, tmp_path: Pa
     for d in devs:
         for p in d.publishes:
             assert data["devices"][d.name]["published"][str(p.subject_id)] == pytest.approx(1.5 * p.rate_hz, abs=2)
+
+
+@pytest.mark.slow
+def test_sim_command_line_vehicle_options_and_truth_file(gen: Any, tmp_path: Path) -> None:
+    truth = tmp_path / "truth.jsonl"
+    env = {k: v for k, v in os.environ.items() if not k.startswith("UAVCAN__")}
+    env["SAM_GENERATED_DIR"] = str(gen.root)
+    base = [sys.executable, "-m", "sam_runtime.cli", "sim", "--transport", "can", "--iface",
+            f"virtual:simtruth{os.getpid()}", "--mtu", "64", "--devices", "pressure"]
+    proc = subprocess.run(
+        [*base, "--duration", "1.5", "--truth-file", str(truth), "--truth-rate", "10", "--seed", "7",
+         "--start", "5,-3,2,1.0", "--sea-floor", "0:20,50:8", "--battery-start", "40", "--gps-origin", "10.5,20.25"],
+        env=env, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    lines = [json.loads(x) for x in truth.read_text().splitlines()]
+    assert len(lines) >= 10, lines  # 10 Hz over 1.5 s, and a last one at exit
+    first, last = lines[0], lines[-1]
+    assert (first["x"], first["y"], first["depth"], first["yaw"]) == pytest.approx((5.0, -3.0, 2.0, 1.0), abs=1e-3)
+    assert first["sea_floor_depth"] == pytest.approx(20 - 12 * 5 / 50) and first["altitude"] == pytest.approx(16.8)
+    assert first["battery_percent"] == pytest.approx(40.0, abs=0.01) and first["gps_origin"] == [10.5, 20.25]
+    assert last["t"] >= 1.4 and all(b["t"] >= a["t"] for a, b in itertools.pairwise(lines))
+    assert last["depth"] == pytest.approx(2.0, abs=0.01)  # neutral buoyancy, no thrust: it stays
+    # Four times faster than the wall clock: the vehicle's time, the rates and the stamps.
+    fast = tmp_path / "fast.json"
+    report = tmp_path / "report.json"
+    proc = subprocess.run([*base, "--duration", "1.0", "--time-scale", "4", "--truth-file", str(fast), "--report",
+                           str(report)], env=env, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert json.loads(fast.read_text())["t"] >= 3.6  # at exit: 4 x (start-up + 1 s of publishing)
+    pressure = json.loads(report.read_text())["devices"]["pressure"]
+    # 20 Hz of vehicle time = 80 per wall second; ticks the loaded process was too late for are skipped and counted
+    # (a stall near the end may count a few beyond the window).
+    published, late = pressure["published"]["1103"], pressure["late"].get("1103", 0)
+    assert 40 <= published <= 83 and published + late >= 77, pressure
+    for bad, message in ((["--start", "0,0,30,0"], "the sea floor there"), (["--sea-floor", "deep"], "sea floor"),
+                         (["--gps-origin", "95,0"], "GPS origin")):
+        proc = subprocess.run([*base, "--duration", "0.1", *bad], env=env, capture_output=True, text=True, timeout=60)
+        assert proc.returncode == 1 and "Traceback" not in proc.stderr and message in proc.stderr, proc.stderr
+
+
+@pytest.mark.slow
+def test_a_non_sam_spec_gets_generic_values_and_its_own_actuator_model(tmp_path: Path) -> None:
+    """tests/specs/rover.yaml has none of SAM's devices: every port publishes generic in-range values, the vehicle
+    model is there but drives nothing, commands are accepted from the bridge only."""
+    import pycyphal.dsdl
+
+    from sam_runtime.genpkg import GeneratedPackage
+
+    out = tmp_path / "generated"
+    spec = Path(__file__).resolve().parent / "specs" / "rover.yaml"
+    proc = subprocess.run([sys.executable, "-m", "sam_codegen.cli", "build", "--spec", str(spec), "--out", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    rover = GeneratedPackage(out)
+
+    async def scenario() -> dict[str, Any]:
+        sim = Simulator(rover, SimConfig("can", f"virtual:rover{os.getpid()}", 64, truth_file=tmp_path / "t.json"))
+        await sim.start(publish_now=True)
+        try:
+            await asyncio.sleep(1.0)
+            samples = {}
+            for dev in sim.devices:
+                for pp in dev.pubs:
+                    a, b = sim.make_sample(dev, pp, 0.1), sim.make_sample(dev, pp, 0.1)
+                    wire = pycyphal.dsdl.deserialize(pp.dtype, list(pycyphal.dsdl.serialize(a)))
+                    samples[pp.port.subject_id] = (pycyphal.dsdl.to_builtin(wire), pycyphal.dsdl.to_builtin(b))
+            drive = sim.device("drive")
+            sp = drive.subs[0]
+            sim._on_command(drive, sp, sp.dtype(), _Transfer(sim.bridge_node_id))
+            sim._on_command(drive, sp, sp.dtype(), _Transfer(3))
+            return {"report": sim.report(), "samples": samples}
+        finally:
+            await sim.close()
+
+    res = _run(scenario())
+    report = res["report"]
+    assert set(report["devices"]) == {"drive", "thermo", "air", "nav", "lights"}
+    assert report["devices"]["nav"]["published"]["520"] >= 20  # 50 Hz for a second, on a loaded machine too
+    assert report["devices"]["drive"]["commands"]["501"]["accepted"] == 1
+    assert report["devices"]["drive"]["commands"]["501"]["rejected"] == 1
+    assert report["vehicle"]["depth"] == 0.0 and report["vehicle"]["speed"] == 0.0  # nothing drives it
+    assert set(res["samples"]) == {500, 510, 511, 520}
+    assert json.loads((tmp_path / "t.json").read_text())["t"] >= 0.9  # the atomic truth file, rewritten
