@@ -38,8 +38,9 @@ INSTALL_TIMEOUT_S = 900
 STEP_TIMEOUT_S = 600
 # What `pip wheel` needs: the project's metadata and the package folders (package-dir in pyproject.toml).
 SOURCE = ("pyproject.toml", "README.md", "codegen", "runtime", "templates")
-# Where the old defaults wrote, relative to site-packages (the install's "repository root").
-INSTALL_LOCATION_WRITES = ("generated", ".cache", "build", "spec", ".sam-codegen-cache")
+# Where the old defaults wrote, relative to site-packages (the install's "repository root"): generated/, the DSDL
+# cache, ROS build folders and logs under .cache/, ros-install's build/ros. (site-packages/build is pypa's `build`.)
+INSTALL_LOCATION_WRITES = ("generated", ".cache", "build/ros", ".sam-codegen-cache")
 
 
 def _run(cmd: Sequence[str | Path], *, cwd: Path, env: dict[str, str], timeout: float = STEP_TIMEOUT_S,
