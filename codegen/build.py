@@ -18,12 +18,13 @@ from .model import DsdlStruct
 from .spec_loader import load_spec_file
 from .typesys import DsdlType, split_composite_name
 from .validate import Resolved, validate
+from .workspace import GENERATED_MARKER, OutDirError, check_out_dir
 
 Emitter = Callable[[Resolved], dict[str, str]]
-MARKER = ".sam-codegen"  # marks a directory as ours, so that a rebuild never replaces someone else's folder
+MARKER = GENERATED_MARKER  # marks a directory as ours, so that a rebuild never replaces someone else's folder
 
 
-class OutputError(Exception):
+class OutputError(OutDirError):
     """The output folder cannot be written (not ours, or a file system error); the spec may well be valid."""
 
 
@@ -195,6 +196,8 @@ def compare(files: dict[str, str], out_dir: Path) -> Staleness:
 
 def write_atomically(files: dict[str, str], out_dir: Path) -> None:
     """Write the whole tree beside out_dir, then swap it in: a failure leaves the old tree as it was."""
+    # Resolved first: the staging and backup folders are named after out_dir's own name, which `.` or `..` lack.
+    out_dir = Path(out_dir).resolve()
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputError(f"{out_dir} is not a folder; choose an empty or generated output folder")
     if out_dir.exists() and any(out_dir.iterdir()) and not (out_dir / MARKER).exists():
@@ -229,8 +232,13 @@ def write_atomically(files: dict[str, str], out_dir: Path) -> None:
 
 
 def build(spec_path: Path, out_dir: Path, *, check: bool = False) -> Staleness:
-    """Generate from spec_path. With check, compare only; otherwise write when anything differs."""
-    files = generate(spec_path)
+    """Generate from spec_path. With check, compare only; otherwise write when anything differs.
+
+    Raises OutDirError, before reading anything, for an out_dir that is or holds the spec (a rebuild replaces it).
+    """
+    out_dir = Path(out_dir).resolve()
+    check_out_dir(Path(spec_path).resolve(), out_dir)
+    files = generate(spec_path)  # as given: the spec's diagnostics name it the way the user did
     try:
         stale = compare(files, out_dir)
     except OSError as exc:

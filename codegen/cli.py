@@ -1,4 +1,10 @@
-"""The `sam-codegen` command line."""
+"""The `sam-codegen` command line.
+
+It acts on the project where it runs, like ruff or nox: the spec is --spec, else spec/interfaces.yaml in the working
+directory or its nearest parent that has one; generated/ is --out, else generated/ in the spec's project (the folder
+holding spec/, or the spec file's own folder for a spec elsewhere). Caches and logs stay in the project
+(.sam-codegen-cache/) or the user's cache directory, never where sam-codegen is installed.
+"""
 
 from __future__ import annotations
 
@@ -6,37 +12,56 @@ import argparse
 import sys
 from pathlib import Path
 
+from .cyphal_path import CyphalPathError
 from .diagnostics import SpecError
+from .workspace import Workspace, WorkspaceError, ensure_state_dir, workspace_for
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_SPEC = REPO_ROOT / "spec" / "interfaces.yaml"
-DEFAULT_OUT = REPO_ROOT / "generated"
+SPEC_HELP = "the interface spec (default: spec/interfaces.yaml in the working directory or its nearest parent)"
+OUT_HELP = ("the generated folder (default: generated/ in the spec's project: beside spec/, or beside a spec file "
+            "kept elsewhere); it may not be or hold the spec")
+
+
+def _workspace(args: argparse.Namespace, *, need_spec: bool = True) -> Workspace:
+    return workspace_for(Path(args.spec) if args.spec else None, Path(args.out) if args.out else None,
+                         need_spec=need_spec)
+
+
+def _shown(path: Path, cwd: Path) -> str:
+    """A path as the user reads it best: relative to the working directory when it is inside it."""
+    try:
+        return str(path.relative_to(cwd)) or "."
+    except ValueError:
+        return str(path)
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    from .build import OutputError, build
+    from .build import build
 
+    ws = _workspace(args)
+    assert ws.spec is not None
+    # Taken before the build: when it runs inside generated/ (`--out .`), the rebuild replaces the working directory.
+    cwd = Path.cwd().resolve()
+    out, spec = _shown(ws.generated, cwd), _shown(ws.spec, cwd)
     try:
-        stale = build(Path(args.spec), Path(args.out), check=args.check)
-    except OutputError as exc:
-        print(f"sam-codegen: {exc}", file=sys.stderr)
-        return 1
+        stale = build(ws.spec, ws.generated, check=args.check)
     except SpecError as exc:
         for diagnostic in exc.diagnostics:
             print(diagnostic, file=sys.stderr)
         count = len(exc.diagnostics)
-        print(f"sam-codegen: {count} error{'s' if count != 1 else ''} in the spec; {args.out} left unchanged",
+        print(f"sam-codegen: {count} error{'s' if count != 1 else ''} in the spec; {out} left unchanged",
               file=sys.stderr)
         return 1
     if args.check:
         if stale:
             for line in stale.lines():
                 print(line, file=sys.stderr)
-            print(f"sam-codegen: {args.out} is stale; run `sam-codegen build`", file=sys.stderr)
+            print(f"sam-codegen: {out} is stale; run `sam-codegen build`", file=sys.stderr)
             return 1
-        print(f"sam-codegen: {args.out} is up to date")
+        print(f"sam-codegen: {out} is up to date with {spec}")
         return 0
-    print(f"sam-codegen: {args.out} {'updated' if stale else 'already up to date'}")
+    print(f"sam-codegen: {out} {'updated' if stale else 'already up to date'} from {spec}")
+    if stale and (cwd == ws.generated or ws.generated in cwd.parents):
+        print(f"sam-codegen: note: {ws.generated} is a new folder now; a shell inside the old one needs `cd {cwd}`")
     return 0
 
 
@@ -44,43 +69,53 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     from .spec_loader import load_spec_file
     from .validate import validate
 
+    ws = _workspace(args)
+    assert ws.spec is not None
     try:
-        validate(load_spec_file(Path(args.spec)))
+        validate(load_spec_file(ws.spec))
     except SpecError as exc:
         for diagnostic in exc.diagnostics:
             print(diagnostic, file=sys.stderr)
         return 1
-    print(f"sam-codegen: {args.spec} is valid")
+    print(f"sam-codegen: {_shown(ws.spec, Path.cwd().resolve())} is valid")
     return 0
 
 
 def _cmd_ros_install(args: argparse.Namespace) -> int:
-    from .ros_build import RosBuildError, build_ros_package
-    from .spec_loader import load_spec_file
+    from .ros_build import RosBuildError, build_ros_packages, ros_packages_in_order
 
+    ws = _workspace(args, need_spec=False)
+    ros_dir = ws.generated / "ros"
     try:
-        package = load_spec_file(Path(args.spec)).ros.name
-    except SpecError as exc:
-        print(exc, file=sys.stderr)
-        return 1
-    prefix = Path(args.prefix or sys.prefix)
-    try:
-        build_ros_package(Path(args.out) / "ros" / package, Path(args.build_dir) / package, prefix)
+        packages = ros_packages_in_order(ros_dir)
     except RosBuildError as exc:
-        print(f"sam-codegen: building {package} failed: {exc}", file=sys.stderr)
+        print(f"sam-codegen: {exc}", file=sys.stderr)
         return 1
-    print(f"sam-codegen: {package} installed into {prefix}")
+    if not packages:
+        print(f"sam-codegen: no ROS package under {ros_dir}; run `sam-codegen build` first", file=sys.stderr)
+        return 1
+    prefix = Path(args.prefix or sys.prefix).absolute()
+    build_root = Path(args.build_dir).absolute() if args.build_dir else ensure_state_dir(ws) / "ros-build"
+    names = ", ".join(p.name for p in packages)
+    try:
+        build_ros_packages(packages, build_root, prefix, log=lambda name: print(f"sam-codegen: building {name}...",
+                                                                                 flush=True))
+    except RosBuildError as exc:
+        print(f"sam-codegen: building {exc.package or names} failed: {exc}", file=sys.stderr)
+        return 1
+    print(f"sam-codegen: {names} installed into {prefix}")
     return 0
 
 
 def make_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__)
+    parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, run."
     sub = parser.add_subparsers(dest="command", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--spec", default=str(DEFAULT_SPEC), help="the interface spec (default: %(default)s)")
-        p.add_argument("--out", default=str(DEFAULT_OUT), help="the generated folder (default: %(default)s)")
+        p.add_argument("--spec", default=None, help=SPEC_HELP)
+        p.add_argument("--out", default=None, help=OUT_HELP)
 
     p = sub.add_parser("build", help="validate the spec and generate generated/")
     common(p)
@@ -89,10 +124,12 @@ def make_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("validate", help="validate the spec only")
     common(p)
     p.set_defaults(func=_cmd_validate)
-    p = sub.add_parser("ros-install", help="build the generated ROS package with CMake and install it")
+    p = sub.add_parser("ros-install", help="build every ROS package under generated/ros with CMake, in dependency "
+                       "order, and install them")
     common(p)
     p.add_argument("--prefix", help="install prefix (default: this Python's environment)")
-    p.add_argument("--build-dir", default=str(REPO_ROOT / "build" / "ros"), help="CMake build folder")
+    p.add_argument("--build-dir", default=None,
+                   help="parent of the CMake build folders (default: .sam-codegen-cache/ros-build in the project)")
     p.set_defaults(func=_cmd_ros_install)
     return parser
 
@@ -114,6 +151,9 @@ def main(argv: list[str] | None = None) -> int:
     args = make_parser().parse_args(argv)
     try:
         return int(args.func(args))
+    except (WorkspaceError, CyphalPathError) as exc:
+        print(f"sam-codegen: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 130
 

@@ -12,10 +12,19 @@ import re
 import shutil
 import subprocess
 import sys
-from collections.abc import Mapping, Sequence
+import xml.etree.ElementTree as ET
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-__all__ = ["RosBuildError", "build_ros_package", "is_installed", "ros_runtime_env"]
+__all__ = [
+    "RosBuildError",
+    "build_ros_package",
+    "build_ros_packages",
+    "is_installed",
+    "package_dependencies",
+    "ros_packages_in_order",
+    "ros_runtime_env",
+]
 
 # Lines of CMake output kept in an error: enough to include rosidl's message and CMake's call stack.
 _TAIL_LINES = 40
@@ -30,8 +39,9 @@ _ERROR_LINE = re.compile(r"CMake Error|Error processing|\berror:|\bError:")
 class RosBuildError(Exception):
     """A CMake step failed; the message ends with the tail of that step's output."""
 
-    def __init__(self, message: str, output: str = "") -> None:
+    def __init__(self, message: str, output: str = "", package: str | None = None) -> None:
         self.output = output
+        self.package = package  # the package whose build failed, when several were built
         lines = output.splitlines()
         self.tail = "\n".join(lines[-_TAIL_LINES:])
         # A long Python traceback from a generator can push the real cause out of the tail,
@@ -156,6 +166,7 @@ def build_ros_package(
     # A stale setting from the caller's shell would override the prefix variables above.
     env.pop("COLCON_PREFIX_PATH", None)
 
+    _forget_build_of_other_source(build_dir, package_dir)
     build_dir.mkdir(parents=True, exist_ok=True)
     cmake_prefix_path = ";".join(env["CMAKE_PREFIX_PATH"].split(os.pathsep))
     _run_step(
@@ -177,6 +188,84 @@ def build_ros_package(
     )
     _run_step("build", [cmake, "--build", str(build_dir), "-j", str(max(1, jobs))], env)
     _run_step("install", [cmake, "--install", str(build_dir)], env)
+
+
+def _forget_build_of_other_source(build_dir: Path, package_dir: Path) -> None:
+    """Empty a build folder that CMake configured for another source folder (a moved or copied project): CMake
+    refuses to reuse it ("CMakeCache.txt directory ... is different")."""
+    cache = build_dir / "CMakeCache.txt"
+    try:
+        text = cache.read_text(errors="replace")
+    except OSError:
+        return
+    match = re.search(r"^CMAKE_HOME_DIRECTORY:INTERNAL=(.*)$", text, re.MULTILINE)
+    if match is None or Path(match.group(1)).resolve() != package_dir.resolve():
+        shutil.rmtree(build_dir, ignore_errors=True)
+
+
+# The package.xml tags that order a build: what is needed to build, or to use, a package (tests and docs are not).
+_ORDERING_TAGS = ("depend", "build_depend", "buildtool_depend", "build_export_depend", "exec_depend")
+
+
+def package_dependencies(package_dir: Path) -> tuple[str, set[str]]:
+    """(name, the names it depends on) from a package.xml; raises RosBuildError when it is unreadable."""
+    manifest = Path(package_dir) / "package.xml"
+    try:
+        root = ET.parse(manifest).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise RosBuildError(f"cannot read {manifest}: {exc}") from None
+    name = (root.findtext("name") or "").strip()
+    if not name:
+        raise RosBuildError(f"{manifest} has no <name>")
+    deps = {(e.text or "").strip() for tag in _ORDERING_TAGS for e in root.iter(tag)}
+    return name, deps - {"", name}
+
+
+def ros_packages_in_order(ros_dir: Path) -> list[Path]:
+    """The package folders under ``ros_dir`` (each holding a package.xml), every package after the ones of the same
+    folder it depends on; otherwise by name. Raises RosBuildError on a dependency cycle or a repeated name."""
+    ros_dir = Path(ros_dir)
+    if not ros_dir.is_dir():
+        return []
+    folders: dict[str, Path] = {}
+    needs: dict[str, set[str]] = {}
+    for folder in sorted(p for p in ros_dir.iterdir() if (p / "package.xml").is_file()):
+        name, deps = package_dependencies(folder)
+        if name in folders:
+            raise RosBuildError(f"two packages named {name} under {ros_dir}: {folders[name].name}, {folder.name}")
+        folders[name], needs[name] = folder, deps
+    local = {name: deps & folders.keys() for name, deps in needs.items()}
+    ordered: list[str] = []
+    while len(ordered) < len(local):
+        ready = sorted(n for n, deps in local.items() if n not in ordered and deps <= set(ordered))
+        if not ready:
+            cycle = sorted(set(local) - set(ordered))
+            raise RosBuildError(f"the ROS packages under {ros_dir} depend on each other in a cycle: {', '.join(cycle)}")
+        ordered.extend(ready)
+    return [folders[n] for n in ordered]
+
+
+def build_ros_packages(
+    package_dirs: Sequence[Path],
+    build_root: Path,
+    install_prefix: Path,
+    *,
+    python: Path | None = None,
+    jobs: int = 2,
+    log: Callable[[str], None] | None = None,
+) -> None:
+    """Build and install several packages in the given order (see :func:`ros_packages_in_order`), each in its own
+    folder ``build_root/<name>``; a later one finds the earlier ones in ``install_prefix``. A failure stops there and
+    names the package (``RosBuildError.package``)."""
+    for package_dir in package_dirs:
+        name = Path(package_dir).name
+        if log is not None:
+            log(name)
+        try:
+            build_ros_package(package_dir, Path(build_root) / name, install_prefix, python=python, jobs=jobs)
+        except RosBuildError as exc:
+            exc.package = name
+            raise
 
 
 def ros_runtime_env(install_prefix: Path, base: Mapping[str, str] | None = None) -> dict[str, str]:

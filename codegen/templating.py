@@ -9,13 +9,22 @@ import jinja2
 
 from .filters import FILTERS
 
-TEMPLATE_DIR = Path(__file__).resolve().parents[1] / "templates"
+
+def template_dir() -> Path:
+    """The templates: package data ``sam_codegen/templates`` in an installed wheel; ``<checkout>/templates`` when
+    running from the source tree (an editable install maps only the Python packages)."""
+    here = Path(__file__).resolve().parent
+    for candidate in (here / "templates", here.parent / "templates"):
+        if (candidate / "ros").is_dir():
+            return candidate
+    raise FileNotFoundError(f"the sam-codegen templates are missing (looked in {here / 'templates'} and "
+                            f"{here.parent / 'templates'}); reinstall sam-codegen")
 
 
 @cache
 def environment() -> jinja2.Environment:
     env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(TEMPLATE_DIR)),
+        loader=jinja2.FileSystemLoader(str(template_dir())),
         keep_trailing_newline=True,
         trim_blocks=True,
         lstrip_blocks=True,

@@ -4,6 +4,9 @@ Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_
 :func:`run_main`; ``sam-codegen bridge|sim|run ...`` dispatches to :func:`main`. Also ``python -m
 sam_runtime.cli {bridge,sim,run} ...``.
 
+Where: ``--generated``, else ``$SAM_GENERATED_DIR``, else the generated folder of the project the working directory
+is in (see sam_codegen.workspace); ``run`` also finds the spec the way ``sam-codegen build`` does.
+
 Transport selection (bridge and sim): ``--transport udp|can|loopback|env``; without it, the standard
 Cyphal register environment variables are used when one of UAVCAN__UDP__IFACE, UAVCAN__CAN__IFACE,
 UAVCAN__LOOPBACK or UAVCAN__SERIAL__IFACE is set, else Cyphal/UDP on 127.0.0.1.
@@ -19,10 +22,13 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 import argparse
 import asyncio
 import contextlib
+import ctypes
+import importlib.util
 import json
 import logging
 import signal
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -32,6 +38,71 @@ __all__ = ["bridge_main", "main", "run_main", "sim_main"]
 
 _ENV_TRANSPORT_KEYS = ("UAVCAN__UDP__IFACE", "UAVCAN__CAN__IFACE", "UAVCAN__LOOPBACK", "UAVCAN__SERIAL__IFACE")
 EXIT_OK, EXIT_ERROR, EXIT_USAGE = 0, 1, 2
+
+# What each command imports beyond the base install: the [runtime] extra.
+_RUNTIME_MODULES = {
+    "bridge": ("pycyphal", "nunavut", "rclpy"),
+    "sim": ("pycyphal", "nunavut"),
+    "run": ("pycyphal", "nunavut", "rclpy"),
+}
+# Set by the main job (`run`) in its children's environment: the pid they must not outlive.
+PARENT_ENV_VAR = "SAM_RUN_PARENT_PID"
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+_PARENT_POLL_S = 0.25
+# An orphan gets this long to stop cleanly after its SIGTERM, then it exits at once.
+ORPHAN_GRACE_S = 5.0
+
+
+def _missing_runtime(command: str) -> list[str]:
+    """The modules of the runtime extra that the command needs and this environment lacks."""
+    missing = []
+    for name in _RUNTIME_MODULES[command]:
+        try:
+            found = importlib.util.find_spec(name) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            missing.append(name)
+    return missing
+
+
+def _require_runtime(command: str) -> None:
+    """Exit with one clear line when the [runtime] extra is not installed (instead of an ImportError's traceback)."""
+    missing = _missing_runtime(command)
+    if missing:
+        print(f"sam-codegen {command}: the runtime is not installed (missing: {', '.join(missing)}); install the "
+              "runtime extra: pip install 'sam-codegen[runtime]'", file=sys.stderr)
+        raise SystemExit(EXIT_ERROR)
+
+
+def _stay_with_parent() -> None:
+    """A child of the main job ends when the main job ends, however it ends (a crash, SIGKILL, a closed terminal):
+    left running, a second run would find two of every device and the rates doubled.
+
+    Linux delivers SIGTERM at the parent's death (PR_SET_PDEATHSIG), which starts the usual clean stop. A thread also
+    watches the parent (other systems, and a parent that died before the prctl call) and, once it is gone, sends that
+    SIGTERM itself and ends the process ORPHAN_GRACE_S later whatever state the clean stop is in.
+    """
+    raw = os.environ.get(PARENT_ENV_VAR, "").strip()
+    if not raw.isdigit():
+        return
+    parent = int(raw)
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+    if os.getppid() != parent:
+        print(f"the main job (pid {parent}) has already ended; not starting", file=sys.stderr)
+        raise SystemExit(EXIT_ERROR)
+    threading.Thread(target=_watch_parent, args=(parent,), name="parent-watch", daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(_PARENT_POLL_S)
+    with contextlib.suppress(OSError):
+        os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(ORPHAN_GRACE_S)
+    os._exit(EXIT_ERROR)
 
 
 def _setup_logging(level: str) -> None:
@@ -44,9 +115,12 @@ def _setup_logging(level: str) -> None:
         logging.getLogger(noisy).setLevel(max(logging.WARNING, logging.getLogger().level))
 
 
-def _add_generated_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--generated", type=Path, default=None,
-                   help="generated package directory (default: $SAM_GENERATED_DIR or <repo>/generated)")
+_GENERATED_HELP = ("the generated folder (default: $SAM_GENERATED_DIR, else generated/ of the project the working "
+                   "directory is in)")
+
+
+def _add_generated_args(p: argparse.ArgumentParser, generated_help: str = _GENERATED_HELP) -> None:
+    p.add_argument("--generated", type=Path, default=None, help=generated_help)
     p.add_argument("--package", default=None, help="python package name under generated/python (default: the "
                    "only *_bridge package)")
 
@@ -195,6 +269,8 @@ def _bridge_parser() -> argparse.ArgumentParser:
 
 def bridge_main(argv: Sequence[str] | None = None) -> int:
     args = _bridge_parser().parse_args(argv)
+    _require_runtime("bridge")
+    _stay_with_parent()
     _setup_logging(args.log_level)
     from sam_runtime.bridge import Bridge, BridgeConfigError, TransportConfig
     from sam_runtime.genpkg import GeneratedPackageError
@@ -301,6 +377,8 @@ def _vehicle_options(args: argparse.Namespace) -> dict[str, Any]:
 
 def sim_main(argv: Sequence[str] | None = None) -> int:
     args = _sim_parser().parse_args(argv)
+    _require_runtime("sim")
+    _stay_with_parent()
     _setup_logging(args.log_level)
     from sam_runtime.genpkg import GeneratedPackageError
     from sam_runtime.sim import SimConfig, Simulator
@@ -349,8 +427,10 @@ def _run_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sam-run",
         description="Build, start the simulated devices and the bridge, and show live what flows (Ctrl-C stops).")
-    p.add_argument("--spec", type=Path, default=None, help="the spec (default: <repo>/spec/interfaces.yaml)")
-    _add_generated_args(p)
+    p.add_argument("--spec", type=Path, default=None,
+                   help="the spec (default: spec/interfaces.yaml in the working directory or its nearest parent)")
+    _add_generated_args(p, "the generated folder (default: generated/ in the project of --spec when it is given, "
+                           "else $SAM_GENERATED_DIR, else generated/ of the project the working directory is in)")
     p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface of sim and bridge (default 127.0.0.1)")
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until Ctrl-C)")
     p.add_argument("--no-build", action="store_true", help="use generated/ as it is")
@@ -358,7 +438,8 @@ def _run_parser() -> argparse.ArgumentParser:
                    help="do not publish demo actuator commands (by default slow sweeps move the actuators)")
     p.add_argument("--window", type=float, default=2.0, help="rate window [s] (default 2)")
     p.add_argument("--plain", action="store_true", help="plain lines every second even on a terminal")
-    p.add_argument("--log-dir", type=Path, default=None, help="children's logs (default <repo>/.cache/run-logs)")
+    p.add_argument("--log-dir", type=Path, default=None,
+                   help="children's logs (default: .sam-codegen-cache/run-logs in the project)")
     p.add_argument("--ros-prefix", type=Path, default=None,
                    help="install prefix of the generated ROS package (default: the running venv)")
     p.add_argument("--log-level", default="WARNING")
@@ -367,6 +448,7 @@ def _run_parser() -> argparse.ArgumentParser:
 
 def run_main(argv: Sequence[str] | None = None) -> int:
     args = _run_parser().parse_args(argv)
+    _require_runtime("run")
     _setup_logging(args.log_level)
     from sam_runtime.monitor import RunOptions, run
 

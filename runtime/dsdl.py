@@ -27,7 +27,8 @@ import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from sam_codegen.cyphal_path import CyphalPathError, dsdl_lookup_roots, repo_root
+from sam_codegen.cyphal_path import CyphalPathError, dsdl_lookup_roots
+from sam_codegen.workspace import user_cache_dir
 
 from .nunavut_fix import FIX_VERSION, fix_support
 
@@ -57,8 +58,10 @@ class DsdlCompileError(Exception):
 
 
 def default_cache_dir() -> Path:
+    """``$SAM_DSDL_CACHE``, else ``dsdl`` in the user's cache directory: the entries are content-addressed, so every
+    project (and every install) shares them safely."""
     env = os.environ.get(CACHE_ENV_VAR, "").strip()
-    return Path(env).expanduser().resolve() if env else repo_root() / ".cache" / "dsdl"
+    return Path(env).expanduser().resolve() if env else user_cache_dir() / "dsdl"
 
 
 def _versions() -> str:
@@ -234,7 +237,7 @@ def ensure_compiled(namespace_dirs: Sequence[Path], cache_dir: Path | None = Non
 
     :param namespace_dirs: DSDL root namespace directories (the last path component is the namespace name),
         e.g. ``[Path("generated/dsdl/sam")]``. May be empty: then only ``uavcan`` is compiled.
-    :param cache_dir: parent of the cache entries; default ``$SAM_DSDL_CACHE`` or ``<repo>/.cache/dsdl``.
+    :param cache_dir: parent of the cache entries; default ``$SAM_DSDL_CACHE`` or ``$XDG_CACHE_HOME/sam-codegen/dsdl``.
     :returns: the cache entry directory (holding ``uavcan/``, the given namespaces, ``nunavut_support.py``),
         inserted at ``sys.path[0]`` if it was not on ``sys.path`` yet.
     :raises DsdlCompileError: invalid DSDL, no ``uavcan`` on CYPHAL_PATH, missing directory, write failure.

@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import hashlib
 import importlib
-import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from sam_codegen.cyphal_path import repo_root
+from sam_codegen.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
 
 __all__ = [
     "GENERATED_ENV_VAR",
@@ -35,7 +34,6 @@ __all__ = [
     "ros_package_hash",
 ]
 
-GENERATED_ENV_VAR = "SAM_GENERATED_DIR"
 _HASH_STAMP = ".sam_codegen_source_hash"
 
 
@@ -44,9 +42,12 @@ class GeneratedPackageError(Exception):
 
 
 def default_generated_dir() -> Path:
-    """``$SAM_GENERATED_DIR`` or ``<repo>/generated``."""
-    env = os.environ.get(GENERATED_ENV_VAR, "").strip()
-    return Path(env).expanduser().resolve() if env else repo_root() / "generated"
+    """``$SAM_GENERATED_DIR``, else the generated folder of the project the working directory is in (the folder
+    itself when the working directory is inside it; see sam_codegen.workspace)."""
+    try:
+        return find_generated()
+    except WorkspaceError as ex:
+        raise GeneratedPackageError(str(ex)) from None
 
 
 def _find_python_package(python_dir: Path, name: str | None) -> str:
@@ -179,30 +180,41 @@ def _same_interfaces(src: Path, installed: Path) -> bool:
         return False
 
 
-def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log: Any = None) -> Path:
-    """Build and install the generated ROS package into ``prefix`` (default: ``sys.prefix``, the venv) unless
-    an install of the same sources is already there. Returns the prefix.
+def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log: Any = None,
+                       build_root: Path | None = None) -> Path:
+    """Build and install every ROS package under ``<generated>/ros`` (the spec's own and any other it generates, in
+    dependency order) into ``prefix`` (default: ``sys.prefix``, the venv), each unless an install of the same sources
+    is already there. Returns the prefix.
 
-    The build directory is ``<repo>/.cache/ros-build/<package>-<hash>``; the install is stamped with the
-    sources' hash, so a changed spec triggers a rebuild and an unchanged one costs a few ms.
+    The build folders are ``<build_root>/<package>-<hash>`` (default build_root: ``ros-build`` in the user's cache
+    directory); an install is stamped with its sources' hash, so a changed spec triggers a rebuild and an unchanged
+    one costs a few ms.
     """
-    from sam_codegen.ros_build import build_ros_package, is_installed
+    from sam_codegen.ros_build import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
 
     prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
-    pkg_dir = gen.ros_package_dir()
-    if not (pkg_dir / "package.xml").is_file():
-        raise GeneratedPackageError(f"{pkg_dir} has no package.xml; run `sam-codegen build` first")
-    name = gen.tables().ROS_PACKAGE
-    digest = ros_package_hash(pkg_dir)
-    stamp = prefix / "share" / name / _HASH_STAMP
-    if is_installed(name, prefix) and (
-        (stamp.is_file() and stamp.read_text().strip() == digest) or _same_interfaces(pkg_dir, prefix / "share" / name)
-    ):
-        return prefix
-    if log is not None:
-        log(f"building ROS package {name} into {prefix} (about 30 s)...")
-    build_dir = repo_root() / ".cache" / "ros-build" / f"{name}-{digest}"
-    build_ros_package(pkg_dir, build_dir, prefix)
-    stamp.parent.mkdir(parents=True, exist_ok=True)
-    stamp.write_text(digest + "\n")
+    own = gen.ros_package_dir()
+    if not (own / "package.xml").is_file():
+        raise GeneratedPackageError(f"{own} has no package.xml; run `sam-codegen build` first")
+    try:
+        packages = ros_packages_in_order(own.parent)
+    except RosBuildError as ex:
+        raise GeneratedPackageError(str(ex)) from None
+    root = Path(build_root) if build_root is not None else user_cache_dir() / "ros-build"
+    for pkg_dir in packages:
+        name = pkg_dir.name
+        digest = ros_package_hash(pkg_dir)
+        stamp = prefix / "share" / name / _HASH_STAMP
+        if is_installed(name, prefix) and (
+            (stamp.is_file() and stamp.read_text().strip() == digest)
+            or _same_interfaces(pkg_dir, prefix / "share" / name)
+        ):
+            continue
+        if log is not None:
+            log(f"building ROS package {name} into {prefix} (about 30 s)...")
+        # The source folder is part of the name: a CMake build folder belongs to one source folder.
+        where = hashlib.sha256(str(pkg_dir.resolve()).encode()).hexdigest()[:8]
+        build_ros_package(pkg_dir, root / f"{name}-{digest}-{where}", prefix)
+        stamp.parent.mkdir(parents=True, exist_ok=True)
+        stamp.write_text(digest + "\n")
     return prefix

@@ -2,16 +2,20 @@
 
 :func:`run` (``sam-run`` / ``sam-codegen run``):
 
-1. regenerates ``generated/`` from the spec (``sam_codegen.build.build``) unless ``build=False``;
-2. builds and installs the generated ROS message package into the venv if it is missing or stale;
+1. regenerates ``generated/`` from the spec (``sam_codegen.build.build``) unless ``build=False``; the spec and
+   generated/ are found from the working directory like ``sam-codegen build`` does (sam_codegen.workspace);
+2. builds and installs the generated ROS message packages into the venv if they are missing or stale (build folders
+   under the project's ``.sam-codegen-cache/ros-build``);
 3. compiles the DSDL once (the children reuse the cache);
-4. starts ``sam-sim`` and ``sam-bridge`` as subprocesses on Cyphal/UDP 127.0.0.1 (own sessions, logs under
-   ``.cache/run-logs``);
+4. starts ``sam-sim`` and ``sam-bridge`` as subprocesses on Cyphal/UDP 127.0.0.1 (own sessions, logs under the
+   project's ``.sam-codegen-cache/run-logs``); they never outlive this process (see sam_runtime.cli's
+   ``_stay_with_parent``);
 5. runs an rclpy monitor node in this process: every bridged topic's rate over a sliding window and its last
    value, every device's heartbeat (from the bridge's /diagnostics) and the bridge's drop counters; a
    refreshing table on a terminal, plain lines every second otherwise. By default it also publishes slow
    demo sweeps on the command topics so the simulated actuators move;
-6. stops on ``--duration``, Ctrl-C or SIGTERM: children get SIGTERM (SIGKILL after a deadline), exit 0.
+6. stops on ``--duration``, Ctrl-C, SIGTERM or SIGHUP (the terminal closed): children get SIGTERM together (SIGKILL
+   after one deadline), exit 0.
    A child that dies on its own ends the run with exit code 1 and the tail of its log.
 """
 
@@ -22,6 +26,7 @@ import os
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 import collections
+import contextlib
 import importlib
 import math
 import shutil
@@ -34,11 +39,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sam_codegen.cyphal_path import repo_root
-
 __all__ = ["RunOptions", "TopicMonitor", "run", "summarize_message"]
 
 CHILD_STOP_TIMEOUT_S = 8.0
+CHILD_KILL_TIMEOUT_S = 5.0
+# The signals that end the main job cleanly; SIGHUP is the terminal closing.
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 @dataclass
@@ -279,26 +285,37 @@ class TopicMonitor:
 # ============================================================================================ processes
 class _Child:
     def __init__(self, name: str, cmd: list[str], env: Mapping[str, str], log: Path) -> None:
+        from sam_runtime.cli import PARENT_ENV_VAR
+
         self.name, self.log = name, log
         log.parent.mkdir(parents=True, exist_ok=True)
         self._fh = open(log, "w")
-        # Own session: the terminal's Ctrl-C reaches only us; we stop the children in order.
-        self.proc = subprocess.Popen(cmd, env=dict(env), stdout=self._fh, stderr=subprocess.STDOUT,
-                                     stdin=subprocess.DEVNULL, start_new_session=True)
+        # Own session: the terminal's Ctrl-C and hangup reach only us, and we stop the children. They end with us
+        # however we end (even SIGKILL or a crash): they watch this pid (sam_runtime.cli._stay_with_parent).
+        self.proc = subprocess.Popen(cmd, env={**env, PARENT_ENV_VAR: str(os.getpid())}, stdout=self._fh,
+                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
 
     def alive(self) -> bool:
         return self.proc.poll() is None
 
-    def stop(self, timeout: float = CHILD_STOP_TIMEOUT_S) -> int | None:
-        if self.proc.poll() is None:
-            try:
-                self.proc.send_signal(signal.SIGTERM)
-                self.proc.wait(timeout=timeout)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(timeout=5)
+    def signal(self, sig: int) -> None:
+        """Signal the child's whole process group (its session), so nothing it started stays behind."""
+        if self.proc.poll() is not None:
+            return
+        try:
+            os.killpg(self.proc.pid, sig)
+        except (ProcessLookupError, PermissionError):
+            with contextlib.suppress(ProcessLookupError):
+                self.proc.send_signal(sig)
+
+    def wait(self, timeout: float) -> int | None:
+        try:
+            return self.proc.wait(timeout=max(0.0, timeout))
+        except subprocess.TimeoutExpired:
+            return None
+
+    def close_log(self) -> None:
         self._fh.close()
-        return self.proc.returncode
 
     def tail(self, n: int = 15) -> str:
         try:
@@ -307,53 +324,84 @@ class _Child:
             return ""
 
 
-def _build(opts: RunOptions, gen_dir: Path, say: Any) -> None:
-    spec = opts.spec or repo_root() / "spec" / "interfaces.yaml"
-    try:
-        from sam_codegen.build import build  # type: ignore[import-not-found]
-    except ImportError:
-        # TODO(wire): sam_codegen.build.build(spec_path, out_dir, check=False) is not there yet; until it is,
-        # generated/ is used as it is.
-        say(f"note: sam_codegen.build is not available; using {gen_dir} as it is")
-        return
+def _stop_children(children: list[_Child], timeout: float = CHILD_STOP_TIMEOUT_S) -> dict[str, int | None]:
+    """SIGTERM to every child at once (the bridge first: it consumes), then one shared deadline, then SIGKILL to
+    those still running. Bounded by timeout + CHILD_KILL_TIMEOUT_S; never raises. Returns the exit codes."""
+    for c in reversed(children):
+        c.signal(signal.SIGTERM)
+    deadline = time.monotonic() + timeout
+    for c in children:
+        c.wait(deadline - time.monotonic())
+    late = [c for c in children if c.alive()]
+    for c in late:
+        c.signal(signal.SIGKILL)
+    deadline = time.monotonic() + CHILD_KILL_TIMEOUT_S
+    for c in late:
+        c.wait(deadline - time.monotonic())
+    for c in children:
+        c.close_log()
+    return {c.name: c.proc.returncode for c in children}
+
+
+def _workspace(opts: RunOptions) -> Any:
+    """Where this run works (sam_codegen.workspace): the spec and generated/ as `sam-codegen build` finds them when it
+    builds; with --no-build and no --spec, only the generated folder (--generated, $SAM_GENERATED_DIR or found from
+    the working directory)."""
+    from sam_codegen.workspace import GENERATED_ENV_VAR, find_generated, workspace_for
+
+    env_generated = os.environ.get(GENERATED_ENV_VAR, "").strip()
+    generated = opts.generated or (Path(env_generated) if env_generated and opts.spec is None else None)
+    if opts.build or opts.spec is not None:
+        return workspace_for(opts.spec, generated)
+    return workspace_for(None, generated or find_generated(), need_spec=False)
+
+
+def _build(spec: Path, gen_dir: Path, say: Any) -> None:
+    from sam_codegen.build import build
+
     stale = build(spec, gen_dir, check=False)
-    lines = stale.lines() if hasattr(stale, "lines") else []
-    say(f"generated {gen_dir} from {spec}: " + (f"{len(lines)} file(s) updated" if stale else "up to date"))
+    say(f"generated {gen_dir} from {spec}: " + (f"{len(stale.lines())} file(s) updated" if stale else "up to date"))
 
 
 def run(opts: RunOptions) -> int:
-    from sam_codegen.ros_build import ros_runtime_env
-    from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, default_generated_dir, ensure_ros_package
+    from sam_codegen.cyphal_path import CyphalPathError
+    from sam_codegen.diagnostics import SpecError
+    from sam_codegen.ros_build import RosBuildError, ros_runtime_env
+    from sam_codegen.workspace import WorkspaceError, ensure_state_dir
+    from sam_runtime.dsdl import DsdlCompileError
+    from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, ensure_ros_package
 
     def say(text: str) -> None:
         print(text, flush=True)
 
-    gen_dir = (opts.generated or default_generated_dir()).resolve()
     stop_reason: list[str] = []
 
     def on_signal(signum: int, _frame: Any) -> None:
         stop_reason.append(signal.Signals(signum).name)
 
-    old_handlers = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    old_handlers = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     children: list[_Child] = []
     monitor: TopicMonitor | None = None
     exit_code = 0
     try:
-        if opts.build:
-            from sam_codegen.diagnostics import SpecError
-
-            try:
-                _build(opts, gen_dir, say)
-            except SpecError as ex:
-                say(f"sam-run: the spec is invalid:\n{ex}")
-                return 1
         try:
+            ws = _workspace(opts)
+            gen_dir = ws.generated
+            if opts.build:
+                _build(ws.spec, gen_dir, say)
+            state = ensure_state_dir(ws)
             gen = GeneratedPackage(gen_dir, opts.package)
-            prefix = ensure_ros_package(gen, opts.ros_prefix, log=say)
+            prefix = ensure_ros_package(gen, opts.ros_prefix, log=say, build_root=state / "ros-build")
             importlib.invalidate_caches()  # a package installed just now into this venv
             gen.compile_dsdl()
-        except GeneratedPackageError as ex:
+        except SpecError as ex:
+            say(f"sam-run: the spec is invalid:\n{ex}")
+            return 1
+        except (WorkspaceError, CyphalPathError, GeneratedPackageError, DsdlCompileError) as ex:
             say(f"sam-run: {ex}")
+            return 1
+        except RosBuildError as ex:
+            say(f"sam-run: building the generated ROS packages failed: {ex}")
             return 1
         if stop_reason:
             return 0
@@ -365,12 +413,12 @@ def run(opts: RunOptions) -> int:
             for sig, h in old_handlers.items():
                 signal.signal(sig, h)
             sys.stdout.flush()
-            os.execve(sys.executable, [sys.executable, "-m", "sam_runtime.cli", "run", *opts.argv, "--no-build"],
-                      env)
+            os.execve(sys.executable, [sys.executable, "-m", "sam_runtime.cli", "run", *opts.argv, "--no-build",
+                                       "--generated", str(gen_dir)], env)
         env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "LOCALHOST"
         env["PYTHONUNBUFFERED"] = "1"
         env.setdefault("SAM_GENERATED_DIR", str(gen_dir))
-        log_dir = (opts.log_dir or repo_root() / ".cache" / "run-logs").resolve()
+        log_dir = (opts.log_dir or state / "run-logs").resolve()
         common = ["--generated", str(gen_dir), "--transport", "udp", "--iface", opts.iface]
         if opts.package:
             common += ["--package", opts.package]
@@ -413,16 +461,19 @@ def run(opts: RunOptions) -> int:
                               f"{time.monotonic() - started:.1f} s")
         say("\n".join(final))
     finally:
+        # Our handlers stay in place until the children are stopped: a second Ctrl-C must not cut the stop short.
+        codes = _stop_children(children)
         for s, h in old_handlers.items():
             signal.signal(s, h)
-        # Bridge first (it consumes), then the devices.
-        for c in reversed(children):
-            rc = c.stop()
-            if rc not in (0, None, -signal.SIGTERM) and exit_code == 0 and (not stop_reason or
-                                                                           stop_reason[0] != "child exited"):
-                say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
         if monitor is not None:
-            monitor.close()
-        if children:
-            say("logs: " + ", ".join(str(c.log) for c in children))
+            with contextlib.suppress(Exception):  # the children are stopped already; nothing else depends on it
+                monitor.close()
+        with contextlib.suppress(OSError):  # the terminal may be gone (SIGHUP): reporting must not fail the stop
+            for c in children:
+                rc = codes[c.name]
+                if rc not in (0, None, -signal.SIGTERM) and exit_code == 0 and (
+                        not stop_reason or stop_reason[0] != "child exited"):
+                    say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
+            if children:
+                say("logs: " + ", ".join(str(c.log) for c in children))
     return exit_code

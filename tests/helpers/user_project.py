@@ -1,0 +1,57 @@
+"""A new user's project for the workspace tests: tests/specs/glider.yaml as <root>/spec/interfaces.yaml, outside this
+repository; and processes judged alive or gone by /proc (they may be grandchildren, reaped by someone else)."""
+
+from __future__ import annotations
+
+import shutil
+import time
+from pathlib import Path
+
+from helpers.runtime_support import REPO, TEST_ROS_PREFIX
+
+GLIDER_SPEC = REPO / "tests" / "specs" / "glider.yaml"
+# glider_msgs goes into the runtime tests' prefix too, stamped with its sources' hash, so a later session reuses it.
+TEST_ROS_BUILD = REPO / ".cache" / "ros-test-build"
+
+
+def make_project(root: Path) -> Path:
+    """``root``/spec/interfaces.yaml = the glider spec; returns root."""
+    (root / "spec").mkdir(parents=True)
+    shutil.copy(GLIDER_SPEC, root / "spec" / "interfaces.yaml")
+    return root
+
+
+def built_project(root: Path) -> tuple[Path, Path]:
+    """A glider project with generated/ built and glider_msgs installed: (project, ROS prefix)."""
+    from sam_codegen.build import build
+    from sam_runtime.genpkg import GeneratedPackage, ensure_ros_package
+
+    project = make_project(root)
+    build(project / "spec" / "interfaces.yaml", project / "generated")
+    gen = GeneratedPackage(project / "generated")
+    prefix = ensure_ros_package(gen, TEST_ROS_PREFIX, build_root=TEST_ROS_BUILD)
+    gen.compile_dsdl()  # once here, so that the processes of a test start in seconds
+    return project, prefix
+
+
+def start_time(pid: int) -> int | None:
+    """The process's start time in clock ticks since boot (None once it is gone): with the pid it names one process,
+    even if the pid is reused later."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = stat[stat.rindex(")") + 2:].split()
+    if fields[0] in ("Z", "X"):  # a zombie has ended; whoever reaps it does not matter here
+        return None
+    return int(fields[19])
+
+
+def wait_gone(processes: dict[int, int], timeout: float) -> list[int]:
+    """Poll until every (pid, start time) has ended or the deadline passes; returns those still running."""
+    deadline = time.monotonic() + timeout
+    while True:
+        alive = [pid for pid, started in processes.items() if start_time(pid) == started]
+        if not alive or time.monotonic() > deadline:
+            return alive
+        time.sleep(0.05)
