@@ -1,0 +1,153 @@
+"""A dronecan CAN driver for a multicast bus that never leaves the machine.
+
+Same packets, groups and ports as dronecan's own ``mcast:`` driver (see :mod:`.mcast_packet`), so the dronecan
+library and its GUI tool can join the bus, but:
+
+- it sends with ``IP_MULTICAST_IF`` 127.0.0.1 and TTL 0 and joins the group on 127.0.0.1 only: no frame and no
+  IGMP report leaves through the outward interface (dronecan's ``mcast:`` joins and sends on the default route);
+- no IO process and no busy wait: a non-blocking socket whose :meth:`fileno` an event loop can watch, and a
+  blocking :meth:`receive` (dronecan's ``Node.spin(timeout)``) that sleeps in ``poll``.
+
+Like dronecan's SocketCAN and ``mcast:`` drivers it does not hand a node its own frames back (dronecan's Node has
+no loopback handling: an echo would be received as a transfer from itself). Frames of other drivers on the same bus
+in the same process are delivered.
+"""
+
+from __future__ import annotations
+
+import errno
+import select
+import socket
+import time
+
+from dronecan.driver.common import AbstractDriver, CANFrame, DriverError, TxQueueFullError
+
+from .drops import DropCounter, DropReason
+from .mcast_packet import MCAST_PORT, PacketError, decode_packet, encode_packet, group_for_bus
+
+__all__ = ["LOOPBACK_ADDRESS", "LoopbackMulticastDriver"]
+
+LOOPBACK_ADDRESS = "127.0.0.1"
+_RECV_SIZE = 2048  # more than the largest valid packet (74 bytes), so an oversized one is seen whole and rejected
+
+
+class LoopbackMulticastDriver(AbstractDriver):
+    """dronecan driver for bus ``bus`` (group 239.65.82.<bus>) on UDP ``port``, confined to 127.0.0.1.
+
+    ``drops`` counts received datagrams that are not CAN frames and frames that could not be sent; a
+    :class:`~.node_loop.NodeLoop` reports them with its own. ``rcvbuf`` is the socket receive buffer asked for:
+    a node that is busy for a while (a loaded machine) must not lose frames that a CAN controller's FIFO would
+    have lost only on a saturated bus.
+    """
+
+    def __init__(self, bus: int = 0, port: int = MCAST_PORT, *, drops: DropCounter | None = None,
+                 rcvbuf: int = 1 << 21, send_timeout: float = 0.1) -> None:
+        super().__init__()
+        if not 1 <= port <= 65535:
+            raise ValueError(f"UDP port must be 1..65535, got {port}")
+        self.bus = bus
+        self.port = port
+        self.group = group_for_bus(bus)
+        self.drops = drops if drops is not None else DropCounter()
+        self._rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        self._tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        try:
+            self._rx.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            self._rx.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
+            # Bound to the group (as dronecan's driver), so unicast to the port and other groups are not received.
+            self._rx.bind((self.group, port))
+            mreq = socket.inet_aton(self.group) + socket.inet_aton(LOOPBACK_ADDRESS)
+            self._rx.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, mreq)
+            self._rx.setblocking(False)
+
+            self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(LOOPBACK_ADDRESS))
+            self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+            self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+            self._tx.bind((LOOPBACK_ADDRESS, 0))
+            self._tx.connect((self.group, port))
+            self._tx.settimeout(send_timeout)
+        except OSError as ex:
+            self._rx.close()
+            self._tx.close()
+            raise DriverError(f"cannot open the loopback multicast bus {self.group}:{port}: {ex}") from ex
+        # Datagrams from this address are this driver's own (dronecan's mcast: compares the port only).
+        self._own_address = self._tx.getsockname()
+        self._poll = select.poll()
+        self._poll.register(self._rx.fileno(), select.POLLIN)
+        self._closed = False
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(bus={self.bus}, port={self.port})"
+
+    @property
+    def receive_buffer_size(self) -> int:
+        """What the kernel granted for ``rcvbuf`` (Linux doubles the request, capped by net.core.rmem_max)."""
+        return int(self._rx.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF))
+
+    def fileno(self) -> int:
+        """The receive socket: readable when :meth:`receive` may return a frame without waiting."""
+        self._check_open()
+        return self._rx.fileno()
+
+    def receive(self, timeout: float | None = None) -> CANFrame | None:
+        """The next frame from another driver on the bus; None when none came within ``timeout`` seconds
+        (0: only what is already there; None: wait for ever)."""
+        self._check_open()
+        deadline = None if timeout is None else time.monotonic() + max(timeout, 0.0)
+        while True:
+            try:
+                data, source = self._rx.recvfrom(_RECV_SIZE)
+            except BlockingIOError:
+                if not self._wait_readable(deadline):
+                    return None
+                continue
+            if source == self._own_address:
+                continue
+            try:
+                frame = decode_packet(data)
+            except PacketError as ex:
+                self.drops.add(DropReason.BAD_PACKET, detail=f"datagram from {source[0]}:{source[1]}: {ex}")
+                continue
+            self._rx_hook(frame)
+            return frame
+
+    def _wait_readable(self, deadline: float | None) -> bool:
+        if deadline is None:
+            self._poll.poll()
+            return True
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return False
+        # poll() takes milliseconds; round up so a short timeout does not become a busy loop of zero-waits.
+        return bool(self._poll.poll(max(1, int(left * 1000 + 0.999))))
+
+    def send_frame(self, frame: CANFrame) -> None:
+        self._check_open()
+        try:
+            self._tx.send(encode_packet(frame))
+        except (TimeoutError, BlockingIOError) as ex:
+            self.drops.add(DropReason.TX_FAILED, detail=f"socket full for the send timeout: {ex}")
+            raise TxQueueFullError(f"{self!r}: could not send within {self._tx.gettimeout()} s") from ex
+        except OSError as ex:
+            if ex.errno != errno.ENOBUFS:
+                raise DriverError(f"{self!r}: send failed: {ex}") from ex
+            self.drops.add(DropReason.TX_FAILED, detail=str(ex))
+            raise TxQueueFullError(f"{self!r}: {ex}") from ex
+        self._tx_hook(frame)
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self._rx.close()
+        self._tx.close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise DriverError(f"{self!r} is closed")
+
+    def __enter__(self) -> LoopbackMulticastDriver:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
