@@ -49,8 +49,8 @@ from sam_runtime.dronecan_io import (  # noqa: E402
     NodeLoop,
     group_for_bus,
     make_node,
-    payload_length,
     parse_iface,
+    payload_length,
     transfer_cost,
 )
 from sam_runtime.dronecan_io.bus_load import transfer_frame_lengths  # noqa: E402
@@ -433,6 +433,49 @@ def test_bad_input_counted_and_node_keeps_working(caplog: pytest.LogCaptureFixtu
     for reason in ("unknown_data_type", "toggle_error", "cyphal_v1_frame", "incomplete_transfer", "handler_error"):
         assert sum(f"drop {reason}" in ln for ln in lines) >= 1, reason
     assert not any(r.exc_info for r in caplog.records)
+
+
+class NoFdDriver:
+    """The loopback driver without fileno(), as dronecan's SLCAN driver: the NodeLoop has to poll it."""
+
+    def __init__(self, inner: LoopbackMulticastDriver) -> None:
+        self._inner = inner
+        self.drops = inner.drops
+
+    def receive(self, timeout: float | None = None) -> CANFrame | None:
+        return self._inner.receive(timeout)
+
+    def send_frame(self, frame: CANFrame) -> None:
+        self._inner.send_frame(frame)
+
+    def close(self) -> None:
+        self._inner.close()
+
+
+def test_two_node_loops_in_one_process_one_polled() -> None:
+    spec = parse_iface(private_iface())
+
+    async def scenario() -> None:
+        watched = dronecan.node.Node(FrameGate(LoopbackMulticastDriver(spec.bus, spec.port)), node_id=10)
+        polled = dronecan.node.Node(FrameGate(NoFdDriver(LoopbackMulticastDriver(spec.bus, spec.port))),
+                                    node_id=11)
+        got: dict[int, list[int]] = {10: [], 11: []}
+        loops = [NodeLoop(watched), NodeLoop(polled, poll_interval=0.005)]
+        loops[0].add_handler(RAW_IMU, lambda e: got[10].append(imu_seq(e.message)))
+        loops[1].add_handler(RAW_IMU, lambda e: got[11].append(imu_seq(e.message)))
+        async with loops[0], loops[1]:
+            for i in range(50):
+                watched.broadcast(raw_imu_message(i, 1))
+                polled.broadcast(raw_imu_message(i, 1))
+                await asyncio.sleep(0.002)
+            await until(lambda: len(got[10]) == len(got[11]) == 50, 20.0, f"50 RawIMU each way, have {got}")
+        assert got == {10: list(range(50)), 11: list(range(50))}
+        assert loops[0].snapshot() == loops[1].snapshot() == {}
+        assert loops[1].stats.wakeups > 0
+        watched.close()
+        polled.close()
+
+    asyncio.run(scenario())
 
 
 # -- across processes ------------------------------------------------------------------------------------------

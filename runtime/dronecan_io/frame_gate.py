@@ -54,7 +54,9 @@ class FrameGate(AbstractDriver):
         super().__init__()
         self.inner = inner
         inner_drops = getattr(inner, "drops", None)
-        self.drops: DropCounter = drops or (inner_drops if isinstance(inner_drops, DropCounter) else DropCounter())
+        if drops is None:
+            drops = inner_drops if isinstance(inner_drops, DropCounter) else DropCounter()
+        self.drops: DropCounter = drops
         self.transfer_timeout = transfer_timeout
         self._max_partial = max_partial_transfers
         self._clock = clock

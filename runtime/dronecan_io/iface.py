@@ -85,7 +85,9 @@ def parse_iface(uri: str) -> Iface:
 
 def make_driver(uri: str, *, bitrate: int = DEFAULT_BITRATE, drops: DropCounter | None = None,
                 **driver_kwargs: Any) -> Any:
-    """A dronecan CAN driver for ``uri`` (``bitrate`` is for SLCAN adapters; the loopback bus has none)."""
+    """A dronecan CAN driver for ``uri``. ``bitrate`` is for SLCAN adapters (the loopback bus has none, a SocketCAN
+    interface is configured outside); ``drops`` counts what the loopback driver rejects (the others count nothing:
+    their :class:`FrameGate` does)."""
     iface = parse_iface(uri)
     if iface.kind == "mcast-lo":
         return LoopbackMulticastDriver(iface.bus, iface.port, drops=drops, **driver_kwargs)
@@ -110,9 +112,7 @@ def make_node(uri: str, node_id: int | None, *, bitrate: int = DEFAULT_BITRATE, 
 
     if node_id is not None and not 1 <= node_id <= 127:
         raise ValueError(f"UAVCAN v0 node id must be 1..127 (or None for a passive node), got {node_id}")
-    driver = make_driver(uri, bitrate=bitrate, drops=drops) if parse_iface(uri).kind == "mcast-lo" else \
-        make_driver(uri, bitrate=bitrate)
-    gate = FrameGate(driver, drops=drops, transfer_timeout=transfer_timeout)
+    gate = FrameGate(make_driver(uri, bitrate=bitrate, drops=drops), drops=drops, transfer_timeout=transfer_timeout)
     node_kwargs.setdefault("catch_handler_exceptions", False)
     try:
         return dronecan.node.Node(gate, node_id=node_id, **node_kwargs)
