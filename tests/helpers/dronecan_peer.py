@@ -4,6 +4,7 @@ python dronecan_peer.py --iface mcast-lo:<bus>:<port> | slcan:/dev/pts/N  --node
     [--wait-for 10]                      wait until node 10's NodeStatus is seen before publishing
     [--publish-imu 600 --rate 200]       broadcast RawIMU number 0..599 at 200 Hz (values: raw_imu_message)
     [--listen-imu-from 10]               record RawIMU from node 10 (sequence, values checked, latency)
+    [--expect-imu 600]                   print RECEIVED 600 when the 600th has come
     [--query-info-of 10]                 GetNodeInfo request to node 10 once it is seen
     [--max-life 120]
 
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 import threading
 import time
@@ -96,10 +98,13 @@ def main() -> int:
     p.add_argument("--publish-imu", type=int, default=0)
     p.add_argument("--rate", type=float, default=200.0)
     p.add_argument("--listen-imu-from", type=int)
+    p.add_argument("--expect-imu", type=int, default=0, help="print RECEIVED n when n RawIMU have come")
     p.add_argument("--query-info-of", type=int)
     p.add_argument("--max-life", type=float, default=120.0)
     args = p.parse_args()
 
+    # dronecan's drivers log what goes wrong at INFO and above (the SLCAN one from its IO process): keep it.
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     import dronecan
 
     node = _make_node(args.iface, args.node_id, args.name)  # before any thread: dronecan's SLCAN driver forks
@@ -132,6 +137,8 @@ def main() -> int:
         latencies_us.append(now_us - got["timestamp"])
         if got != raw_imu_fields(seq, got["timestamp"]):
             mismatched.append(seq)
+        if len(received) == args.expect_imu:
+            print(f"RECEIVED {len(received)}", flush=True)
 
     def on_info(e: Any) -> None:
         if e is None:
