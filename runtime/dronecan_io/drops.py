@@ -21,6 +21,8 @@ __all__ = ["DropCounter", "DropKey", "DropReason", "RateLimitedLog"]
 class DropReason(StrEnum):
     # A datagram on the loopback bus that is not an mcast: CAN frame (short, bad magic or CRC, bad length).
     BAD_PACKET = "bad_packet"
+    # Frames the kernel dropped because the node's receive buffer was full (it did not keep up).
+    RX_OVERFLOW = "rx_overflow"
     # Frames dronecan would ignore silently: UAVCAN v0 uses 29-bit ids only, and every frame has a tail byte.
     NOT_EXTENDED_ID = "not_extended_id"
     EMPTY_FRAME = "empty_frame"
@@ -73,12 +75,12 @@ class DropCounter:
         self._listeners: list[Callable[[DropKey, str], None]] = []
 
     def add(self, reason: DropReason, *, data_type_id: int | None = None, source_node_id: int | None = None,
-            detail: str = "") -> None:
+            detail: str = "", count: int = 1) -> None:
         key = DropKey(reason, data_type_id, source_node_id)
         with self._lock:
-            self._counts[key] += 1
+            self._counts[key] += count
         for listener in self._listeners:
-            listener(key, detail)
+            listener(key, detail if count == 1 else f"{count} at once: {detail}")
 
     def add_listener(self, listener: Callable[[DropKey, str], None]) -> None:
         """``listener(key, detail)`` is called for every drop, in the thread that counted it."""

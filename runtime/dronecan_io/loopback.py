@@ -78,6 +78,11 @@ class LoopbackMulticastDriver(AbstractDriver):
         self._own_address = self._tx.getsockname()
         self.kernel_self_filter = _attach_self_filter(self._rx, self._own_address)
         self.own_frames_skipped = 0
+        # The kernel counts the datagrams it dropped for this socket (full buffer), and this driver's own ones the
+        # filter above dropped: one per frame sent. Read when the socket is empty (SO_MEMINFO).
+        self._count_drops = _kernel_drops(self._rx) is not None
+        self._sent = 0
+        self._overflow_reported = 0
         self._poll = select.poll()
         self._poll.register(self._rx.fileno(), select.POLLIN)
         self._closed = False
@@ -104,6 +109,8 @@ class LoopbackMulticastDriver(AbstractDriver):
             try:
                 data, source = self._rx.recvfrom(_RECV_SIZE)
             except BlockingIOError:
+                if self._count_drops:
+                    self._count_overflow()
                 if not self._wait_readable(deadline):
                     return None
                 continue
@@ -140,7 +147,19 @@ class LoopbackMulticastDriver(AbstractDriver):
                 raise DriverError(f"{self!r}: send failed: {ex}") from ex
             self.drops.add(DropReason.TX_FAILED, detail=str(ex))
             raise TxQueueFullError(f"{self!r}: {ex}") from ex
+        self._sent += 1
         self._tx_hook(frame)
+
+    def _count_overflow(self) -> None:
+        kernel_drops = _kernel_drops(self._rx)
+        if kernel_drops is None:
+            return
+        # An own frame still on its way to the filter makes the difference smaller, never larger: an overflow may
+        # be reported a little late, never invented.
+        lost = kernel_drops - (self._sent if self.kernel_self_filter else 0) - self._overflow_reported
+        if lost > 0:
+            self._overflow_reported += lost
+            self.drops.add(DropReason.RX_OVERFLOW, detail=f"the receive buffer of {self!r} was full", count=lost)
 
     def close(self) -> None:
         if self._closed:
@@ -161,6 +180,18 @@ class LoopbackMulticastDriver(AbstractDriver):
 
 
 _SO_ATTACH_FILTER = 26  # Linux; not exported by the socket module
+_SO_MEMINFO = 55  # Linux >= 4.12: u32[SK_MEMINFO_VARS]
+_MEMINFO = struct.Struct("9I")
+_SK_MEMINFO_DROPS = 8
+
+
+def _kernel_drops(sock: socket.socket) -> int | None:
+    """How many datagrams the kernel dropped for ``sock`` so far (sk_drops), or None where it cannot tell."""
+    try:
+        raw = sock.getsockopt(socket.SOL_SOCKET, _SO_MEMINFO, _MEMINFO.size)
+    except OSError:
+        return None
+    return _MEMINFO.unpack(raw)[_SK_MEMINFO_DROPS] if len(raw) == _MEMINFO.size else None
 _SKF_NET_OFF = -0x100000
 _BPF = struct.Struct("HBBI")
 
