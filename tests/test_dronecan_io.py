@@ -340,6 +340,9 @@ def test_loopback_driver_delivers_to_others_only() -> None:
         b.send(0x1403EB0B, b"\x03\xc2", extended=True)
         got = a.receive(5.0)
         assert got is not None and bytes(got.data) == b"\x03\xc2"
+        deadline = time.monotonic() + 10.0
+        while not a.drops.snapshot() and time.monotonic() < deadline:  # (two senders: no order between them)
+            assert a.receive(0.05) is None
         assert a.drops.snapshot() == {"bad_packet": 1}
     with pytest.raises(DriverError, match="is closed"):
         a.receive(0)

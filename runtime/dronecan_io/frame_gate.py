@@ -65,6 +65,8 @@ class FrameGate(AbstractDriver):
         self._v1: dict[tuple[int, int], float] = {}
         self._budget: int | None = None
         self.last_frame: CANFrame | None = None
+        # The last receive() found the driver empty (not just a batch limit): held transfers are really waiting.
+        self.drained = False
 
     def __repr__(self) -> str:
         return f"FrameGate({self.inner!r})"
@@ -93,7 +95,9 @@ class FrameGate(AbstractDriver):
                 raw = self.inner.receive(left)
                 if raw is None:
                     self.last_frame = None
+                    self.drained = True
                     return None
+                self.drained = False
                 if self._budget is not None:
                     self._budget -= 1
                 frame = self._admit(raw)
@@ -114,7 +118,8 @@ class FrameGate(AbstractDriver):
         return bool(self._ready)
 
     def sweep(self) -> None:
-        """Count and forget multi-frame transfers whose next frame is overdue."""
+        """Count and forget multi-frame transfers whose next frame is overdue. Call it when :attr:`drained`: a
+        frame still in the driver is not overdue, however long this process was kept from reading it."""
         now = self._clock()
         stale = [k for k, p in self._partial.items() if now - p.last_seen > self.transfer_timeout]
         for key in stale:

@@ -232,9 +232,10 @@ class NodeLoop:
 
     def _on_timer(self) -> None:
         self._timer = None
-        self.gate.sweep()
-        self._log.flush()
         self._service()
+        if self.gate.drained:
+            self.gate.sweep()
+        self._log.flush()
 
     def _arm_timer(self) -> None:
         assert self._loop is not None
