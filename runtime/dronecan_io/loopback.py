@@ -9,8 +9,9 @@ library and its GUI tool can join the bus, but:
   blocking :meth:`receive` (dronecan's ``Node.spin(timeout)``) that sleeps in ``poll``.
 
 Like dronecan's SocketCAN and ``mcast:`` drivers it does not hand a node its own frames back (dronecan's Node has
-no loopback handling: an echo would be received as a transfer from itself). Frames of other drivers on the same bus
-in the same process are delivered.
+no loopback handling: an echo would be received as a transfer from itself); on Linux a socket filter drops them in
+the kernel. Frames of other drivers on the same bus in the same process are delivered. Datagrams the kernel drops
+because the node did not read in time are counted, not lost silently.
 """
 
 from __future__ import annotations
@@ -36,10 +37,10 @@ _RECV_SIZE = 2048  # more than the largest valid packet (74 bytes), so an oversi
 class LoopbackMulticastDriver(AbstractDriver):
     """dronecan driver for bus ``bus`` (group 239.65.82.<bus>) on UDP ``port``, confined to 127.0.0.1.
 
-    ``drops`` counts received datagrams that are not CAN frames and frames that could not be sent; a
-    :class:`~.node_loop.NodeLoop` reports them with its own. ``rcvbuf`` is the socket receive buffer asked for:
-    a node that is busy for a while (a loaded machine) must not lose frames that a CAN controller's FIFO would
-    have lost only on a saturated bus.
+    ``drops`` counts datagrams that are not CAN frames (``bad_packet``), frames lost because the receive buffer was
+    full (``rx_overflow``) and frames that could not be sent (``tx_failed``); a :class:`~.node_loop.NodeLoop`
+    reports them with its own. ``rcvbuf`` is the receive buffer asked for (the kernel caps it at
+    net.core.rmem_max): how long the node may be kept from reading, at a given bus load, before frames are lost.
     """
 
     def __init__(self, bus: int = 0, port: int = MCAST_PORT, *, drops: DropCounter | None = None,
