@@ -1,5 +1,6 @@
 """DroneCAN transport groundwork (sam_runtime.dronecan_io): the loopback multicast driver, the frame gate, the
-asyncio node loop, frame accounting and SLCAN, against dronecan's own code and across processes.
+asyncio node loop, frame accounting and SLCAN lines, against dronecan's own code, in one process (the
+cross-process tests are in test_dronecan_io_processes.py).
 
 Every bus here is private to this test session (bus number and UDP port from the pid), so concurrent runs do not
 see each other; dronecan's own ``mcast:`` driver is never created (its packing code is run with fake sockets).
@@ -10,21 +11,11 @@ from __future__ import annotations
 import asyncio
 import doctest
 import importlib
-import itertools
-import json
 import logging
-import os
 import queue
-import signal
 import socket
-import statistics
-import subprocess
-import sys
-import threading
 import time
 import types
-from collections.abc import Callable, Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -34,7 +25,7 @@ dronecan = pytest.importorskip("dronecan")
 from dronecan import transport  # noqa: E402
 from dronecan.driver.common import CANFrame, DriverError  # noqa: E402
 from helpers.dronecan_peer import imu_seq, raw_imu_fields, raw_imu_message, read_raw_imu  # noqa: E402
-from helpers.runtime_support import HELPERS  # noqa: E402
+from helpers.dronecan_support import frames_of, private_iface, until  # noqa: E402
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
@@ -59,18 +50,6 @@ from sam_runtime.dronecan_io.slcan import SlcanError, decode_line, encode_line  
 
 RAW_IMU = dronecan.uavcan.equipment.ahrs.RawIMU
 MODULES = ("can_id", "mcast_packet", "drops", "frame_gate", "loopback", "node_loop", "bus_load", "slcan", "iface")
-_bus_numbers = itertools.count()
-
-
-def private_iface() -> str:
-    """A loopback bus no other test session uses: bus and port from the pid, a new port per call."""
-    pid = os.getpid()
-    return f"mcast-lo:{pid % 250 + 1}:{20000 + (pid % 1000) * 10 + next(_bus_numbers) % 10}"
-
-
-def frames_of(msg: Any, source: int, transfer_id: int) -> list[CANFrame]:
-    t = transport.Transfer(payload=msg, source_node_id=source, transfer_id=transfer_id, transfer_priority=20)
-    return [CANFrame(f.message_id, bytearray(f.bytes), True) for f in t.to_frames()]
 
 
 def test_module_doctests() -> None:
@@ -371,15 +350,6 @@ def test_loopback_driver_counts_receive_buffer_overflow() -> None:
 
 # -- the node loop: bad input on the bus, in one process ------------------------------------------------------------
 
-async def until(pred: Callable[[], Any], timeout: float, what: str) -> Any:
-    deadline = time.monotonic() + timeout
-    while not (value := pred()):
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
-        await asyncio.sleep(0.02)
-    return value
-
-
 def test_bad_input_counted_and_node_keeps_working(caplog: pytest.LogCaptureFixture) -> None:
     caplog.set_level(logging.WARNING, logger="sam_runtime.dronecan_io")
     iface = private_iface()
@@ -519,213 +489,6 @@ def test_node_loop_runs_the_scheduler_at_its_deadlines() -> None:
         node.close()
 
     asyncio.run(scenario())
-
-
-# -- across processes ------------------------------------------------------------------------------------------
-
-class Child:
-    """A helper program in its own session: stdout lines collected, stdin closed to ask it to finish."""
-
-    def __init__(self, name: str, script: str, args: list[str], log_dir: Path) -> None:
-        self.name = name
-        self.log = log_dir / f"{name}.stderr"
-        with open(self.log, "w") as err:
-            self.proc = subprocess.Popen([sys.executable, str(HELPERS / script), *args], stdin=subprocess.PIPE,
-                                         stdout=subprocess.PIPE, stderr=err, text=True, start_new_session=True)
-        self.lines: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.lines.append(line.rstrip("\n"))
-
-    def line(self, prefix: str) -> str | None:
-        return next((ln for ln in self.lines if ln.startswith(prefix)), None)
-
-    async def wait_line(self, prefix: str, timeout: float) -> str:
-        def found() -> str | None:
-            if self.proc.poll() is not None and self.line(prefix) is None:
-                raise AssertionError(f"{self.name} exited ({self.proc.returncode}) without {prefix!r}: "
-                                     f"{self.stderr_tail()}")
-            return self.line(prefix)
-        return await until(found, timeout, f"{self.name}: {prefix!r}")
-
-    async def finish(self, prefix: str, timeout: float = 30.0) -> dict[str, Any]:
-        assert self.proc.stdin is not None
-        self.proc.stdin.close()
-        line = await self.wait_line(prefix, timeout)
-        await until(lambda: self.proc.poll() is not None, timeout, f"{self.name} to exit")
-        assert self.proc.returncode == 0, self.stderr_tail()
-        return json.loads(line.split(" ", 1)[1])
-
-    def stderr_tail(self) -> str:
-        return self.log.read_text(errors="replace")[-3000:]
-
-    def group_alive(self) -> list[int]:
-        """Processes left in this child's process group (its forked helpers), zombies aside."""
-        alive = []
-        for entry in Path("/proc").iterdir():
-            if entry.name.isdigit():
-                try:
-                    fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
-                except OSError:
-                    continue
-                if int(fields[2]) == self.proc.pid and fields[0] != "Z":
-                    alive.append(int(entry.name))
-        return alive
-
-    def kill(self) -> None:
-        if self.group_alive():
-            os.killpg(self.proc.pid, signal.SIGKILL)
-        if self.proc.poll() is None:
-            self.proc.wait(timeout=10)
-
-
-@pytest.fixture
-def children(tmp_path: Path) -> Iterator[Callable[[str, str, list[str]], Child]]:
-    made: list[Child] = []
-
-    def start(name: str, script: str, args: list[str]) -> Child:
-        made.append(Child(name, script, args, tmp_path))
-        return made[-1]
-
-    yield start
-    for child in made:
-        child.kill()
-
-
-def _percentiles(values_us: list[int]) -> str:
-    q = statistics.quantiles(values_us, n=100)
-    return f"p50 {q[49] / 1000:.2f} ms, p99 {q[98] / 1000:.2f} ms"
-
-
-async def _exchange_imu(iface: str, peer: Child, n: int, rate: float) -> tuple[NodeLoop, dict[str, Any], str]:
-    """Node 10 here and the peer (node 42) each send n RawIMU at `rate` once they see each other."""
-    node = make_node(iface, 10, node_status_interval=0.5)
-    nl = NodeLoop(node)
-    received: list[int] = []
-    mismatched: list[int] = []
-    latencies: list[int] = []
-    statuses: dict[int, Any] = {}
-    publish_times: list[float] = []
-
-    def on_imu(e: Any) -> None:
-        now_us = time.monotonic_ns() // 1000
-        got = read_raw_imu(e.message)
-        received.append(imu_seq(e.message))
-        latencies.append(now_us - got["timestamp"])
-        if got != raw_imu_fields(received[-1], got["timestamp"]) or e.transfer.source_node_id != 42:
-            mismatched.append(received[-1])
-
-    def publish() -> None:
-        if len(publish_times) < n:
-            node.broadcast(raw_imu_message(len(publish_times), time.monotonic_ns() // 1000))
-            publish_times.append(time.monotonic())
-
-    nl.add_handler(RAW_IMU, on_imu)
-    nl.add_handler(dronecan.uavcan.protocol.NodeStatus, lambda e: statuses.setdefault(e.transfer.source_node_id, 1))
-    async with nl:
-        await peer.wait_line("READY", 60.0)
-        await until(lambda: 42 in statuses, 20.0, "the peer's NodeStatus")
-        node.periodic(1.0 / rate, publish)
-        nl.wake()
-        budget = n / rate + 60.0  # the nominal time plus a margin for a loaded machine
-        failure = ""
-        try:
-            await until(lambda: (len(received) >= n and len(publish_times) >= n) or peer.proc.poll() is not None,
-                        budget, f"{n} RawIMU each way")
-            await peer.wait_line("RECEIVED", budget)
-            await peer.wait_line("PUBLISHED", budget)
-        except AssertionError as ex:
-            failure = f"{ex}; "
-        summary = await peer.finish("SUMMARY")
-        here = (f"here: published {len(publish_times)}, received {len(received)}, missing "
-                f"{sorted(set(range(n)) - set(received))[:20]}, drops {nl.snapshot()}, {nl.stats}; peer: "
-                f"published {summary['published']}, received {len(summary['received'])}, missing "
-                f"{sorted(set(range(n)) - set(summary['received']))[:20]}; peer log: {peer.stderr_tail()}")
-        assert not failure, failure + here
-    node.close()
-    assert received == list(range(n)) and mismatched == [], here
-    assert summary["received"] == list(range(n)) and summary["mismatched"] == [], here
-    assert nl.snapshot() == {}, here
-    # Timing is the machine's business (dronecan's scheduler catches up after a stall); printed, not asserted.
-    gap = statistics.median(b - a for a, b in itertools.pairwise(publish_times))
-    figures = (f"peer->node {_percentiles(latencies)}; node->peer {_percentiles(summary['latencies_us'])}; "
-               f"median publish interval {gap * 1000:.2f} ms; {nl.stats}")
-    return nl, summary, figures
-
-
-@pytest.mark.slow
-def test_raw_imu_200hz_both_ways_across_processes(children: Callable[..., Child]) -> None:
-    iface = private_iface()
-    peer = children("peer", "dronecan_peer.py", ["--iface", iface, "--node-id", "42", "--wait-for", "10",
-                                                 "--publish-imu", "600", "--rate", "200", "--listen-imu-from", "10",
-                                                 "--expect-imu", "600"])
-    _, _, figures = asyncio.run(_exchange_imu(iface, peer, 600, 200.0))
-    print(f"\nRawIMU 200 Hz x 3 s over mcast-lo, 0 lost: {figures}")
-
-
-@pytest.mark.slow
-def test_node_status_and_get_node_info_across_processes(children: Callable[..., Child]) -> None:
-    iface = private_iface()
-    peer = children("peer", "dronecan_peer.py", ["--iface", iface, "--node-id", "42", "--query-info-of", "10"])
-
-    async def scenario() -> None:
-        info = dronecan.uavcan.protocol.GetNodeInfo.Response()
-        info.name = "org.sam.test.bridge"
-        node = make_node(iface, 10, node_status_interval=0.5, node_info=info)
-        statuses: list[Any] = []
-        replies: dict[int, Any] = {}
-        async with NodeLoop(node) as nl:
-            nl.add_handler(dronecan.uavcan.protocol.NodeStatus,
-                           lambda e: statuses.append(e.message) if e.transfer.source_node_id == 42 else None)
-            await peer.wait_line("READY", 60.0)
-            await until(lambda: statuses, 20.0, "the peer's NodeStatus")
-            assert (statuses[0].health, statuses[0].mode) == (0, 0)  # OK, OPERATIONAL
-            t0 = time.monotonic()
-            for target in (42, 99):  # 99 does not exist: dronecan's request timeout, run by the NodeLoop timer
-                node.request(dronecan.uavcan.protocol.GetNodeInfo.Request(), target,
-                             lambda e, t=target: replies.__setitem__(t, (e, time.monotonic() - t0)), timeout=0.3)
-            nl.wake()
-            await until(lambda: len(replies) == 2, 20.0, "the GetNodeInfo response and the timeout")
-            event, _ = replies[42]
-            assert event.response.name.decode() == "org.sam.test.peer"
-            assert bytes(event.response.hardware_version.unique_id) == bytes(range(16))
-            assert (event.response.software_version.major, event.response.software_version.minor) == (1, 27)
-            assert replies[99][0] is None and replies[99][1] >= 0.3
-            summary = await peer.finish("SUMMARY")
-            assert summary["info"]["name"] == "org.sam.test.bridge" and summary["info"]["source"] == 10
-            assert nl.snapshot() == {}
-        node.close()
-
-    asyncio.run(scenario())
-
-
-@pytest.mark.slow
-def test_slcan_adapter_standin_exchanges_with_loopback_bus(children: Callable[..., Child]) -> None:
-    """dronecan's own SLCAN driver (make_node('slcan:/dev/pts/N')) in one process, a node on the loopback bus in
-    another, an adapter stand-in on a pty between them."""
-    iface = private_iface()
-    standin = children("standin", "slcan_standin.py", ["--bus", iface])
-
-    async def scenario() -> tuple[str, dict[str, Any]]:
-        pty = (await standin.wait_line("PTY ", 30.0)).split()[1]
-        peer = children("slcan-peer", "dronecan_peer.py", [
-            "--iface", f"slcan:{pty}", "--node-id", "42", "--wait-for", "10", "--publish-imu", "600",
-            "--rate", "200", "--listen-imu-from", "10", "--expect-imu", "600"])
-        try:
-            _, _, figures = await _exchange_imu(iface, peer, 600, 200.0)
-        except AssertionError as ex:
-            raise AssertionError(f"{ex}; stand-in: {await standin.finish('STATS')}") from None
-        # dronecan's SLCAN driver forked an IO process: it must have ended with the peer.
-        await until(lambda: not peer.group_alive(), 20.0, f"the peer's process group to end: {peer.group_alive()}")
-        stats = await standin.finish("STATS")
-        return figures, stats
-
-    figures, stats = asyncio.run(scenario())
-    assert stats["bitrate"] == 1_000_000 and stats["rejected_lines"] == 0 and stats["bus_drops"] == {}
-    print(f"\nRawIMU 200 Hz x 3 s, SLCAN (dronecan driver, pty stand-in) <-> mcast-lo, 0 lost: {figures}")
 
 
 def test_bus_load_meter_counts_frames_on_the_wire() -> None:
