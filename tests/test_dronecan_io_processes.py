@@ -72,27 +72,29 @@ async def _exchange_imu(iface: str, peer: Child, n: int, rate: float) -> tuple[N
 
     nl.add_handler(RAW_IMU, on_imu)
     nl.add_handler(dronecan.uavcan.protocol.NodeStatus, lambda e: statuses.setdefault(e.transfer.source_node_id, 1))
-    async with nl:
-        await peer.wait_line("READY", 60.0)
-        await until(lambda: 42 in statuses, 20.0, "the peer's NodeStatus")
-        node.periodic(1.0 / rate, publish)
-        nl.wake()
-        budget = n / rate + 60.0  # the nominal time plus a margin for a loaded machine
-        failure = ""
-        try:
-            await until(lambda: (len(received) >= n and len(publish_times) >= n) or peer.proc.poll() is not None,
-                        budget, f"{n} RawIMU each way")
-            await peer.wait_line("RECEIVED", budget)
-            await peer.wait_line("PUBLISHED", budget)
-        except AssertionError as ex:
-            failure = f"{ex}; "
-        summary = await peer.finish("SUMMARY")
-        here = (f"here: published {len(publish_times)}, received {len(received)}, missing "
-                f"{sorted(set(range(n)) - set(received))[:20]}, drops {nl.snapshot()}, {nl.stats}; peer: "
-                f"published {summary['published']}, received {len(summary['received'])}, missing "
-                f"{sorted(set(range(n)) - set(summary['received']))[:20]}; peer log: {peer.stderr_tail()}")
-        assert not failure, failure + here
-    node.close()
+    try:
+        async with nl:
+            await peer.wait_line("READY", 60.0)
+            await until(lambda: 42 in statuses, 20.0, "the peer's NodeStatus")
+            node.periodic(1.0 / rate, publish)
+            nl.wake()
+            budget = n / rate + 60.0  # the nominal time plus a margin for a loaded machine
+            failure = ""
+            try:
+                await until(lambda: (len(received) >= n and len(publish_times) >= n) or peer.proc.poll() is not None,
+                            budget, f"{n} RawIMU each way")
+                await peer.wait_line("RECEIVED", budget)
+                await peer.wait_line("PUBLISHED", budget)
+            except AssertionError as ex:
+                failure = f"{ex}; "
+            summary = await peer.finish("SUMMARY")
+            here = (f"here: published {len(publish_times)}, received {len(received)}, missing "
+                    f"{sorted(set(range(n)) - set(received))[:20]}, drops {nl.snapshot()}, {nl.stats}; peer: "
+                    f"published {summary['published']}, received {len(summary['received'])}, missing "
+                    f"{sorted(set(range(n)) - set(summary['received']))[:20]}; peer log: {peer.stderr_tail()}")
+            assert not failure, failure + here
+    finally:
+        node.close()
     assert received == list(range(n)) and mismatched == [], here
     assert summary["received"] == list(range(n)) and summary["mismatched"] == [], here
     assert nl.snapshot() == {}, here
