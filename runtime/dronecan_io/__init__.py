@@ -1,0 +1,44 @@
+"""DroneCAN (UAVCAN v0) transport groundwork: drivers, the receive path, an asyncio runner, bus accounting.
+
+- :class:`LoopbackMulticastDriver` (``mcast-lo:``): dronecan's ``mcast:`` packet format on 127.0.0.1 only.
+- :class:`FrameGate`: between any dronecan driver and its Node; passes whole v0 transfers, counts the rest.
+- :class:`NodeLoop`: runs a Node in the asyncio loop's thread; every ``spin()`` exception counted, never raised.
+- :class:`DropCounter` / :class:`DropReason`: what was dropped and why.
+- :mod:`.bus_load`: frames and bits per transfer; the share of a classic 1 Mbit/s CAN bus.
+- :mod:`.slcan`: SLCAN lines and the adapter side of the protocol.
+- :func:`make_node` / :func:`parse_iface`: nodes from interface URIs (``mcast-lo:``, ``slcan:``, ``socketcan:``).
+
+The ``dronecan`` package is imported by these modules: install the ``runtime`` extra.
+"""
+
+from .bus_load import BusLoadMeter, TransferCost, frame_bits, payload_length, transfer_cost
+from .drops import DropCounter, DropKey, DropReason, RateLimitedLog
+from .frame_gate import FrameGate
+from .iface import Iface, IfaceError, make_driver, make_node, parse_iface
+from .loopback import LoopbackMulticastDriver
+from .mcast_packet import MCAST_PORT, group_for_bus
+from .node_loop import HandlerError, NodeLoop, classify_spin_error
+
+__all__ = [
+    "MCAST_PORT",
+    "BusLoadMeter",
+    "DropCounter",
+    "DropKey",
+    "DropReason",
+    "FrameGate",
+    "HandlerError",
+    "Iface",
+    "IfaceError",
+    "LoopbackMulticastDriver",
+    "NodeLoop",
+    "RateLimitedLog",
+    "TransferCost",
+    "classify_spin_error",
+    "frame_bits",
+    "group_for_bus",
+    "make_driver",
+    "make_node",
+    "parse_iface",
+    "payload_length",
+    "transfer_cost",
+]

@@ -1,0 +1,221 @@
+"""A dronecan CAN driver for a multicast bus that never leaves the machine.
+
+Same packets, groups and ports as dronecan's own ``mcast:`` driver (see :mod:`.mcast_packet`), so the dronecan
+library and its GUI tool can join the bus, but:
+
+- it sends with ``IP_MULTICAST_IF`` 127.0.0.1 and TTL 0 and joins the group on 127.0.0.1 only: no frame and no
+  IGMP report leaves through the outward interface (dronecan's ``mcast:`` joins and sends on the default route);
+- no IO process and no busy wait: a non-blocking socket whose :meth:`fileno` an event loop can watch, and a
+  blocking :meth:`receive` (dronecan's ``Node.spin(timeout)``) that sleeps in ``poll``.
+
+Like dronecan's SocketCAN and ``mcast:`` drivers it does not hand a node its own frames back (dronecan's Node has
+no loopback handling: an echo would be received as a transfer from itself); on Linux a socket filter drops them in
+the kernel. Frames of other drivers on the same bus in the same process are delivered. Datagrams the kernel drops
+because the node did not read in time are counted, not lost silently.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import errno
+import select
+import socket
+import struct
+import time
+
+from dronecan.driver.common import AbstractDriver, CANFrame, DriverError, TxQueueFullError
+
+from .drops import DropCounter, DropReason
+from .mcast_packet import MCAST_PORT, PacketError, decode_packet, encode_packet, group_for_bus
+
+__all__ = ["LOOPBACK_ADDRESS", "LoopbackMulticastDriver"]
+
+LOOPBACK_ADDRESS = "127.0.0.1"
+_RECV_SIZE = 2048  # more than the largest valid packet (74 bytes), so an oversized one is seen whole and rejected
+
+
+class LoopbackMulticastDriver(AbstractDriver):
+    """dronecan driver for bus ``bus`` (group 239.65.82.<bus>) on UDP ``port``, confined to 127.0.0.1.
+
+    ``drops`` counts datagrams that are not CAN frames (``bad_packet``), frames lost because the receive buffer was
+    full (``rx_overflow``) and frames that could not be sent (``tx_failed``); a :class:`~.node_loop.NodeLoop`
+    reports them with its own. ``rcvbuf`` is the receive buffer asked for (the kernel caps it at
+    net.core.rmem_max): how long the node may be kept from reading, at a given bus load, before frames are lost.
+    """
+
+    def __init__(self, bus: int = 0, port: int = MCAST_PORT, *, drops: DropCounter | None = None,
+                 rcvbuf: int = 1 << 21, send_timeout: float = 0.1) -> None:
+        super().__init__()
+        if not 1 <= port <= 65535:
+            raise ValueError(f"UDP port must be 1..65535, got {port}")
+        self.bus = bus
+        self.port = port
+        self.group = group_for_bus(bus)
+        self.drops = drops if drops is not None else DropCounter()
+        self._rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        self._tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        try:
+            self._rx.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            self._rx.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
+            # Bound to the group (as dronecan's driver), so unicast to the port and other groups are not received.
+            self._rx.bind((self.group, port))
+            mreq = socket.inet_aton(self.group) + socket.inet_aton(LOOPBACK_ADDRESS)
+            self._rx.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, mreq)
+            self._rx.setblocking(False)
+
+            self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(LOOPBACK_ADDRESS))
+            self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+            self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+            self._tx.bind((LOOPBACK_ADDRESS, 0))
+            self._tx.connect((self.group, port))
+            self._tx.settimeout(send_timeout)
+        except OSError as ex:
+            self._rx.close()
+            self._tx.close()
+            raise DriverError(f"cannot open the loopback multicast bus {self.group}:{port}: {ex}") from ex
+        # Datagrams from this address are this driver's own (dronecan's mcast: compares the port only). The kernel
+        # drops them before they take receive-buffer space (half the buffer on a bus where this node sends as much
+        # as it receives) when the filter can be attached; the check in receive() stays for when it cannot.
+        self._own_address = self._tx.getsockname()
+        self.kernel_self_filter = _attach_self_filter(self._rx, self._own_address)
+        self.own_frames_skipped = 0
+        # The kernel counts the datagrams it dropped for this socket (full buffer), and this driver's own ones the
+        # filter above dropped: one per frame sent. Read when the socket is empty (SO_MEMINFO).
+        self._count_drops = _kernel_drops(self._rx) is not None
+        self._sent = 0
+        self._overflow_reported = 0
+        self._poll = select.poll()
+        self._poll.register(self._rx.fileno(), select.POLLIN)
+        self._closed = False
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(bus={self.bus}, port={self.port})"
+
+    @property
+    def receive_buffer_size(self) -> int:
+        """What the kernel granted for ``rcvbuf`` (Linux doubles the request, capped by net.core.rmem_max)."""
+        return int(self._rx.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF))
+
+    def fileno(self) -> int:
+        """The receive socket: readable when :meth:`receive` may return a frame without waiting."""
+        self._check_open()
+        return self._rx.fileno()
+
+    def receive(self, timeout: float | None = None) -> CANFrame | None:
+        """The next frame from another driver on the bus; None when none came within ``timeout`` seconds
+        (0: only what is already there; None: wait for ever)."""
+        self._check_open()
+        deadline = None if timeout is None else time.monotonic() + max(timeout, 0.0)
+        while True:
+            try:
+                data, source = self._rx.recvfrom(_RECV_SIZE)
+            except BlockingIOError:
+                if self._count_drops:
+                    self._count_overflow()
+                if not self._wait_readable(deadline):
+                    return None
+                continue
+            if source == self._own_address:
+                self.own_frames_skipped += 1
+                continue
+            try:
+                frame = decode_packet(data)
+            except PacketError as ex:
+                self.drops.add(DropReason.BAD_PACKET, detail=f"datagram from {source[0]}:{source[1]}: {ex}")
+                continue
+            self._rx_hook(frame)
+            return frame
+
+    def _wait_readable(self, deadline: float | None) -> bool:
+        if deadline is None:
+            self._poll.poll()
+            return True
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return False
+        # poll() takes milliseconds; round up so a short timeout does not become a busy loop of zero-waits.
+        return bool(self._poll.poll(max(1, int(left * 1000 + 0.999))))
+
+    def send_frame(self, frame: CANFrame) -> None:
+        self._check_open()
+        try:
+            self._tx.send(encode_packet(frame))
+        except (TimeoutError, BlockingIOError) as ex:
+            self.drops.add(DropReason.TX_FAILED, detail=f"socket full for the send timeout: {ex}")
+            raise TxQueueFullError(f"{self!r}: could not send within {self._tx.gettimeout()} s") from ex
+        except OSError as ex:
+            if ex.errno != errno.ENOBUFS:
+                raise DriverError(f"{self!r}: send failed: {ex}") from ex
+            self.drops.add(DropReason.TX_FAILED, detail=str(ex))
+            raise TxQueueFullError(f"{self!r}: {ex}") from ex
+        self._sent += 1
+        self._tx_hook(frame)
+
+    def _count_overflow(self) -> None:
+        kernel_drops = _kernel_drops(self._rx)
+        if kernel_drops is None:
+            return
+        # An own frame still on its way to the filter makes the difference smaller, never larger: an overflow may
+        # be reported a little late, never invented.
+        lost = kernel_drops - (self._sent if self.kernel_self_filter else 0) - self._overflow_reported
+        if lost > 0:
+            self._overflow_reported += lost
+            self.drops.add(DropReason.RX_OVERFLOW, detail=f"the receive buffer of {self!r} was full", count=lost)
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self._rx.close()
+        self._tx.close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise DriverError(f"{self!r} is closed")
+
+    def __enter__(self) -> LoopbackMulticastDriver:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+
+_SO_ATTACH_FILTER = 26  # Linux; not exported by the socket module
+_SO_MEMINFO = 55  # Linux >= 4.12: u32[SK_MEMINFO_VARS]
+_MEMINFO = struct.Struct("9I")
+_SK_MEMINFO_DROPS = 8
+
+
+def _kernel_drops(sock: socket.socket) -> int | None:
+    """How many datagrams the kernel dropped for ``sock`` so far (sk_drops), or None where it cannot tell."""
+    try:
+        raw = sock.getsockopt(socket.SOL_SOCKET, _SO_MEMINFO, _MEMINFO.size)
+    except OSError:
+        return None
+    return _MEMINFO.unpack(raw)[_SK_MEMINFO_DROPS] if len(raw) == _MEMINFO.size else None
+_SKF_NET_OFF = -0x100000
+_BPF = struct.Struct("HBBI")
+
+
+def _attach_self_filter(sock: socket.socket, own: tuple[str, int]) -> bool:
+    """A classic BPF socket filter dropping datagrams from ``own`` (address, port); False where unsupported.
+
+    A UDP socket's filter sees the packet at its UDP header; the IP source address is reached through
+    SKF_NET_OFF. Loads of header fields are in network order and compared as numbers.
+    """
+    address = struct.unpack("!I", socket.inet_aton(own[0]))[0]
+    program = [
+        (0x20, 0, 0, (_SKF_NET_OFF + 12) & 0xFFFFFFFF),  # A = IP source address
+        (0x15, 0, 3, address),                            # A != own address: accept
+        (0x28, 0, 0, 0),                                  # A = UDP source port
+        (0x15, 0, 1, own[1]),                             # A == own port: drop, else accept
+        (0x06, 0, 0, 0),                                  # drop
+        (0x06, 0, 0, 0xFFFFFFFF),                         # accept all of it
+    ]
+    code = ctypes.create_string_buffer(b"".join(_BPF.pack(*ins) for ins in program))
+    fprog = struct.pack("HL", len(program), ctypes.addressof(code))
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, _SO_ATTACH_FILTER, fprog)
+    except OSError:
+        return False
+    return True
