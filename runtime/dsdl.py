@@ -40,7 +40,7 @@ __all__ = [
 
 CACHE_ENV_VAR = "SAM_DSDL_CACHE"
 # Bump when the layout or the compile rule of a cache entry changes.
-_CACHE_FORMAT = "sam-dsdl-cache-1"
+_CACHE_FORMAT = "sam-dsdl-cache-2"
 _COMPLETE_MARKER = ".complete"
 _STALE_TMP_AGE_S = 3600.0
 try:
@@ -185,7 +185,28 @@ def _compile_into(out_dir: Path, targets: Sequence[Path], lookups: Sequence[Path
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             pycyphal.dsdl.compile(None, output_directory=out_dir)
+    _fix_nunavut_support(out_dir / "nunavut_support.py")
     return done
+
+
+# nunavut 2.3's serializer does integer arithmetic on the numpy element of an array of signed integers of at most
+# 8 bits (int2..int8 arrays are numpy.int8 arrays): `value & 0xFF`, `2**8 + value`. NumPy 2 refuses a Python int
+# beyond int8's range there (OverflowError), so every such array failed to serialize. Python ints instead.
+_NUNAVUT_FIXES = (
+    ("        value &= 2**bit_length - 1\n", "        value = int(value) & (2**bit_length - 1)\n"),
+    ("        self.add_unaligned_unsigned((2**bit_length + value) if value < 0 else value, bit_length)\n",
+     "        value = int(value)\n"
+     "        self.add_unaligned_unsigned((2**bit_length + value) if value < 0 else value, bit_length)\n"),
+)
+
+
+def _fix_nunavut_support(path: Path) -> None:
+    text = path.read_text(encoding="utf-8")
+    for old, new in _NUNAVUT_FIXES:
+        if text.count(old) != 1:
+            raise DsdlCompileError(f"{path}: unexpected nunavut_support (looked for {old.strip()!r} once)")
+        text = text.replace(old, new)
+    path.write_text(text, encoding="utf-8")
 
 
 @contextlib.contextmanager
