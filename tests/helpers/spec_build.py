@@ -51,15 +51,10 @@ def _tree_hash(folder: Path) -> str:
     return h.hexdigest()[:20]
 
 
-def built_spec(name: str) -> BuiltSpec:
-    """``tests/specs/<name>.yaml`` generated and its ROS package installed (skips without cmake/ROS tools)."""
-    if shutil.which("cmake") is None:
-        pytest.skip("cmake is not installed")
-    if not (Path(sys.prefix) / "share" / "rosidl_default_generators" / "package.xml").is_file():
-        pytest.skip("rosidl_default_generators is not installed (pip extra 'rosbuild')")
+def generated_spec(name: str) -> Path:
+    """The generated/ folder of ``tests/specs/<name>.yaml`` (what needs only the DSDL and Python needs no ROS
+    build)."""
     from sam_codegen.build import build
-    from sam_codegen.ros_build import build_ros_package
-    from sam_runtime.genpkg import GeneratedPackage
 
     spec = SPECS / f"{name}.yaml"
     digest = hashlib.sha256(spec.read_bytes()).hexdigest()[:16]
@@ -67,12 +62,25 @@ def built_spec(name: str) -> BuiltSpec:
     gen_dir = cache / f"{name}-{digest}" / "generated"
     with _locked(cache / f".lock-{name}"):
         build(spec, gen_dir)  # rewrites only when the generator's output changed
+    return gen_dir
+
+
+def built_spec(name: str) -> BuiltSpec:
+    """``tests/specs/<name>.yaml`` generated and its ROS package installed (skips without cmake/ROS tools)."""
+    if shutil.which("cmake") is None:
+        pytest.skip("cmake is not installed")
+    if not (Path(sys.prefix) / "share" / "rosidl_default_generators" / "package.xml").is_file():
+        pytest.skip("rosidl_default_generators is not installed (pip extra 'rosbuild')")
+    from sam_codegen.ros_build import build_ros_package
+    from sam_runtime.genpkg import GeneratedPackage
+
+    gen_dir = generated_spec(name)
     pkg_dir = GeneratedPackage(gen_dir).ros_package_dir()
     prefixes = REPO / ".cache" / "ros-prefix"
     prefix = prefixes / f"{pkg_dir.name}-{_tree_hash(pkg_dir)}"
     with _locked(prefixes / f".lock-{prefix.name}"):
         if not (prefix / ".complete").is_file():
             shutil.rmtree(prefix, ignore_errors=True)
-            build_ros_package(pkg_dir, cache / f"{name}-{digest}" / "ros-build", prefix)
+            build_ros_package(pkg_dir, gen_dir.parent / "ros-build", prefix)
             (prefix / ".complete").write_text("built by tests/helpers/spec_build.py\n")
-    return BuiltSpec(spec, gen_dir, prefix)
+    return BuiltSpec(SPECS / f"{name}.yaml", gen_dir, prefix)
