@@ -258,14 +258,14 @@ class TopicMonitor:
             lines.append(f"{d.name:22} {d.node_id:4d} {age_txt:>10} {v.get('health', '-'):9} "
                          f"{v.get('mode', '-'):12} {status}")
         total = self.diagnostics.get(bridge)
-        drops = []
+        warnings = []  # mappings not OK: recent drops, or silent while their device is alive
         for n, d in sorted(self.diagnostics.items()):
             if n.startswith(f"{bridge}/mapping/") and d["level"] != 0:
                 why = ", ".join(f"{k}={x}" for k, x in d["values"].items() if k.startswith("dropped."))
-                drops.append(f"{n.split('/')[-1]}: {d['message']} ({why})")
+                warnings.append(f"{n.split('/')[-1]}: {d['message']}" + (f" ({why})" if why else ""))
         lines.append("")
         lines.append(f"bridge: {total['message'] if total else 'no /diagnostics yet'}")
-        lines.extend("  drop " + x for x in drops)
+        lines.extend("  warn " + x for x in warnings)
         return lines
 
 

@@ -68,6 +68,17 @@ def udp_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         return _scenario(tmp_path_factory.mktemp("glider_udp"), "udp", offset=52)
 
 
+def test_every_glider_mapping_with_a_publishing_device_reaches_ros(can_run: dict[str, Any]) -> None:
+    """The messages the bridge builds for this spec (float32[2] from float16[2], bools, one subject to two
+    topics) are accepted by rclpy and arrive: a wrongly shaped field would have crashed the scenario."""
+    counts = can_run["probe_counts"]
+    for topic in ("/fins/state", "/pump/status", "/pump/volume", "/ctd/altitude"):
+        assert counts.get(topic, 0) > 0, counts
+    assert "/altitude" not in counts  # the altimeter never publishes
+    maps = can_run["bridge"]["mappings"]
+    assert maps["pump_status"]["published"] == maps["pump_volume"]["published"] > 0
+
+
 # ============================================================================================ defect 12
 def test_registers_name_the_ports_after_the_mappings(can_run: dict[str, Any]) -> None:
     regs = can_run["phases"]["registers"]

@@ -313,6 +313,7 @@ async def main_can(args: argparse.Namespace, log: LogRecords) -> dict[str, Any]:
         await wait_for(lambda: probe.diag_messages >= n0 + 2, 10, "two more /diagnostics")
         result["warn_events"] = {m.name: warn_events(probe, m.name) for m in tables.MAPPINGS}
         result["diag_events"] = probe.diag_events
+        result["probe_counts"] = dict(probe.counts)
         result["diagnostics"] = probe.diag_latest
         result["bridge"] = bridge.stats()
     finally:
