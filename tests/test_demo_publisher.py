@@ -83,7 +83,7 @@ def test_run_on_the_glider_spec_bridges_the_demo_commands(tmp_path: Path) -> Non
     b = built_spec("glider")
     env = child_env(b.prefix, domain_id(43))
     cmd = [sys.executable, "-m", "sam_runtime.cli", "run", "--spec", str(b.spec), "--generated", str(b.generated),
-           "--no-build", "--ros-prefix", str(b.prefix), "--duration", "8", "--plain", "--log-dir", str(tmp_path)]
+           "--no-build", "--ros-prefix", str(b.prefix), "--duration", "12", "--plain", "--log-dir", str(tmp_path)]
     with cyphal_udp_lock():
         proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=180)
     logs = {p.name: p.read_text(errors="replace") for p in tmp_path.glob("*.log")}
