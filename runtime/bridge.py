@@ -68,6 +68,8 @@ message is still published), rejected ones under ``rejected.<...>``.
   device timestamp (``header.stamp``) older than the previous message of the same source on the same mapping
   is published anyway, in arrival order, and counted under ``out_of_order``: the bridge never reorders or
   holds data back, and the stamp tells ROS consumers (tf2, message_filters, estimators) what to do with it.
+  A device that restarted (its heartbeat's uptime went down; on Cyphal/UDP also its transfer ids starting over)
+  may have restarted its clock: its next stamp is compared with nothing.
 - Unknown timestamps (0): the ROS receive time. float16 NaN/+-inf from a device are passed to ROS unchanged
   (float32/float64 hold them); the devices' ranges are the consumers' business.
 - Logging is bounded: the first occurrence of a (mapping, reason) is a WARNING at once, later ones are
@@ -76,7 +78,15 @@ message is still published), rejected ones under ``rejected.<...>``.
 - Heartbeats: a device is alive while its last uavcan.node.Heartbeat is younger than the Cyphal offline
   timeout (3 s). The moment it is not, /diagnostics shows it at ERROR (published at once, not at the next
   period), and it is logged; when heartbeats come back it is OK again (a restart - uptime going backwards - is
-  counted). A device never heard of is STALE.
+  counted and logged). A device never heard of is STALE. Nodes that are no device of the spec (tools such as
+  yakut) are tracked in the stats; their first appearance is logged at INFO, their comings and goings at DEBUG.
+- Silence: a UAVCAN -> ROS mapping that gets nothing from its device while the device's heartbeat is alive -
+  never, or no more - for longer than max(3 s, 5 nominal periods) is WARN in /diagnostics ("no message for N s
+  while device X is alive; nominal R Hz"), logged once when it starts and when it ends (sam_runtime.liveness).
+- Cyphal ports and registers: the bridge's ports are named after its mappings, with the standard registers
+  ``uavcan.sub.<mapping>.id``/``.type`` and ``uavcan.pub.<mapping>.id``/``.type`` (a subject of several mappings:
+  the first one's name) whose defaults are the spec's subject ids, overridable as usual (e.g.
+  ``UAVCAN__SUB__IMU__ID``), and ``uavcan.node.id`` (sam_runtime.cyphal_ports).
 - A Cyphal transport that dies (pycyphal's CAN media close themselves for good on unrecoverable OS errors,
   e.g. ENETDOWN when a SocketCAN interface goes down) is detected within 0.2 s and reopened with back-off
   (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
@@ -109,7 +119,15 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from sam_runtime.cyphal_ports import (
+    PortConfigError,
+    register_environment,
+    register_node_id,
+    resolve_subject,
+    subscription_names,
+)
 from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.liveness import LivenessMonitor
 
 __all__ = [
     "Bridge",
@@ -324,6 +342,7 @@ class _HeartbeatRecord:
     alive: bool = True  # as last reported (transitions are logged and published at once)
     lost_events: int = 0  # times the heartbeat timed out
     restarts: int = 0  # times the uptime went backwards
+    alive_since: float = 0.0  # time.monotonic() when the heartbeat (re)appeared
 
 
 @dataclass
@@ -334,6 +353,7 @@ class _OutMapping:
     to_uavcan: Callable[..., Any]
     stats: MappingStats
     publisher: Any = None  # pycyphal Publisher
+    port_id: int | None = None  # the subject it publishes on (register uavcan.pub.<mapping>.id)
     queue: asyncio.Queue[Any] | None = None
     worker: asyncio.Task[None] | None = None
 
@@ -352,10 +372,12 @@ class _InMapping:
 
 @dataclass
 class _SubjectGroup:
-    subject_id: int
+    subject_id: int  # the spec's
     dtype: type
     mappings: list[_InMapping] = field(default_factory=list)
     subscriber: Any = None
+    port_name: str = ""  # register uavcan.sub.<port_name>.id
+    port_id: int | None = None  # the subject it listens on (the register's value, default the spec's)
     accepted_sources: frozenset[int] = frozenset()
     last_tid: dict[int, tuple[int, float]] = field(default_factory=dict)  # source -> (transfer id, monotonic s)
     rate: dict[int, tuple[float, int, float]] = field(default_factory=dict)  # source -> (since, count, rate)
@@ -517,6 +539,13 @@ class Bridge:
         self._outage_windows: collections.deque[tuple[float, float]] = collections.deque(maxlen=16)
         self._nominal_rates = {(d.node_id, p.subject_id): float(p.rate_hz) for d in self.tables.DEVICES
                                for p in d.publishes if getattr(p, "rate_hz", None)}
+        self._link_up_since = 0.0  # time.monotonic() of the last (re)open of the Cyphal node
+        # UAVCAN -> ROS mappings silent while their device is alive (sam_runtime.liveness)
+        self._liveness = LivenessMonitor(
+            [(m.name, m.rate_hz, m.source_node_ids) for m in self.tables.MAPPINGS if m.direction == "uavcan_to_ros"],
+            {d.node_id: d.name for d in self.tables.DEVICES})
+        self._subject_of = {m.name: m.port.subject_id for m in self.tables.MAPPINGS}
+        self._sub_names = subscription_names(self.tables.MAPPINGS)  # subject -> port name (cyphal_ports)
 
     # ------------------------------------------------------------------------------------------ set-up
     def _resolve_node_id(self, node_id: int | None) -> int:
@@ -623,7 +652,8 @@ class Bridge:
                     self._ros_pubs[m.topic.name] = pub
                 group = self._in_groups.get(m.port.subject_id)
                 if group is None:
-                    group = _SubjectGroup(m.port.subject_id, self.gen.dsdl_class(m.port))
+                    group = _SubjectGroup(m.port.subject_id, self.gen.dsdl_class(m.port),
+                                          port_name=self._sub_names[m.port.subject_id])
                     self._in_groups[m.port.subject_id] = group
                 elif group.dtype is not self.gen.dsdl_class(m.port):
                     raise BridgeConfigError(
@@ -748,7 +778,10 @@ class Bridge:
             om.queue = asyncio.Queue(maxsize=self._queue_size)
         for group in self._in_groups.values():
             group.accepted_sources = frozenset(n for im in group.mappings for n in im.info.source_node_ids)
-        self._open_cyphal()
+        try:
+            self._open_cyphal()
+        except PortConfigError as ex:
+            raise BridgeConfigError(str(ex)) from None
         for om in self._out.values():
             om.worker = asyncio.create_task(self._out_worker(om), name=f"bridge-out-{om.info.name}")
 
@@ -773,8 +806,12 @@ class Bridge:
         from sam_runtime.transport import make_node
 
         name = f"org.{self.tables.VEHICLE}.{self.name}"[:50]
-        node = make_node(name, self.node_id, transport=self._make_transport())
+        tc = self.transport_config
+        env = tc.environ if tc.kind == "env" and tc.environ is not None else os.environ
+        # The registers (uavcan.node.id, uavcan.pub/sub.<port>.id/.type) and their UAVCAN__* overrides.
+        node = make_node(name, self.node_id, transport=self._make_transport(), environ=register_environment(env))
         try:
+            register_node_id(node.registry, self.node_id)
             node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
             transport = node.presentation.transport
             self._tid_modulo = int(transport.protocol_parameters.transfer_id_modulo)
@@ -782,11 +819,14 @@ class Bridge:
                 transport.add_error_hook(self._on_transport_error)
             rxq = self._rx_queue_size if self._rx_queue_size > 0 else None
             for om in self._out.values():
-                pub = node.make_publisher(self.gen.dsdl_class(om.info.port), om.info.port.subject_id)
+                dtype = self.gen.dsdl_class(om.info.port)
+                om.port_id = resolve_subject(node.registry, "pub", om.info.name, dtype, om.info.port.subject_id)
+                pub = node.presentation.make_publisher(dtype, om.port_id)
                 pub.send_timeout = 1.0
                 om.publisher = pub
             for group in self._in_groups.values():
-                group.subscriber = node.presentation.make_subscriber(group.dtype, group.subject_id, rxq)
+                group.port_id = resolve_subject(node.registry, "sub", group.port_name, group.dtype, group.subject_id)
+                group.subscriber = node.presentation.make_subscriber(group.dtype, group.port_id, rxq)
                 group.seen = {}
                 group.subscriber.receive_in_background(
                     lambda msg, transfer, group=group: self._on_uavcan(group, msg, transfer))
@@ -797,6 +837,7 @@ class Bridge:
             raise
         self._cy_node = node
         self._link_up, self._link_state, self._link_suspect = True, "up", None
+        self._link_up_since = time.monotonic()
 
     async def _close_cyphal(self) -> None:
         """Close every Cyphal port and the node (the workers and their queues stay)."""
@@ -892,6 +933,7 @@ class Bridge:
             try:
                 self._poll_cyphal_stats()
                 self._check_heartbeats()
+                self._check_liveness()
                 self.log.flush()
                 if self._reopen_task is None or self._reopen_task.done():
                     why = self._check_link()
@@ -986,6 +1028,8 @@ class Bridge:
         elif d != 0:
             group.rate.pop(src, None)
         if d <= 1 or d >= modulo // 2:  # next in sequence, duplicate, or backwards (the source restarted)
+            if d >= modulo // 2 and modulo >= 2**32:  # UDP: ids start over only when the node restarts
+                self._forget_stamps(src)  # (whether its heartbeat said so before this message or not)
             return 0, 0
         return d - 1, 0
 
@@ -1079,22 +1123,44 @@ class Bridge:
         if rec is None:
             self._heartbeats[nid] = _HeartbeatRecord(
                 nid, now, int(msg.health.value), int(msg.mode.value), int(msg.uptime),
-                int(msg.vendor_specific_status_code))
+                int(msg.vendor_specific_status_code), alive_since=now)
+            if nid not in self._devices_by_id and nid != self.node_id:  # a tool (yakut, ...): noted once
+                _log.info("node %d (no device of the spec) appeared on the bus", nid)
             return
         uptime = int(msg.uptime)
+        if not rec.alive or now - rec.last_seen >= HEARTBEAT_STALE_S:
+            rec.alive_since = now  # back (possibly before housekeeping noticed it was gone)
         if uptime < rec.uptime:
             rec.restarts += 1
+            rec.alive_since = now  # a device that just booted gets its grace before it must publish
+            self._device_restarted(nid, rec.uptime, uptime)
         rec.last_seen, rec.health, rec.mode = now, int(msg.health.value), int(msg.mode.value)
         rec.uptime, rec.vssc, rec.count = uptime, int(msg.vendor_specific_status_code), rec.count + 1
         if not rec.alive:
             self._check_heartbeats()  # back: report at once
 
+    def _device_restarted(self, nid: int, old_uptime: int, uptime: int) -> None:
+        """A node restarted (its uptime went down): its device clock may have restarted too, so the next stamp of
+        each of its mappings is compared with nothing (it is no ``out_of_order``)."""
+        self._forget_stamps(nid)
+        if nid in self._devices_by_id:
+            _log.warning("%s restarted (uptime %d s, before %d s)", self._device_name(nid), uptime, old_uptime)
+        else:
+            _log.debug("node %d restarted (uptime %d s, before %d s)", nid, uptime, old_uptime)
+
     def _device_name(self, nid: int) -> str:
         dev = self._devices_by_id.get(nid)
         return f"device {dev.name} (node {nid})" if dev is not None else f"node {nid}"
 
+    def _forget_stamps(self, nid: int) -> None:
+        for group in self._in_groups.values():
+            for im in group.mappings:
+                im.last_stamp_ns.pop(nid, None)
+
     def _check_heartbeats(self) -> None:
-        """Log and publish (at once) every change between alive and lost of a node's heartbeat."""
+        """Log and publish (at once) every change between alive and lost of a device's heartbeat. Other nodes
+        (tools such as yakut come and go) are tracked and shown in stats, their comings and goings logged at
+        DEBUG only."""
         now = time.monotonic()
         changed = False
         for nid, rec in list(self._heartbeats.items()):
@@ -1102,14 +1168,44 @@ class Bridge:
             if alive == rec.alive:
                 continue
             rec.alive = alive
+            if not alive:
+                rec.lost_events += 1
+            if nid not in self._devices_by_id:
+                _log.debug("node %d: heartbeat %s", nid, "back" if alive else "gone")
+                continue
             changed = True
             if alive:
-                _log.warning("%s: heartbeat back (uptime %d s, %d restarts seen)", self._device_name(nid),
-                             rec.uptime, rec.restarts)
+                _log.info("%s: heartbeat back (uptime %d s, %d restarts seen)", self._device_name(nid),
+                          rec.uptime, rec.restarts)
             else:
-                rec.lost_events += 1
                 _log.warning("%s: heartbeat lost (none for %.1f s)", self._device_name(nid), now - rec.last_seen)
         if changed:
+            self._publish_diagnostics()
+
+    def _alive_since(self, nid: int) -> float | None:
+        rec = self._heartbeats.get(nid)
+        if rec is None or time.monotonic() - rec.last_seen >= HEARTBEAT_STALE_S:
+            return None
+        return rec.alive_since
+
+    def _last_message(self, mapping: str, nid: int) -> float | None:
+        group = self._in_groups.get(self._subject_of[mapping])
+        last = group.last_tid.get(nid) if group is not None else None
+        return None if last is None else last[1]
+
+    def _check_liveness(self) -> None:
+        """Log and publish (at once) a UAVCAN -> ROS mapping going silent while its device is alive, and the end
+        of it (sam_runtime.liveness)."""
+        changes = self._liveness.update(time.monotonic(), alive_since=self._alive_since,
+                                        last_message=self._last_message, listening_since=self._link_up_since)
+        for name, before, found in changes:
+            if found is not None:
+                _log.warning("%s: %s", name, found.message())
+            elif before is not None:
+                why = ("messages again from" if self._alive_since(before.node_id) is not None
+                       else "no longer watched: no heartbeat from")
+                _log.info("%s: %s device %s (node %d)", name, why, before.device, before.node_id)
+        if changes:
             self._publish_diagnostics()
 
     # ------------------------------------------------------------------------------------------ ROS -> UAVCAN
@@ -1251,6 +1347,14 @@ class Bridge:
             if m.direction == "uavcan_to_ros":
                 entry["source_node_ids"] = sorted(m.source_node_ids)
                 group = self._in_groups.get(m.port.subject_id)
+                entry["port"] = f"uavcan.sub.{self._sub_names[m.port.subject_id]}"
+                if group is not None and group.port_id is not None:
+                    entry["subject_id"] = group.port_id  # the register's value (the spec's by default)
+                silence = self._liveness.findings.get(m.name)
+                entry["liveness"] = {"state": "ok"} if silence is None else {
+                    "state": silence.state, "message": silence.message(), "node_id": silence.node_id,
+                    "silent_s": round(silence.silent_s, 3), "grace_s": silence.grace_s,
+                    "nominal_rate_hz": silence.rate_hz}
                 if group is not None:
                     with self._poll_lock:
                         tot = dict(group.cyphal_total)
@@ -1270,6 +1374,9 @@ class Bridge:
             else:
                 entry["destination_node_id"] = m.destination_node_id
                 om = self._out.get(m.name)
+                entry["port"] = f"uavcan.pub.{m.name}"
+                if om is not None and om.port_id is not None:
+                    entry["subject_id"] = om.port_id
                 entry["queued"] = om.queue.qsize() if om is not None and om.queue is not None else 0
                 entry["ros_publishers"] = self._safe_count(self._ros_subs.get(m.topic.name), "get_publisher_count")
             mappings[m.name] = entry
@@ -1335,7 +1442,8 @@ class Bridge:
     def diagnostics_message(self) -> Any:
         """diagnostic_msgs/DiagnosticArray: one status for the bridge (ERROR while its Cyphal link is down), one
         per mapping (received, published, dropped and dropped.<reason>, saturated and saturated.<field>,
-        rejected.<field>, out_of_order, pycyphal's counters; WARN while it dropped within the last 10 s), one per
+        rejected.<field>, out_of_order, pycyphal's counters; WARN while it dropped within the last 10 s, or while it
+        gets nothing from a device whose heartbeat is alive for longer than its grace: sam_runtime.liveness), one per
         device (OK while its heartbeat is alive and its health NOMINAL/ADVISORY, WARN on CAUTION, ERROR on
         WARNING health or when the heartbeat is lost, STALE when never seen)."""
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -1364,7 +1472,7 @@ class Bridge:
         ))
         for name, m in snap["mappings"].items():
             values: dict[str, Any] = {
-                "direction": m["direction"], "topic": m["topic"], "subject_id": m["subject_id"],
+                "direction": m["direction"], "topic": m["topic"], "subject_id": m["subject_id"], "port": m["port"],
                 "received": m["received"], "published": m["published"], "dropped": m["dropped_total"],
             }
             values.update({f"dropped.{k}": v for k, v in sorted(m["dropped"].items())})
@@ -1391,6 +1499,14 @@ class Bridge:
             bad = sum(int(cy.get(k, 0)) for k in self._CYPHAL_PROBLEMS)
             if bad:
                 msg += f", {bad} frames/transfers discarded by pycyphal"
+            live = m.get("liveness")
+            if live is not None:
+                values["liveness"] = live["state"]
+                if live["state"] != "ok":  # silent while its device is alive (sam_runtime.liveness)
+                    level = warn
+                    msg = live["message"] + ("" if msg == "ok" else f"; {msg}")
+                    values.update(silent_s=live["silent_s"], grace_s=live["grace_s"],
+                                  nominal_rate_hz=live["nominal_rate_hz"])
             arr.status.append(DiagnosticStatus(
                 level=level, name=f"{self.name}/mapping/{name}", hardware_id=f"subject {m['subject_id']}",
                 message=msg, values=kv(values)))

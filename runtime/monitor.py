@@ -174,6 +174,8 @@ class TopicMonitor:
         self.diagnostics: dict[str, Any] = {}
         self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 10)
         self._demo: list[tuple[Any, type, float, str]] = []
+        self.demo_published: collections.Counter[str] = collections.Counter()
+        self.demo_errors: collections.Counter[str] = collections.Counter()
         self._demo_t0 = time.monotonic()
         if demo_commands:
             seen = set()
@@ -200,31 +202,22 @@ class TopicMonitor:
             }
 
     def _publish_demo(self, i: int) -> None:
-        pub, cls, _rate, _name = self._demo[i]
-        t = time.monotonic() - self._demo_t0
-        msg = cls()
-        fields = msg.get_fields_and_field_types()
-        for k, (name, typ) in enumerate(fields.items()):
-            if name == "header":
-                msg.header.stamp = self.node.get_clock().now().to_msg()
-                continue
-            s = math.sin(2 * math.pi * t / 30.0 + k)
-            if "percent" in name:
-                val: Any = 50.0 + 40.0 * s
-            elif "rpm" in name:
-                val = 1000.0 * s
-            elif "radian" in name:
-                val = 0.3 * s
-            else:
-                val = s
-            try:
-                if typ.startswith(("int", "uint")):
-                    setattr(msg, name, round(val))
-                elif typ.startswith(("float", "double")):
-                    setattr(msg, name, float(val))
-            except (AssertionError, TypeError, ValueError):
-                pass
-        pub.publish(msg)
+        """One demo command on topic i: every field from its own rosidl type (sam_runtime.ros_demo), checked by
+        rclpy as it is set. A message that cannot be built is counted and logged once, never published."""
+        import logging
+
+        from sam_runtime.ros_demo import demo_message
+
+        pub, cls, _rate, name = self._demo[i]
+        try:
+            pub.publish(demo_message(cls, time.monotonic() - self._demo_t0, self.node.get_clock().now().to_msg()))
+        except Exception as ex:  # a value rclpy refuses (a bug of ros_demo) or a closing context: never a crash
+            self.demo_errors[name] += 1
+            if self.demo_errors[name] == 1:
+                logging.getLogger("sam_runtime.monitor").error("demo command on %s not published: %s: %s", name,
+                                                               type(ex).__name__, ex)
+            return
+        self.demo_published[name] += 1
 
     def spin_for(self, seconds: float) -> None:
         deadline = time.monotonic() + seconds
@@ -271,14 +264,14 @@ class TopicMonitor:
             lines.append(f"{d.name:22} {d.node_id:4d} {age_txt:>10} {v.get('health', '-'):9} "
                          f"{v.get('mode', '-'):12} {status}")
         total = self.diagnostics.get(bridge)
-        drops = []
+        warnings = []  # mappings not OK: recent drops, or silent while their device is alive
         for n, d in sorted(self.diagnostics.items()):
             if n.startswith(f"{bridge}/mapping/") and d["level"] != 0:
                 why = ", ".join(f"{k}={x}" for k, x in d["values"].items() if k.startswith("dropped."))
-                drops.append(f"{n.split('/')[-1]}: {d['message']} ({why})")
+                warnings.append(f"{n.split('/')[-1]}: {d['message']}" + (f" ({why})" if why else ""))
         lines.append("")
         lines.append(f"bridge: {total['message'] if total else 'no /diagnostics yet'}")
-        lines.extend("  drop " + x for x in drops)
+        lines.extend("  warn " + x for x in warnings)
         return lines
 
 

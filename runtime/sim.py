@@ -91,6 +91,7 @@ class SimConfig:
                                 battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
                                 battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
                                 params=self.vehicle_params, noise=self.noise)
+    log_interval: float = 10.0  # failed publications: the first logged at once, then a count per interval
 
 
 @dataclass
@@ -159,6 +160,9 @@ class Simulator:
         self._publishing_since: float | None = None
         self._publishing_until: float | None = None
         self._closed = False
+        from sam_runtime.bridge import RateLimitedLog
+
+        self.log = RateLimitedLog(_log, self.config.log_interval)  # bounded, like the bridge's
 
     # ---------------------------------------------------------------------------------- lifecycle
     async def start(self, *, publish_now: bool = False) -> None:
@@ -314,6 +318,7 @@ class Simulator:
         if self._record is not None:
             self._record.close()
             self._record = None
+        self.log.flush(force=True)  # no count stays unlogged
 
     # ---------------------------------------------------------------------------------- publishing
     def make_sample(self, dev: _SimDevice, pp: _PubPort, dt: float) -> Any:
@@ -363,15 +368,16 @@ class Simulator:
             if pp.publisher is None:  # powered off meanwhile
                 return
             pp.busy = True
+            pub = pp.publisher
             try:
-                ok = await pp.publisher.publish(obj)
+                ok = await pub.publish(obj)
             except asyncio.CancelledError:
                 raise
             except Exception as ex:
                 pp.failed += 1
-                _log.warning("%s: publish on %d failed: %s: %s", dev.info.name, pp.port.subject_id,
-                             type(ex).__name__, ex)
-                ok = False
+                self.log.note((dev.info.name, f"publish on {pp.port.subject_id}"), logging.WARNING, "failed: %s: %s",
+                              type(ex).__name__, ex)
+                ok = None
             finally:
                 pp.busy = False
             if ok:
@@ -380,6 +386,10 @@ class Simulator:
                     self._write_record("tx", dev, pp.port.subject_id, obj, seq=pp.sent)
             elif ok is False:
                 pp.failed += 1
+                self.log.note((dev.info.name, f"publish on {pp.port.subject_id}"), logging.WARNING,
+                              "not every frame sent within %.1f s", pub.send_timeout)
+            if pp.failed:
+                self.log.flush()  # a count whose interval has passed, also when the failures have stopped
             k += 1
 
     # ---------------------------------------------------------------------------------- commands

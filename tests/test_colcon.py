@@ -1,5 +1,5 @@
 """The generated ament packages build with colcon, the way a ROS user builds a workspace, not only with our own CMake
-call (issue 11): this repository's generated/ros/* and a user's (the glider spec) in one temporary workspace, against
+call (issue 11): this repository's generated/ros/* and a user's (the skiff spec) in one temporary workspace, against
 the ROS 2 wheels of this environment; then every message of every package imports and goes through serialization
 with the workspace's install on the paths."""
 
@@ -45,12 +45,12 @@ _CHECK = textwrap.dedent("""\
 
 @pytest.mark.skipif(not COLCON.exists(), reason="colcon is not installed: pip install -e '.[test]'")
 def test_generated_packages_build_with_colcon(tmp_path: Path) -> None:
-    glider = make_project(tmp_path / "glider")
-    build(glider / "spec" / "interfaces.yaml", glider / "generated")
+    skiff = make_project(tmp_path / "skiff")
+    build(skiff / "spec" / "interfaces.yaml", skiff / "generated")
     src = tmp_path / "ws" / "src"
     packages = [*ros_packages_in_order(REPO / "generated" / "ros"),
-                *ros_packages_in_order(glider / "generated" / "ros")]
-    assert {"sam_msgs", "glider_msgs"} <= {p.name for p in packages}
+                *ros_packages_in_order(skiff / "generated" / "ros")]
+    assert {"sam_msgs", "skiff_msgs"} <= {p.name for p in packages}
     for package in packages:
         shutil.copytree(package, src / package.name)
 

@@ -1,6 +1,6 @@
 """The main job's children (the simulated devices and the bridge) never outlive it, whatever ends it (issue 11,
 defect 4's orphans): a crash, SIGKILL, or the terminal closing (SIGHUP). Left running, they doubled every rate of the
-next run. On a user's project (the glider spec), with its logs in the project's .sam-codegen-cache."""
+next run. On a user's project (the skiff spec), with its logs in the project's .sam-codegen-cache."""
 
 from __future__ import annotations
 
@@ -36,8 +36,8 @@ HEADER = re.compile(r"sim pid (\d+)\s+bridge pid (\d+)")
 
 
 @pytest.fixture(scope="module")
-def glider(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    return built_project(tmp_path_factory.mktemp("user") / "glider")
+def skiff(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    return built_project(tmp_path_factory.mktemp("user") / "skiff")
 
 
 def _no_core_dump() -> None:
@@ -46,8 +46,8 @@ def _no_core_dump() -> None:
 
 @pytest.mark.parametrize(("sig", "offset"), [(signal.SIGKILL, 41), (signal.SIGSEGV, 42), (signal.SIGHUP, 43)],
                          ids=["SIGKILL", "SIGSEGV-a-crash", "SIGHUP-terminal-closed"])
-def test_children_end_with_the_main_job(glider: tuple[Path, Path], tmp_path: Path, sig: int, offset: int) -> None:
-    project, prefix = glider
+def test_children_end_with_the_main_job(skiff: tuple[Path, Path], tmp_path: Path, sig: int, offset: int) -> None:
+    project, prefix = skiff
     env = child_env(prefix, domain_id(offset))
     env.pop("SAM_GENERATED_DIR", None)  # found from the working directory, like a user's run
     logs = project / STATE_DIR_NAME / "run-logs"

@@ -386,3 +386,50 @@ def test_a_non_sam_spec_gets_generic_values_and_its_own_actuator_model(tmp_path:
     assert report["vehicle"]["depth"] == 0.0 and report["vehicle"]["speed"] == 0.0  # nothing drives it
     assert set(res["samples"]) == {500, 510, 511, 520}
     assert json.loads((tmp_path / "t.json").read_text())["t"] >= 0.9  # the atomic truth file, rewritten
+
+
+def test_failed_publications_are_logged_at_a_bounded_rate(caplog: pytest.LogCaptureFixture) -> None:
+    """Issue 11, defect 14: a device whose every publication fails (here the glider spec's altimeter at 10x its
+    rate, its publish raising) logs the first failure at once, then one line per log interval with the count,
+    and the lines add up to every failure; it used to log one line per failure."""
+    import logging
+    import re
+
+    from helpers.spec_build import generated_spec
+
+    from sam_runtime.genpkg import GeneratedPackage
+
+    glider = GeneratedPackage(generated_spec("glider"))
+    glider.compile_dsdl()
+    interval = 1.0
+
+    async def scenario() -> tuple[int, float]:
+        sim = Simulator(glider, SimConfig("can", f"virtual:simlog{os.getpid()}", 64, devices=["altimeter"],
+                                          rate_scale=10.0, log_interval=interval))
+        await sim.start()
+        pp = sim.device("altimeter").pubs[0]
+
+        async def failing(obj: Any) -> bool:
+            raise OSError("injected send failure")
+
+        pp.publisher.publish = failing  # type: ignore[method-assign]
+        t0 = time.monotonic()
+        sim.start_publishing()
+        while pp.failed < 100 or time.monotonic() - t0 < 2.5 * interval:
+            await asyncio.sleep(0.05)
+        await sim.close()
+        return pp.failed, time.monotonic() - t0
+
+    with caplog.at_level(logging.WARNING, logger="sam_runtime.sim"):
+        failed, elapsed = _run(scenario())
+    lines = [r.getMessage() for r in caplog.records if r.name == "sam_runtime.sim"]
+    assert lines and lines[0] == ("altimeter: publish on 620: failed: OSError: injected send failure (1; more are "
+                                  "summed at most every 1 s)")
+    # At most one line per interval (+ the first, + the one flushed at close); together they count every failure.
+    assert len(lines) <= 2 + math.ceil(elapsed / interval) and len(lines) < failed / 10, (len(lines), failed)
+    counted = 0
+    for line in lines:
+        m = re.search(r"\((\d+); more are summed", line) or re.search(r": (\d+) in the last ", line)
+        assert m, line
+        counted += int(m.group(1))
+    assert counted == failed

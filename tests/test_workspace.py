@@ -1,6 +1,6 @@
 """sam-codegen acts on the project where it runs, never on its install (issue 11, defects 1, 2, 3 and 11).
 
-A new user's project is a copy of tests/specs/glider.yaml at <tmp>/glider/spec/interfaces.yaml: not SAM's spec, and
+A new user's project is a copy of tests/specs/skiff.yaml at <tmp>/skiff/spec/interfaces.yaml: not SAM's spec, and
 not inside this repository.
 """
 
@@ -31,7 +31,7 @@ from sam_codegen.workspace import (
 )
 
 REPO = Path(__file__).resolve().parents[1]
-GLIDER = Path(__file__).parent / "specs" / "glider.yaml"
+SKIFF = Path(__file__).parent / "specs" / "skiff.yaml"
 SHARED_DSDL = REPO.parent / "shared" / "dsdl" / "public_regulated_data_types"
 
 
@@ -44,9 +44,9 @@ def _tree(folder: Path) -> dict[str, str]:
 @pytest.fixture
 def project(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """A user's project outside this repository; the runtime's override of generated/ is not set."""
-    root = tmp_path / "glider"
+    root = tmp_path / "skiff"
     (root / "spec").mkdir(parents=True)
-    shutil.copy(GLIDER, root / "spec" / "interfaces.yaml")
+    shutil.copy(SKIFF, root / "spec" / "interfaces.yaml")
     (root / "src" / "pilot").mkdir(parents=True)
     monkeypatch.delenv("SAM_GENERATED_DIR", raising=False)
     return root
@@ -124,8 +124,8 @@ def test_cli_acts_on_the_project_where_it_runs(project: Path, monkeypatch: pytes
     assert main(["build"]) == 0
     assert "updated" in capsys.readouterr().out
     generated = project / "generated"
-    assert (generated / "ros" / "glider_msgs" / "package.xml").is_file()
-    assert (generated / "python" / "glider_bridge" / "tables.py").is_file()
+    assert (generated / "ros" / "skiff_msgs" / "package.xml").is_file()
+    assert (generated / "python" / "skiff_bridge" / "tables.py").is_file()
     assert main(["build", "--check"]) == 0
 
     # The user edits their spec: the check sees it, a build takes it.
@@ -133,7 +133,7 @@ def test_cli_acts_on_the_project_where_it_runs(project: Path, monkeypatch: pytes
     spec.write_text(spec.read_text().replace("rate_hz: 10}", "rate_hz: 20}"))
     capsys.readouterr()
     assert main(["build", "--check"]) == 1
-    assert "python/glider_bridge/tables.py" in capsys.readouterr().err
+    assert "python/skiff_bridge/tables.py" in capsys.readouterr().err
     assert main(["build"]) == 0
     assert main(["build", "--check"]) == 0
     assert _tree(REPO / "generated") == mine
@@ -225,16 +225,16 @@ def test_ros_install_builds_every_generated_package(project: Path, tmp_path: Pat
 
     monkeypatch.chdir(project)
     assert main(["build"]) == 0
-    _package(project / "generated" / "ros" / "aa_extra_msgs", "aa_extra_msgs", "glider_msgs")
+    _package(project / "generated" / "ros" / "aa_extra_msgs", "aa_extra_msgs", "skiff_msgs")
     built: list[tuple[str, Path, Path]] = []
     monkeypatch.setattr(ros_build, "build_ros_package",
                         lambda pkg, build, prefix, **_: built.append((Path(pkg).name, Path(build), Path(prefix))))
     assert main(["ros-install", "--prefix", str(tmp_path / "prefix")]) == 0
     state = project / ".sam-codegen-cache"
-    assert built == [("glider_msgs", state / "ros-build" / "glider_msgs", tmp_path / "prefix"),
+    assert built == [("skiff_msgs", state / "ros-build" / "skiff_msgs", tmp_path / "prefix"),
                      ("aa_extra_msgs", state / "ros-build" / "aa_extra_msgs", tmp_path / "prefix")]
     assert (state / ".gitignore").read_text().splitlines()[-1] == "*"
-    assert "glider_msgs, aa_extra_msgs installed into" in capsys.readouterr().out
+    assert "skiff_msgs, aa_extra_msgs installed into" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------------------- CYPHAL_PATH

@@ -1,4 +1,4 @@
-"""A new user's project for the workspace tests: tests/specs/glider.yaml as <root>/spec/interfaces.yaml, outside this
+"""A new user's project for the workspace tests: tests/specs/skiff.yaml as <root>/spec/interfaces.yaml, outside this
 repository; and processes judged alive or gone by /proc (they may be grandchildren, reaped by someone else)."""
 
 from __future__ import annotations
@@ -9,20 +9,20 @@ from pathlib import Path
 
 from helpers.runtime_support import REPO, TEST_ROS_PREFIX
 
-GLIDER_SPEC = REPO / "tests" / "specs" / "glider.yaml"
-# glider_msgs goes into the runtime tests' prefix too, stamped with its sources' hash, so a later session reuses it.
+SKIFF_SPEC = REPO / "tests" / "specs" / "skiff.yaml"
+# skiff_msgs goes into the runtime tests' prefix too, stamped with its sources' hash, so a later session reuses it.
 TEST_ROS_BUILD = REPO / ".cache" / "ros-test-build"
 
 
 def make_project(root: Path) -> Path:
-    """``root``/spec/interfaces.yaml = the glider spec; returns root."""
+    """``root``/spec/interfaces.yaml = the skiff spec; returns root."""
     (root / "spec").mkdir(parents=True)
-    shutil.copy(GLIDER_SPEC, root / "spec" / "interfaces.yaml")
+    shutil.copy(SKIFF_SPEC, root / "spec" / "interfaces.yaml")
     return root
 
 
 def built_project(root: Path) -> tuple[Path, Path]:
-    """A glider project with generated/ built and glider_msgs installed: (project, ROS prefix)."""
+    """A skiff project with generated/ built and skiff_msgs installed: (project, ROS prefix)."""
     from sam_codegen.build import build
     from sam_runtime.genpkg import GeneratedPackage, ensure_ros_package
 
