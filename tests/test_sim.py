@@ -348,15 +348,12 @@ def test_a_non_sam_spec_gets_generic_values_and_its_own_actuator_model(tmp_path:
     """tests/specs/rover.yaml has none of SAM's devices: every port publishes generic in-range values, the vehicle
     model is there but drives nothing, commands are accepted from the bridge only."""
     import pycyphal.dsdl
+    from helpers.spec_build import generated_spec
 
     from sam_runtime.genpkg import GeneratedPackage
 
-    out = tmp_path / "generated"
-    spec = Path(__file__).resolve().parent / "specs" / "rover.yaml"
-    proc = subprocess.run([sys.executable, "-m", "sam_codegen.cli", "build", "--spec", str(spec), "--out", str(out)],
-                          capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    rover = GeneratedPackage(out)
+    # The shared build of the rover spec: one process imports one rover_bridge (genpkg refuses a second copy).
+    rover = GeneratedPackage(generated_spec("rover"))
 
     async def scenario() -> dict[str, Any]:
         sim = Simulator(rover, SimConfig("can", f"virtual:rover{os.getpid()}", 64, truth_file=tmp_path / "t.json"))
