@@ -16,11 +16,43 @@ from .emit_docs import (
     fmt_rate,
     mermaid_context,
 )
+from .emit_nodes import nodes_package, params_file
 from .mapping_rules import ResolvedMapping, Step, format_path
-from .model import Port
+from .model import QOS_PROFILES, Node, Port, Qos, Spec
 from .validate import Resolved
+from .validate_nodes import (
+    TF_STATIC_TOPIC,
+    class_name,
+    node_published_topics,
+    node_subscribed_topics,
+    parameter_identifier,
+    ros_parameter_name,
+    topic_identifier,
+    transform_identifier,
+)
 
 # ---- Markdown context -------------------------------------------------------------------------------------
+
+def _vector(values: tuple[float, float, float]) -> str:
+    """
+    >>> _vector((0.35, 0.0, -0.08))
+    '[0.35, 0.0, -0.08]'
+    """
+    return "[" + ", ".join(fmt_number(float(v) + 0.0) for v in values) + "]"
+
+
+def node_interface(spec: Spec, node: Node) -> list[str]:
+    """The members of a node's generated base class, as the reference lists them."""
+    items = []
+    for item in node.subscribe_items:
+        own = f", own QoS {item.qos.describe()}" if item.qos is not None else ""
+        items.append(f"on_{topic_identifier(item.topic)}({spec.topics[item.topic].type.split('/')[1]}){own}")
+    items += [f"publish_{topic_identifier(t)}({spec.topics[t].type.split('/')[1]})" for t in node.publishes]
+    items += [f"{parameter_identifier(p)} (parameter {ros_parameter_name(p)})" for p in node.parameters]
+    items += [f"lookup_{transform_identifier(p, c)}()" for p, c in node.reads_transforms]
+    items += [f"publish_{transform_identifier(p, c)}(stamp, translation, rotation)" for p, c in node.transforms]
+    return [*items, "report_status(level, message, **values)"]
+
 
 def _range(minimum: float | None, maximum: float | None) -> str:
     if minimum is not None and maximum is not None:
@@ -85,8 +117,9 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     # Indexes built once (spec order kept): asking every node, mapping or port per topic, message and subject
     # made the reference quadratic in the size of the spec.
     ports = PortIndex(spec)
-    node_publishers = _users((n.name, n.publishes) for n in spec.nodes.values())  # topic -> nodes
-    node_subscribers = _users((n.name, n.subscribes) for n in spec.nodes.values())
+    node_publishers = _users((n.name, node_published_topics(spec, n)) for n in spec.nodes.values())  # topic -> nodes
+    node_subscribers = _users((n.name, node_subscribed_topics(spec, n)) for n in spec.nodes.values())
+    static_frames = [f for f in spec.frames.values() if f.parent is not None]
     node_readers = _users((n.name, n.parameters) for n in spec.nodes.values())  # parameter -> nodes
     topics_of_type = _users((t.name, [t.type]) for t in spec.topics.values())  # ROS type -> topics
     mappings_of_subject = _users((m.name, [m.subject_id]) for m in mappings)
@@ -102,7 +135,11 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
                 publishers.append(bridge.name)
             if (name, ROS_TO_UAVCAN) in bridged_topics:
                 subscribers.append(bridge.name)
-        topics.append({"name": name, "type": t.type, "section": t.section, "description": t.description,
+        if name == TF_STATIC_TOPIC and static_frames:
+            publishers.append("node host (static frames)")
+        qos = t.qos.describe() + (f"; default: {t.qos_origin}" if t.qos_origin != "declared" else "") \
+            if t.qos is not None else ""
+        topics.append({"name": name, "type": t.type, "section": t.section, "description": t.description, "qos": qos,
                        "publishers": publishers, "subscribers": subscribers})
 
     def used_by(full_name: str) -> list[str]:
@@ -137,7 +174,9 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
               if r.left in spec.parameters and r.right in spec.parameters else ""}
              for r in spec.parameter_rules]
 
-    frames = [{"name": f.name, "parent": f.parent, "description": f.description} for f in spec.frames.values()]
+    frames = [{"name": f.name, "parent": f.parent, "description": f.description,
+               "mounting": f"xyz {_vector(f.xyz)}, rpy {_vector(f.rpy)}" if f.parent is not None else ""}
+              for f in spec.frames.values()]
     transforms = [{"parent": t.parent, "child": t.child, "publisher": t.publisher, "description": t.description}
                   for t in spec.transforms]
 
@@ -216,6 +255,11 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
             "topic": m.topic,
             "ros_type": topic.type if topic is not None else "",
             "nodes": nodes,
+        "nodes_package": nodes_package(spec),
+        "params_file": params_file(spec),
+        "qos_profiles": [{"name": name, "text": Qos(q.reliability, q.durability, q.depth).describe()}
+                         for name, q in QOS_PROFILES.items()],
+        "external_packages": sorted({m.package for m in spec.external_messages.values()}),
             "nodes_note": nodes_note,
             "frame_id": m.frame_id,
             "rate": fmt_rate(rm.rate_hz) if rm is not None else "",
@@ -225,7 +269,9 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         })
 
     nodes = [{"name": n.name, "description": n.description, "publishes": n.publishes, "subscribes": n.subscribes,
-              "parameters": n.parameters, "transforms": [f"{p}->{c}" for p, c in n.transforms]}
+              "parameters": n.parameters, "transforms": [f"{p}->{c}" for p, c in n.transforms],
+              "reads_transforms": [f"{p}->{c}" for p, c in n.reads_transforms],
+              "interface": node_interface(spec, n), "base": f"{nodes_package(spec)}.{n.name}.{class_name(n.name)}"}
              for n in spec.nodes.values()]
 
     return {
@@ -239,6 +285,11 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         "mermaid": mermaid_context(resolved, graph),
         "topics": topics,
         "nodes": nodes,
+        "nodes_package": nodes_package(spec),
+        "params_file": params_file(spec),
+        "qos_profiles": [{"name": name, "text": Qos(q.reliability, q.durability, q.depth).describe()}
+                         for name, q in QOS_PROFILES.items()],
+        "external_packages": sorted({m.package for m in spec.external_messages.values()}),
         "messages": messages,
         "externals": externals,
         "parameters": parameters,

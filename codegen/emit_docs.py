@@ -23,6 +23,7 @@ from .mapping_rules import Step
 from .model import Device, Mapping, Scalar, Spec
 from .templating import render
 from .validate import Resolved
+from .validate_nodes import node_published_topics, node_subscribed_topics
 
 MD_PATH = "docs/interfaces.md"
 SVG_PATH = "docs/dataflow.svg"
@@ -273,10 +274,10 @@ def build_graph(resolved: Resolved) -> Graph:
                 dev_edges = [add(Edge(ROS_TO_UAVCAN, b, ("device", d.name), label)) for d in devices]
             graph.links.append((m.direction, dev_edges, topic_edge))
     for node in spec.nodes.values():
-        for topic in node.subscribes:
+        for topic in node_subscribed_topics(spec, node):
             if topic in spec.topics:
                 add(Edge(SUBSCRIBE, ("topic", topic), ("node", node.name)))
-        for topic in node.publishes:
+        for topic in node_published_topics(spec, node):
             if topic in spec.topics:
                 add(Edge(PUBLISH, ("node", node.name), ("topic", topic)))
     return graph
