@@ -4,6 +4,7 @@ Layout (written by ``sam-codegen build``)::
 
     <generated>/dsdl/<root namespace>/...       Cyphal DSDL of the vehicle's own types
     <generated>/ros/<ros package>/              the ament package of the custom ROS messages
+    <generated>/ros/<external package>/         one per package of the spec's external_messages (tf2_msgs)
     <generated>/python/<vehicle>_bridge/        tables.py (stdlib only) and convert.py (converters)
 
 Nothing here is SAM-specific: the Python package is found by scanning ``<generated>/python`` for a
@@ -180,29 +181,34 @@ def _same_interfaces(src: Path, installed: Path) -> bool:
 
 
 def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log: Any = None) -> Path:
-    """Build and install the generated ROS package into ``prefix`` (default: ``sys.prefix``, the venv) unless
-    an install of the same sources is already there. Returns the prefix.
+    """Build and install the generated ROS packages (the tables' ROS_PACKAGES in dependency order: the spec's own
+    and one per package of its external_messages, e.g. tf2_msgs) into ``prefix`` (default: ``sys.prefix``, the
+    venv), each unless an install of the same sources is already there. Returns the prefix.
 
     The build directory is ``<repo>/.cache/ros-build/<package>-<hash>``; the install is stamped with the
     sources' hash, so a changed spec triggers a rebuild and an unchanged one costs a few ms.
     """
+    prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
+    tables = gen.tables()
+    for name in getattr(tables, "ROS_PACKAGES", (tables.ROS_PACKAGE,)):
+        _ensure_one(gen.root / "ros" / name, name, prefix, log)
+    return prefix
+
+
+def _ensure_one(pkg_dir: Path, name: str, prefix: Path, log: Any) -> None:
     from sam_codegen.ros_build import build_ros_package, is_installed
 
-    prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
-    pkg_dir = gen.ros_package_dir()
     if not (pkg_dir / "package.xml").is_file():
         raise GeneratedPackageError(f"{pkg_dir} has no package.xml; run `sam-codegen build` first")
-    name = gen.tables().ROS_PACKAGE
     digest = ros_package_hash(pkg_dir)
     stamp = prefix / "share" / name / _HASH_STAMP
     if is_installed(name, prefix) and (
         (stamp.is_file() and stamp.read_text().strip() == digest) or _same_interfaces(pkg_dir, prefix / "share" / name)
     ):
-        return prefix
+        return
     if log is not None:
         log(f"building ROS package {name} into {prefix} (about 30 s)...")
     build_dir = repo_root() / ".cache" / "ros-build" / f"{name}-{digest}"
     build_ros_package(pkg_dir, build_dir, prefix)
     stamp.parent.mkdir(parents=True, exist_ok=True)
     stamp.write_text(digest + "\n")
-    return prefix

@@ -80,64 +80,64 @@ class ControllerBase(Node):
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
                  parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
-        self._support = node_support.NodeSupport(self)
-        self._parameters = node_support.declare_parameters(
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
         self.tf: tf_buffer.TfBuffer | None = tf_buffer.TfBuffer()
-        self._tf_feed = node_support.feed_tf(
-            self, self.tf, self._support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
+        self._gen_tf_feed = node_support.feed_tf(
+            self, self.tf, self._gen_support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
             "/tf_static", node_support.qos_profile("reliable", "transient_local", 1))
-        self._pub_thruster_rpms = self.create_publisher(
+        self._gen_pub_thruster_rpms = self.create_publisher(
             ThrusterRPMs, "/thruster_rpms",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._pub_thruster_angles = self.create_publisher(
+        self._gen_pub_thruster_angles = self.create_publisher(
             ThrusterAngles, "/thruster_angles",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._pub_ballast_angles = self.create_publisher(
+        self._gen_pub_ballast_angles = self.create_publisher(
             BallastAngles, "/ballast_angles",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._pub_longitudinal_weight_position = self.create_publisher(
+        self._gen_pub_longitudinal_weight_position = self.create_publisher(
             PercentStamped, "/longitudinal_weight_position",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._pub_buoyancy_piston_position = self.create_publisher(
+        self._gen_pub_buoyancy_piston_position = self.create_publisher(
             PercentStamped, "/buoyancy_piston_position",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._sub_global_plan = self.create_subscription(
+        self._gen_sub_global_plan = self.create_subscription(
             Path, "/global_plan",
-            self._support.callback("on_global_plan", self.on_global_plan),
+            self._gen_support.callback("on_global_plan", self.on_global_plan),
             node_support.qos_profile("reliable", "volatile", 10))
-        self._sub_abort = self.create_subscription(
+        self._gen_sub_abort = self.create_subscription(
             Abort, "/abort",
-            self._support.callback("on_abort", self.on_abort),
+            self._gen_support.callback("on_abort", self.on_abort),
             node_support.qos_profile("reliable", "transient_local", 1))
 
     def on_global_plan(self, msg: Path) -> None:
         """A message on /global_plan: override; this default counts and drops it."""
-        self._support.unhandled("/global_plan", "on_global_plan")
+        self._gen_support.unhandled("/global_plan", "on_global_plan")
 
     def on_abort(self, msg: Abort) -> None:
         """A message on /abort: override; this default counts and drops it."""
-        self._support.unhandled("/abort", "on_abort")
+        self._gen_support.unhandled("/abort", "on_abort")
 
     def publish_thruster_rpms(self, msg: ThrusterRPMs) -> None:
         """Publish on /thruster_rpms (sam_msgs/ThrusterRPMs)."""
-        self._pub_thruster_rpms.publish(msg)
+        self._gen_pub_thruster_rpms.publish(msg)
 
     def publish_thruster_angles(self, msg: ThrusterAngles) -> None:
         """Publish on /thruster_angles (sam_msgs/ThrusterAngles)."""
-        self._pub_thruster_angles.publish(msg)
+        self._gen_pub_thruster_angles.publish(msg)
 
     def publish_ballast_angles(self, msg: BallastAngles) -> None:
         """Publish on /ballast_angles (sam_msgs/BallastAngles)."""
-        self._pub_ballast_angles.publish(msg)
+        self._gen_pub_ballast_angles.publish(msg)
 
     def publish_longitudinal_weight_position(self, msg: PercentStamped) -> None:
         """Publish on /longitudinal_weight_position (sam_msgs/PercentStamped)."""
-        self._pub_longitudinal_weight_position.publish(msg)
+        self._gen_pub_longitudinal_weight_position.publish(msg)
 
     def publish_buoyancy_piston_position(self, msg: PercentStamped) -> None:
         """Publish on /buoyancy_piston_position (sam_msgs/PercentStamped)."""
-        self._pub_buoyancy_piston_position.publish(msg)
+        self._gen_pub_buoyancy_piston_position.publish(msg)
 
     def lookup_world_to_base_link(
         self, max_age_s: float | None = None, *, time_ns: int | None = None
@@ -149,4 +149,4 @@ class ControllerBase(Node):
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
-        self._support.report(level, message, values)
+        self._gen_support.report(level, message, values)

@@ -78,68 +78,68 @@ class DeadReckoningBase(Node):
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
                  parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
-        self._support = node_support.NodeSupport(self)
-        self._parameters = node_support.declare_parameters(
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
         self.tf: tf_buffer.TfBuffer | None = None
-        self._pub_tf = self.create_publisher(
+        self._gen_pub_tf = self.create_publisher(
             TFMessage, "/tf", node_support.qos_profile("reliable", "volatile", 100))
-        self._sub_imu = self.create_subscription(
+        self._gen_sub_imu = self.create_subscription(
             Imu, "/imu",
-            self._support.callback("on_imu", self.on_imu),
+            self._gen_support.callback("on_imu", self.on_imu),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_magnetic_field = self.create_subscription(
+        self._gen_sub_magnetic_field = self.create_subscription(
             MagneticField, "/magnetic_field",
-            self._support.callback("on_magnetic_field", self.on_magnetic_field),
+            self._gen_support.callback("on_magnetic_field", self.on_magnetic_field),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_pressure = self.create_subscription(
+        self._gen_sub_pressure = self.create_subscription(
             FluidPressure, "/pressure",
-            self._support.callback("on_pressure", self.on_pressure),
+            self._gen_support.callback("on_pressure", self.on_pressure),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_gps_fix = self.create_subscription(
+        self._gen_sub_gps_fix = self.create_subscription(
             NavSatFix, "/gps_fix",
-            self._support.callback("on_gps_fix", self.on_gps_fix),
+            self._gen_support.callback("on_gps_fix", self.on_gps_fix),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_thruster_1_feedback = self.create_subscription(
+        self._gen_sub_thruster_1_feedback = self.create_subscription(
             ThrusterFeedback, "/thruster_1/feedback",
-            self._support.callback("on_thruster_1_feedback", self.on_thruster_1_feedback),
+            self._gen_support.callback("on_thruster_1_feedback", self.on_thruster_1_feedback),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_thruster_2_feedback = self.create_subscription(
+        self._gen_sub_thruster_2_feedback = self.create_subscription(
             ThrusterFeedback, "/thruster_2/feedback",
-            self._support.callback("on_thruster_2_feedback", self.on_thruster_2_feedback),
+            self._gen_support.callback("on_thruster_2_feedback", self.on_thruster_2_feedback),
             node_support.qos_profile("best_effort", "volatile", 5))
 
     def on_imu(self, msg: Imu) -> None:
         """A message on /imu: override; this default counts and drops it."""
-        self._support.unhandled("/imu", "on_imu")
+        self._gen_support.unhandled("/imu", "on_imu")
 
     def on_magnetic_field(self, msg: MagneticField) -> None:
         """A message on /magnetic_field: override; this default counts and drops it."""
-        self._support.unhandled("/magnetic_field", "on_magnetic_field")
+        self._gen_support.unhandled("/magnetic_field", "on_magnetic_field")
 
     def on_pressure(self, msg: FluidPressure) -> None:
         """A message on /pressure: override; this default counts and drops it."""
-        self._support.unhandled("/pressure", "on_pressure")
+        self._gen_support.unhandled("/pressure", "on_pressure")
 
     def on_gps_fix(self, msg: NavSatFix) -> None:
         """A message on /gps_fix: override; this default counts and drops it."""
-        self._support.unhandled("/gps_fix", "on_gps_fix")
+        self._gen_support.unhandled("/gps_fix", "on_gps_fix")
 
     def on_thruster_1_feedback(self, msg: ThrusterFeedback) -> None:
         """A message on /thruster_1/feedback: override; this default counts and drops it."""
-        self._support.unhandled("/thruster_1/feedback", "on_thruster_1_feedback")
+        self._gen_support.unhandled("/thruster_1/feedback", "on_thruster_1_feedback")
 
     def on_thruster_2_feedback(self, msg: ThrusterFeedback) -> None:
         """A message on /thruster_2/feedback: override; this default counts and drops it."""
-        self._support.unhandled("/thruster_2/feedback", "on_thruster_2_feedback")
+        self._gen_support.unhandled("/thruster_2/feedback", "on_thruster_2_feedback")
 
     def publish_odom_to_base_link(
         self, stamp: Any, translation: tuple[float, float, float], rotation: tuple[float, float, float, float]
     ) -> None:
         """Publish the pose of base_link in odom on /tf (ValueError for a bad value)."""
         node_support.publish_transform(
-            self._pub_tf, "odom", "base_link", stamp, translation, rotation)
+            self._gen_pub_tf, "odom", "base_link", stamp, translation, rotation)
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
-        self._support.report(level, message, values)
+        self._gen_support.report(level, message, values)

@@ -65,25 +65,25 @@ class MissionBase(Node):
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
                  parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
-        self._support = node_support.NodeSupport(self)
-        self._parameters = node_support.declare_parameters(
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
         self.tf: tf_buffer.TfBuffer | None = None
-        self._pub_nav_goal = self.create_publisher(
+        self._gen_pub_nav_goal = self.create_publisher(
             PoseStamped, "/nav_goal",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._pub_nav_heading = self.create_publisher(
+        self._gen_pub_nav_heading = self.create_publisher(
             HeadingStamped, "/nav_heading",
             node_support.qos_profile("reliable", "volatile", 10))
 
     def publish_nav_goal(self, msg: PoseStamped) -> None:
         """Publish on /nav_goal (geometry_msgs/PoseStamped)."""
-        self._pub_nav_goal.publish(msg)
+        self._gen_pub_nav_goal.publish(msg)
 
     def publish_nav_heading(self, msg: HeadingStamped) -> None:
         """Publish on /nav_heading (sam_msgs/HeadingStamped)."""
-        self._pub_nav_heading.publish(msg)
+        self._gen_pub_nav_heading.publish(msg)
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
-        self._support.report(level, message, values)
+        self._gen_support.report(level, message, values)

@@ -139,27 +139,27 @@ class MotionPlannerBase(Node):
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
                  parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
-        self._support = node_support.NodeSupport(self)
-        self._parameters = node_support.declare_parameters(
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
         self.tf: tf_buffer.TfBuffer | None = tf_buffer.TfBuffer()
-        self._tf_feed = node_support.feed_tf(
-            self, self.tf, self._support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
+        self._gen_tf_feed = node_support.feed_tf(
+            self, self.tf, self._gen_support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
             "/tf_static", node_support.qos_profile("reliable", "transient_local", 1))
-        self._pub_global_plan = self.create_publisher(
+        self._gen_pub_global_plan = self.create_publisher(
             Path, "/global_plan",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._sub_nav_goal = self.create_subscription(
+        self._gen_sub_nav_goal = self.create_subscription(
             PoseStamped, "/nav_goal",
-            self._support.callback("on_nav_goal", self.on_nav_goal),
+            self._gen_support.callback("on_nav_goal", self.on_nav_goal),
             node_support.qos_profile("reliable", "volatile", 10))
-        self._sub_nav_heading = self.create_subscription(
+        self._gen_sub_nav_heading = self.create_subscription(
             HeadingStamped, "/nav_heading",
-            self._support.callback("on_nav_heading", self.on_nav_heading),
+            self._gen_support.callback("on_nav_heading", self.on_nav_heading),
             node_support.qos_profile("reliable", "volatile", 10))
-        self._sub_altitude = self.create_subscription(
+        self._gen_sub_altitude = self.create_subscription(
             Range, "/altitude",
-            self._support.callback("on_altitude", self.on_altitude),
+            self._gen_support.callback("on_altitude", self.on_altitude),
             node_support.qos_profile("best_effort", "volatile", 5))
 
     @property
@@ -174,19 +174,19 @@ class MotionPlannerBase(Node):
 
     def on_nav_goal(self, msg: PoseStamped) -> None:
         """A message on /nav_goal: override; this default counts and drops it."""
-        self._support.unhandled("/nav_goal", "on_nav_goal")
+        self._gen_support.unhandled("/nav_goal", "on_nav_goal")
 
     def on_nav_heading(self, msg: HeadingStamped) -> None:
         """A message on /nav_heading: override; this default counts and drops it."""
-        self._support.unhandled("/nav_heading", "on_nav_heading")
+        self._gen_support.unhandled("/nav_heading", "on_nav_heading")
 
     def on_altitude(self, msg: Range) -> None:
         """A message on /altitude: override; this default counts and drops it."""
-        self._support.unhandled("/altitude", "on_altitude")
+        self._gen_support.unhandled("/altitude", "on_altitude")
 
     def publish_global_plan(self, msg: Path) -> None:
         """Publish on /global_plan (nav_msgs/Path)."""
-        self._pub_global_plan.publish(msg)
+        self._gen_pub_global_plan.publish(msg)
 
     def lookup_world_to_base_link(
         self, max_age_s: float | None = None, *, time_ns: int | None = None
@@ -198,4 +198,4 @@ class MotionPlannerBase(Node):
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
-        self._support.report(level, message, values)
+        self._gen_support.report(level, message, values)

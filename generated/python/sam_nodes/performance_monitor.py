@@ -151,30 +151,30 @@ class PerformanceMonitorBase(Node):
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
                  parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
-        self._support = node_support.NodeSupport(self)
-        self._parameters = node_support.declare_parameters(
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
         self.tf: tf_buffer.TfBuffer | None = None
-        self._pub_abort = self.create_publisher(
+        self._gen_pub_abort = self.create_publisher(
             Abort, "/abort",
             node_support.qos_profile("reliable", "transient_local", 1))
-        self._pub_thruster_rpms = self.create_publisher(
+        self._gen_pub_thruster_rpms = self.create_publisher(
             ThrusterRPMs, "/thruster_rpms",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._pub_buoyancy_piston_position = self.create_publisher(
+        self._gen_pub_buoyancy_piston_position = self.create_publisher(
             PercentStamped, "/buoyancy_piston_position",
             node_support.qos_profile("reliable", "volatile", 10))
-        self._sub_pressure = self.create_subscription(
+        self._gen_sub_pressure = self.create_subscription(
             FluidPressure, "/pressure",
-            self._support.callback("on_pressure", self.on_pressure),
+            self._gen_support.callback("on_pressure", self.on_pressure),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_altitude = self.create_subscription(
+        self._gen_sub_altitude = self.create_subscription(
             Range, "/altitude",
-            self._support.callback("on_altitude", self.on_altitude),
+            self._gen_support.callback("on_altitude", self.on_altitude),
             node_support.qos_profile("best_effort", "volatile", 5))
-        self._sub_battery_state = self.create_subscription(
+        self._gen_sub_battery_state = self.create_subscription(
             BatteryState, "/battery_state",
-            self._support.callback("on_battery_state", self.on_battery_state),
+            self._gen_support.callback("on_battery_state", self.on_battery_state),
             node_support.qos_profile("best_effort", "volatile", 5))
 
     @property
@@ -194,28 +194,28 @@ class PerformanceMonitorBase(Node):
 
     def on_pressure(self, msg: FluidPressure) -> None:
         """A message on /pressure: override; this default counts and drops it."""
-        self._support.unhandled("/pressure", "on_pressure")
+        self._gen_support.unhandled("/pressure", "on_pressure")
 
     def on_altitude(self, msg: Range) -> None:
         """A message on /altitude: override; this default counts and drops it."""
-        self._support.unhandled("/altitude", "on_altitude")
+        self._gen_support.unhandled("/altitude", "on_altitude")
 
     def on_battery_state(self, msg: BatteryState) -> None:
         """A message on /battery_state: override; this default counts and drops it."""
-        self._support.unhandled("/battery_state", "on_battery_state")
+        self._gen_support.unhandled("/battery_state", "on_battery_state")
 
     def publish_abort(self, msg: Abort) -> None:
         """Publish on /abort (sam_msgs/Abort)."""
-        self._pub_abort.publish(msg)
+        self._gen_pub_abort.publish(msg)
 
     def publish_thruster_rpms(self, msg: ThrusterRPMs) -> None:
         """Publish on /thruster_rpms (sam_msgs/ThrusterRPMs)."""
-        self._pub_thruster_rpms.publish(msg)
+        self._gen_pub_thruster_rpms.publish(msg)
 
     def publish_buoyancy_piston_position(self, msg: PercentStamped) -> None:
         """Publish on /buoyancy_piston_position (sam_msgs/PercentStamped)."""
-        self._pub_buoyancy_piston_position.publish(msg)
+        self._gen_pub_buoyancy_piston_position.publish(msg)
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
-        self._support.report(level, message, values)
+        self._gen_support.report(level, message, values)

@@ -70,23 +70,23 @@ class SlamBase(Node):
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
                  parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
-        self._support = node_support.NodeSupport(self)
-        self._parameters = node_support.declare_parameters(
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
         self.tf: tf_buffer.TfBuffer | None = tf_buffer.TfBuffer()
-        self._tf_feed = node_support.feed_tf(
-            self, self.tf, self._support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
+        self._gen_tf_feed = node_support.feed_tf(
+            self, self.tf, self._gen_support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
             "/tf_static", node_support.qos_profile("reliable", "transient_local", 1))
-        self._pub_tf = self.create_publisher(
+        self._gen_pub_tf = self.create_publisher(
             TFMessage, "/tf", node_support.qos_profile("reliable", "volatile", 100))
-        self._sub_gps_fix = self.create_subscription(
+        self._gen_sub_gps_fix = self.create_subscription(
             NavSatFix, "/gps_fix",
-            self._support.callback("on_gps_fix", self.on_gps_fix),
+            self._gen_support.callback("on_gps_fix", self.on_gps_fix),
             node_support.qos_profile("best_effort", "volatile", 5))
 
     def on_gps_fix(self, msg: NavSatFix) -> None:
         """A message on /gps_fix: override; this default counts and drops it."""
-        self._support.unhandled("/gps_fix", "on_gps_fix")
+        self._gen_support.unhandled("/gps_fix", "on_gps_fix")
 
     def lookup_odom_to_base_link(
         self, max_age_s: float | None = None, *, time_ns: int | None = None
@@ -101,8 +101,8 @@ class SlamBase(Node):
     ) -> None:
         """Publish the pose of odom in world on /tf (ValueError for a bad value)."""
         node_support.publish_transform(
-            self._pub_tf, "world", "odom", stamp, translation, rotation)
+            self._gen_pub_tf, "world", "odom", stamp, translation, rotation)
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
-        self._support.report(level, message, values)
+        self._gen_support.report(level, message, values)
