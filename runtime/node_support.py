@@ -43,7 +43,6 @@ __all__ = [
     "RuleSpec",
     "declare_parameters",
     "feed_tf",
-    "parameter_overrides",
     "publish_static_transforms",
     "publish_transform",
     "qos_profile",
@@ -220,28 +219,6 @@ def rule_violation(rules: Iterable[RuleInfoLike], values: Mapping[str, Any], cha
     return None
 
 
-def parameter_overrides(values: Mapping[str, Any] | Sequence[Any] | None,
-                        parameters: Sequence[ParameterInfoLike]) -> list[Any]:
-    """rclpy Parameters for Node(parameter_overrides=...) from {spec or ROS name: value} (or Parameters, passed
-    through); a name that is none of `parameters` is a ParameterConfigError."""
-    from rclpy.parameter import Parameter
-
-    if not values:
-        return []
-    if not isinstance(values, Mapping):
-        return list(values)
-    by_name = {ros_parameter_name(p.name): p for p in parameters}
-    result = []
-    for key, value in values.items():
-        name = ros_parameter_name(key)
-        p = by_name.get(name)
-        if p is None:
-            raise ParameterConfigError(f"unknown parameter {key!r}: this node has {', '.join(sorted(by_name))}"
-                                       if by_name else f"unknown parameter {key!r}: this node has no parameters")
-        result.append(Parameter(name, value=_coerce(p, value)))
-    return result
-
-
 class ParameterGuard:
     """The rule check of one node's parameters; made by declare_parameters."""
 
@@ -284,22 +261,24 @@ class ParameterGuard:
                 continue
             try:
                 value = _coerce(self.partners[param.name], parameter_value_to_python(param.value))
-            except (ParameterConfigError, Exception):  # a value of another type: not the spec's parameter
+            except (ParameterConfigError, RuntimeError, ValueError):  # another type: not the spec's parameter
                 continue
             self.partner_values[param.name] = value
             self.partner_sources[param.name] = f"as set on {event.node}"
 
 
 def declare_parameters(node: Any, parameters: Sequence[ParameterInfoLike],
-                       rules: Sequence[RuleInfoLike] = (), *, overrides: Mapping[str, Any] | None = None,
+                       rules: Sequence[RuleInfoLike] = (), *,
+                       overrides: Mapping[str, Any] | Sequence[Any] | None = None,
                        partners: Sequence[ParameterInfoLike] = ()) -> ParameterGuard:
     """Declare `parameters` on an rclpy node (descriptor with type, range, unit, description and its rules) and
-    install the rule check. Values: `overrides` (spec or ROS names, here also for partners), else the node's own
-    overrides (Node(parameter_overrides=...), --params-file), else the spec default. Raises ParameterConfigError
+    install the rule check. Values: `overrides` ({spec or ROS name: value}, or rclpy Parameters; here also for
+    partners), else the node's own overrides (--params-file), else the spec default. Raises ParameterConfigError
     for an unknown override, a value outside the range or of the wrong type, or initial values that break a rule.
     """
     guard = ParameterGuard(node, parameters, rules, partners)
-    given = {ros_parameter_name(k): v for k, v in (overrides or {}).items()}
+    pairs = overrides.items() if isinstance(overrides, Mapping) else ((p.name, p.value) for p in overrides or ())
+    given = {ros_parameter_name(k): v for k, v in pairs}
     unknown = set(given) - set(guard.own) - set(guard.partners)
     if unknown:
         raise ParameterConfigError(f"unknown parameter(s) {sorted(unknown)}; this node has "
