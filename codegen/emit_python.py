@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from . import emit_nodes  # the tables' QoS, transforms and nodes
 from .filters import py_str
 from .mapping_rules import ResolvedMapping, Step, format_path
 from .model import DsdlStruct, Port, RosMessage, Scalar
@@ -1049,7 +1050,8 @@ def emit(resolved: Resolved) -> dict[str, str]:
     root = f"python/{package}"
     return {
         f"{root}/__init__.py": render("python/__init__.py.j2", **common),
-        f"{root}/tables.py": render("python/tables.py.j2", **common, **_tables_context(resolved)),
+        f"{root}/tables.py": render("python/tables.py.j2", **common, **_tables_context(resolved),
+                                    **emit_nodes.tables_context(resolved)),
         f"{root}/convert.py": render("python/convert.py.j2", **common, **_convert_context(resolved)),
     }
 

@@ -12,6 +12,8 @@ from .diagnostics import NOWHERE, Pos
 from .typesys import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
+Reliability = Literal["reliable", "best_effort"]
+Durability = Literal["volatile", "transient_local"]
 OutOfRange = Literal["saturate", "reject"]
 Scalar = bool | int | float | str
 
@@ -95,6 +97,37 @@ class DsdlStruct:
         return next((f for f in self.fields if f.name == name), None)
 
 
+@dataclass(frozen=True)
+class Qos:
+    """The QoS of a topic's endpoints: reliability, durability and keep-last history depth."""
+
+    reliability: Reliability
+    durability: Durability
+    depth: int
+    profile: str = ""  # the named profile it came from; "" for a spelled-out mapping
+
+    def describe(self) -> str:
+        """
+        >>> QOS_PROFILES["latched"].describe()
+        'latched (reliable, transient_local, keep last 1)'
+        >>> Qos("best_effort", "volatile", 3).describe()
+        'best_effort, volatile, keep last 3'
+        """
+        text = f"{self.reliability}, {self.durability}, keep last {self.depth}"
+        return f"{self.profile} ({text})" if self.profile else text
+
+
+# The named profiles a spec may give as `qos: <name>`. sensor_data is rclpy's qos_profile_sensor_data.
+QOS_PROFILES: dict[str, Qos] = {
+    "sensor_data": Qos("best_effort", "volatile", 5, "sensor_data"),
+    "reliable": Qos("reliable", "volatile", 10, "reliable"),
+    "latched": Qos("reliable", "transient_local", 1, "latched"),
+    "tf": Qos("reliable", "volatile", 100, "tf"),
+}
+RELIABILITIES: tuple[Reliability, ...] = ("reliable", "best_effort")
+DURABILITIES: tuple[Durability, ...] = ("volatile", "transient_local")
+
+
 @dataclass
 class Topic:
     name: str
@@ -102,6 +135,11 @@ class Topic:
     description: str = ""
     section: str = ""
     pos: Pos = NOWHERE
+    declared_qos: Qos | None = None  # the spec's `qos:`, if any
+    qos_pos: Pos = NOWHERE
+    # Set by validation: the declared QoS or the default for the topic (validate_nodes.default_qos).
+    qos: Qos | None = None
+    qos_origin: str = ""  # why: "declared", or the default rule that chose it
 
 
 @dataclass
@@ -132,6 +170,10 @@ class Frame:
     parent: str | None = None
     description: str = ""
     pos: Pos = NOWHERE
+    # A static child frame's mounting offset in its parent (URDF's origin): metres, and roll, pitch, yaw in
+    # radians (fixed axes x, y, z).
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass
@@ -201,15 +243,61 @@ class Bridge:
     pos: Pos = NOWHERE
 
 
+@dataclass(frozen=True)
+class NodeTopic:
+    """One entry of a node's `publishes` or `subscribes`."""
+
+    topic: str
+    qos: Qos | None = None  # a subscription's own QoS; None: the topic's
+    pos: Pos = NOWHERE
+    type: str | None = None  # the type the node expects, checked against the topic's
+
+
+@dataclass(frozen=True)
+class NodeTransform:
+    """One `parent->child` entry of a node's `transforms` (it publishes) or `reads_transforms` (it looks up)."""
+
+    parent: str
+    child: str
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
+class NodeParameter:
+    name: str
+    pos: Pos = NOWHERE
+
+
 @dataclass
 class Node:
     name: str
     description: str = ""
-    publishes: list[str] = field(default_factory=list)
-    subscribes: list[str] = field(default_factory=list)
-    parameters: list[str] = field(default_factory=list)
-    transforms: list[tuple[str, str]] = field(default_factory=list)
+    publish_items: list[NodeTopic] = field(default_factory=list)
+    subscribe_items: list[NodeTopic] = field(default_factory=list)
+    parameter_items: list[NodeParameter] = field(default_factory=list)
+    transform_items: list[NodeTransform] = field(default_factory=list)  # published on /tf
+    read_transform_items: list[NodeTransform] = field(default_factory=list)  # looked up from /tf, /tf_static
     pos: Pos = NOWHERE
+
+    @property
+    def publishes(self) -> list[str]:
+        return [item.topic for item in self.publish_items]
+
+    @property
+    def subscribes(self) -> list[str]:
+        return [item.topic for item in self.subscribe_items]
+
+    @property
+    def parameters(self) -> list[str]:
+        return [item.name for item in self.parameter_items]
+
+    @property
+    def transforms(self) -> list[tuple[str, str]]:
+        return [(item.parent, item.child) for item in self.transform_items]
+
+    @property
+    def reads_transforms(self) -> list[tuple[str, str]]:
+        return [(item.parent, item.child) for item in self.read_transform_items]
 
 
 @dataclass

@@ -9,6 +9,9 @@ from typing import Any, TypeVar
 
 from .diagnostics import Diagnostics, Pos, SpecError
 from .model import (
+    DURABILITIES,
+    QOS_PROFILES,
+    RELIABILITIES,
     Bridge,
     Constant,
     Device,
@@ -18,9 +21,13 @@ from .model import (
     Frame,
     Mapping,
     Node,
+    NodeParameter,
+    NodeTopic,
+    NodeTransform,
     Parameter,
     ParameterRule,
     Port,
+    Qos,
     RosMessage,
     RosPackageInfo,
     Scalar,
@@ -388,8 +395,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     for key, pos, node in _items(top.node("dsdl_types"), "dsdl_types", diag):
         spec.dsdl_types[key] = _dsdl_struct(key, pos, node, diag)
     for key, pos, node in _items(top.node("frames"), "frames", diag):
-        r = _Reader(node, f"frame {key!r}", diag, ("parent", "description"))
-        spec.frames[key] = Frame(key, r.get("parent", str, None), _text(r, "description"), pos)
+        spec.frames[key] = _frame(key, pos, node, diag)
     for item in _list(top.node("transforms"), "transforms", diag):
         r = _Reader(item, "a transform", diag, ("parent", "child", "publisher", "description"))
         parent, child, publisher = r.get("parent", str), r.get("child", str), r.get("publisher", str)
@@ -405,11 +411,14 @@ def parse_spec(root: YNode, file: str) -> Spec:
                        + (f", types {' and '.join(map(str, types))}" if types else "")
                        + "): two types on one topic", "one type per topic; give the second its own topic")
     for key, pos, node in _items(topics, "topics", diag, duplicates=False):
-        r = _Reader(node, f"topic {key!r}", diag, ("type", "description", "section"))
+        r = _Reader(node, f"topic {key!r}", diag, ("type", "description", "section", "qos"))
         type_ = r.get("type", str)
+        qos_node = r.node("qos")
+        qos = parse_qos(qos_node, f"the QoS of topic {key!r}", diag) if qos_node is not None else None
         if type_ is not None:
             spec.topics[key] = Topic(key, type_.replace("/msg/", "/"), _text(r, "description"),
-                                     str(r.get("section", (str, float, int), "")), pos)
+                                     str(r.get("section", (str, float, int), "")), pos, qos,
+                                     qos_node.pos if qos_node is not None else pos)
     for key, pos, node in _items(top.node("parameters"), "parameters", diag):
         _parameter(spec, key, pos, node, diag)
     for item in _list(top.node("parameter_rules"), "parameter_rules", diag):
@@ -472,22 +481,113 @@ def _parameter(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -
         )
 
 
-def _node(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -> None:
-    what = f"node {key!r}"
-    r = _Reader(node, what, diag, ("description", "publishes", "subscribes", "parameters", "transforms"))
-    transforms = []
-    for text, item_pos in _str_list(r.node("transforms"), f"transforms of {what}", diag):
+_QOS_KEYS = ("reliability", "durability", "depth")
+QOS_DEPTH_MAX = 10000  # a deeper keep-last history is a mistake rather than a need (and costs memory per endpoint)
+
+
+def parse_qos(node: YNode, what: str, diag: Diagnostics) -> Qos | None:
+    """`qos:` as a profile name (sensor_data, reliable, latched, tf) or a {reliability, durability, depth} mapping."""
+    if isinstance(node, YScalar) and isinstance(node.value, str):
+        profile = QOS_PROFILES.get(node.value)
+        if profile is None:
+            diag.error(node.pos, f"unknown QoS profile {node.value!r} in {what}",
+                       "one of " + ", ".join(QOS_PROFILES) + ", or a mapping {reliability, durability, depth}")
+        return profile
+    if not isinstance(node, YMap):
+        diag.error(node.pos, f"{what} must be a profile name or a mapping, found {_kind(node)}",
+                   "one of " + ", ".join(QOS_PROFILES) + ", or a mapping {reliability, durability, depth}")
+        return None
+    r = _Reader(node, what, diag, _QOS_KEYS)
+    reliability, durability, depth = r.get("reliability", str), r.get("durability", str), r.get("depth", int)
+    ok = r.ok
+    if reliability is not None and reliability not in RELIABILITIES:
+        diag.error(r.key_pos("reliability"), f"reliability {reliability!r} in {what} is unknown",
+                   " or ".join(RELIABILITIES))
+        ok = False
+    if durability is not None and durability not in DURABILITIES:
+        diag.error(r.key_pos("durability"), f"durability {durability!r} in {what} is unknown",
+                   " or ".join(DURABILITIES))
+        ok = False
+    if depth is not None and not 1 <= depth <= QOS_DEPTH_MAX:
+        diag.error(r.key_pos("depth"), f"depth {depth} in {what} is out of range", f"1..{QOS_DEPTH_MAX}")
+        ok = False
+    if not ok or reliability is None or durability is None or depth is None:
+        return None
+    return Qos(reliability, durability, depth)
+
+
+def _vector3(node: YNode | None, what: str, diag: Diagnostics) -> tuple[float, float, float] | None:
+    if node is None:
+        return None
+    items = _list(node, what, diag)
+    values = [_number(item, f"an element of {what}", diag) for item in items]
+    if isinstance(node, YSeq) and len(items) != 3:
+        diag.error(node.pos, f"{what} must have 3 elements, found {len(items)}", "[x, y, z]")
+        return None
+    if len(values) != 3 or any(v is None for v in values):
+        return None
+    return (float(values[0]), float(values[1]), float(values[2]))  # type: ignore[arg-type]
+
+
+def _frame(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Frame:
+    what = f"frame {key!r}"
+    r = _Reader(node, what, diag, ("parent", "description", "xyz", "rpy"))
+    frame = Frame(key, r.get("parent", str, None), _text(r, "description"), pos)
+    for attr in ("xyz", "rpy"):
+        value = _vector3(r.node(attr), f"{attr} of {what}", diag)
+        if value is None:
+            continue
+        if frame.parent is None:
+            diag.error(r.key_pos(attr), f"{what} has no parent: its {attr} would offset it from nothing",
+                       "a `parent` for a static child frame")
+        setattr(frame, attr, value)
+    return frame
+
+
+def _node_topics(node: YNode | None, what: str, diag: Diagnostics, with_qos: bool) -> list[NodeTopic]:
+    """Entries `/topic` or `{topic: /topic, type: pkg/Name}` (subscriptions also `qos: ...`)."""
+    items = []
+    keys = ("topic", "type", "qos") if with_qos else ("topic", "type")
+    for item in _list(node, what, diag):
+        if isinstance(item, YMap):
+            r = _Reader(item, f"an entry of {what}", diag, keys)
+            topic, type_ = r.get("topic", str), r.get("type", str, None)
+            qos_node = r.node("qos")
+            qos = parse_qos(qos_node, f"the QoS of {topic or '?'} in {what}", diag) if qos_node is not None else None
+            if topic is not None:
+                items.append(NodeTopic(topic, qos, item.pos, type_.replace("/msg/", "/") if type_ else None))
+            continue
+        topic = scalar(item, str, f"an entry of {what}", diag)
+        if topic is not None:
+            items.append(NodeTopic(topic, None, item.pos))
+    return items
+
+
+def _node_transforms(node: YNode | None, what: str, diag: Diagnostics) -> list[NodeTransform]:
+    result = []
+    for text, item_pos in _str_list(node, what, diag):
         parent, sep, child = text.partition("->")
         if not sep or not parent.strip() or not child.strip():
-            diag.error(item_pos, f"transform {text!r} of {what} is not parent->child", "parent->child")
+            diag.error(item_pos, f"transform {text!r} in {what} is not parent->child", "parent->child")
             continue
-        transforms.append((parent.strip(), child.strip()))
+        result.append(NodeTransform(parent.strip(), child.strip(), item_pos))
+    return result
+
+
+_NODE_KEYS = ("description", "publishes", "subscribes", "parameters", "transforms", "reads_transforms")
+
+
+def _node(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -> None:
+    what = f"node {key!r}"
+    r = _Reader(node, what, diag, _NODE_KEYS)
     spec.nodes[key] = Node(
         key, _text(r, "description"),
-        [t for t, _ in _str_list(r.node("publishes"), f"publishes of {what}", diag)],
-        [t for t, _ in _str_list(r.node("subscribes"), f"subscribes of {what}", diag)],
-        [t for t, _ in _str_list(r.node("parameters"), f"parameters of {what}", diag)],
-        transforms, pos,
+        _node_topics(r.node("publishes"), f"publishes of {what}", diag, with_qos=False),
+        _node_topics(r.node("subscribes"), f"subscribes of {what}", diag, with_qos=True),
+        [NodeParameter(t, p) for t, p in _str_list(r.node("parameters"), f"parameters of {what}", diag)],
+        _node_transforms(r.node("transforms"), f"transforms of {what}", diag),
+        _node_transforms(r.node("reads_transforms"), f"reads_transforms of {what}", diag),
+        pos,
     )
 
 

@@ -25,6 +25,7 @@ from .typesys import (
     split_composite_name,
 )
 from .validate_mappings import MappingValidator
+from .validate_nodes import check_nodes
 from .validate_values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value
 from .validate_values import python_safe as _python_safe
 
@@ -249,23 +250,6 @@ class _Validator:
             elif self.ros.get(topic.type) is None:
                 self.error(topic.pos, f"unknown ROS type {topic.type!r} of topic {topic.name}",
                            "a message of this spec, an external_messages entry or an installed ROS message")
-        for node in s.nodes.values():
-            if not re.fullmatch(r"[a-z][a-z0-9_]*", node.name):
-                self.error(node.pos, f"node name {node.name!r} is not a valid ROS node name", "lower_case")
-            for topic in [*node.publishes, *node.subscribes]:
-                if topic not in s.topics:
-                    self.error(node.pos, f"node {node.name} uses undeclared topic {topic!r}")
-            for param in node.parameters:
-                if param not in s.parameters:
-                    self.error(node.pos, f"node {node.name} reads undeclared parameter {param!r}")
-            for parent, child in node.transforms:
-                if not any(t.parent == parent and t.child == child and t.publisher == node.name
-                           for t in s.transforms):
-                    self.error(node.pos, f"node {node.name} claims transform {parent}->{child}, which the "
-                               "transforms list does not give to it")
-        if s.bridge is not None and s.bridge.name in s.nodes:
-            self.error(s.nodes[s.bridge.name].pos, f"node {s.bridge.name!r} is the bridge: its topics follow "
-                       "from its mappings, do not declare it under nodes")
 
     def check_devices(self) -> None:
         s = self.spec
@@ -323,6 +307,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     messages = v.resolve_messages()
     v.check_frames_and_parameters()
     v.check_topics_and_nodes()
+    check_nodes(spec, ros, v.diag)  # nodes, QoS, TF topics, external packages (validate_nodes)
     v.check_devices()
     mappings = v.resolve_mappings()
     v.diag.check()

@@ -191,6 +191,7 @@ CASES: tuple[Case, ...] = (
         (
             "minimal.yaml:26:3: error: topic name '/valve/' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
             "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
+            "minimal.yaml:67:17: error: node valve_control publishes undeclared topic '/valve' (expected a topic of `topics`)",
         ),
     ),
     Case(
@@ -256,6 +257,8 @@ CASES: tuple[Case, ...] = (
         '      topic: /levels\n',
         (
             "minimal.yaml:45:5: error: mapping 'level' uses undeclared topic '/levels' (expected a topic of `topics`)",
+            "minimal.yaml:63:18: error: node logger subscribes to /level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
+            "minimal.yaml:66:18: error: node valve_control subscribes to /level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
         ),
     ),
     Case(
@@ -336,7 +339,7 @@ CASES: tuple[Case, ...] = (
         '    subscribes: [/level]',
         '    subscribes: [/levle]',
         (
-            "minimal.yaml:62:3: error: node logger uses undeclared topic '/levle'",
+            "minimal.yaml:63:18: error: node logger subscribes to undeclared topic '/levle' (expected a topic of `topics`)",
         ),
     ),
     Case(

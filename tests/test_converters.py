@@ -248,8 +248,14 @@ if WORKER:
 
     # ---------------------------------------------------------------------------------------- strategies
 
+    # rclpy's float32 setters check |x| <= 3.402823466e+38, a decimal just below FLT_MAX (3.4028234663852886e+38):
+    # with ROS_PYTHON_CHECK_FIELDS=1 a float32 field refuses +-FLT_MAX itself (it still serializes fine, and the
+    # fast constructors, the default, set it). The checked run stays inside rclpy's bound: the float32 below FLT_MAX.
+    RCLPY_FLOAT32_MAX = float(np.nextafter(np.float32(FLOAT32_MAX), np.float32(0))) \
+        if os.environ.get("ROS_PYTHON_CHECK_FIELDS") == "1" else FLOAT32_MAX
+
     def float_range_strategy(width: int, lo: float = -math.inf, hi: float = math.inf) -> st.SearchStrategy[float]:
-        bound = {16: FLOAT16_MAX, 32: FLOAT32_MAX, 64: sys.float_info.max}[width]
+        bound = {16: FLOAT16_MAX, 32: RCLPY_FLOAT32_MAX, 64: sys.float_info.max}[width]
         return st.floats(max(lo, -bound), min(hi, bound), allow_nan=False, allow_infinity=False, width=width)
 
     def utf8_strategy(capacity: int) -> st.SearchStrategy[str]:

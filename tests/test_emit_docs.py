@@ -202,10 +202,11 @@ def test_markdown_covers_the_spec(resolved: Resolved, output: dict[str, str]) ->
 def test_topic_publishers_include_the_bridge(resolved: Resolved, output: dict[str, str]) -> None:
     rows = {row[0]: row for sec, _, rs in tables(output[MD_PATH]) if sec == "ROS topics" for row in rs}
     bridge = md_code("uavcan_ros_bridge")
-    assert bridge in rows["`/imu`"][4] and bridge not in rows["`/imu`"][5]
-    assert bridge in rows["`/thruster_rpms`"][5] and "`controller`" in rows["`/thruster_rpms`"][4]
-    assert rows["`/nav_goal`"][4] == "—" and rows["`/nav_goal`"][5] == "`motion_planner`"
-    assert rows["`/tf`"][4] == "`dead_reckoning`, `slam`"
+    assert bridge in rows["`/imu`"][5] and bridge not in rows["`/imu`"][6]
+    assert bridge in rows["`/thruster_rpms`"][6] and "`controller`" in rows["`/thruster_rpms`"][5]
+    assert rows["`/nav_goal`"][5] == "`mission`" and rows["`/nav_goal`"][6] == "`motion_planner`"
+    assert rows["`/tf`"][5] == "`dead_reckoning`, `slam`"
+    assert rows["`/imu`"][4].startswith("sensor\\_data (best\\_effort, volatile, keep last 5)")
 
 
 def test_mapping_field_tables(resolved: Resolved, output: dict[str, str]) -> None:
@@ -273,7 +274,8 @@ def test_hostile_text_stays_inert(tmp_path: Path) -> None:
         ('comment: "Thruster 1 speed [rpm]; the device takes int18, larger values saturate."', f"comment: {quoted}"),
         ('comment: "Latest angular rate sample [rad/s]."', f"comment: {quoted}"),
         ("description: Inertial measurement unit.", f"description: {quoted}"),
-        ('description: "The global reference frame."', f"description: {quoted}"),
+        ('description: "The global reference frame: a local metric frame (ENU) around the first GPS fix."',
+         f"description: {quoted}"),
         ("section: IV.C.1,", f"section: {quoted},"),
     ]
     for old, new in replacements:
@@ -306,6 +308,8 @@ def test_hostile_text_stays_inert(tmp_path: Path) -> None:
 def test_spec_without_bridge(tmp_path: Path) -> None:
     data = yaml.safe_load(SPEC.read_text(encoding="utf-8"))
     del data["bridge"]
+    for node in data["nodes"].values():  # with no bridge nobody publishes the sensor topics
+        node.pop("subscribes", None)
     resolved = _spec_from_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), tmp_path)
     out = emit(resolved)
     check_well_formed(out[MD_PATH], out[SVG_PATH])

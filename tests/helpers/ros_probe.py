@@ -1,7 +1,7 @@
 """A separate rclpy process for the bridge tests: listens to topics or publishes commands.
 
 listen:  python ros_probe.py listen --generated DIR --topics /imu,/pressure --out OUT.json [--record REC.jsonl]
-    Subscribes (reliable, deep history) to the topics with the generated package's types, prints READY once
+    Subscribes (the spec's QoS, deep history) to the topics with the generated package's types, prints READY once
     every topic has a publisher, records every message as a JSON line (topic, receive wall time, fields) and
     rewrites OUT.json ({"counts": {topic: n}}) every 0.2 s and at exit (SIGTERM/SIGINT).
 publish: python ros_probe.py publish --generated DIR --plan PLAN.json --out OUT.json
@@ -24,6 +24,18 @@ import sys
 import time
 from pathlib import Path
 from typing import Any
+
+PROBE_DEPTH = 1000
+
+
+def topic_qos(topic: Any, depth: int = PROBE_DEPTH) -> Any:
+    """The spec's QoS of a topic (reliability and durability, so that the probe matches the bridge's endpoints:
+    a reliable probe gets nothing from a best-effort publisher) with a deep keep-last history, so that a probe
+    that falls behind for a while loses nothing."""
+    from sam_runtime.node_support import qos_profile
+
+    q = topic.qos
+    return qos_profile(q.reliability, q.durability, max(depth, q.depth))
 
 
 def to_plain(msg: Any) -> Any:
@@ -53,19 +65,18 @@ class ThreadedProbe:
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
-        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
         from rclpy.signals import SignalHandlerOptions
 
         info = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
         self.ctx = rclpy.Context()
         rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
         self.node = Node(self.node_name, context=self.ctx)
-        qos = QoSProfile(depth=depth, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
         self.setup()
         for t in in_topics:
-            self.node.create_subscription(gen.ros_class(info[t]), t, lambda msg, t=t: self.on_message(t, msg), qos)
+            self.node.create_subscription(gen.ros_class(info[t]), t, lambda msg, t=t: self.on_message(t, msg),
+                                          topic_qos(info[t], depth))
         self.classes = {t: gen.ros_class(info[t]) for t in out_topics}
-        self.pubs = {t: self.node.create_publisher(self.classes[t], t, qos) for t in out_topics}
+        self.pubs = {t: self.node.create_publisher(self.classes[t], t, topic_qos(info[t], depth)) for t in out_topics}
         self.ex = SingleThreadedExecutor(context=self.ctx)
         self.ex.add_node(self.node)
         self._stop = threading.Event()
@@ -96,7 +107,8 @@ class ThreadedProbe:
         self.ctx.shutdown()
 
 
-def _tables_and_classes(generated: Path, topics: list[str]) -> dict[str, type]:
+def _tables_and_classes(generated: Path, topics: list[str]) -> tuple[dict[str, type], dict[str, Any]]:
+    """The message class and the spec's QoS (deep history) of each topic."""
     from sam_runtime.genpkg import GeneratedPackage
 
     gen = GeneratedPackage(generated)
@@ -104,7 +116,7 @@ def _tables_and_classes(generated: Path, topics: list[str]) -> dict[str, type]:
     missing = [t for t in topics if t not in by_topic]
     if missing:
         raise SystemExit(f"topics not in the generated tables: {missing}")
-    return {t: gen.ros_class(by_topic[t]) for t in topics}
+    return {t: gen.ros_class(by_topic[t]) for t in topics}, {t: topic_qos(by_topic[t]) for t in topics}
 
 
 def _write(path: Path, data: Any) -> None:
@@ -117,13 +129,11 @@ def listen(args: argparse.Namespace) -> int:
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
-    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     topics = [t for t in args.topics.split(",") if t]
-    classes = _tables_and_classes(args.generated, topics)
+    classes, qos = _tables_and_classes(args.generated, topics)
     rclpy.init(args=[])
     node = Node("test_probe_listener")
-    qos = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
     counts = dict.fromkeys(topics, 0)
     rec = open(args.record, "w", buffering=1 << 16) if args.record else None
 
@@ -134,7 +144,7 @@ def listen(args: argparse.Namespace) -> int:
                 rec.write(json.dumps({"topic": topic, "wall_ns": time.time_ns(), "msg": to_plain(msg)}) + "\n")
         return cb
 
-    subs = {t: node.create_subscription(classes[t], t, make_cb(t), qos) for t in topics}
+    subs = {t: node.create_subscription(classes[t], t, make_cb(t), qos[t]) for t in topics}
     diagnostics: dict[str, Any] = {}
     if args.diagnostics:
         from diagnostic_msgs.msg import DiagnosticArray
@@ -190,15 +200,13 @@ def publish(args: argparse.Namespace) -> int:
     import rclpy
     from rclpy.duration import Duration
     from rclpy.node import Node
-    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     plan = json.loads(args.plan.read_text())
     topics = list(plan["topics"])
-    classes = _tables_and_classes(args.generated, topics)
+    classes, qos = _tables_and_classes(args.generated, topics)
     rclpy.init(args=[])
     node = Node("test_probe_publisher")
-    qos = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
-    pubs = {t: node.create_publisher(classes[t], t, qos) for t in topics}
+    pubs = {t: node.create_publisher(classes[t], t, qos[t]) for t in topics}
     deadline = time.monotonic() + args.discovery_timeout
     while not all(p.get_subscription_count() > 0 for p in pubs.values()):
         if time.monotonic() > deadline:

@@ -39,7 +39,7 @@ from sam_msgs.msg import (
     ThrusterRPMs,
     ThrustVectorFeedback,
 )
-from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix, NavSatStatus
+from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix, NavSatStatus, Range
 from std_msgs.msg import Header
 
 __all__ = ["CONVERTERS", "FAST_CONSTRUCTORS", "ConversionStats"]
@@ -458,6 +458,27 @@ def _new_NavSatStatus(status: int = -2, service: int = 0) -> NavSatStatus:
     return _m
 
 
+def _new_Range(
+    header: Header | None = None,
+    radiation_type: int = 0,
+    field_of_view: float = 0.0,
+    min_range: float = 0.0,
+    max_range: float = 0.0,
+    range: float = 0.0,
+    variance: float = 0.0,
+) -> Range:
+    _m = _NEW(Range)
+    _m._check_fields = False
+    _m._header = _new_Header() if header is None else header
+    _m._radiation_type = radiation_type
+    _m._field_of_view = field_of_view
+    _m._min_range = min_range
+    _m._max_range = max_range
+    _m._range = range
+    _m._variance = variance
+    return _m
+
+
 def _new_Header(stamp: Time | None = None, frame_id: str = '') -> Header:
     _m = _NEW(Header)
     _m._check_fields = False
@@ -581,6 +602,21 @@ def _new_sam_power_BatteryInfo_0_1(
         _m._model_name = _np.frombuffer(model_name, _np.uint8)
     else:
         _m._model_name = _np.array(model_name, _np.uint8)
+    return _m
+
+
+def _new_sam_sensor_Altitude_0_1(
+    timestamp: Any = None,
+    altitude: float = 0.0,
+    altitude_variance: float = 0.0,
+) -> sam.sensor.Altitude_0_1:
+    _m = _NEW(sam.sensor.Altitude_0_1)
+    if timestamp is None:
+        _m._timestamp = _new_uavcan_time_SynchronizedTimestamp_1_0()
+    else:
+        _m._timestamp = timestamp
+    _m._altitude = float(altitude)
+    _m._altitude_variance = float(altitude_variance)
     return _m
 
 
@@ -730,6 +766,7 @@ _FACTORIES: tuple[tuple[Callable[..., Any], type], ...] = (
     (_new_MagneticField, MagneticField),
     (_new_NavSatFix, NavSatFix),
     (_new_NavSatStatus, NavSatStatus),
+    (_new_Range, Range),
     (_new_Header, Header),
     (_new_sam_actuator_BallastAngles_0_1, sam.actuator.BallastAngles_0_1),
     (_new_sam_actuator_PercentCommand_0_1, sam.actuator.PercentCommand_0_1),
@@ -739,6 +776,7 @@ _FACTORIES: tuple[tuple[Callable[..., Any], type], ...] = (
     (_new_sam_actuator_ThrusterFeedback_0_1, sam.actuator.ThrusterFeedback_0_1),
     (_new_sam_actuator_ThrusterRPM_0_1, sam.actuator.ThrusterRPM_0_1),
     (_new_sam_power_BatteryInfo_0_1, sam.power.BatteryInfo_0_1),
+    (_new_sam_sensor_Altitude_0_1, sam.sensor.Altitude_0_1),
     (_new_sam_sensor_GNSSFix_0_1, sam.sensor.GNSSFix_0_1),
     (_new_sam_sensor_MagneticFieldStrength_0_1, sam.sensor.MagneticFieldStrength_0_1),
     (_new_sam_sensor_RawIMU_0_1, sam.sensor.RawIMU_0_1),
@@ -773,6 +811,7 @@ if not FAST_CONSTRUCTORS:
     _new_MagneticField = MagneticField
     _new_NavSatFix = NavSatFix
     _new_NavSatStatus = NavSatStatus
+    _new_Range = Range
     _new_Header = Header
     _new_sam_actuator_BallastAngles_0_1 = sam.actuator.BallastAngles_0_1
     _new_sam_actuator_PercentCommand_0_1 = sam.actuator.PercentCommand_0_1
@@ -782,6 +821,7 @@ if not FAST_CONSTRUCTORS:
     _new_sam_actuator_ThrusterFeedback_0_1 = sam.actuator.ThrusterFeedback_0_1
     _new_sam_actuator_ThrusterRPM_0_1 = sam.actuator.ThrusterRPM_0_1
     _new_sam_power_BatteryInfo_0_1 = sam.power.BatteryInfo_0_1
+    _new_sam_sensor_Altitude_0_1 = sam.sensor.Altitude_0_1
     _new_sam_sensor_GNSSFix_0_1 = sam.sensor.GNSSFix_0_1
     _new_sam_sensor_MagneticFieldStrength_0_1 = sam.sensor.MagneticFieldStrength_0_1
     _new_sam_sensor_RawIMU_0_1 = sam.sensor.RawIMU_0_1
@@ -1152,6 +1192,57 @@ def battery_state_to_uavcan(src: BatteryState, stats: ConversionStats) -> sam.po
         voltage=voltage,
         current=current,
         state_of_charge_pct=state_of_charge_pct,
+    )
+
+
+def altitude_to_ros(src: sam.sensor.Altitude_0_1, receive_ns: int, stats: ConversionStats) -> Range | None:
+    """Mapping 'altitude', UAVCAN -> ROS.
+
+    sam.sensor.Altitude.0.1 -> sensor_msgs/Range
+    """
+    us = src.timestamp.microsecond
+    if us == 0:  # unknown: the receive time
+        sec = receive_ns // 1_000_000_000
+        nanosec = receive_ns % 1_000_000_000
+    elif us > 2147483647999999:  # beyond builtin_interfaces/Time
+        stats.saturate('altitude.header.stamp')
+        sec = 2147483647
+        nanosec = 999_999_999
+    else:
+        sec = us // 1_000_000
+        nanosec = us % 1_000_000 * 1000
+    return _new_Range(
+        header=_new_Header(stamp=_new_Time(sec=sec, nanosec=nanosec), frame_id='altimeter_link'),
+        radiation_type=0,
+        field_of_view=0.1,
+        min_range=0.3,
+        max_range=100.0,
+        range=src.altitude,
+        variance=src.altitude_variance,
+    )
+
+
+def altitude_to_uavcan(src: Range, stats: ConversionStats) -> sam.sensor.Altitude_0_1 | None:
+    """Mapping 'altitude', ROS -> UAVCAN.
+
+    sensor_msgs/Range -> sam.sensor.Altitude.0.1
+    """
+    stamp = src.header.stamp
+    us = stamp.sec * 1_000_000 + stamp.nanosec // 1000
+    if us < 0:
+        stats.saturate('altitude.timestamp.microsecond')
+        us = 0
+    altitude_variance = src.variance
+    if altitude_variance > 65504.0:
+        stats.saturate('altitude.altitude_variance')
+        altitude_variance = 65504.0
+    elif altitude_variance < -65504.0:
+        stats.saturate('altitude.altitude_variance')
+        altitude_variance = -65504.0
+    return _new_sam_sensor_Altitude_0_1(
+        timestamp=_new_uavcan_time_SynchronizedTimestamp_1_0(microsecond=us),
+        altitude=src.range,
+        altitude_variance=altitude_variance,
     )
 
 
@@ -1794,6 +1885,7 @@ CONVERTERS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     'gps_fix': (gps_fix_to_ros, gps_fix_to_uavcan),
     'pressure': (pressure_to_ros, pressure_to_uavcan),
     'battery_state': (battery_state_to_ros, battery_state_to_uavcan),
+    'altitude': (altitude_to_ros, altitude_to_uavcan),
     'battery_info': (battery_info_to_ros, battery_info_to_uavcan),
     'thruster_1_rpm': (thruster_1_rpm_to_ros, thruster_1_rpm_to_uavcan),
     'thruster_2_rpm': (thruster_2_rpm_to_ros, thruster_2_rpm_to_uavcan),

@@ -1,5 +1,5 @@
 # Generated from interfaces.yaml by sam-codegen; do not edit.
-"""The sam interface as data: devices, topics, bridge mappings, parameters and frames.
+"""The sam interface as data: devices, topics and their QoS, bridge mappings, parameters, frames and nodes.
 
 Standard library only: the bridge runtime reads this module without importing ROS or the DSDL packages.
 """
@@ -32,14 +32,27 @@ class DeviceInfo:
 
 
 @dataclass(frozen=True)
+class QosInfo:
+    """The QoS of a topic's endpoints (keep-last history); the rclpy profile:
+    sam_runtime.node_support.qos_profile(q.reliability, q.durability, q.depth)."""
+
+    reliability: str  # "reliable" | "best_effort"
+    durability: str  # "volatile" | "transient_local"
+    depth: int
+    profile: str  # the spec's profile name ("sensor_data", "reliable", "latched", "tf"), "" if spelled out
+
+
+@dataclass(frozen=True)
 class TopicInfo:
-    """A ROS topic."""
+    """A ROS topic; its publishers (the bridge's too) use its QoS, and so do its subscriptions unless a node's
+    own differs (NodeInfo)."""
 
     name: str
     ros_type: str  # e.g. "sensor_msgs/msg/Imu"
     ros_module: str  # e.g. "sensor_msgs.msg"
     ros_class: str  # e.g. "Imu"
     description: str
+    qos: QosInfo
 
 
 @dataclass(frozen=True)
@@ -77,6 +90,48 @@ class ParameterInfo:
 
 
 @dataclass(frozen=True)
+class StaticTransformInfo:
+    """A static child frame: the pose of `child` in `parent` (its mounting), published once on /tf_static."""
+
+    parent: str
+    child: str
+    translation: tuple[float, float, float]  # m
+    rotation: tuple[float, float, float, float]  # unit quaternion x, y, z, w
+
+
+@dataclass(frozen=True)
+class TransformInfo:
+    """A transform a node publishes on /tf."""
+
+    parent: str
+    child: str
+    publisher: str  # the node
+
+
+@dataclass(frozen=True)
+class EndpointInfo:
+    """A node's publication or subscription and the QoS it uses."""
+
+    topic: str
+    qos: QosInfo
+
+
+@dataclass(frozen=True)
+class NodeInfo:
+    """A node of the spec and its generated base class."""
+
+    name: str
+    description: str
+    module: str  # e.g. "sam_nodes.motion_planner"
+    base_class: str  # e.g. "MotionPlannerBase"
+    publishes: tuple[EndpointInfo, ...]
+    subscribes: tuple[EndpointInfo, ...]
+    parameters: tuple[str, ...]  # spec names, e.g. "/safe_depth"
+    transforms: tuple[tuple[str, str], ...]  # (parent, child) it publishes
+    reads_transforms: tuple[tuple[str, str], ...]  # (parent, child) it looks up
+
+
+@dataclass(frozen=True)
 class ParameterRuleInfo:
     """A relation two parameters must keep: `left op right`."""
 
@@ -91,6 +146,11 @@ ROS_PACKAGE = 'sam_msgs'
 DSDL_ROOT_NAMESPACE = 'sam'
 BRIDGE_NAME = 'uavcan_ros_bridge'
 BRIDGE_NODE_ID = 100
+NODES_PACKAGE = 'sam_nodes'
+# Under the generated folder: every parameter's default in ROS 2's --params-file format.
+PARAMS_FILE = 'params/sam.params.yaml'
+# The generated ROS packages (generated/ros/<name>), each after those it depends on.
+ROS_PACKAGES: tuple[str, ...] = ('sam_msgs', 'tf2_msgs')
 
 DEVICES: tuple[DeviceInfo, ...] = (
     DeviceInfo(
@@ -141,6 +201,15 @@ DEVICES: tuple[DeviceInfo, ...] = (
         description='Battery management system.',
         publishes=(
             PortInfo(1104, 'sam.power.BatteryInfo.0.1', 'sam.power', 'BatteryInfo_0_1', 1.0),
+        ),
+        subscribes=(),
+    ),
+    DeviceInfo(
+        name='altimeter',
+        node_id=16,
+        description='Altimeter looking down at the sea floor (an addition to the document).',
+        publishes=(
+            PortInfo(1106, 'sam.sensor.Altitude.0.1', 'sam.sensor', 'Altitude_0_1', 10.0),
         ),
         subscribes=(),
     ),
@@ -223,6 +292,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='Imu',
         description='IMU samples.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/magnetic_field',
@@ -230,6 +300,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='MagneticField',
         description='Magnetometer samples.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/gps_fix',
@@ -237,6 +308,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='NavSatFix',
         description='GPS fixes, at the surface.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/pressure',
@@ -244,6 +316,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='FluidPressure',
         description='Water pressure.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thruster_rpms',
@@ -251,6 +324,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrusterRPMs',
         description='Thruster speed commands.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/thruster_angles',
@@ -258,6 +332,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrusterAngles',
         description='Thrust vector commands.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/ballast_angles',
@@ -265,6 +340,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='BallastAngles',
         description='Ballast weight commands.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/longitudinal_weight_position',
@@ -272,6 +348,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='PercentStamped',
         description='Longitudinal weight position command.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/buoyancy_piston_position',
@@ -279,6 +356,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='PercentStamped',
         description='Buoyancy piston position command.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/tf',
@@ -286,6 +364,15 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='tf2_msgs.msg',
         ros_class='TFMessage',
         description='Transforms odom->base_link (DR) and world->odom (SLAM).',
+        qos=QosInfo('reliable', 'volatile', 100, 'tf'),
+    ),
+    TopicInfo(
+        name='/tf_static',
+        ros_type='tf2_msgs/msg/TFMessage',
+        ros_module='tf2_msgs.msg',
+        ros_class='TFMessage',
+        description='The static child frames (sensor mountings), published once.',
+        qos=QosInfo('reliable', 'transient_local', 1, 'latched'),
     ),
     TopicInfo(
         name='/nav_heading',
@@ -293,6 +380,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='HeadingStamped',
         description='Heading goal; z < 0 depth, z > 0 altitude.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/nav_goal',
@@ -300,6 +388,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='geometry_msgs.msg',
         ros_class='PoseStamped',
         description='Pose goal in /world; position.z < 0 depth, > 0 altitude.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/global_plan',
@@ -307,6 +396,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='nav_msgs.msg',
         ros_class='Path',
         description='The planned path the controller follows.',
+        qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/battery_state',
@@ -314,6 +404,23 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='BatteryState',
         description='Battery health and charge.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+    ),
+    TopicInfo(
+        name='/altitude',
+        ros_type='sensor_msgs/msg/Range',
+        ros_module='sensor_msgs.msg',
+        ros_class='Range',
+        description='Altitude above the sea floor from the altimeter; NaN range = no bottom lock.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+    ),
+    TopicInfo(
+        name='/abort',
+        ros_type='sam_msgs/msg/Abort',
+        ros_module='sam_msgs.msg',
+        ros_class='Abort',
+        description='Emergency ascent ordered (active) or cleared by the performance monitor.',
+        qos=QosInfo('reliable', 'transient_local', 1, 'latched'),
     ),
     TopicInfo(
         name='/battery_info',
@@ -321,6 +428,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='BatteryInfo',
         description="The battery's full UAVCAN report.",
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thruster_1/feedback',
@@ -328,6 +436,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrusterFeedback',
         description='Thruster 1 feedback.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thruster_2/feedback',
@@ -335,6 +444,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrusterFeedback',
         description='Thruster 2 feedback.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thrust_vector/feedback',
@@ -342,6 +452,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrustVectorFeedback',
         description='Thrust vector feedback.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/longitudinal_weight/feedback',
@@ -349,6 +460,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='PositionFeedback',
         description='Longitudinal weight position.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/buoyancy_piston/feedback',
@@ -356,6 +468,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='PositionFeedback',
         description='Buoyancy piston position.',
+        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
 )
 
@@ -475,6 +588,21 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='battery_state_to_uavcan',
         exact_uavcan_fields=('voltage', 'current', 'state_of_charge_pct'),
         linked_uavcan_fields=('voltage', 'current', 'temperature', 'state_of_charge_pct'),
+    ),
+    MappingInfo(
+        name='altitude',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/altitude'],
+        port=PortInfo(1106, 'sam.sensor.Altitude.0.1', 'sam.sensor', 'Altitude_0_1', 10.0),
+        source_node_ids=frozenset({16}),
+        destination_node_id=None,
+        frame_id='altimeter_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='altitude_to_ros',
+        to_uavcan='altitude_to_uavcan',
+        exact_uavcan_fields=('timestamp.microsecond', 'altitude', 'altitude_variance'),
+        linked_uavcan_fields=('timestamp.microsecond', 'altitude', 'altitude_variance'),
     ),
     MappingInfo(
         name='battery_info',
@@ -755,6 +883,15 @@ PARAMETERS: tuple[ParameterInfo, ...] = (
         unit='m',
         description='The monitor triggers an emergency ascent when below this water depth.',
     ),
+    ParameterInfo(
+        name='/min_battery_percent',
+        type='double',
+        default=20.0,
+        minimum=0.0,
+        maximum=100.0,
+        unit='%',
+        description='The monitor triggers an emergency ascent when the charge falls below this.',
+    ),
 )
 
 PARAMETER_RULES: tuple[ParameterRuleInfo, ...] = (
@@ -781,4 +918,165 @@ FRAMES: tuple[tuple[str, str | None], ...] = (
     ('magnetometer_link', 'base_link'),
     ('gps_link', 'base_link'),
     ('pressure_link', 'base_link'),
+    ('altimeter_link', 'base_link'),
+)
+
+# The static child frames (a frame with a parent), published once on /tf_static.
+STATIC_TRANSFORMS: tuple[StaticTransformInfo, ...] = (
+    StaticTransformInfo(
+        'base_link', 'imu_link',
+        translation=(0.1, 0.0, 0.0),
+        rotation=(0.0, 0.0, 0.0, 1.0),
+    ),
+    StaticTransformInfo(
+        'base_link', 'magnetometer_link',
+        translation=(0.3, 0.0, 0.04),
+        rotation=(0.0, 0.0, 0.0, 1.0),
+    ),
+    StaticTransformInfo(
+        'base_link', 'gps_link',
+        translation=(-0.2, 0.0, 0.12),
+        rotation=(0.0, 0.0, 0.0, 1.0),
+    ),
+    StaticTransformInfo(
+        'base_link', 'pressure_link',
+        translation=(-0.55, 0.0, 0.0),
+        rotation=(0.0, 0.0, 0.0, 1.0),
+    ),
+    StaticTransformInfo(
+        'base_link', 'altimeter_link',
+        translation=(0.35, 0.0, -0.08),
+        rotation=(0.0, 0.7071067811865475, 0.0, 0.7071067811865476),
+    ),
+)
+
+TRANSFORMS: tuple[TransformInfo, ...] = (
+    TransformInfo('odom', 'base_link', 'dead_reckoning'),
+    TransformInfo('world', 'odom', 'slam'),
+)
+
+NODES: tuple[NodeInfo, ...] = (
+    NodeInfo(
+        name='dead_reckoning',
+        description=(
+            'Dead reckoning; high-rate pose of base_link in odom from the IMU, compass, depth and '
+            'thrusters (IV.E.1).'
+        ),
+        module='sam_nodes.dead_reckoning',
+        base_class='DeadReckoningBase',
+        publishes=(),
+        subscribes=(
+            EndpointInfo('/imu', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/magnetic_field', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/pressure', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/gps_fix', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/thruster_1/feedback', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/thruster_2/feedback', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+        ),
+        parameters=(),
+        transforms=(
+            ('odom', 'base_link'),
+        ),
+        reads_transforms=(),
+    ),
+    NodeInfo(
+        name='slam',
+        description='SLAM; low-rate correction of odom in world from GPS fixes at the surface (IV.E.2).',
+        module='sam_nodes.slam',
+        base_class='SlamBase',
+        publishes=(),
+        subscribes=(
+            EndpointInfo('/gps_fix', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+        ),
+        parameters=(),
+        transforms=(
+            ('world', 'odom'),
+        ),
+        reads_transforms=(
+            ('odom', 'base_link'),
+        ),
+    ),
+    NodeInfo(
+        name='motion_planner',
+        description='Plans a path to a heading or pose goal at a target depth or altitude (IV.F).',
+        module='sam_nodes.motion_planner',
+        base_class='MotionPlannerBase',
+        publishes=(
+            EndpointInfo('/global_plan', QosInfo('reliable', 'volatile', 10, 'reliable')),
+        ),
+        subscribes=(
+            EndpointInfo('/nav_goal', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/nav_heading', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/altitude', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+        ),
+        parameters=(
+            '/safe_altitude',
+            '/safe_depth',
+        ),
+        transforms=(),
+        reads_transforms=(
+            ('world', 'base_link'),
+        ),
+    ),
+    NodeInfo(
+        name='controller',
+        description='Follows the planned path by commanding the actuators; obeys an abort (IV.G).',
+        module='sam_nodes.controller',
+        base_class='ControllerBase',
+        publishes=(
+            EndpointInfo('/thruster_rpms', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/thruster_angles', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/ballast_angles', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/longitudinal_weight_position', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/buoyancy_piston_position', QosInfo('reliable', 'volatile', 10, 'reliable')),
+        ),
+        subscribes=(
+            EndpointInfo('/global_plan', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/abort', QosInfo('reliable', 'transient_local', 1, 'latched')),
+        ),
+        parameters=(),
+        transforms=(),
+        reads_transforms=(
+            ('world', 'base_link'),
+        ),
+    ),
+    NodeInfo(
+        name='performance_monitor',
+        description='Watches depth, altitude and the battery; orders an emergency ascent (IV.H).',
+        module='sam_nodes.performance_monitor',
+        base_class='PerformanceMonitorBase',
+        publishes=(
+            EndpointInfo('/abort', QosInfo('reliable', 'transient_local', 1, 'latched')),
+            EndpointInfo('/thruster_rpms', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/buoyancy_piston_position', QosInfo('reliable', 'volatile', 10, 'reliable')),
+        ),
+        subscribes=(
+            EndpointInfo('/pressure', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/altitude', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+            EndpointInfo('/battery_state', QosInfo('best_effort', 'volatile', 5, 'sensor_data')),
+        ),
+        parameters=(
+            '/critical_altitude',
+            '/critical_depth',
+            '/min_battery_percent',
+        ),
+        transforms=(),
+        reads_transforms=(),
+    ),
+    NodeInfo(
+        name='mission',
+        description=(
+            'Gives the motion planner its goals, a pose or a heading at a depth or altitude (an addition).'
+        ),
+        module='sam_nodes.mission',
+        base_class='MissionBase',
+        publishes=(
+            EndpointInfo('/nav_goal', QosInfo('reliable', 'volatile', 10, 'reliable')),
+            EndpointInfo('/nav_heading', QosInfo('reliable', 'volatile', 10, 'reliable')),
+        ),
+        subscribes=(),
+        parameters=(),
+        transforms=(),
+        reads_transforms=(),
+    ),
 )

@@ -1,0 +1,89 @@
+# Generated from interfaces.yaml by sam-codegen; do not edit.
+"""The ROS 2 interface of node mission: Gives the motion planner its goals, a pose or a heading at a depth
+or altitude (an addition).
+
+Write the node as a subclass of ``MissionBase`` with logic only; topic names, types, QoS, parameters and
+frames come from the spec::
+
+    class Mission(MissionBase):
+        ...
+
+``MissionBase(*, node_name=None, namespace=None, parameter_overrides=None, **node_kwargs)``: the node is named
+``mission`` unless node_name says otherwise; node_kwargs go to rclpy's Node (context, cli_args, ...);
+parameter_overrides ({name: value}, spec or ROS names) win over the node's --params-file values, which win
+over the spec defaults. A value out of range or breaking a rule raises
+sam_runtime.node_support.ParameterConfigError.
+
+Subscriptions (override the method; the default counts and drops; a method that raises is counted, logged and
+shown on /diagnostics, and the node goes on):
+- none
+
+Publications:
+- ``publish_nav_goal(msg: PoseStamped)``: /nav_goal (geometry_msgs/PoseStamped), QoS reliable (reliable,
+  volatile, keep last 10). Pose goal in /world; position.z < 0 depth, > 0 altitude.
+- ``publish_nav_heading(msg: HeadingStamped)``: /nav_heading (sam_msgs/HeadingStamped), QoS reliable
+  (reliable, volatile, keep last 10). Heading goal; z < 0 depth, z > 0 altitude.
+
+Parameters (read-only properties with the current value; a change goes through set_parameters or the node's
+~/set_parameters service, which refuses a value out of range or one that breaks a rule, naming it):
+- none
+
+Transforms:
+- ``self.tf`` is None: this node reads no transforms (give it `reads_transforms` in the spec).
+
+Health: ``report_status(level, message, **values)`` publishes the node's DiagnosticStatus (name = the node's
+name) on /diagnostics at once; it is repeated every second with the counters of dropped and failed messages.
+level: sam_runtime.node_support.Level (OK, WARN, ERROR, STALE).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from geometry_msgs.msg import PoseStamped
+from rclpy.node import Node
+from sam_msgs.msg import HeadingStamped
+from sam_runtime import node_support, tf_buffer
+
+NODE_NAME = 'mission'
+
+PARAMETERS: tuple[node_support.ParameterSpec, ...] = (
+)
+
+# Parameters only other nodes read, which a rule compares with one of this node's (mirrored, not declared).
+PARTNERS: tuple[node_support.ParameterSpec, ...] = (
+)
+
+RULES: tuple[node_support.RuleSpec, ...] = (
+)
+
+
+class MissionBase(Node):
+    """Node mission: subclass it and override the on_* methods (see the module docstring)."""
+
+    def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
+                 parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
+        super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
+        self._gen_support = node_support.NodeSupport(self)
+        self._gen_parameters = node_support.declare_parameters(
+            self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
+        self.tf: tf_buffer.TfBuffer | None = None
+        self._gen_pub_nav_goal = self.create_publisher(
+            PoseStamped, "/nav_goal",
+            node_support.qos_profile("reliable", "volatile", 10))
+        self._gen_pub_nav_heading = self.create_publisher(
+            HeadingStamped, "/nav_heading",
+            node_support.qos_profile("reliable", "volatile", 10))
+
+    def publish_nav_goal(self, msg: PoseStamped) -> None:
+        """Publish on /nav_goal (geometry_msgs/PoseStamped)."""
+        self._gen_pub_nav_goal.publish(msg)
+
+    def publish_nav_heading(self, msg: HeadingStamped) -> None:
+        """Publish on /nav_heading (sam_msgs/HeadingStamped)."""
+        self._gen_pub_nav_heading.publish(msg)
+
+    def report_status(self, level: int, message: str, **values: Any) -> None:
+        """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
+        self._gen_support.report(level, message, values)
