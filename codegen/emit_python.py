@@ -80,6 +80,32 @@ def py_class_ref(struct: DsdlStruct) -> str:
     return f"{py_module(struct.namespace)}.{py_class_name(struct)}"
 
 
+def dict_literal(prefix: str, pairs: list[tuple[str, str]], width: int = 110) -> str:
+    """``prefix{k: v, ...}`` on one line when it fits in `width`, else wrapped with four spaces of indent.
+
+    >>> dict_literal("T = ", [("0", "1"), ("2", "3")])
+    'T = {0: 1, 2: 3}'
+    >>> print(dict_literal("T = ", [(str(k), "3") for k in range(8)], width=30))
+    T = {
+        0: 3, 1: 3, 2: 3, 3: 3,
+        4: 3, 5: 3, 6: 3, 7: 3,
+    }
+    """
+    one = prefix + "{" + ", ".join(f"{k}: {v}" for k, v in pairs) + "}"
+    if len(one) <= width:
+        return one
+    lines, line = [prefix + "{"], ""
+    for k, v in pairs:
+        item = f"{k}: {v},"
+        if line and 4 + len(line) + 1 + len(item) > width:
+            lines.append("    " + line)
+            line = ""
+        line = f"{line} {item}" if line else item
+    if line:
+        lines.append("    " + line)
+    return "\n".join([*lines, "}"])
+
+
 def py_literal(value: Scalar) -> str:
     """A Python literal; non-finite floats refer to the module constants _NAN and _INF of convert.py.
 
@@ -543,9 +569,11 @@ class _MappingEmitter:
             items = sorted(inverse.items())
             const += "_TO_UAVCAN"
         if not any(t["name"] == const for t in self.module.tables):
+            pairs = [(py_literal(k), py_literal(v)) for k, v in items]
             self.module.tables.append({
                 "name": const,
-                "items": [(py_literal(k), py_literal(v)) for k, v in items],
+                "items": pairs,
+                "literal": dict_literal(f"{const}: dict[int, int] = ", pairs),
                 "what": f"{self.name}: {s.uavcan} -> {s.ros}" if direction == "to_ros"
                 else f"{self.name}: {s.ros} -> {s.uavcan} (first key per value)",
             })

@@ -53,6 +53,15 @@ _GPS_FIX_STATUS_STATUS_TO_ROS: dict[int, int] = {0: -1, 1: -1, 2: 0, 3: 0}
 # gps_fix: status.status -> status (first key per value)
 _GPS_FIX_STATUS_STATUS_TO_UAVCAN: dict[int, int] = {-1: 0, 0: 2}
 
+# battery_state: state_of_health_pct -> power_supply_health
+_BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_ROS: dict[int, int] = {
+    0: 3, 1: 3, 2: 3, 3: 3, 4: 3, 5: 3, 6: 3, 7: 3, 8: 3, 9: 3, 10: 3, 11: 3, 12: 3, 13: 3, 14: 3, 15: 3,
+    16: 3, 17: 3, 18: 3, 19: 3, 20: 3, 21: 3, 22: 3, 23: 3, 24: 3, 25: 3, 26: 3, 27: 3, 28: 3, 29: 3, 127: 0,
+}
+
+# battery_state: power_supply_health -> state_of_health_pct (first key per value)
+_BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_UAVCAN: dict[int, int] = {0: 127, 3: 0}
+
 
 class ConversionStats:
     """Counts, per "<mapping>.<field>", the values that were saturated and the messages that were rejected."""
@@ -1133,6 +1142,7 @@ def battery_state_to_ros(
 
     sam.power.BatteryInfo.0.1 -> sensor_msgs/BatteryState
     """
+    power_supply_health = _BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_ROS.get(src.state_of_health_pct, 1)
     return _new_BatteryState(
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
@@ -1145,6 +1155,7 @@ def battery_state_to_ros(
         capacity=_NAN,
         design_capacity=_NAN,
         percentage=src.state_of_charge_pct * 0.01,
+        power_supply_health=power_supply_health,
         present=True,
     )
 
@@ -1187,10 +1198,15 @@ def battery_state_to_uavcan(src: BatteryState, stats: ConversionStats) -> sam.po
         state_of_charge_pct = 0
     else:
         state_of_charge_pct = round(state_of_charge_pct)
+    state_of_health_pct = _BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_UAVCAN.get(src.power_supply_health)
+    if state_of_health_pct is None:
+        stats.reject('battery_state.state_of_health_pct')
+        return None
     return _new_sam_power_BatteryInfo_0_1(
         temperature=temperature,
         voltage=voltage,
         current=current,
+        state_of_health_pct=state_of_health_pct,
         state_of_charge_pct=state_of_charge_pct,
     )
 

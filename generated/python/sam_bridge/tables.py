@@ -587,7 +587,13 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_ros='battery_state_to_ros',
         to_uavcan='battery_state_to_uavcan',
         exact_uavcan_fields=('voltage', 'current', 'state_of_charge_pct'),
-        linked_uavcan_fields=('voltage', 'current', 'temperature', 'state_of_charge_pct'),
+        linked_uavcan_fields=(
+            'voltage',
+            'current',
+            'temperature',
+            'state_of_charge_pct',
+            'state_of_health_pct',
+        ),
     ),
     MappingInfo(
         name='altitude',
@@ -1077,6 +1083,8 @@ NODES: tuple[NodeInfo, ...] = (
         subscribes=(),
         parameters=(),
         transforms=(),
-        reads_transforms=(),
+        reads_transforms=(
+            ('world', 'base_link'),
+        ),
     ),
 )

@@ -29,7 +29,10 @@ Parameters (read-only properties with the current value; a change goes through s
 - none
 
 Transforms:
-- ``self.tf`` is None: this node reads no transforms (give it `reads_transforms` in the spec).
+- ``self.tf``: a sam_runtime.tf_buffer.TfBuffer fed from /tf and /tf_static.
+- ``lookup_world_to_base_link(max_age_s=None, *, time_ns=None) -> Transform``: the pose of base_link in
+  world, chained through the tree (TfMissingEdge; TfStale when an edge is older than max_age_s on this
+  node's clock; time_ns: at that time, interpolated).
 
 Health: ``report_status(level, message, **values)`` publishes the node's DiagnosticStatus (name = the node's
 name) on /diagnostics at once; it is repeated every second with the counters of dropped and failed messages.
@@ -68,7 +71,10 @@ class MissionBase(Node):
         self._gen_support = node_support.NodeSupport(self)
         self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
-        self.tf: tf_buffer.TfBuffer | None = None
+        self.tf: tf_buffer.TfBuffer | None = tf_buffer.TfBuffer()
+        self._gen_tf_feed = node_support.feed_tf(
+            self, self.tf, self._gen_support, "/tf", node_support.qos_profile("reliable", "volatile", 100),
+            "/tf_static", node_support.qos_profile("reliable", "transient_local", 1))
         self._gen_pub_nav_goal = self.create_publisher(
             PoseStamped, "/nav_goal",
             node_support.qos_profile("reliable", "volatile", 10))
@@ -83,6 +89,14 @@ class MissionBase(Node):
     def publish_nav_heading(self, msg: HeadingStamped) -> None:
         """Publish on /nav_heading (sam_msgs/HeadingStamped)."""
         self._gen_pub_nav_heading.publish(msg)
+
+    def lookup_world_to_base_link(
+        self, max_age_s: float | None = None, *, time_ns: int | None = None
+    ) -> tf_buffer.Transform:
+        """The pose of base_link in world (raises tf_buffer.TfError subclasses)."""
+        assert self.tf is not None
+        return self.tf.lookup("world", "base_link", now_ns=self.get_clock().now().nanoseconds,
+                              max_age_s=max_age_s, time_ns=time_ns)
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""
