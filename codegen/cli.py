@@ -110,7 +110,7 @@ def _cmd_ros_install(args: argparse.Namespace) -> int:
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, run."
+    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, nodes, run."
     sub = parser.add_subparsers(dest="command", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:
@@ -134,7 +134,7 @@ def make_parser() -> argparse.ArgumentParser:
     return parser
 
 
-RUNTIME_COMMANDS = ("bridge", "sim", "run")
+RUNTIME_COMMANDS = ("bridge", "sim", "nodes", "run")
 
 
 def main(argv: list[str] | None = None) -> int:

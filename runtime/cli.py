@@ -1,8 +1,8 @@
-"""Command line of the runtime: ``bridge``, ``sim`` and ``run`` (the main job).
+"""Command line of the runtime: ``bridge``, ``sim``, ``nodes`` (the node host) and ``run`` (the main job).
 
-Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_main`, ``sam-run`` =
-:func:`run_main`; ``sam-codegen bridge|sim|run ...`` dispatches to :func:`main`. Also ``python -m
-sam_runtime.cli {bridge,sim,run} ...``.
+Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_main`, ``sam-nodes`` =
+:func:`nodes_main`, ``sam-run`` = :func:`run_main`; ``sam-codegen bridge|sim|nodes|run ...`` dispatches to
+:func:`main`. Also ``python -m sam_runtime.cli {bridge,sim,nodes,run} ...``.
 
 Where: ``--generated``, else ``$SAM_GENERATED_DIR``, else the generated folder of the project the working directory
 is in (see sam_codegen.workspace); ``run`` also finds the spec the way ``sam-codegen build`` does.
@@ -34,7 +34,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["bridge_main", "main", "run_main", "sim_main"]
+__all__ = ["bridge_main", "main", "nodes_main", "run_main", "sim_main"]
 
 _ENV_TRANSPORT_KEYS = ("UAVCAN__UDP__IFACE", "UAVCAN__CAN__IFACE", "UAVCAN__LOOPBACK", "UAVCAN__SERIAL__IFACE")
 EXIT_OK, EXIT_ERROR, EXIT_USAGE = 0, 1, 2
@@ -43,6 +43,7 @@ EXIT_OK, EXIT_ERROR, EXIT_USAGE = 0, 1, 2
 _RUNTIME_MODULES = {
     "bridge": ("pycyphal", "nunavut", "rclpy"),
     "sim": ("pycyphal", "nunavut"),
+    "nodes": ("rclpy",),
     "run": ("pycyphal", "nunavut", "rclpy"),
 }
 # Set by the main job (`run`) in its children's environment: the pid they must not outlive.
@@ -325,6 +326,13 @@ def _sim_parser() -> argparse.ArgumentParser:
                    help="heartbeats at once, but publish only once this file exists (for scripted tests)")
     p.add_argument("--record", type=Path, default=None, help="JSON lines of every message sent and received")
     p.add_argument("--report", type=Path, default=None, help="write the counters as JSON here at exit")
+    _add_vehicle_args(p)
+    return p
+
+
+def _add_vehicle_args(p: argparse.ArgumentParser, *, main_job: bool = False) -> None:
+    """The simulated vehicle's options (``sim``; ``run`` forwards them to its sim, except --time-scale: the nodes
+    run on the wall clock)."""
     v = p.add_argument_group("simulated vehicle (frames: ENU metres around --gps-origin, yaw counter-clockwise "
                              "from east, depth positive down)")
     v.add_argument("--seed", type=int, default=0, help="sensor noise seed (default 0)")
@@ -342,13 +350,13 @@ def _sim_parser() -> argparse.ArgumentParser:
                    help="state of health; below 60 the BMS flags NEED_SERVICE, below 30 BAD_BATTERY (default 98)")
     v.add_argument("--gps-origin", default="59.35,18.07", metavar="LAT,LON",
                    help="latitude and longitude of the sim's origin (default 59.35,18.07: KTH, Stockholm)")
-    v.add_argument("--time-scale", type=float, default=1.0,
-                   help="vehicle seconds per wall second; rates and stamps follow (default 1)")
+    if not main_job:
+        v.add_argument("--time-scale", type=float, default=1.0,
+                       help="vehicle seconds per wall second; rates and stamps follow (default 1)")
     v.add_argument("--truth-file", type=Path, default=None,
                    help="the vehicle's true state: JSON lines if it ends in .jsonl, else one JSON object replaced "
                         "atomically")
     v.add_argument("--truth-rate", type=float, default=5.0, help="truth samples per vehicle second (default 5)")
-    return p
 
 
 def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
@@ -370,7 +378,7 @@ def _vehicle_options(args: argparse.Namespace) -> dict[str, Any]:
         "seed": args.seed, "sea_floor": SeaFloor.parse(args.sea_floor, axis_yaw=args.sea_floor_axis),
         "start": _floats(args.start, 4, "--start"), "battery_percent": args.battery_start,
         "battery_drain_factor": args.battery_drain_factor, "battery_health_pct": args.battery_health,
-        "gps_origin": (lat, lon), "time_scale": args.time_scale, "truth_file": args.truth_file,
+        "gps_origin": (lat, lon), "time_scale": getattr(args, "time_scale", 1.0), "truth_file": args.truth_file,
         "truth_rate_hz": args.truth_rate,
     }
 
@@ -422,6 +430,84 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
     return _serve("sam-sim", run, (GeneratedPackageError, TransportConfigError, ValueError))
 
 
+# ============================================================================================ nodes
+def _add_mission_args(p: argparse.ArgumentParser) -> None:
+    m = p.add_mutually_exclusive_group()
+    m.add_argument("--goal", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+                   help="one pose goal in world (ENU metres around the first GPS fix; z < 0 a depth, z > 0 an "
+                        "altitude above the sea floor, 0 the surface) instead of the demo mission")
+    m.add_argument("--mission", type=Path, default=None, metavar="FILE",
+                   help="a mission file (YAML: a list of pose/heading goals with arrival tolerances, see "
+                        "sam_runtime.nodes.mission_plan) instead of the demo mission")
+
+
+def _mission_goals(args: argparse.Namespace) -> Any:
+    """The mission's goals from --goal/--mission (None: the demo mission); MissionError for a bad file or goal."""
+    from sam_runtime.nodes.mission_plan import load_mission, single_goal
+
+    if args.goal is not None:
+        return single_goal(*args.goal)
+    if args.mission is not None:
+        return load_mission(args.mission)
+    return None
+
+
+def _nodes_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sam-nodes", description="The node host: the spec's nodes that have an implementation, in one process "
+                                      "(one rclpy context and executor, each node its own ROS node).")
+    _add_generated_args(p)
+    p.add_argument("--params-file", type=Path, default=None,
+                   help="ROS 2 parameters file (default: the generated params/<vehicle>.params.yaml)")
+    p.add_argument("--only", default=None, metavar="A,B",
+                   help="run only these nodes (comma-separated names of the spec's nodes)")
+    _add_mission_args(p)
+    p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
+    p.add_argument("--log-level", default="INFO")
+    return p
+
+
+def nodes_main(argv: Sequence[str] | None = None) -> int:
+    args = _nodes_parser().parse_args(argv)
+    _require_runtime("nodes")
+    _stay_with_parent()
+    _setup_logging(args.log_level)
+    from sam_runtime.genpkg import GeneratedPackageError
+    from sam_runtime.nodes.host import HostConfigError, NodeHost, plan_host
+    from sam_runtime.nodes.mission_plan import MissionError
+
+    try:
+        goals = _mission_goals(args)
+        gen = _generated(args)
+        only = None if args.only is None else [n.strip() for n in args.only.split(",") if n.strip()]
+        plan = plan_host(gen.tables(), only)
+    except (GeneratedPackageError, HostConfigError, MissionError) as ex:
+        print(f"sam-nodes: {ex}", file=sys.stderr)
+        return EXIT_ERROR if not isinstance(ex, HostConfigError) else EXIT_USAGE
+    if plan.missing:
+        print(f"sam-nodes: no implementation for node(s) {', '.join(plan.missing)} of the spec; "
+              + (f"running {', '.join(plan.run)}" if plan.run else "nothing to run"), flush=True)
+    if not plan.run:
+        return EXIT_OK
+    if "mission" not in plan.run and goals is not None:
+        print("sam-nodes: --goal/--mission need the mission node, which is not run", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        host = NodeHost(gen, plan, params_file=args.params_file, goals=goals)
+    except HostConfigError as ex:
+        print(f"sam-nodes: {ex}", file=sys.stderr)
+        return EXIT_ERROR
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: host.stop())
+    print(f"READY nodes {','.join(plan.run)} params={host.params_file}", flush=True)
+    try:
+        host.spin(args.duration)
+    finally:
+        host.close()
+    print(f"DONE nodes errors={host.errors}", flush=True)
+    return EXIT_OK
+
+
 # ============================================================================================ run
 def _run_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
@@ -435,7 +521,13 @@ def _run_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until Ctrl-C)")
     p.add_argument("--no-build", action="store_true", help="use generated/ as it is")
     p.add_argument("--no-demo-commands", dest="demo_commands", action="store_false",
-                   help="do not publish demo actuator commands (by default slow sweeps move the actuators)")
+                   help="specs without node implementations: do not publish demo actuator commands (by default "
+                        "slow sweeps move the actuators)")
+    p.add_argument("--no-nodes", dest="nodes", action="store_false",
+                   help="do not start the node host (the simulated devices and the bridge only)")
+    p.add_argument("--params-file", type=Path, default=None,
+                   help="the node host's ROS 2 parameters file (default: the generated params/<vehicle>.params.yaml)")
+    _add_mission_args(p)
     p.add_argument("--window", type=float, default=2.0, help="rate window [s] (default 2)")
     p.add_argument("--plain", action="store_true", help="plain lines every second even on a terminal")
     p.add_argument("--log-dir", type=Path, default=None,
@@ -443,7 +535,18 @@ def _run_parser() -> argparse.ArgumentParser:
     p.add_argument("--ros-prefix", type=Path, default=None,
                    help="install prefix of the generated ROS package (default: the running venv)")
     p.add_argument("--log-level", default="WARNING")
+    _add_vehicle_args(p, main_job=True)
     return p
+
+
+def _sim_vehicle_argv(args: argparse.Namespace) -> list[str]:
+    """The vehicle options the main job forwards to its sim (checked here first: ValueError, one clear line)."""
+    _vehicle_options(args)
+    out = ["--seed", str(args.seed), "--sea-floor", args.sea_floor, "--sea-floor-axis", repr(args.sea_floor_axis),
+           "--start", args.start, "--battery-start", repr(args.battery_start), "--battery-drain-factor",
+           repr(args.battery_drain_factor), "--battery-health", str(args.battery_health), "--gps-origin",
+           args.gps_origin, "--truth-rate", repr(args.truth_rate)]
+    return out
 
 
 def run_main(argv: Sequence[str] | None = None) -> int:
@@ -451,21 +554,34 @@ def run_main(argv: Sequence[str] | None = None) -> int:
     _require_runtime("run")
     _setup_logging(args.log_level)
     from sam_runtime.monitor import RunOptions, run
+    from sam_runtime.nodes.mission_plan import MissionError
 
+    try:
+        _mission_goals(args)  # a bad mission file stops here, before anything starts
+        sim_args = _sim_vehicle_argv(args)
+    except (MissionError, ValueError) as ex:
+        print(f"sam-run: {ex}", file=sys.stderr)
+        return EXIT_USAGE
+    node_args = [] if args.params_file is None else ["--params-file", str(args.params_file.resolve())]
+    if args.goal is not None:
+        node_args += ["--goal", *(repr(v) for v in args.goal)]
+    elif args.mission is not None:
+        node_args += ["--mission", str(args.mission.resolve())]
     return run(RunOptions(
         spec=args.spec, generated=args.generated, package=args.package, iface=args.iface,
         duration=args.duration, build=not args.no_build, demo_commands=args.demo_commands,
         window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
-        argv=list(sys.argv[1:] if argv is None else argv),
+        argv=list(sys.argv[1:] if argv is None else argv), nodes=args.nodes, node_args=node_args,
+        sim_args=sim_args, truth_file=args.truth_file,
     ))
 
 
 # ============================================================================================ dispatch
-_COMMANDS = {"bridge": bridge_main, "sim": sim_main, "run": run_main}
+_COMMANDS = {"bridge": bridge_main, "sim": sim_main, "nodes": nodes_main, "run": run_main}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``main(["bridge", ...])`` etc.: the entry ``sam-codegen bridge|sim|run`` dispatches to."""
+    """``main(["bridge", ...])`` etc.: the entry ``sam-codegen bridge|sim|nodes|run`` dispatches to."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if not argv or argv[0] not in _COMMANDS:
         print(f"usage: {Path(sys.argv[0]).name} {{{','.join(_COMMANDS)}}} [options]  (--help per command)",

@@ -1,4 +1,4 @@
-"""The main job: build, start the simulated devices and the bridge, and show live what flows.
+"""The main job: build, start the simulated devices, the bridge and the node host, and show live what flows.
 
 :func:`run` (``sam-run`` / ``sam-codegen run``):
 
@@ -7,13 +7,16 @@
 2. builds and installs the generated ROS message packages into the venv if they are missing or stale (build folders
    under the project's ``.sam-codegen-cache/ros-build``);
 3. compiles the DSDL once (the children reuse the cache);
-4. starts ``sam-sim`` and ``sam-bridge`` as subprocesses on Cyphal/UDP 127.0.0.1 (own sessions, logs under the
-   project's ``.sam-codegen-cache/run-logs``); they never outlive this process (see sam_runtime.cli's
-   ``_stay_with_parent``);
-5. runs an rclpy monitor node in this process: every bridged topic's rate over a sliding window and its last
-   value, every device's heartbeat (from the bridge's /diagnostics) and the bridge's drop counters; a
-   refreshing table on a terminal, plain lines every second otherwise. By default it also publishes slow
-   demo sweeps on the command topics so the simulated actuators move;
+4. starts ``sam-sim`` (with the vehicle options and a truth file), ``sam-bridge`` and, when the spec has nodes with
+   an implementation (sam_runtime.nodes), ``sam-nodes`` (the node host, flying the demo mission unless ``--goal`` or
+   ``--mission`` says otherwise) as subprocesses on Cyphal/UDP 127.0.0.1 (own sessions, logs under the project's
+   ``.sam-codegen-cache/run-logs``); they never outlive this process (see sam_runtime.cli's ``_stay_with_parent``);
+5. runs an rclpy monitor node in this process: the vehicle, its goal, plan and commands and every node's state
+   (sam_runtime.run_view, when nodes are hosted), every bridged topic's rate over a sliding window and its last
+   value, every device's heartbeat (from the bridge's /diagnostics) and the bridge's drop counters; a refreshing
+   table on a terminal, plain lines every second otherwise. For a spec without node implementations it publishes
+   slow demo sweeps on the command topics instead, so that the simulated actuators move (never on a topic a
+   hosted node publishes);
 6. stops on ``--duration``, Ctrl-C, SIGTERM or SIGHUP (the terminal closed): children get SIGTERM together (SIGKILL
    after one deadline), exit 0.
    A child that dies on its own ends the run with exit code 1 and the tail of its log.
@@ -62,6 +65,10 @@ class RunOptions:
     refresh_s: float = 0.5
     ros_prefix: Path | None = None  # where the generated ROS package is installed (default: the venv)
     argv: list[str] | None = None  # for the re-exec when ros_prefix needs a new process environment
+    nodes: bool = True  # start the node host when the spec has node implementations
+    node_args: list[str] | None = None  # for `sam-nodes` (--goal, --mission, --params-file)
+    sim_args: list[str] | None = None  # for `sam-sim` (the vehicle options)
+    truth_file: Path | None = None  # the sim's truth file (default: truth.json in the log folder)
 
 
 # ============================================================================================ formatting
@@ -152,7 +159,8 @@ class _TopicState:
 class TopicMonitor:
     """An rclpy node subscribing to every bridged topic and to /diagnostics (own context)."""
 
-    def __init__(self, tables: Any, gen: Any, *, window: float = 2.0, demo_commands: bool = False) -> None:
+    def __init__(self, tables: Any, gen: Any, *, window: float = 2.0, demo_commands: bool = False,
+                 hosted: list[str] | None = None, truth_file: Path | None = None) -> None:
         import rclpy
         from diagnostic_msgs.msg import DiagnosticArray
         from rclpy.node import Node
@@ -177,8 +185,16 @@ class TopicMonitor:
         self.demo_published: collections.Counter[str] = collections.Counter()
         self.demo_errors: collections.Counter[str] = collections.Counter()
         self._demo_t0 = time.monotonic()
+        hosted = list(hosted or ())
+        # The hosted nodes command the actuators: no demo sweep may compete with them on a topic.
+        seen = {ep.topic for n in getattr(tables, "NODES", ()) if n.name in hosted for ep in n.publishes}
+        self.view = None
+        if hosted:
+            from sam_runtime.run_view import VehicleView
+
+            self.view = VehicleView(self.node, tables, topics=self.topics, diagnostics=self.diagnostics,
+                                    hosted=hosted, truth_file=truth_file)
         if demo_commands:
-            seen = set()
             for m in tables.MAPPINGS:
                 if m.direction == "ros_to_uavcan" and m.topic.name not in seen:
                     seen.add(m.topic.name)
@@ -244,6 +260,8 @@ class TopicMonitor:
                 v = d["values"]
                 drops_by_topic[v.get("topic", "?")] += int(v.get("dropped", "0") or 0)
         lines = [header, ""]
+        if self.view is not None:
+            lines += [*self.view.lines(), ""]
         lines.append(f"{'TOPIC':32} {'DIR':3} {'RATE Hz':>8} {'NOMINAL':>7} {'COUNT':>7} {'DROPS':>5}  LAST VALUE")
         for st in self.topics.values():
             last = summarize_message(st.last, 60) if st.last is not None else "-"
@@ -363,6 +381,7 @@ def run(opts: RunOptions) -> int:
     from sam_codegen.workspace import WorkspaceError, ensure_state_dir
     from sam_runtime.dsdl import DsdlCompileError
     from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, ensure_ros_package
+    from sam_runtime.nodes import implemented, unimplemented
 
     def say(text: str) -> None:
         print(text, flush=True)
@@ -416,9 +435,22 @@ def run(opts: RunOptions) -> int:
         if opts.package:
             common += ["--package", opts.package]
         py = [sys.executable, "-m", "sam_runtime.cli"]
-        children.append(_Child("sim", [*py, "sim", *common], env, log_dir / "sim.log"))
+        tables = gen.tables()
+        hosted = implemented(tables) if opts.nodes else []
+        missing = unimplemented(tables)
+        if opts.nodes and missing:
+            say(f"no implementation for node(s) {', '.join(missing)} of the spec"
+                + (f"; hosting {', '.join(hosted)}" if hosted else "; demo commands move the actuators"))
+        truth = (opts.truth_file or log_dir / "truth.json").resolve()
+        children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth)],
+                               env, log_dir / "sim.log"))
         children.append(_Child("bridge", [*py, "bridge", *common], env, log_dir / "bridge.log"))
-        monitor = TopicMonitor(gen.tables(), gen, window=opts.window, demo_commands=opts.demo_commands)
+        if hosted:
+            gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
+            children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
+                                   log_dir / "nodes.log"))
+        monitor = TopicMonitor(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
+                               truth_file=truth)
 
         tty = sys.stdout.isatty() and not opts.plain
         started = time.monotonic()
@@ -439,7 +471,7 @@ def run(opts: RunOptions) -> int:
             monitor.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
             if time.monotonic() >= next_draw:
                 next_draw += refresh
-                header = (f"{gen.tables().VEHICLE} bridge run  t={elapsed:6.1f} s  "
+                header = (f"{tables.VEHICLE} bridge run  t={elapsed:6.1f} s  "
                           + "  ".join(f"{c.name} pid {c.proc.pid}" for c in children)
                           + ("" if opts.duration is None else f"  (stops at {opts.duration:.0f} s)")
                           + ("  Ctrl-C to stop" if tty else ""))
