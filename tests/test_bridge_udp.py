@@ -428,7 +428,7 @@ def test_run_job_stops_cleanly_on_ctrl_c(tmp_path: Path) -> None:
         try:
             header = p.wait_line(f"{gen.tables().VEHICLE} bridge run", 60)
             pids = [int(x) for x in re.findall(r"pid (\d+)", header)]
-            assert len(pids) == 2
+            assert len(pids) == 3  # sim, bridge, node host
             # Wait until data flows (a non-zero /imu rate in a table), then Ctrl-C.
             poll_until(lambda: any(ln.startswith("/imu") and float(ln.split()[2]) > 0 for ln in p.lines), 30,
                        "data in the monitor")

@@ -96,16 +96,17 @@ def _goal(item: Any, where: str, problems: list[str]) -> MissionGoal | None:
         problems.append(f"{where}: missing {missing}")
         return None
     n = len(problems)
-    z = _number(item["z"], f"{where}.z", problems)
     if heading:
         h = (math.radians(_number(item["heading_deg"], f"{where}.heading_deg", problems)) if "heading_deg" in item
              else _number(item["heading"], f"{where}.heading", problems))
+        z = _number(item["z"], f"{where}.z", problems)
         duration = (_number(item["duration"], f"{where}.duration", problems, positive=True) if "duration" in item
                     else None)
         goal = MissionGoal("heading", z, heading=h, duration=duration)
     else:
+        x, y = _number(item["x"], f"{where}.x", problems), _number(item["y"], f"{where}.y", problems)
         goal = MissionGoal(
-            "pose", z, _number(item["x"], f"{where}.x", problems), _number(item["y"], f"{where}.y", problems),
+            "pose", _number(item["z"], f"{where}.z", problems), x, y,
             tolerance=_number(item.get("tolerance", DEFAULT_TOLERANCE_M), f"{where}.tolerance", problems,
                               positive=True),
             depth_tolerance=_number(item.get("depth_tolerance", DEFAULT_DEPTH_TOLERANCE_M),
