@@ -19,7 +19,7 @@ from sam_nodes.motion_planner import MotionPlannerBase
 from sam_runtime.nav.controller import ControllerPose
 from sam_runtime.nav.planner import Goal, Plan, Planner, PlannerConfig
 from sam_runtime.nodes.common import Level, StatusReporter, guarded_timer, now_s
-from sam_runtime.tf_buffer import TfError
+from sam_runtime.tf_buffer import TfError, TfStale
 
 __all__ = ["REPLAN_PERIOD_S", "MotionPlanner"]
 
@@ -47,6 +47,7 @@ class MotionPlanner(MotionPlannerBase):
         self.next_replan = math.inf
         self.last_refusal: tuple[float, str] | None = None  # (monotonic time, reason)
         self.last_problem = ""
+        self.tf_problem = ""
         self.status = StatusReporter(self)
         self.add_post_set_parameters_callback(self._on_parameters)
         self.timer = guarded_timer(self, TICK_S, "replan", self.tick)
@@ -95,9 +96,11 @@ class MotionPlanner(MotionPlannerBase):
     def replan(self, t: float) -> None:
         try:
             pose = ControllerPose.from_transform(*self._world_pose())
-        except TfError as ex:
-            self.last_problem = f"no plan: {ex}"
+        except TfError as ex:  # the message stays stable (it is the status message); the details are a value
+            self.last_problem = f"no plan: world -> base_link {'stale' if isinstance(ex, TfStale) else 'unavailable'}"
+            self.tf_problem = str(ex)
             return
+        self.tf_problem = ""
         altitude, at = self.altitude
         if t - at > ALTITUDE_MAX_AGE_S:
             altitude = math.nan
@@ -140,6 +143,7 @@ class MotionPlanner(MotionPlannerBase):
         values: dict[str, Any] = dict(refused=sum(self.planner.refused.values()), **refused,
                                       last_refused=None if self.last_refusal is None else self.last_refusal[1],
                                       safe_depth=self.safe_depth, safe_altitude=self.safe_altitude,
+                                      tf_problem=self.tf_problem or None,
                                       plans_published=self.published)
         plan = self.plan
         if plan is not None:
