@@ -111,14 +111,15 @@ def test_no_demo_sweep_on_the_topics_of_hosted_nodes(monkeypatch: pytest.MonkeyP
 
     tables = gen.tables()
     commands = sorted({m.topic.name for m in tables.MAPPINGS if m.direction == "ros_to_uavcan"})
-    alone = TopicMonitor(tables, gen, demo_commands=True)
-    hosted = TopicMonitor(tables, gen, demo_commands=True, hosted=implemented(tables))
-    only_monitor = TopicMonitor(tables, gen, demo_commands=True, hosted=["performance_monitor"])
-    try:
-        assert sorted(name for *_, name in alone._demo) == commands and alone.view is None
-        assert hosted._demo == [] and hosted.view is not None
-        assert sorted(name for *_, name in only_monitor._demo) == [
-            "/ballast_angles", "/longitudinal_weight_position", "/thruster_angles"]
-    finally:
-        for m in (alone, hosted, only_monitor):
-            m.close()
+
+    def demo_topics(**kwargs: Any) -> tuple[list[str], bool]:
+        monitor = TopicMonitor(tables, gen, demo_commands=True, **kwargs)  # one at a time: one node name
+        try:
+            return sorted(name for *_, name in monitor._demo), monitor.view is not None
+        finally:
+            monitor.close()
+
+    assert demo_topics() == (commands, False)
+    assert demo_topics(hosted=implemented(tables)) == ([], True)
+    assert demo_topics(hosted=["performance_monitor"]) == (
+        ["/ballast_angles", "/longitudinal_weight_position", "/thruster_angles"], True)

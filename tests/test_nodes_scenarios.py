@@ -145,6 +145,7 @@ def test_safe_depth_clamps_the_plan_rules_refuse_updates_and_a_lowered_critical_
     assert planner is not None and planner.level == 1 and "clamped to safe_depth 3.00 m" in planner.message
     assert "goal depth 8.00 m clamped to safe_depth 3.00 m" in planner.values["clamped"]
     assert max_depth_held < safe + 0.3  # the depth controller's overshoot only
+    assert s.probe.rec.aborts[0][1] is False  # the latched nominal state, published before the probe existed
     assert not ok_planner and "critical_depth > safe_depth" in why_planner, why_planner
     assert not ok_monitor and "critical_depth > safe_depth" in why_monitor, why_monitor
     assert crossing_depth > 2.0 + 0.3  # the vehicle was below the new critical depth when it took effect
@@ -243,6 +244,8 @@ def test_the_controller_stops_on_a_stale_an_empty_or_a_foreign_plan(tmp_path: Pa
             assert go[0] < sent
         controller = wait_for(lambda: (st := p.status("controller")) and "plans_refused.frame" in st.values and st,
                               5, "the controller's count of refused plans")
+        imu = p.tf.lookup("base_link", "imu_link")  # /tf_static from the host, latched: sent before we started
+        altimeter = p.tf.lookup("base_link", "altimeter_link")
     stale_after = (stopped[0] - stamp) / S
     figures(tmp_path, "stale plan", {"plan_timeout_s": timeout, "stale_stop_after_s": stale_after,
                                      "empty_stop_after_s": after["empty"], "foreign_stop_after_s": after["foreign"]})
@@ -251,6 +254,9 @@ def test_the_controller_stops_on_a_stale_an_empty_or_a_foreign_plan(tmp_path: Pa
     assert stale_status is not None and "stale plan" in stale_status.message
     assert after["empty"] < margin and after["foreign"] < margin
     assert controller.values["plans_refused.frame"] == "1"
+    assert imu.translation == pytest.approx((0.1, 0.0, 0.0))
+    assert altimeter.translation == pytest.approx((0.35, 0.0, -0.08))
+    assert altimeter.rotation == pytest.approx((0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5)))  # looking down
     assert int(controller.values["plans_empty"]) >= 1
 
 
