@@ -92,8 +92,9 @@ message is still published), rejected ones under ``rejected.<...>``.
   (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
   /diagnostics shows the bridge at ERROR. Transient bus errors (a send raising) are counted and the next
   message goes through.
-- A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last (``qos_depth``),
-  so DDS drops that subscriber's oldest samples instead of blocking the bridge.
+- ROS QoS: each topic's from the spec (``qos``: sensor data best effort, commands and states reliable, ...).
+  A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last, so DDS drops that
+  subscriber's oldest samples (reliable topics) or never waits for it (best effort) instead of blocking the bridge.
 - Security: a mapping accepts transfers only from its spec's source node ids (``unknown_source`` otherwise);
   actuators (the simulated ones too) accept commands only from the bridge's node id. Cyphal/UDP binds
   127.0.0.1 and ROS discovery stays on localhost (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) unless the user
@@ -110,9 +111,6 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 import asyncio
 import collections
 import logging
-import math
-import operator
-import sys
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -128,6 +126,7 @@ from sam_runtime.cyphal_ports import (
 )
 from sam_runtime.genpkg import GeneratedPackage
 from sam_runtime.liveness import LivenessMonitor
+from sam_runtime.node_support import ros_parameter_name
 
 __all__ = [
     "Bridge",
@@ -145,7 +144,6 @@ _log = logging.getLogger("sam_runtime.bridge")
 HEARTBEAT_STALE_S = 3.0  # uavcan.node.Heartbeat.OFFLINE_TIMEOUT
 DEFAULT_QUEUE_SIZE = 256
 DEFAULT_RX_QUEUE_SIZE = 1000
-DEFAULT_QOS_DEPTH = 100
 DEFAULT_LOG_INTERVAL_S = 10.0
 HOUSEKEEPING_PERIOD_S = 0.2
 RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
@@ -153,14 +151,6 @@ TRANSFER_ID_TIMEOUT_S = 2.0  # Cyphal's default transfer-id timeout
 REOPEN_BACKOFF_S = (0.5, 2.0)
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
                 "queue_full", "link_down", "shutdown", "lost", "lost_link_down")
-_RULE_OPS: dict[str, Callable[[Any, Any], bool]] = {
-    "<": operator.lt,
-    "<=": operator.le,
-    ">": operator.gt,
-    ">=": operator.ge,
-    "==": operator.eq,
-    "!=": operator.ne,
-}
 _HEALTH = {0: "NOMINAL", 1: "ADVISORY", 2: "CAUTION", 3: "WARNING"}
 _MODE = {0: "OPERATIONAL", 1: "INITIALIZATION", 2: "MAINTENANCE", 3: "SOFTWARE_UPDATE"}
 
@@ -425,12 +415,6 @@ async def cancel_and_wait(tasks: Sequence[asyncio.Task[Any]], timeout: float = 2
     return pending
 
 
-def ros_parameter_name(spec_name: str) -> str:
-    """Spec parameter names are written like ROS 1 globals (``/safe_depth``); ROS 2 parameters are node-local
-    names without the leading slash."""
-    return spec_name.lstrip("/").replace("/", ".")
-
-
 def _error_kinds(session_stats: Any) -> dict[str, int]:
     """pycyphal's breakdown of a session's errors, where the transport gives one (UDP: reassembly errors per
     source node; CAN: reception error counters)."""
@@ -459,8 +443,10 @@ class Bridge:
     :param transport: see :class:`TransportConfig`.
     :param ros_args: extra ROS arguments (``--ros-args ...``) for rclpy.init, e.g. remappings.
     :param parameter_overrides: initial values of the spec's parameters, by spec or ROS name.
-    :param qos_depth: history depth of the ROS publishers and subscriptions (reliable, keep-last).
-    :param command_reliability: ``reliable`` (default) or ``best_effort`` for the ROS command subscriptions.
+    :param qos_depth: history depth of the ROS publishers and subscriptions (keep-last); default: each topic's
+        from the spec (its ``qos``, like reliability and durability).
+    :param command_reliability: ``reliable`` or ``best_effort`` for the ROS command subscriptions; default: the
+        topic's from the spec.
     :param diagnostics_period: seconds between /diagnostics messages (0 disables them).
     :param queue_size: bound of each ROS -> UAVCAN mapping's Cyphal publish queue (beyond: ``queue_full``).
     :param rx_queue_size: bound of each subject's pycyphal receive queue (beyond: ``overrun``); 0 = unbounded.
@@ -475,9 +461,9 @@ class Bridge:
         transport: TransportConfig | None = None,
         ros_args: Sequence[str] = (),
         parameter_overrides: Mapping[str, Any] | None = None,
-        qos_depth: int = DEFAULT_QOS_DEPTH,
+        qos_depth: int | None = None,
         queue_size: int = DEFAULT_QUEUE_SIZE,
-        command_reliability: str = "reliable",
+        command_reliability: str | None = None,
         diagnostics_period: float = 1.0,
         rx_queue_size: int = DEFAULT_RX_QUEUE_SIZE,
         log_interval: float = DEFAULT_LOG_INTERVAL_S,
@@ -488,9 +474,9 @@ class Bridge:
         self.node_id = self._resolve_node_id(node_id)
         self._ros_args = list(ros_args)
         self._overrides = dict(parameter_overrides or {})
-        self._qos_depth = int(qos_depth)
+        self._qos_depth = None if qos_depth is None else int(qos_depth)
         self._queue_size = int(queue_size)
-        if command_reliability not in ("reliable", "best_effort"):
+        if command_reliability not in (None, "reliable", "best_effort"):
             raise BridgeConfigError(f"command_reliability must be reliable or best_effort, not {command_reliability!r}")
         self._command_reliability = command_reliability
         self._diag_period = float(diagnostics_period)
@@ -617,7 +603,6 @@ class Bridge:
         from diagnostic_msgs.msg import DiagnosticArray
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
-        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
         from rclpy.signals import SignalHandlerOptions
 
         self._ros_ctx = rclpy.Context()
@@ -635,20 +620,13 @@ class Bridge:
         self._ros_node.add_post_set_parameters_callback(self._after_set_parameters)
         self._declare_parameters()
 
-        reliable = QoSProfile(depth=self._qos_depth, history=HistoryPolicy.KEEP_LAST,
-                              reliability=ReliabilityPolicy.RELIABLE)
-        cmd_qos = QoSProfile(
-            depth=self._qos_depth, history=HistoryPolicy.KEEP_LAST,
-            reliability=ReliabilityPolicy.RELIABLE if self._command_reliability == "reliable"
-            else ReliabilityPolicy.BEST_EFFORT,
-        )
         for m in self.tables.MAPPINGS:
             stats = self._mstats.setdefault(m.name, MappingStats(self._lock, m.name, self.log))
             ros_cls = self.gen.ros_class(m.topic)
             if m.direction == "uavcan_to_ros":
                 pub = self._ros_pubs.get(m.topic.name)
                 if pub is None:
-                    pub = self._ros_node.create_publisher(ros_cls, m.topic.name, reliable)
+                    pub = self._ros_node.create_publisher(ros_cls, m.topic.name, self._topic_qos(m.topic))
                     self._ros_pubs[m.topic.name] = pub
                 group = self._in_groups.get(m.port.subject_id)
                 if group is None:
@@ -671,7 +649,8 @@ class Bridge:
         for topic, oms in self._out_by_topic.items():
             ros_cls = self.gen.ros_class(oms[0].info.topic)
             self._ros_subs[topic] = self._ros_node.create_subscription(
-                ros_cls, topic, lambda msg, oms=oms: self._on_ros(oms, msg), cmd_qos)
+                ros_cls, topic, lambda msg, oms=oms: self._on_ros(oms, msg),
+                self._topic_qos(oms[0].info.topic, self._command_reliability))
         if self._diag_period > 0:
             self._diag_pub = self._ros_node.create_publisher(DiagnosticArray, "/diagnostics", 10)
             self._ros_node.create_timer(self._diag_period, self._publish_diagnostics)
@@ -692,6 +671,15 @@ class Bridge:
             self._executor = SingleThreadedExecutor(context=self._ros_ctx)
         self._executor.add_node(self._ros_node)
 
+    def _topic_qos(self, topic: Any, reliability: str | None = None) -> Any:
+        """The topic's QoS from the spec (sensor data best effort, commands reliable, ...); ``qos_depth`` and
+        ``command_reliability`` override the depth and the commands' reliability when given."""
+        from sam_runtime.node_support import qos_profile
+
+        q = topic.qos
+        return qos_profile(reliability or q.reliability, q.durability,
+                           q.depth if self._qos_depth is None else self._qos_depth)
+
     def _after_set_parameters(self, params: list[Any]) -> None:
         self._ros_time_active = bool(self._clock.ros_time_is_active)
 
@@ -700,77 +688,14 @@ class Bridge:
         return self._clock.now().nanoseconds if self._ros_time_active else time.time_ns()
 
     def _declare_parameters(self) -> None:
-        from rcl_interfaces.msg import (
-            FloatingPointRange,
-            IntegerRange,
-            ParameterDescriptor,
-            ParameterType,
-            SetParametersResult,
-        )
+        """The spec's parameters with their ranges and rules (sam_runtime.node_support, as the generated nodes)."""
+        from sam_runtime.node_support import ParameterConfigError, declare_parameters
 
-        overrides = {ros_parameter_name(k): v for k, v in self._overrides.items()}
-        known = set()
-        for p in self.tables.PARAMETERS:
-            name = ros_parameter_name(p.name)
-            known.add(name)
-            desc = ParameterDescriptor(name=name, description=p.description + (f" [{p.unit}]" if p.unit else ""))
-            value: Any = overrides.get(name, p.default)
-            ptype = str(p.type).lower()
-            if ptype in ("double", "float", "float64", "float32"):
-                desc.type = ParameterType.PARAMETER_DOUBLE
-                value = float(value)
-                if p.minimum is not None or p.maximum is not None:
-                    lo = -sys.float_info.max if p.minimum is None else float(p.minimum)
-                    hi = sys.float_info.max if p.maximum is None else float(p.maximum)
-                    desc.floating_point_range = [FloatingPointRange(from_value=lo, to_value=hi, step=0.0)]
-            elif ptype in ("int", "integer", "int64", "int32"):
-                desc.type = ParameterType.PARAMETER_INTEGER
-                value = int(value)
-                if p.minimum is not None or p.maximum is not None:
-                    lo = -(2**63) if p.minimum is None else math.ceil(p.minimum)
-                    hi = 2**63 - 1 if p.maximum is None else math.floor(p.maximum)
-                    desc.integer_range = [IntegerRange(from_value=int(lo), to_value=int(hi), step=1)]
-            elif ptype in ("bool", "boolean"):
-                desc.type = ParameterType.PARAMETER_BOOL
-                value = value if isinstance(value, bool) else str(value).lower() in ("1", "true", "yes", "on")
-            else:
-                desc.type = ParameterType.PARAMETER_STRING
-                value = str(value)
-            try:
-                self._ros_node.declare_parameter(name, value, desc)
-            except Exception as ex:  # range violations of an override, invalid names
-                raise BridgeConfigError(f"parameter {name}: {type(ex).__name__}: {ex}") from None
-        unknown = set(overrides) - known
-        if unknown:
-            raise BridgeConfigError(f"unknown parameter(s) {sorted(unknown)}; the spec declares {sorted(known)}")
-        current = {n: self._ros_node.get_parameter(n).value for n in known}
-        problem = self._rule_violation(current)
-        if problem:
-            raise BridgeConfigError(f"initial parameters break a rule: {problem}")
-
-        def on_set(params: list[Any]) -> Any:
-            values = {n: self._ros_node.get_parameter(n).value for n in known}
-            for prm in params:
-                values[prm.name] = prm.value
-            reason = self._rule_violation(values)
-            return SetParametersResult(successful=reason is None, reason=reason or "")
-
-        self._ros_node.add_on_set_parameters_callback(on_set)
-
-    def _rule_violation(self, values: Mapping[str, Any]) -> str | None:
-        for rule in getattr(self.tables, "PARAMETER_RULES", ()):
-            left, right = ros_parameter_name(rule.left), ros_parameter_name(rule.right)
-            op = _RULE_OPS.get(rule.op)
-            if op is None or left not in values or right not in values:
-                continue
-            lv, rv = values[left], values[right]
-            try:
-                ok = op(lv, rv)
-            except TypeError:
-                ok = False
-            if not ok:
-                return f"{left}={lv} must be {rule.op} {right}={rv}: {rule.description}"
-        return None
+        try:
+            declare_parameters(self._ros_node, self.tables.PARAMETERS, getattr(self.tables, "PARAMETER_RULES", ()),
+                               overrides=self._overrides)
+        except ParameterConfigError as ex:
+            raise BridgeConfigError(str(ex)) from None
 
     # Cyphal side --------------------------------------------------------------------------------
     async def _start_cyphal(self, converters: Mapping[str, Any]) -> None:
