@@ -116,18 +116,22 @@ def _ros_process(conn: Any, generated: str, in_topics: list[str], out_topic: str
     from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
-    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
     from rclpy.signals import SignalHandlerOptions
 
     import bench.common  # noqa: F401  (loopback discovery before rclpy)
     from sam_runtime.genpkg import GeneratedPackage
+    from sam_runtime.node_support import qos_profile
 
     gen = GeneratedPackage(Path(generated))
     topic_info = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
     ctx = rclpy.Context()
     rclpy.init(args=[], context=ctx, signal_handler_options=SignalHandlerOptions.NO)
     node = Node("sam_bench_ros_side", context=ctx)
-    qos = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
+
+    def qos(topic: str) -> Any:  # the spec's reliability and durability (the bridge's), a deep history
+        q = topic_info[topic].qos
+        return qos_profile(q.reliability, q.durability, 1000)
+
     state: dict[str, Any] = {"lat": None}
 
     def counter(i: int) -> Any:
@@ -150,10 +154,10 @@ def _ros_process(conn: Any, generated: str, in_topics: list[str], out_topic: str
     # The cheapest consumer rclpy offers, so that the figures are the bridge's: no QoS-event waitables, and the
     # C++ events executor where this rclpy has it (the Python executor costs ~0.3 ms per message here).
     for i, t in enumerate(in_topics):
-        node.create_subscription(gen.ros_class(topic_info[t]), t, on_imu if i == imu_i else counter(i), qos,
+        node.create_subscription(gen.ros_class(topic_info[t]), t, on_imu if i == imu_i else counter(i), qos(t),
                                  event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
     cmd_cls = gen.ros_class(topic_info[out_topic])
-    pub = node.create_publisher(cmd_cls, out_topic, qos,
+    pub = node.create_publisher(cmd_cls, out_topic, qos(out_topic),
                                 event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
     try:
         from rclpy.experimental import EventsExecutor

@@ -7,7 +7,7 @@ Runs the flow-controlled throughput measurement of bench/bridge.py on that path 
 functions by own time and the top cumulative entries (PROFILE_FILTER=regex restricts the listing; PROFILE=0 runs
 without the profiler, for the plain figure). Not part of `nox -s bench`.
 
-Experiments (monkeypatches in this process only, to size a proposed fix of runtime/bridge.py before anyone makes
+Experiments (monkeypatches in this process only, to size a proposed fix of runtime/bridge/ before anyone makes
 it; nothing is changed on disk):
 - ``events_executor``: the bridge's rclpy executor is rclpy.experimental.EventsExecutor instead of the Python
   SingleThreadedExecutor;
@@ -22,7 +22,7 @@ noisy: only figures of the same run compare):
 
 Every rep runs u2r_raw, each variant on u2r_bridge, r2u_raw, each variant on r2u_bridge (the order rotated per
 rep) and prints per variant the median msg/s, the median of the per-rep ratios to raw, and CPU ms per 1000
-messages (process, asyncio thread, rclpy thread). A variant is ``new`` (runtime/bridge.py as it is) or a
+messages (process, asyncio thread, rclpy thread). A variant is ``new`` (runtime/bridge/ as it is) or a
 ``+``-joined list of what to put back as it was before, switched on the running bridge between runs:
 - ``old_handoff``: one ``call_soon_threadsafe`` (one self-pipe write) per command instead of one per batch;
 - ``old_clock``: receive stamps from rclpy's ``Clock.now()`` for every transfer instead of ``time.time_ns()``;
@@ -92,8 +92,8 @@ class _SpinSwitch:
 
 
 def _old_on_ros(self: Any, oms: list[Any], msg: Any) -> None:
-    """runtime/bridge.py's _on_ros before the batched hand-off (without its log lines)."""
-    loop = self._loop
+    """The bridge's Outbound.on_ros before the batched hand-off (without its log lines)."""
+    loop = self.handoff.loop
     for om in oms:
         st = om.stats
         st.receive()
@@ -119,30 +119,31 @@ def _set_variant(bridge: Any, variant: str) -> None:
     if unknown:
         raise SystemExit(f"unknown variant part(s) {sorted(unknown)}")
     if "old_handoff" in parts:
-        bridge._on_ros = types.MethodType(_old_on_ros, bridge)
+        bridge.outbound.on_ros = types.MethodType(_old_on_ros, bridge.outbound)
     else:
-        bridge.__dict__.pop("_on_ros", None)
-    # The ROS clock is read for every stamp while _ros_time_active (as under use_sim_time); the system clock is
+        bridge.outbound.__dict__.pop("on_ros", None)
+    # The ROS clock is read for every stamp while ros_time_active (as under use_sim_time); the system clock is
     # ROS time here (no use_sim_time), so the stamps are the same either way.
-    bridge._ros_time_active = "old_clock" in parts
-    bridge._executor.old_spin = "old_spin" in parts
+    bridge.ros.ros_time_active = "old_clock" in parts
+    bridge.ros.executor.old_spin = "old_spin" in parts
 
 
 async def ab(kind: str, seconds: float, reps: int, variants: list[str]) -> None:
     from bench.bridge import PATHS, Rig
     from bench.common import generated_package, median
-    from sam_runtime.bridge import Bridge, quiet_late_media_completions
+    from sam_runtime.bridge import quiet_late_media_completions
+    from sam_runtime.bridge.ros_side import RosSide
 
     quiet_late_media_completions(asyncio.get_running_loop())
     gen = generated_package()
     gen.convert()
-    start_ros = Bridge._start_ros
+    open_ros = RosSide._open
 
-    def _start_ros(self: Any, *args: Any) -> None:
-        start_ros(self, *args)
-        self._executor = _SpinSwitch(self._executor)
+    def _open_ros(self: Any) -> None:
+        open_ros(self)
+        self.executor = _SpinSwitch(self.executor)
 
-    Bridge._start_ros = _start_ros  # type: ignore[method-assign]
+    RosSide._open = _open_ros  # type: ignore[method-assign]
     pid = os.getpid()
     rig = (Rig(gen, "udp", "127.0.0.1", "127.0.0.1", None) if kind == "udp"
            else Rig(gen, "can", f"virtual:ab{pid}", f"virtual:ar{pid}", 64))

@@ -109,8 +109,14 @@ def _check(res: dict[str, Any], record: Path) -> None:
 def test_virtual_can_fd_one_process(tmp_path: Path) -> None:
     res = _run_scenario(tmp_path, f"virtual:samfd{os.getpid()}", 64, rate_scale=1.0, duration=3.0, offset=11)
     _check(res, tmp_path / "result.sim.jsonl")
-    # At nominal rates (IMU 100 Hz) for 3 s.
-    assert res["expected"]["/imu"] >= 0.8 * 300
+    # At nominal rates (IMU 100 Hz) for 3 s: the device's schedule had 300 ticks (less the edges); the ones its
+    # event loop was too late for are skipped and counted, never sent in a burst. The device shares this process
+    # with the bridge and the probe, so how many it skips depends on the CPU it gets (up to ~25 % with other
+    # test processes beside it); everything it sent is checked above.
+    imu_dev = res["sim"]["devices"]["imu"]
+    sent, late = imu_dev["published"]["1100"], imu_dev["late"].get("1100", 0)
+    assert sent == res["expected"]["/imu"] and sent + late >= 0.95 * 300, imu_dev
+    assert sent >= 0.5 * 300, imu_dev
 
 
 def test_virtual_classic_can_one_process_from_env_registers(tmp_path: Path) -> None:

@@ -1,4 +1,4 @@
-"""The bridge's ROS -> UAVCAN hand-off and its receive stamps (runtime/bridge.py).
+"""The bridge's ROS -> UAVCAN hand-off and its receive stamps (runtime/bridge/outbound.py, handoff.py).
 
 - hand-off, without ROS or a transport: objects handed off from another thread reach the mapping's bounded
   queue in order, with one wake-up of the asyncio loop per batch, and the same drops (``queue_full``,
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import logging
 import subprocess
 import sys
 import threading
@@ -26,21 +27,24 @@ from helpers.runtime_support import HELPERS, child_env, domain_id, generated_or_
 
 
 # ============================================================================================ hand-off
-def _bridge(queue_size: int) -> tuple[Any, Any]:
-    """An unstarted Bridge with one ROS -> UAVCAN mapping whose converter passes the object through."""
-    from sam_runtime.bridge import Bridge, MappingStats, _OutMapping
+def _outbound(queue_size: int) -> tuple[Any, Any]:
+    """The bridge's ROS -> UAVCAN path, not started, with one mapping whose converter passes the object through
+    (no ROS node, no backend)."""
+    from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+    from sam_runtime.bridge.lifetime import Lifetime
+    from sam_runtime.bridge.outbound import Outbound, OutMapping
 
     gen = generated_or_skip()
-    bridge = Bridge(gen, queue_size=queue_size)
     info = next((m for m in gen.tables().MAPPINGS if m.direction == "ros_to_uavcan"), None)
     if info is None:
         pytest.skip("the spec has no ROS -> UAVCAN mapping")
-    om = _OutMapping(info, lambda msg, stats: msg, MappingStats(threading.Lock(), info.name, bridge.log))
-    return bridge, om
+    lifetime = Lifetime("test", RateLimitedLog(logging.getLogger("test_bridge_handoff")))
+    om = OutMapping(info, lambda msg, stats: msg, MappingStats(threading.Lock(), info.name, lifetime.rlog))
+    return Outbound(lifetime, [om], lambda: True, queue_size=queue_size), om
 
 
 class _CountingLoop:
-    """Counts the bridge's call_soon_threadsafe calls on a real loop (one per wake-up)."""
+    """Counts the hand-off's call_soon_threadsafe calls on a real loop (one per wake-up)."""
 
     def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
         self.loop = loop
@@ -60,20 +64,20 @@ def _drops(om: Any) -> dict[str, int]:
 
 def test_handoff_batch_overflows_like_one_call_per_object() -> None:
     """300 objects handed off while the loop is busy: one wake-up, the first 8 queued in order, 292 queue_full."""
-    bridge, om = _bridge(queue_size=8)
+    out, om = _outbound(queue_size=8)
 
     async def main() -> None:
         loop = asyncio.get_running_loop()
         counting = _CountingLoop(loop)
-        bridge._loop = counting
+        out.handoff.loop = counting
         om.queue = asyncio.Queue(maxsize=8)
-        producer = threading.Thread(target=lambda: [bridge._on_ros([om], i) for i in range(300)])
+        producer = threading.Thread(target=lambda: [out.on_ros([om], i) for i in range(300)])
         producer.start()
         producer.join()  # blocks the loop: every hand-off happens before the first drain
-        assert counting.calls == 1 and len(bridge._handoff) == 300
+        assert counting.calls == 1 and len(out.handoff) == 300
         await asyncio.sleep(0.01)
         assert [om.queue.get_nowait() for _ in range(om.queue.qsize())] == list(range(8))
-        assert counting.calls == 1 and not bridge._handoff and not bridge._handoff_scheduled
+        assert counting.calls == 1 and not len(out.handoff) and not out.handoff.scheduled
 
     asyncio.run(main())
     st = om.stats.snapshot()
@@ -84,13 +88,13 @@ def test_handoff_race_with_the_drain_loses_nothing() -> None:
     """A producer thread and a consuming worker race for 20,000 objects: all arrive, in order, with fewer
     wake-ups than objects, and no drop."""
     n = 20_000
-    bridge, om = _bridge(queue_size=n)
+    out, om = _outbound(queue_size=n)
     got: list[int] = []
 
     async def main() -> None:
         loop = asyncio.get_running_loop()
         counting = _CountingLoop(loop)
-        bridge._loop = counting
+        out.handoff.loop = counting
         om.queue = asyncio.Queue(maxsize=n)
 
         async def worker() -> None:
@@ -100,7 +104,7 @@ def test_handoff_race_with_the_drain_loses_nothing() -> None:
 
         def produce() -> None:
             for i in range(n):
-                bridge._on_ros([om], i)
+                out.on_ros([om], i)
                 if i % 97 == 0:
                     time.sleep(0)  # let the loop drain mid-stream
 
@@ -121,31 +125,31 @@ def test_handoff_race_with_the_drain_loses_nothing() -> None:
 def test_handoff_after_the_loop_closed_counts_shutdown() -> None:
     """A drain scheduled before the loop closed never runs: what it would have taken and every later hand-off
     is counted as shutdown, not left in the deque."""
-    bridge, om = _bridge(queue_size=8)
+    out, om = _outbound(queue_size=8)
     loop = asyncio.new_event_loop()
-    bridge._loop = loop
+    out.handoff.loop = loop
     om.queue = None
-    bridge._on_ros([om], 1)  # schedules a drain on a loop that will never run it
-    bridge._on_ros([om], 2)
-    assert bridge._handoff_scheduled and len(bridge._handoff) == 2
+    out.on_ros([om], 1)  # schedules a drain on a loop that will never run it
+    out.on_ros([om], 2)
+    assert out.handoff.scheduled and len(out.handoff) == 2
     loop.close()
-    bridge._on_ros([om], 3)
-    assert not bridge._handoff
+    out.on_ros([om], 3)
+    assert not len(out.handoff)
     assert om.stats.snapshot()["received"] == 3 and _drops(om) == {"shutdown": 3}
 
 
 def test_a_failing_ros_callback_is_counted_and_never_raises() -> None:
     """A bug inside the hand-off (here: no loop to hand to) must not escape into the rclpy executor, where it
     would also hold back the messages it has queued: counted as handler_error, and the next message goes on."""
-    bridge, om = _bridge(queue_size=8)
-    bridge._loop = None  # _hand_off_ros asserts a loop
-    bridge._on_ros([om], 1)
-    assert _drops(om) == {"handler_error": 1} and bridge._errors["handler_error"] == 1
+    out, om = _outbound(queue_size=8)
+    out.handoff.loop = None  # not started: nothing to hand to
+    out.on_ros([om], 1)
+    assert _drops(om) == {"handler_error": 1} and out.lifetime.errors["handler_error"] == 1
     loop = asyncio.new_event_loop()
     try:
-        bridge._loop = loop
+        out.handoff.loop = loop
         om.queue = asyncio.Queue(maxsize=8)
-        bridge._on_ros([om], 2)
+        out.on_ros([om], 2)
         loop.run_until_complete(asyncio.sleep(0))
         assert om.queue.get_nowait() == 2
     finally:
@@ -155,14 +159,14 @@ def test_a_failing_ros_callback_is_counted_and_never_raises() -> None:
 
 def test_handoff_drained_at_close_counts_shutdown() -> None:
     """What the rclpy thread handed off last, still in the deque when the bridge closes: shutdown."""
-    bridge, om = _bridge(queue_size=8)
+    out, om = _outbound(queue_size=8)
 
     async def main() -> None:
-        bridge._loop = asyncio.get_running_loop()
+        out.handoff.loop = asyncio.get_running_loop()
         om.queue = asyncio.Queue(maxsize=8)
-        bridge._on_ros([om], 1)
-        bridge._closed = True
-        bridge._drain_handoff()
+        out.on_ros([om], 1)
+        out.lifetime.closed = True
+        out.handoff.drain()
 
     asyncio.run(main())
     assert _drops(om) == {"shutdown": 1}

@@ -56,7 +56,7 @@ def check_parameters(bridge: Any) -> dict[str, Any]:
 
     from sam_runtime.bridge import ros_parameter_name
 
-    node = bridge._ros_node
+    node = bridge.ros.node
     out: dict[str, Any] = {"declared": {}, "sets": []}
     for p in bridge.tables.PARAMETERS:
         name = ros_parameter_name(p.name)

@@ -459,6 +459,10 @@ async def main_can(args: argparse.Namespace) -> dict[str, Any]:
         await wait_for(lambda: all(d["alive"] for d in bridge.stats()["devices"].values()), 10, "heartbeats")
         await wait_for(lambda: all(probe.level(f"{BRIDGE}/device/{d.name}") == 0 for d in tables.DEVICES), 5,
                        "every device OK on /diagnostics")
+        # The baseline of the phases: every device OK on /diagnostics. What the probe saw before it depends on
+        # when its subscription matched: a /diagnostics message published before a device's first heartbeat
+        # reached the bridge rightly shows that device STALE (never heard).
+        result["diag_events_baseline"] = len(probe.diag_events)
         sim.start_publishing()
         lag = LoopLag()
         phases: dict[str, Any] = {}

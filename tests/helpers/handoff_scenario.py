@@ -126,10 +126,10 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
             after = time.time_ns()
             st = probe.imu[n].header.stamp
             return {"stamp_ns": st.sec * 1_000_000_000 + st.nanosec, "before_ns": before, "after_ns": after,
-                    "ros_time_active": bridge._ros_time_active}
+                    "ros_time_active": bridge.ros.ros_time_active}
 
         stamps = {"system": await stamp("system")}
-        res = bridge._ros_node.set_parameters([Parameter("use_sim_time", value=True)])[0]
+        res = bridge.ros.node.set_parameters([Parameter("use_sim_time", value=True)])[0]
         assert res.successful, res.reason
         from rosgraph_msgs.msg import Clock
 
@@ -139,11 +139,11 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
 
         def on_clock() -> bool:
             probe.clock_pub.publish(clock)  # again until it is there (the /clock subscription may be best effort)
-            return bool(bridge._clock.now().nanoseconds == SIM_CLOCK_NS)
+            return bool(bridge.ros.clock.now().nanoseconds == SIM_CLOCK_NS)
 
         await wait_for(on_clock, 10, "the bridge on /clock")
         stamps["sim"] = await stamp("sim") | {"clock_ns": SIM_CLOCK_NS}
-        res = bridge._ros_node.set_parameters([Parameter("use_sim_time", value=False)])[0]
+        res = bridge.ros.node.set_parameters([Parameter("use_sim_time", value=False)])[0]
         assert res.successful, res.reason
         stamps["system_again"] = await stamp("system again")
         result["stamps"] = stamps

@@ -1,7 +1,8 @@
-"""A slow ROS subscriber in its own process, for tests/test_faults.py: subscribes to a sensor_msgs/Imu topic
-(reliable, keep-last DEPTH) and sleeps SLEEP seconds in every callback.
+"""A slow ROS subscriber in its own process, for tests/test_faults.py: subscribes to a bridged topic with the
+spec's QoS (reliability and durability of the generated tables, as any ROS node of the vehicle would; keep-last
+DEPTH) and sleeps SLEEP seconds in every callback.
 
-python slow_subscriber.py --topic /imu --sleep 0.1 --depth 10 --out OUT.json
+python slow_subscriber.py --topic /imu --sleep 0.1 --depth 10 --out OUT.json   (SAM_GENERATED_DIR or --generated)
 Prints READY once the topic has a publisher, then ``COUNT n`` (messages received so far) every 0.2 s; writes
 OUT.json ({"received": n, "slept_s": s}) at SIGTERM.
 """
@@ -26,26 +27,32 @@ def main() -> int:
     p.add_argument("--sleep", type=float, default=0.1)
     p.add_argument("--depth", type=int, default=10)
     p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--generated", type=Path, default=None, help="default: SAM_GENERATED_DIR or the project's")
     p.add_argument("--discovery-timeout", type=float, default=20.0)
     args = p.parse_args()
 
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
-    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-    from sensor_msgs.msg import Imu
 
+    from sam_runtime.genpkg import GeneratedPackage
+    from sam_runtime.node_support import qos_profile
+
+    gen = GeneratedPackage() if args.generated is None else GeneratedPackage(args.generated)
+    topic = next((m.topic for m in gen.tables().MAPPINGS if m.topic.name == args.topic), None)
+    if topic is None:
+        raise SystemExit(f"{args.topic} is no bridged topic of the generated tables")
     rclpy.init(args=[])
     node = Node("test_slow_subscriber")
     state = {"received": 0, "slept_s": 0.0}
 
-    def cb(msg: Imu) -> None:
+    def cb(msg: object) -> None:
         state["received"] += 1
         time.sleep(args.sleep)
         state["slept_s"] += args.sleep
 
-    qos = QoSProfile(depth=args.depth, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
-    node.create_subscription(Imu, args.topic, cb, qos)
+    node.create_subscription(gen.ros_class(topic), args.topic, cb,
+                             qos_profile(topic.qos.reliability, topic.qos.durability, args.depth))
     stop: list[int] = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     signal.signal(signal.SIGINT, lambda *_: stop.append(1))

@@ -1,0 +1,155 @@
+"""What the protocol-agnostic core asks of a protocol backend (Cyphal v1 through pycyphal, DroneCAN through the
+``dronecan`` package), and the events a backend reports.
+
+Threads: the core calls a backend only on the asyncio loop, and a backend calls the core's handlers only there
+(pycyphal's subscribers run in it; a dronecan Node is driven in it by ``sam_runtime.dronecan_io.NodeLoop``).
+
+Ports are declared before :meth:`Backend.open` and live across reopenings: ``subscribe`` and ``advertise`` return
+handles whose underlying protocol objects the backend (re)creates at every ``open`` and drops at ``close``; a
+backend whose link failed is closed and opened again by the core (``sam_runtime.bridge.link``), with back-off,
+without the core declaring anything again.
+
+- UAVCAN -> ROS: ``handler(msg, source_node_id, transfer_id, monotonic_s)`` for every transfer of a subscribed
+  port, from any source (the core filters sources and counts the gaps in transfer ids: ``transfer_id_modulo``).
+  Plain arguments, no object per transfer: this is the hot path.
+- ROS -> UAVCAN: ``await outlet.publish(obj)`` -> True when sent, False when not every frame was sent in time;
+  raises on a transport error (counted by the core), :class:`LinkDownError` when the port is not open.
+- Device health: ``on_device_status(handler)``; the handler gets a :class:`DeviceStatus` for every heartbeat
+  (Cyphal ``uavcan.node.Heartbeat``, DroneCAN ``uavcan.protocol.NodeStatus``) of any node. The core keeps the
+  records, the offline timeouts and the restarts (``sam_runtime.bridge.health``).
+- Link: ``link_problem()`` says why the link must be reopened (a dead transport), polled by the core.
+- Counters below the bridge (frames and transfers the protocol stack discarded): ``poll_statistics()``, then
+  ``inlet.below`` per port.
+"""
+
+from __future__ import annotations
+
+import abc
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Backend", "BelowBridge", "BridgeConfigError", "DeviceStatus", "Inlet", "LinkDownError", "Outlet",
+           "TransferHandler"]
+
+TransferHandler = Callable[[Any, "int | None", int, float], None]
+
+
+class BridgeConfigError(Exception):
+    """The generated tables, the transport or the parameters do not allow the bridge to start."""
+
+
+class LinkDownError(Exception):
+    """A port used while the backend's link is not open."""
+
+
+@dataclass(frozen=True)
+class DeviceStatus:
+    """One heartbeat of a node, in the protocol's own words, with what it means for /diagnostics."""
+
+    node_id: int
+    health: str  # e.g. NOMINAL (Cyphal), OK (DroneCAN)
+    level: int  # what the health means on /diagnostics: 0 OK, 1 WARN, 2 ERROR
+    mode: str  # e.g. OPERATIONAL
+    uptime_s: int
+    vssc: int  # vendor-specific status code
+
+
+class BelowBridge:
+    """A subscribed port's counters of the protocol stack, cumulative across reopenings: ``totals`` (transfers,
+    frames, errors, drops, deserialization_failures, overruns: whatever the stack counts), ``error_kinds`` (the
+    stack's breakdown of its errors), and when it last discarded something. Thread-safe."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._totals: dict[str, int] = {}
+        self._kinds: dict[str, int] = {}
+        self._last_problem: float | None = None
+
+    def count(self, key: str, delta: int, problem: bool) -> None:
+        with self._lock:
+            self._totals[key] = self._totals.get(key, 0) + delta
+            if problem:
+                self._last_problem = time.monotonic()
+
+    def count_kind(self, kind: str, delta: int) -> None:
+        with self._lock:
+            self._kinds[kind] = self._kinds.get(kind, 0) + delta
+
+    def snapshot(self) -> tuple[dict[str, int], dict[str, int], float | None]:
+        """(totals, error kinds, monotonic time of the last problem or None)."""
+        with self._lock:
+            return dict(self._totals), dict(self._kinds), self._last_problem
+
+
+class Inlet(abc.ABC):
+    """A subscribed port (handle): its name for registers and reports, the port id it listens on once open."""
+
+    port_name: str  # e.g. uavcan.sub.imu
+    port_id: int | None  # the subject (Cyphal) or data type id (DroneCAN) it listens on; None before open
+    below: BelowBridge
+
+
+class Outlet(abc.ABC):
+    """An advertised port (handle)."""
+
+    port_name: str  # e.g. uavcan.pub.thruster_1_rpm
+    port_id: int | None
+    send_timeout: float  # seconds a publish may take before it counts as not sent
+
+    @property
+    @abc.abstractmethod
+    def ready(self) -> bool:
+        """Whether the port is open (the link is up)."""
+
+    @abc.abstractmethod
+    async def publish(self, obj: Any) -> bool:
+        """Send ``obj``: True when every frame went out within ``send_timeout``."""
+
+
+class Backend(abc.ABC):
+    """One protocol stack and its node on one bus."""
+
+    protocol: str = ""  # key of its counters in the reports ("cyphal", "dronecan")
+    label: str = ""  # for messages ("Cyphal", "DroneCAN")
+    stack: str = ""  # what discards frames below the bridge ("pycyphal", "dronecan")
+    node_id: int
+
+    @abc.abstractmethod
+    def describe(self) -> str:
+        """The transport, for logs and reports (``udp:127.0.0.1``)."""
+
+    @abc.abstractmethod
+    def subscribe(self, name: str, port_id: int, dtype: Any, handler: TransferHandler) -> Inlet:
+        """Declare a subscription (before open): ``name`` for registers/reports, the spec's port id."""
+
+    @abc.abstractmethod
+    def advertise(self, name: str, port_id: int, dtype: Any) -> Outlet:
+        """Declare a publication (before open)."""
+
+    @abc.abstractmethod
+    def on_device_status(self, handler: Callable[[DeviceStatus], None]) -> None:
+        """Call ``handler`` for every heartbeat of any node (declare before open)."""
+
+    @abc.abstractmethod
+    async def open(self) -> None:
+        """Open the node and every declared port; raise (BridgeConfigError for a configuration problem) when it
+        cannot. Called again after :meth:`close` when the link failed."""
+
+    @abc.abstractmethod
+    async def close(self) -> None:
+        """Close every port and the node; never raises."""
+
+    @abc.abstractmethod
+    def link_problem(self) -> str | None:
+        """Why the open link must be reopened (its transport died), or None."""
+
+    @property
+    @abc.abstractmethod
+    def transfer_id_modulo(self) -> int:
+        """Transfer ids of a source wrap at this value (Cyphal/UDP 2**64, Cyphal/CAN and DroneCAN 32)."""
+
+    def poll_statistics(self) -> None:  # noqa: B027  (optional: a stack without counters has nothing to poll)
+        """Bring every inlet's ``below`` up to date (thread-safe; logs what was discarded at a bounded rate)."""

@@ -1,0 +1,177 @@
+"""The composition root: the bridge's parts created, wired through their handlers, and attached to its lifetime in
+start order (ROS node, device health, UAVCAN -> ROS, ROS -> UAVCAN, the link that opens the backend, /diagnostics,
+the rclpy executor thread); they close in reverse order."""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from sam_runtime.genpkg import GeneratedPackage
+
+from .counters import DEFAULT_LOG_INTERVAL_S, MappingStats, RateLimitedLog, log
+from .cyphal_backend import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig, quiet_late_media_completions
+from .health import DeviceHealth
+from .inbound import Inbound
+from .lifetime import Lifetime
+from .link import LinkSupervisor
+from .loss import TransferLoss
+from .outbound import DEFAULT_QUEUE_SIZE, Outbound
+from .reporting import Reporter
+from .ros_side import RosSide
+from .silence import SilenceWatch
+from .wiring import check_destinations, in_groups, nominal_rates, out_mappings
+
+__all__ = ["Bridge"]
+
+HOUSEKEEPING_PERIOD_S = 0.2
+
+
+class Bridge:
+    """The bridge. Create it, then inside a running asyncio loop ``await start()``; ``await close()`` to stop.
+
+    :param gen: the generated package (tables + converters).
+    :param node_id: Cyphal node id; default ``UAVCAN__NODE__ID`` for an ``env`` transport, else the spec's
+        bridge node id.
+    :param transport: see :class:`~.cyphal_backend.TransportConfig`.
+    :param ros_args: extra ROS arguments (``--ros-args ...``) for rclpy.init, e.g. remappings.
+    :param parameter_overrides: initial values of the spec's parameters, by spec or ROS name.
+    :param qos_depth: history depth of the ROS publishers and subscriptions (keep-last); default: each topic's
+        from the spec (its ``qos``, like reliability and durability).
+    :param command_reliability: ``reliable`` or ``best_effort`` for the ROS command subscriptions; default: the
+        topic's from the spec.
+    :param diagnostics_period: seconds between /diagnostics messages (0 disables them).
+    :param queue_size: bound of each ROS -> UAVCAN mapping's publish queue (beyond: ``queue_full``).
+    :param rx_queue_size: bound of each subject's pycyphal receive queue (beyond: ``overrun``); 0 = unbounded.
+    :param log_interval: seconds between two log lines of one (mapping, reason); the first is immediate.
+    """
+
+    def __init__(
+        self,
+        gen: GeneratedPackage,
+        *,
+        node_id: int | None = None,
+        transport: TransportConfig | None = None,
+        ros_args: Sequence[str] = (),
+        parameter_overrides: Mapping[str, Any] | None = None,
+        qos_depth: int | None = None,
+        queue_size: int = DEFAULT_QUEUE_SIZE,
+        command_reliability: str | None = None,
+        diagnostics_period: float = 1.0,
+        rx_queue_size: int = DEFAULT_RX_QUEUE_SIZE,
+        log_interval: float = DEFAULT_LOG_INTERVAL_S,
+    ) -> None:
+        self.gen = gen
+        self.tables = tables = gen.tables()
+        self.transport_config = transport or TransportConfig()
+        self.node_id = self.transport_config.node_id(tables.BRIDGE_NODE_ID) if node_id is None else int(node_id)
+        self.log = RateLimitedLog(log, log_interval)
+        self.lifetime = Lifetime(self.name, self.log)
+        lock = threading.Lock()
+        self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in tables.MAPPINGS}
+        self.backend = CyphalBackend(f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.transport_config,
+                                     rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
+        self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
+                           rules=getattr(tables, "PARAMETER_RULES", ()), overrides=parameter_overrides,
+                           qos_depth=qos_depth, command_reliability=command_reliability)
+        self.health = DeviceHealth({d.node_id: d.name for d in tables.DEVICES}, self.node_id)
+        self.backend.on_device_status(self.health.on_status)
+        self.link = LinkSupervisor(self.lifetime, self.backend)
+        self._queue_size = int(queue_size)
+        self._diagnostics_period = float(diagnostics_period)
+        self.inbound: Inbound | None = None
+        self.outbound: Outbound | None = None
+        self.reporter: Reporter | None = None
+
+    @property
+    def name(self) -> str:
+        return str(self.tables.BRIDGE_NAME)
+
+    async def start(self) -> None:
+        """Import the converters, assemble the parts, start them in order."""
+        if self.lifetime.loop is not None or self.inbound is not None:
+            raise RuntimeError("Bridge.start() called twice")
+        quiet_late_media_completions(asyncio.get_running_loop())
+        convert = self.gen.convert()  # compiles the DSDL first (before uavcan/pycyphal.application)
+        try:
+            self._assemble(convert)
+        except BaseException:
+            await self.lifetime.close()
+            raise
+        await self.lifetime.start()
+        assert self.inbound is not None and self.outbound is not None
+        log.info("%s started: %s node %d on %s, %d UAVCAN->ROS and %d ROS->UAVCAN mappings", self.name,
+                 self.backend.label, self.node_id, self.backend.describe(),
+                 sum(len(g.mappings) for g in self.inbound.groups.values()), len(self.outbound.mappings))
+
+    def _assemble(self, convert: Any) -> None:
+        tables, lifetime, backend, health, link = self.tables, self.lifetime, self.backend, self.health, self.link
+        check_destinations(tables)
+        rates = nominal_rates(tables)
+
+        def loss(port_id: int) -> TransferLoss:
+            return TransferLoss(port_id, rates, lambda: backend.transfer_id_modulo, health.uptime_of,
+                                lambda: link.outage_windows, self._forget_stamps)
+
+        self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss), self.ros, backend)
+        self.outbound = outbound = Outbound(lifetime, out_mappings(self.gen, convert, self.counters),
+                                            lambda: link.up, queue_size=self._queue_size, ros=self.ros,
+                                            backend=backend)
+        silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in tables.MAPPINGS
+                                if m.direction == "uavcan_to_ros"], health.devices,
+                               alive_since=health.alive_since, last_message=inbound.last_message,
+                               listening_since=lambda: link.up_since)
+        self.reporter = reporter = Reporter(
+            lifetime, self.name, tables.MAPPINGS, self.counters, backend=backend, health=health, link=link,
+            inbound=inbound, outbound=outbound, silence=silence, ros=self.ros, period=self._diagnostics_period)
+        health.add_handler(self._on_health)
+        link.add_handler(lambda _event: reporter.publish_now())
+        silence.add_handler(reporter.publish_now)
+
+        self.ros.attach()
+        health.attach(lifetime)
+        inbound.attach()
+        outbound.attach()
+        lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
+        silence.attach(lifetime)
+        lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
+        link.attach()
+        reporter.attach()
+        self.ros.attach_spinner()
+
+    def _on_health(self, nid: int, event: str, device: bool) -> None:
+        if event == "restarted":
+            self._forget_stamps(nid)  # its clock may have restarted: its next stamp is no out_of_order
+        elif device:
+            assert self.reporter is not None
+            self.reporter.publish_now()  # a device lost or back: at once, not at the next period
+
+    def _forget_stamps(self, nid: int) -> None:
+        if self.inbound is not None:
+            self.inbound.forget_stamps(nid)
+
+    def stats(self) -> dict[str, Any]:
+        """A JSON-serialisable snapshot of every counter, the devices' heartbeats and the bridge itself."""
+        if self.reporter is None:
+            raise RuntimeError("start() the bridge first")
+        return self.reporter.snapshot()
+
+    def diagnostics_message(self) -> Any:
+        """The /diagnostics message now (diagnostic_msgs/DiagnosticArray)."""
+        if self.reporter is None:
+            raise RuntimeError("start() the bridge first")
+        return self.reporter.diagnostics_message()
+
+    async def close(self) -> None:
+        """Stop the ROS half first (no more hand-offs), then the backend's ports and node, then the ROS node."""
+        await self.lifetime.close()
+
+    async def __aenter__(self) -> Bridge:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self.close()
+

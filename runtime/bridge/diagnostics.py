@@ -1,0 +1,108 @@
+"""The bridge's stats snapshot as diagnostic_msgs/DiagnosticArray: one status for the bridge (ERROR while its link
+is down), one per mapping (received, published, dropped and dropped.<reason>, saturated and saturated.<field>,
+rejected.<field>, out_of_order, the protocol stack's counters; WARN while it dropped within the last 10 s, or while
+it gets nothing from a device whose heartbeat is alive for longer than its grace: sam_runtime.liveness), one per
+device (OK while its heartbeat is alive and its health means OK, WARN or ERROR as its health says, ERROR when the
+heartbeat is lost, STALE when never seen)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "diagnostic_array"]
+
+RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
+_PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
+
+
+@dataclass(frozen=True)
+class Naming:
+    """How the statuses are named: ``bridge`` (the bridge's status name), ``protocol`` (the key of the stack's
+    counters: ``cyphal``), ``label`` (``Cyphal``), ``stack`` (``pycyphal``)."""
+
+    bridge: str
+    protocol: str
+    label: str
+    stack: str
+
+
+def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any:
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+
+    arr = DiagnosticArray()
+    arr.header.stamp = stamp
+    ok, warn, err, stale = (bytes([v]) for v in (0, 1, 2, 3))
+    proto = naming.protocol
+
+    def kv(values: Mapping[str, Any]) -> list[Any]:
+        return [KeyValue(key=str(k), value=str(v)) for k, v in values.items()]
+
+    b = snap["bridge"]
+    link = b["link"]
+    total_drop = sum(m["dropped_total"] for m in snap["mappings"].values())
+    bmsg = f"{len(snap['mappings'])} mappings, {total_drop} dropped"
+    if not link["up"]:
+        bmsg = f"{naming.label} link {link['state']}; " + bmsg
+    arr.status.append(DiagnosticStatus(
+        level=ok if link["up"] else err, name=naming.bridge, hardware_id=f"{proto} node {b['node_id']}",
+        message=bmsg,
+        values=kv({"node_id": b["node_id"], "transport": b["transport"], "uptime_s": b["uptime_s"],
+                   "dropped_total": total_drop, "link_up": link["up"], "link_state": link["state"],
+                   "link_outages": link["outages"], "link_down_s": link["down_s"],
+                   **{f"error.{k}": v for k, v in sorted(b["errors"].items())}}),
+    ))
+    for name, m in snap["mappings"].items():
+        values: dict[str, Any] = {
+            "direction": m["direction"], "topic": m["topic"], "subject_id": m["subject_id"], "port": m["port"],
+            "received": m["received"], "published": m["published"], "dropped": m["dropped_total"],
+        }
+        values.update({f"dropped.{k}": v for k, v in sorted(m["dropped"].items())})
+        values["saturated"] = m["saturated_total"]
+        values.update({f"saturated.{k}": v for k, v in sorted(m["saturated"].items())})
+        values.update({f"rejected.{k}": v for k, v in sorted(m["rejected_fields"].items())})
+        values["out_of_order"] = m["out_of_order"]
+        below = dict(m.get(proto) or {})
+        kinds = below.pop("error_kinds", {})
+        problem_age = below.pop("last_problem_age_s", None)
+        values.update({f"{proto}.{k}": v for k, v in below.items()})
+        values.update({f"{proto}.error.{k}": v for k, v in sorted(kinds.items())})
+        recent = any(age is not None and age < RECENT_DROP_WINDOW_S for age in (m["last_drop_age_s"], problem_age))
+        level = warn if recent else ok
+        if m["dropped_total"]:
+            parts = ", ".join(f"{k} {v}" for k, v in sorted(m["dropped"].items()))
+            msg = f"{m['dropped_total']} dropped ({parts})" + (
+                f", the last {m['last_drop_age_s']:.0f} s ago" if m["last_drop_age_s"] is not None else "")
+        else:
+            msg = "ok"
+        if m["saturated_total"]:
+            msg += f", {m['saturated_total']} values saturated"
+        bad = sum(int(below.get(k, 0)) for k in _PROBLEMS)
+        if bad:
+            msg += f", {bad} frames/transfers discarded by {naming.stack}"
+        live = m.get("liveness")
+        if live is not None:
+            values["liveness"] = live["state"]
+            if live["state"] != "ok":  # silent while its device is alive (sam_runtime.liveness)
+                level = warn
+                msg = live["message"] + ("" if msg == "ok" else f"; {msg}")
+                values.update(silent_s=live["silent_s"], grace_s=live["grace_s"],
+                              nominal_rate_hz=live["nominal_rate_hz"])
+        arr.status.append(DiagnosticStatus(
+            level=level, name=f"{naming.bridge}/mapping/{name}", hardware_id=f"subject {m['subject_id']}",
+            message=msg, values=kv(values)))
+    for name, d in snap["devices"].items():
+        if not d["seen"]:
+            level, msg = stale, "no heartbeat yet"
+        elif not d["alive"]:
+            level, msg = err, f"heartbeat lost: none for {d['age_s']:.1f} s"
+            if not link["up"]:
+                msg += f" (the bridge's {naming.label} link is down)"
+        else:
+            level = (ok, warn, err)[min(max(int(d["level"]), 0), 2)]
+            msg = f"{d['health']} {d['mode']}"
+        arr.status.append(DiagnosticStatus(
+            level=level, name=f"{naming.bridge}/device/{name}", hardware_id=f"{proto} node {d['node_id']}",
+            message=msg, values=kv({k: v for k, v in d.items() if k not in ("seen", "level")})))
+    return arr

@@ -1,0 +1,160 @@
+"""The UAVCAN -> ROS path, on the asyncio loop: every transfer of a subscribed port is checked against each of the
+port's mappings' accepted source node ids, its transfer-id gaps are counted (:mod:`.loss`), and it is converted
+(``<mapping>_to_ros``, receive time from the ROS clock) and published to ROS at once (rclpy's publish is
+thread-safe).
+
+Several mappings may share one port (one subscription): each gets every transfer and counts it. Drops per mapping:
+``unknown_source``, ``lost`` / ``lost_link_down`` (counted when the next transfer of the source arrives),
+``convert_error``, ``rejected``, ``publish_error``, ``handler_error`` (a bug in this path; never raised into the
+backend's receive loop).
+
+Stamps: a device stamp of 0 (unknown) becomes the receive time; an empty frame id the mapping's; a stamp older than
+the previous one of the same source on the same mapping is published anyway, in arrival order, and counted as
+``out_of_order``. A source that restarted (:meth:`Inbound.forget_stamps`) may have restarted its clock: its next
+stamp is compared with nothing.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from .backend import Backend, Inlet
+from .counters import MappingStats, count_handler_error
+from .lifetime import Lifetime
+from .loss import TransferLoss
+
+__all__ = ["InMapping", "Inbound", "PortGroup"]
+
+
+@dataclass
+class InMapping:
+    """A UAVCAN -> ROS mapping at run time."""
+
+    info: Any
+    to_ros: Callable[..., Any]
+    stats: MappingStats
+    ros_cls: Any = None  # the topic's ROS message class
+    ros_publisher: Any = None
+    has_header: bool = False
+    last_stamp_ns: dict[int, int] = field(default_factory=dict)  # per source: stamp of the last published message
+
+
+@dataclass
+class PortGroup:
+    """The mappings of one subscribed port."""
+
+    port_id: int  # the spec's
+    port_name: str  # for registers and reports (its first mapping's name)
+    dtype: Any
+    mappings: list[InMapping]
+    loss: TransferLoss
+    accepted_sources: frozenset[int] = frozenset()
+    inlet: Inlet | None = None
+
+
+class Inbound:
+    """:param ros: gives the ROS publishers (``ros.publisher(topic, cls)``) and the receive time (``ros.receive_ns()``:
+        nanoseconds of the node's clock) once the bridge starts.
+    :param backend: subscribes each group's port when the bridge starts."""
+
+    def __init__(self, lifetime: Lifetime, groups: Sequence[PortGroup], ros: Any, backend: Backend) -> None:
+        self.lifetime = lifetime
+        self._ros, self._backend = ros, backend
+        self.groups = {g.port_id: g for g in groups}
+        for g in groups:
+            g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
+        self._receive_ns: Callable[[], int] = ros.receive_ns
+        self._group_of = {im.info.name: g for g in groups for im in g.mappings}
+
+    def attach(self) -> None:
+        """The ROS publishers and the backend's subscriptions when the bridge starts (before the backend opens)."""
+        self.lifetime.add_hooks("UAVCAN -> ROS", start=self._start)
+
+    def _start(self) -> None:
+        for group in self.groups.values():
+            for im in group.mappings:
+                im.ros_publisher = self._ros.publisher(im.info.topic, im.ros_cls)
+            group.inlet = self._backend.subscribe(group.port_name, group.port_id, group.dtype, self.handler(group))
+
+    def group_of(self, mapping: str) -> PortGroup | None:
+        return self._group_of.get(mapping)
+
+    def handler(self, group: PortGroup) -> Callable[[Any, int | None, int, float], None]:
+        """The backend's transfer handler of ``group``'s port."""
+
+        def on_transfer(msg: Any, src: int | None, transfer_id: int, monotonic_s: float) -> None:
+            try:
+                self._bridge_transfer(group, msg, src, transfer_id, monotonic_s)
+            except Exception as ex:  # a bug: counted and logged, the receive loop goes on
+                count_handler_error([im.stats for im in group.mappings], f"subject {group.port_id}", ex,
+                                    self.lifetime.errors, self.lifetime.rlog)
+
+        return on_transfer
+
+    def forget_stamps(self, nid: int) -> None:
+        """``nid`` restarted: its next stamps are compared with nothing."""
+        for group in self.groups.values():
+            for im in group.mappings:
+                im.last_stamp_ns.pop(nid, None)
+
+    def last_message(self, mapping: str, nid: int) -> float | None:
+        """When the last transfer of ``nid`` arrived on the port of ``mapping`` (monotonic s)."""
+        group = self._group_of.get(mapping)
+        return None if group is None else group.loss.last_message(nid)
+
+    def _bridge_transfer(self, group: PortGroup, msg: Any, src: int | None, tid: int, now: float) -> None:
+        rlog = self.lifetime.rlog
+        receive_ns: int | None = None
+        lost, lost_est = group.loss.track(src, tid, now) if src in group.accepted_sources else (0, 0)
+        for im in group.mappings:
+            st = im.stats
+            st.receive()
+            name = im.info.name
+            if src is None or src not in im.info.source_node_ids:
+                st.drop("unknown_source")
+                rlog.note((name, "unknown_source"), logging.WARNING,
+                          "dropped a transfer from node %s (accepted: %s)", src, sorted(im.info.source_node_ids))
+                continue
+            if lost:
+                st.drop("lost", lost)
+                rlog.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "
+                          "(transfer id gap before %d)", lost, src, tid, count=lost)
+            if lost_est:
+                st.drop("lost_link_down", lost_est)
+                rlog.note((name, "lost_link_down"), logging.WARNING, "about %d transfers from node %s missed "
+                          "while the link was down (estimated from the nominal rate)", lost_est, src, count=lost_est)
+            if receive_ns is None:
+                receive_ns = self._receive_ns()
+            try:
+                ros_msg = im.to_ros(msg, receive_ns, st)
+            except Exception as ex:
+                st.drop("convert_error")
+                rlog.note((name, "convert_error"), logging.ERROR, "conversion failed: %s: %s", type(ex).__name__, ex)
+                continue
+            if ros_msg is None:
+                st.drop("rejected")
+                continue
+            if im.has_header:
+                hdr = ros_msg.header
+                if not hdr.frame_id and im.info.frame_id:
+                    hdr.frame_id = im.info.frame_id
+                if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
+                    hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
+                stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec
+                last = im.last_stamp_ns.get(src)
+                im.last_stamp_ns[src] = stamp
+                if last is not None and stamp < last:  # published anyway, in arrival order (see the docstring)
+                    st.reorder()
+                    rlog.note((name, "out_of_order"), logging.WARNING,
+                              "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
+                              src, stamp * 1e-9, last * 1e-9)
+            try:
+                im.ros_publisher.publish(ros_msg)
+            except Exception as ex:
+                st.drop("publish_error")
+                rlog.note((name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s", type(ex).__name__, ex)
+                continue
+            st.publish()

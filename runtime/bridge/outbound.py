@@ -1,0 +1,157 @@
+"""The ROS -> UAVCAN path: a ROS message of a command topic, converted in the rclpy executor thread by each of the
+topic's mappings (``<mapping>_to_uavcan``), handed to the asyncio loop (:mod:`.handoff`), queued per mapping in a
+bounded queue, and published in order by one worker task per mapping on its backend port.
+
+Every message that is not published is counted once per mapping: ``convert_error``, ``rejected``, ``queue_full``
+(the bounded queue), ``link_down`` (the backend's link is being reopened), ``publish_error`` (the send raised),
+``not_sent`` (not every frame within the port's send timeout), ``shutdown`` (the bridge was closing),
+``handler_error`` (a bug in this path). Nothing raises into the rclpy executor: an exception out of a callback
+would also leave the EventsExecutor's queued messages waiting for the next one.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from .backend import Backend, LinkDownError, Outlet
+from .counters import MappingStats, count_handler_error, log
+from .handoff import Handoff
+from .lifetime import Lifetime, cancel_and_wait
+
+__all__ = ["DEFAULT_QUEUE_SIZE", "OutMapping", "Outbound"]
+
+DEFAULT_QUEUE_SIZE = 256
+
+
+@dataclass
+class OutMapping:
+    """A ROS -> UAVCAN mapping at run time."""
+
+    info: Any
+    to_uavcan: Callable[..., Any]
+    stats: MappingStats
+    ros_cls: Any = None  # the topic's ROS message class
+    dtype: Any = None  # the port's DSDL class
+    outlet: Outlet | None = None
+    queue: asyncio.Queue[Any] | None = None
+    worker: asyncio.Task[None] | None = None
+
+
+class Outbound:
+    """:param link_up: whether the backend's link is up now.
+    :param ros: subscribes the command topics when the bridge starts (``ros.subscribe(topic, cls, callback)``).
+    :param backend: advertises each mapping's port when the bridge starts; its ``label`` names it in log lines.
+
+    Without ``ros`` and ``backend`` (tests), set ``handoff.loop``, the queues and the outlets yourself."""
+
+    def __init__(self, lifetime: Lifetime, mappings: Sequence[OutMapping], link_up: Callable[[], bool], *,
+                 queue_size: int = DEFAULT_QUEUE_SIZE, ros: Any = None, backend: Backend | None = None) -> None:
+        self.lifetime = lifetime
+        self.mappings = {om.info.name: om for om in mappings}
+        self.by_topic: dict[str, list[OutMapping]] = {}
+        for om in mappings:
+            self.by_topic.setdefault(om.info.topic.name, []).append(om)
+        self._link_up = link_up
+        self.queue_size = int(queue_size)
+        self._ros, self._backend = ros, backend
+        self.label = backend.label if backend is not None else "UAVCAN"
+        self.handoff: Handoff[OutMapping] = Handoff(self._enqueue, lambda om, _obj: om.stats.drop("shutdown"))
+
+    def attach(self) -> None:
+        """Subscribe the command topics, advertise the ports, start the workers when the bridge starts (before the
+        backend opens); hand nothing on once it closes."""
+        self.lifetime.add_hooks("ROS -> UAVCAN", start=self._start, close=self._close)
+
+    def _start(self) -> None:
+        if self._backend is not None:
+            for om in self.mappings.values():
+                om.outlet = self._backend.advertise(om.info.name, om.info.port.subject_id, om.dtype)
+        if self._ros is not None:
+            for oms in self.by_topic.values():
+                self._ros.subscribe(oms[0].info.topic, oms[0].ros_cls, lambda msg, oms=oms: self.on_ros(oms, msg))
+        self.handoff.loop = self.lifetime.loop
+        for om in self.mappings.values():
+            om.queue = asyncio.Queue(maxsize=self.queue_size)
+            om.worker = asyncio.create_task(self._worker(om), name=f"bridge-out-{om.info.name}")
+
+    async def _close(self) -> None:
+        self.handoff.drain()  # what the rclpy thread handed off last: counted as shutdown (see _enqueue)
+        stuck = await cancel_and_wait([om.worker for om in self.mappings.values() if om.worker is not None])
+        if stuck:
+            log.warning("%d bridge tasks did not stop", len(stuck))
+
+    # -------------------------------------------------------------------------------------------- rclpy thread
+    def on_ros(self, oms: Sequence[OutMapping], msg: Any) -> None:
+        """Every message of a command topic (``oms``: the topic's mappings). Never raises."""
+        try:
+            self._convert_and_hand_off(oms, msg)
+        except Exception as ex:  # a bug: counted and logged, the executor goes on
+            count_handler_error([om.stats for om in oms], f"topic {oms[0].info.topic.name if oms else '?'}", ex,
+                                self.lifetime.errors, self.lifetime.rlog)
+
+    def _convert_and_hand_off(self, oms: Sequence[OutMapping], msg: Any) -> None:
+        rlog = self.lifetime.rlog
+        for om in oms:
+            st = om.stats
+            st.receive()
+            try:
+                obj = om.to_uavcan(msg, st)
+            except Exception as ex:
+                st.drop("convert_error")
+                rlog.note((om.info.name, "convert_error"), logging.ERROR, "conversion failed: %s: %s",
+                          type(ex).__name__, ex)
+                continue
+            if obj is None:
+                st.drop("rejected")
+                continue
+            self.handoff.put(om, obj)
+
+    # -------------------------------------------------------------------------------------------- asyncio loop
+    def _enqueue(self, om: OutMapping, obj: Any) -> None:
+        """Queue for the mapping's worker (keeps the order, bounds the backlog)."""
+        if om.queue is None or self.lifetime.closed:
+            om.stats.drop("shutdown")
+            return
+        try:
+            om.queue.put_nowait(obj)
+        except asyncio.QueueFull:
+            om.stats.drop("queue_full")
+            self.lifetime.rlog.note((om.info.name, "queue_full"), logging.WARNING,
+                                    "%s publish queue full (%d): dropping", self.label, self.queue_size)
+
+    async def _worker(self, om: OutMapping) -> None:
+        assert om.queue is not None
+        name, rlog, lifetime = om.info.name, self.lifetime.rlog, self.lifetime
+        while not lifetime.closed:
+            obj = await om.queue.get()
+            outlet = om.outlet
+            if outlet is None or not outlet.ready or not self._link_up():
+                om.stats.drop("link_down")
+                rlog.note((name, "link_down"), logging.WARNING, "the %s transport is being reopened", self.label)
+                continue
+            try:
+                ok = await outlet.publish(obj)
+            except asyncio.CancelledError:
+                om.stats.drop("shutdown")
+                raise
+            except LinkDownError:
+                om.stats.drop("shutdown" if lifetime.closed else "link_down")
+                continue
+            except Exception as ex:
+                if lifetime.closed:
+                    om.stats.drop("shutdown")
+                    continue
+                om.stats.drop("publish_error")
+                rlog.note((name, "publish_error"), logging.WARNING, "%s publish failed: %s: %s", self.label,
+                          type(ex).__name__, ex)
+                continue
+            if ok:
+                om.stats.publish()
+            else:
+                om.stats.drop("not_sent")
+                rlog.note((name, "not_sent"), logging.WARNING, "%s publish: not every frame sent within %.1f s",
+                          self.label, outlet.send_timeout)

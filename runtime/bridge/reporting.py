@@ -1,0 +1,129 @@
+"""The bridge's counters and states: a JSON-serialisable snapshot (:meth:`Reporter.snapshot`, the bridge's
+``stats()``) and /diagnostics (diagnostic_msgs/DiagnosticArray, :mod:`.diagnostics`) once per period and at once
+when a device, a mapping's silence or the link changes state (:meth:`Reporter.publish_now`)."""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Sequence
+from typing import Any
+
+from .backend import Backend
+from .counters import MappingStats, RateLimitedLog
+from .diagnostics import Naming, diagnostic_array
+from .health import DeviceHealth
+from .inbound import Inbound
+from .lifetime import Lifetime
+from .link import LinkSupervisor
+from .outbound import Outbound
+from .silence import SilenceWatch
+
+__all__ = ["DIAGNOSTICS_TOPIC", "Reporter"]
+
+DIAGNOSTICS_TOPIC = "/diagnostics"
+
+
+class Reporter:
+    """:param mappings: the tables' mappings (the order of the reports); ``counters`` theirs by name.
+    :param period: seconds between two /diagnostics messages (0: none)."""
+
+    def __init__(self, lifetime: Lifetime, name: str, mappings: Sequence[Any], counters: dict[str, MappingStats], *,
+                 backend: Backend, health: DeviceHealth, link: LinkSupervisor, inbound: Inbound,
+                 outbound: Outbound, silence: SilenceWatch, ros: Any, period: float = 1.0) -> None:
+        self.lifetime, self.name, self.mappings, self.counters = lifetime, name, list(mappings), counters
+        self.backend, self.health, self.link = backend, health, link
+        self.inbound, self.outbound, self.silence, self.ros = inbound, outbound, silence, ros
+        self.period = float(period)
+        self.naming = Naming(name, backend.protocol, backend.label, backend.stack)
+        self._publisher: Any = None
+
+    def attach(self) -> None:
+        """The /diagnostics publisher and its timer once the ROS node exists."""
+        self.lifetime.add_hooks("diagnostics", start=self._start)
+
+    def _start(self) -> None:
+        if self.period <= 0:
+            return
+        from diagnostic_msgs.msg import DiagnosticArray
+
+        self._publisher = self.ros.node.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, 10)
+        self.ros.node.create_timer(self.period, self.publish_now)
+
+    @property
+    def rlog(self) -> RateLimitedLog:
+        return self.lifetime.rlog
+
+    def publish_now(self) -> None:
+        """Publish /diagnostics (the rclpy timer, and on a state change; rclpy's publish is thread-safe). Never
+        raises."""
+        if self._publisher is None or self.lifetime.closed:
+            return
+        try:
+            self._publisher.publish(self.diagnostics_message())
+        except Exception as ex:
+            self.lifetime.errors["diagnostics_error"] += 1
+            self.rlog.note(("diagnostics", "error"), logging.ERROR, "diagnostics: %s: %s", type(ex).__name__, ex)
+
+    def diagnostics_message(self) -> Any:
+        return diagnostic_array(self.snapshot(), self.naming, self.ros.clock.now().to_msg())
+
+    def snapshot(self) -> dict[str, Any]:
+        """Every counter, the devices' heartbeats and the bridge itself. Polls the protocol stack's counters
+        first, so the below-bridge drops are current."""
+        self.backend.poll_statistics()
+        now = time.monotonic()
+        empty = MappingStats(threading.Lock()).snapshot()
+        proto = self.backend.protocol
+        mappings: dict[str, Any] = {}
+        for m in self.mappings:
+            st = self.counters.get(m.name)
+            entry = {"direction": m.direction, "topic": m.topic.name, "subject_id": m.port.subject_id,
+                     **(st.snapshot() if st else empty)}
+            if m.direction == "uavcan_to_ros":
+                entry["source_node_ids"] = sorted(m.source_node_ids)
+                group = self.inbound.group_of(m.name)
+                inlet = group.inlet if group is not None else None
+                entry["port"] = inlet.port_name if inlet is not None else (
+                    f"uavcan.sub.{group.port_name}" if group is not None else None)
+                if inlet is not None and inlet.port_id is not None:
+                    entry["subject_id"] = inlet.port_id  # the register's value (the spec's by default)
+                entry["liveness"] = self.silence.entry(m.name)
+                if inlet is not None:
+                    totals, kinds, last_problem = inlet.below.snapshot()
+                    below = {k: totals.get(k, 0) for k in ("transfers", "frames", "errors", "drops",
+                                                           "deserialization_failures", "overruns")}
+                    if kinds:
+                        below["error_kinds"] = kinds
+                    if last_problem is not None:
+                        below["last_problem_age_s"] = round(now - last_problem, 3)
+                    entry[proto] = below
+                entry["ros_subscribers"] = self.ros.matched(m.topic.name)
+            else:
+                entry["destination_node_id"] = m.destination_node_id
+                om = self.outbound.mappings.get(m.name)
+                outlet = om.outlet if om is not None else None
+                entry["port"] = outlet.port_name if outlet is not None else f"uavcan.pub.{m.name}"
+                if outlet is not None and outlet.port_id is not None:
+                    entry["subject_id"] = outlet.port_id
+                entry["queued"] = om.queue.qsize() if om is not None and om.queue is not None else 0
+                entry["ros_publishers"] = self.ros.matched(m.topic.name)
+            mappings[m.name] = entry
+        devices, others = self.health.snapshot()
+        started = self.lifetime.started_monotonic
+        return {
+            "bridge": {
+                "name": self.name,
+                "node_id": self.backend.node_id,
+                "transport": self.backend.describe(),
+                "uptime_s": round(now - started, 3) if started else 0.0,
+                "errors": dict(self.lifetime.errors),
+                "link": self.link.snapshot(),
+                "log_lines": sum(self.rlog.lines.values()),
+            },
+            "mappings": mappings,
+            "devices": devices,
+            "other_nodes": others,
+        }
+

@@ -1,0 +1,179 @@
+"""The bridge's ROS node: its own rclpy context, the spec's parameters (ranges and rules, as the generated nodes
+through sam_runtime.node_support), each topic's QoS from the spec, the receive clock, and the executor spinning in
+its own thread.
+
+- QoS: each topic's ``qos`` of the generated tables (sensor data best effort, commands and states reliable, ...);
+  ``qos_depth`` and ``command_reliability`` override the depth of every endpoint and the reliability of the
+  command subscriptions when given. Publishers are keep-last: a slow or stuck ROS subscriber never blocks the
+  bridge (DDS drops that subscriber's oldest samples, or never waits for it on a best-effort topic).
+- Receive stamps: the node's ROS clock reads the system clock (CLOCK_REALTIME, as time.time_ns) unless
+  use_sim_time made ROS time active; time.time_ns costs ~0.06 us against ~2.4 us for Clock.now(), so the clock is
+  asked only while ROS time is active (tracked after every parameter set: use_sim_time may change at run time).
+- The executor: rclpy's EventsExecutor where it exists (it does not rebuild a wait set per wake-up: ~3x the
+  command throughput of SingleThreadedExecutor here, bench/profile_bridge.py), spun in 0.1 s slices of
+  spin_until_future_complete on a future that never completes, instead of returning to Python after every
+  callback as spin_once does (~15 % less CPU per command in the rclpy thread). Not for the Python executors: they
+  add a done callback to the future on every call. An exception out of a callback is counted (``spin_error``) and
+  the executor goes on.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+from .backend import BridgeConfigError
+from .lifetime import Lifetime
+
+__all__ = ["RosSide"]
+
+
+class RosSide:
+    """:param parameters, rules: the spec's (tables.PARAMETERS, tables.PARAMETER_RULES).
+    :param overrides: initial parameter values by spec or ROS name."""
+
+    def __init__(self, lifetime: Lifetime, name: str, *, ros_args: Sequence[str] = (), parameters: Sequence[Any] = (),
+                 rules: Sequence[Any] = (), overrides: Mapping[str, Any] | None = None, qos_depth: int | None = None,
+                 command_reliability: str | None = None) -> None:
+        if command_reliability not in (None, "reliable", "best_effort"):
+            raise BridgeConfigError(f"command_reliability must be reliable or best_effort, not {command_reliability!r}")
+        self.lifetime = lifetime
+        self.name = name
+        self._ros_args = list(ros_args)
+        self._parameters, self._rules = list(parameters), list(rules)
+        self._overrides = dict(overrides or {})
+        self.qos_depth = None if qos_depth is None else int(qos_depth)
+        self.command_reliability = command_reliability
+        self.context: Any = None
+        self.node: Any = None
+        self.clock: Any = None
+        self.executor: Any = None
+        self.ros_time_active = False
+        self._publishers: dict[str, Any] = {}
+        self._subscriptions: dict[str, Any] = {}
+        self._spin_future: Any = None
+        self._spin_thread: threading.Thread | None = None
+        self._stop_spin = threading.Event()
+
+    def attach(self) -> None:
+        """The node first when the bridge starts; destroyed last."""
+        self.lifetime.add_hooks("ROS node", start=self._open, close=self._close)
+
+    # -------------------------------------------------------------------------------------------- lifetime
+    def _open(self) -> None:
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+        from rclpy.signals import SignalHandlerOptions
+
+        from sam_runtime.node_support import ParameterConfigError, declare_parameters
+
+        self.context = rclpy.Context()
+        rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO)
+        cli_args = None
+        if self._ros_args:
+            cli_args = self._ros_args if self._ros_args[0] == "--ros-args" else ["--ros-args", *self._ros_args]
+        self.node = Node(self.name, context=self.context, cli_args=cli_args)
+        self.clock = self.node.get_clock()
+        self.ros_time_active = bool(self.clock.ros_time_is_active)
+        self.node.add_post_set_parameters_callback(self._after_set_parameters)
+        try:
+            declare_parameters(self.node, self._parameters, self._rules, overrides=self._overrides)
+        except ParameterConfigError as ex:
+            raise BridgeConfigError(str(ex)) from None
+        try:
+            from rclpy.experimental import EventsExecutor
+            from rclpy.task import Future
+
+            self.executor = EventsExecutor(context=self.context)
+            self._spin_future = Future()
+        except ImportError:
+            self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+
+    def _close(self) -> None:
+        """After everything else: the executor, the node, the context (each may already be gone)."""
+        steps = [lambda: self.executor.shutdown(timeout_sec=1.0) if self.executor is not None else None,
+                 lambda: self.node.destroy_node() if self.node is not None else None,
+                 lambda: self.context.shutdown() if self.context is not None and self.context.ok() else None]
+        for step in steps:
+            try:
+                step()
+            except Exception:
+                pass
+
+    def attach_spinner(self) -> None:
+        """Spin the executor in its own thread from here on in the start order (attach it last: it stops first,
+        so no hand-off happens after that)."""
+        self.lifetime.add_hooks("rclpy executor", start=self._start_spinning, close=self._stop_spinning)
+
+    def _start_spinning(self) -> None:
+        self._stop_spin.clear()
+        self._spin_thread = threading.Thread(target=self._spin, name=f"{self.name}-rclpy", daemon=True)
+        self._spin_thread.start()
+
+    async def _stop_spinning(self) -> None:
+        import asyncio
+
+        self._stop_spin.set()
+        if self._spin_thread is not None:
+            await asyncio.get_running_loop().run_in_executor(None, self._spin_thread.join, 5.0)
+
+    def _spin(self) -> None:
+        executor, future = self.executor, self._spin_future
+        while not self._stop_spin.is_set():
+            try:
+                if future is not None:
+                    executor.spin_until_future_complete(future, timeout_sec=0.1)
+                else:
+                    executor.spin_once(timeout_sec=0.1)
+            except Exception as ex:  # a callback bug or a context going down: keep spinning until told
+                if self._stop_spin.is_set() or not self.context.ok():
+                    break
+                self.lifetime.errors["spin_error"] += 1
+                self.lifetime.rlog.note(("executor", "spin_error"), logging.ERROR, "rclpy executor: %s: %s",
+                                        type(ex).__name__, ex)
+
+    # -------------------------------------------------------------------------------------------- time
+    def _after_set_parameters(self, params: list[Any]) -> None:
+        self.ros_time_active = bool(self.clock.ros_time_is_active)
+
+    def receive_ns(self) -> int:
+        """The ROS receive time in nanoseconds (the node's clock: system time, or ROS time under use_sim_time)."""
+        return self.clock.now().nanoseconds if self.ros_time_active else time.time_ns()
+
+    # -------------------------------------------------------------------------------------------- endpoints
+    def qos(self, topic: Any, *, command: bool = False) -> Any:
+        """The topic's QoS from the spec, with the overrides."""
+        from sam_runtime.node_support import qos_profile
+
+        q = topic.qos
+        reliability = (self.command_reliability if command else None) or q.reliability
+        return qos_profile(reliability, q.durability, q.depth if self.qos_depth is None else self.qos_depth)
+
+    def publisher(self, topic: Any, cls: Any) -> Any:
+        """The node's publisher of ``topic`` (one per topic, shared by its mappings)."""
+        pub = self._publishers.get(topic.name)
+        if pub is None:
+            pub = self._publishers[topic.name] = self.node.create_publisher(cls, topic.name, self.qos(topic))
+        return pub
+
+    def subscribe(self, topic: Any, cls: Any, callback: Callable[[Any], None]) -> Any:
+        """A command subscription of ``topic``."""
+        sub = self._subscriptions[topic.name] = self.node.create_subscription(
+            cls, topic.name, callback, self.qos(topic, command=True))
+        return sub
+
+    def matched(self, topic: str) -> int | None:
+        """ROS subscribers of a published topic, or ROS publishers of a subscribed one (None: no such endpoint)."""
+        obj, method = ((self._publishers[topic], "get_subscription_count") if topic in self._publishers
+                       else (self._subscriptions.get(topic), "get_publisher_count"))
+        if obj is None:
+            return None
+        try:
+            return int(getattr(obj, method)())
+        except Exception:
+            return None

@@ -1,0 +1,65 @@
+"""UAVCAN -> ROS mappings that get nothing from a device whose heartbeat is alive (the rules: sam_runtime.liveness),
+checked every 0.2 s; a mapping going silent, and the end of it, is logged once and handed to the handlers (the
+bridge publishes /diagnostics at once)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any
+
+from sam_runtime.liveness import LivenessMonitor, Silence
+
+from .counters import log
+from .lifetime import Lifetime
+
+__all__ = ["CHECK_PERIOD_S", "SilenceWatch"]
+
+CHECK_PERIOD_S = 0.2
+
+
+class SilenceWatch:
+    """:param mappings: (name, nominal rate [Hz], accepted source node ids) per UAVCAN -> ROS mapping.
+    :param alive_since: a node's heartbeat (re)appeared at (monotonic s), None if it is not alive.
+    :param last_message: (mapping, node id) -> when its last transfer arrived (monotonic s), or None.
+    :param listening_since: since when the bridge listens (its link last opened; monotonic s)."""
+
+    def __init__(self, mappings: Iterable[tuple[str, float, Iterable[int]]], device_names: Mapping[int, str], *,
+                 alive_since: Callable[[int], float | None], last_message: Callable[[str, int], float | None],
+                 listening_since: Callable[[], float]) -> None:
+        self.monitor = LivenessMonitor(mappings, device_names)
+        self._alive_since, self._last_message, self._listening_since = alive_since, last_message, listening_since
+        self._handlers: list[Callable[[], None]] = []
+
+    def attach(self, lifetime: Lifetime) -> None:
+        lifetime.every(CHECK_PERIOD_S, "silence", self.check)
+
+    def add_handler(self, handler: Callable[[], None]) -> None:
+        self._handlers.append(handler)
+
+    @property
+    def findings(self) -> dict[str, Silence | None]:
+        return self.monitor.findings
+
+    def check(self) -> None:
+        changes = self.monitor.update(time.monotonic(), alive_since=self._alive_since,
+                                      last_message=self._last_message, listening_since=self._listening_since())
+        for name, before, found in changes:
+            if found is not None:
+                log.warning("%s: %s", name, found.message())
+            elif before is not None:
+                why = ("messages again from" if self._alive_since(before.node_id) is not None
+                       else "no longer watched: no heartbeat from")
+                log.info("%s: %s device %s (node %d)", name, why, before.device, before.node_id)
+        if changes:
+            for handler in self._handlers:
+                handler()
+
+    def entry(self, mapping: str) -> dict[str, Any]:
+        """The mapping's liveness for the stats."""
+        silence = self.monitor.findings.get(mapping)
+        if silence is None:
+            return {"state": "ok"}
+        return {"state": silence.state, "message": silence.message(), "node_id": silence.node_id,
+                "silent_s": round(silence.silent_s, 3), "grace_s": silence.grace_s,
+                "nominal_rate_hz": silence.rate_hz}
