@@ -365,12 +365,14 @@ def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
 
 def emit(resolved: Resolved) -> dict[str, str]:
     """The documentation files, by path under generated/."""
-    from .docs_markdown import markdown_context  # they import this module's helpers
+    from .docs_dronecan import dronecan_context  # they import this module's helpers
+    from .docs_markdown import markdown_context
     from .docs_svg import svg_context
 
     graph = build_graph(resolved)
     return {
-        MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph)).rstrip("\n") + "\n",
+        MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph),
+                        **dronecan_context(resolved)).rstrip("\n") + "\n",
         SVG_PATH: render("docs/dataflow.svg.j2", **svg_context(resolved, graph)),
     }
 
