@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import emit_nodes  # the tables' QoS, transforms and nodes
-from .filters import py_str
+from .filters import natural_key, py_str
 from .mapping_rules import ResolvedMapping, Step, format_path
 from .model import DsdlStruct, Port, RosMessage, Scalar
 from .templating import render
@@ -1015,10 +1015,10 @@ def _referenced_roots(resolved: Resolved) -> set[str]:
     return roots
 
 
-def _isort_key(name: str) -> tuple[int, str]:
+def _isort_key(name: str) -> tuple[int, list[Any]]:
     """isort's (and ruff's) order of imported names: CONSTANTS, then Classes, then variables, case-insensitive."""
     kind = 0 if len(name) > 1 and name.isupper() else 1 if name[0].isupper() else 2
-    return kind, name.lower()
+    return kind, natural_key(name)
 
 
 def _convert_context(resolved: Resolved) -> dict[str, Any]:
@@ -1050,7 +1050,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         for name in sorted(set(module.dsdl_factories) - done):
             factories.append(_dsdl_factory(module, module.dsdl_factories[name]))
             done.add(name)
-    if module.dsdl_factories:
+    if any("_np." in str(f["fields"]) for f in factories):
         module.dsdl_modules.add("numpy as _np")
     return {
         "factories": factories,

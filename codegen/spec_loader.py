@@ -404,11 +404,11 @@ def _device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     r = _Reader(node, what, diag, _DEVICE_KEYS)
     node_id = r.get("node_id", int)
     protocol = r.get("protocol", str, "cyphal")
+    device = Device(key, node_id if node_id is not None else -1, _text(r, "description"), pos=pos,
+                    protocol=protocol, protocol_pos={protocol: pos}, protocols=())
     if protocol not in PROTOCOLS:
         diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
-        protocol = "cyphal"
-    device = Device(key, node_id if node_id is not None else -1, _text(r, "description"), pos=pos,
-                    protocol=protocol, protocol_pos={protocol: pos})
+        return device  # its ports would be read in the wrong protocol
     sides = [(protocol, r.map)]
     if r.node(protocol) is not None:
         diag.error(r.key_pos(protocol), f"{what} speaks {protocol}: its {protocol} ports are its `publishes` and "
@@ -437,7 +437,7 @@ def _dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V0Stru
     fields = [f for f in layout if f.name]
     return V0Struct(
         key, fields, _constants(r.node("constants"), what, parse_v0_type, diag), _text(r, "description"),
-        pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int),
+        pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int, None),
     )
 
 

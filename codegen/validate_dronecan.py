@@ -214,7 +214,7 @@ class DronecanValidator:
                 for port, pub in _v0_ports(device):
                     if pub == publishing and port.type == mapping.data_type:
                         users.setdefault(device.node_id, port)
-        verb = "publish" if publishing else "subscribe to"
+        verb, ports = ("publish", "publishes") if publishing else ("subscribe to", "subscribes")
         for node_id in nodes:
             if node_id not in V0_NODE_IDS:
                 self.error(mapping.pos, f"{role} node id {node_id} of {what} is out of range for DroneCAN",
@@ -224,7 +224,7 @@ class DronecanValidator:
                 self.error(mapping.pos, f"{role} node id {node_id} of {what} does not {verb} {mapping.data_type} "
                            "on DroneCAN" + (f" (it is device {owner.name})" if owner else ""),
                            f"the node id of a device that does: {', '.join(map(str, sorted(users)))}" if users
-                           else f"a device with `{mapping.data_type}` in its DroneCAN {verb.split()[0]}s")
+                           else f"a device with `{mapping.data_type}` in its DroneCAN {ports}")
             else:
                 rate = max(rate, users[node_id].rate_hz) if node_id in users else rate
         if len(set(nodes)) < len(nodes):

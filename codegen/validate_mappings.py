@@ -222,8 +222,8 @@ class MappingValidator:
                 self.error(mapping.pos, f"ignore of {what}: {exc}")
             else:
                 self.ignored.add(format_path(path))
-        self.check_elements(resolved, what)
-        self.check_coverage(resolved, what)
+        if self.check_elements(resolved, what):  # (else coverage would only repeat the confusion)
+            self.check_coverage(resolved, what)
         return resolved
 
     def ros_leaf(self, message: RosMessage, path: list) -> RosType:
@@ -376,20 +376,24 @@ class MappingValidator:
             return self.uncovered(nested, path + ".", pool)
         return [(path, t)]
 
-    def check_elements(self, resolved: ResolvedMapping, what: str) -> None:
+    def check_elements(self, resolved: ResolvedMapping, what: str) -> bool:
         """A DroneCAN array's elements are named by position or by one key field, not both."""
+        ok = True
         for path, uses in self.elements.items():
             text = format_path(list(path))
             fields = {key.field for key in uses["key"]}
             if uses["index"] and uses["key"]:
                 self.error(resolved.mapping.pos, f"{what} names elements of {text} both by position and by key",
                            "one way for one array")
+                ok = False
             elif len(fields) > 1:
                 self.error(resolved.mapping.pos, f"{what} chooses items of {text} by more than one key field ("
                            + ", ".join(sorted(fields)) + ")", "one key field per array")
+                ok = False
             else:
                 resolved.elements[path] = list(uses["index"] or uses["key"])
         self.element_uses = {format_path(list(path)): uses for path, uses in self.elements.items()}
+        return ok
 
     def check_coverage(self, resolved: ResolvedMapping, what: str) -> None:
         mapping = resolved.mapping
