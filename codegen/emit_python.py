@@ -665,6 +665,17 @@ class _MappingEmitter:
             return var
         ros_base = s.ros_type.base
         if s.kind == "number":
+            if s.limits is not None and (s.scale is not None or s.offset is not None):
+                # limits are in ROS units: checked before the inverse scale/offset
+                var = names.new(s.uavcan)
+                statements.append(_st("assign", target=var, expr=read))
+                ros_is_float, ros_range, _ = self.to_uavcan_scalar(s, ros_base, var, transform=False)
+                limit_type = DsdlType("float", 64) if ros_is_float else DsdlType("int", 64)
+                statements.extend(_number_checks(var, ros_is_float, ros_range, limit_type, s.limits, pol))
+                value_is_float, value_range, expr = self.to_uavcan_scalar(s, ros_base, var)
+                statements.append(_st("assign", target=var, expr=expr))
+                statements.extend(_number_checks(var, value_is_float, value_range, uav, None, pol))
+                return var
             value_is_float, value_range, expr = self.to_uavcan_scalar(s, ros_base, read)
             if not _number_checks("x", value_is_float, value_range, uav, s.limits, pol):
                 return expr
@@ -700,14 +711,17 @@ class _MappingEmitter:
             statements.append(_st("helper", var=var, helper=helper, args=args))
         return var
 
-    def to_uavcan_scalar(self, s: Step, ros_base: str, read: str) -> tuple[bool, tuple[float, float] | None, str]:
+    def to_uavcan_scalar(self, s: Step, ros_base: str, read: str, transform: bool = True
+                         ) -> tuple[bool, tuple[float, float] | None, str]:
         """(float-valued, range of the value if known, expression) of a ROS-side element after the inverse
-        scale/offset."""
+        scale/offset (without them unless `transform`)."""
         value_range = _ros_range(ros_base)
         value_is_float = ros_base in ROS_FLOAT_BITS
         expr = read
         if ros_base == "byte" and s.kind == "number":
             expr = f"{read}[0]"
+        if not transform:
+            return value_is_float, value_range if value_range and math.isfinite(value_range[1]) else None, expr
         if s.offset is not None:
             off = float(s.offset)
             expr = f"{expr} - {_num(off)}" if off >= 0 else f"{expr} + {_num(-off)}"

@@ -891,7 +891,7 @@ def longitudinal_weight_to_uavcan(src: PercentStamped, stats: ConversionStats) -
 
     sam_msgs/PercentStamped -> uavcan.equipment.actuator.ArrayCommand
     """
-    commands_actuator_id_4_command_value = src.percent / 100.0
+    commands_actuator_id_4_command_value = src.percent
     if commands_actuator_id_4_command_value != commands_actuator_id_4_command_value:  # NaN
         stats.reject('longitudinal_weight.commands[actuator_id=4].command_value')
         return None
@@ -901,6 +901,13 @@ def longitudinal_weight_to_uavcan(src: PercentStamped, stats: ConversionStats) -
     elif commands_actuator_id_4_command_value > 100.0:
         stats.saturate('longitudinal_weight.commands[actuator_id=4].command_value')
         commands_actuator_id_4_command_value = 100.0
+    commands_actuator_id_4_command_value = commands_actuator_id_4_command_value / 100.0
+    if commands_actuator_id_4_command_value > 65504.0:
+        stats.saturate('longitudinal_weight.commands[actuator_id=4].command_value')
+        commands_actuator_id_4_command_value = 65504.0
+    elif commands_actuator_id_4_command_value < -65504.0:
+        stats.saturate('longitudinal_weight.commands[actuator_id=4].command_value')
+        commands_actuator_id_4_command_value = -65504.0
     return _TYPENAMES['uavcan.equipment.actuator.ArrayCommand'](
         commands=[
             _TYPENAMES['uavcan.equipment.actuator.Command'](
@@ -934,7 +941,7 @@ def buoyancy_piston_to_uavcan(src: PercentStamped, stats: ConversionStats) -> An
 
     sam_msgs/PercentStamped -> uavcan.equipment.actuator.ArrayCommand
     """
-    commands_actuator_id_5_command_value = src.percent / 100.0
+    commands_actuator_id_5_command_value = src.percent
     if commands_actuator_id_5_command_value != commands_actuator_id_5_command_value:  # NaN
         stats.reject('buoyancy_piston.commands[actuator_id=5].command_value')
         return None
@@ -944,6 +951,13 @@ def buoyancy_piston_to_uavcan(src: PercentStamped, stats: ConversionStats) -> An
     elif commands_actuator_id_5_command_value > 100.0:
         stats.saturate('buoyancy_piston.commands[actuator_id=5].command_value')
         commands_actuator_id_5_command_value = 100.0
+    commands_actuator_id_5_command_value = commands_actuator_id_5_command_value / 100.0
+    if commands_actuator_id_5_command_value > 65504.0:
+        stats.saturate('buoyancy_piston.commands[actuator_id=5].command_value')
+        commands_actuator_id_5_command_value = 65504.0
+    elif commands_actuator_id_5_command_value < -65504.0:
+        stats.saturate('buoyancy_piston.commands[actuator_id=5].command_value')
+        commands_actuator_id_5_command_value = -65504.0
     return _TYPENAMES['uavcan.equipment.actuator.ArrayCommand'](
         commands=[
             _TYPENAMES['uavcan.equipment.actuator.Command'](
