@@ -157,10 +157,11 @@ def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
             notes.append("not one to one")
         return text + (f" ({', '.join(notes)})" if notes else "")
     transform = _transform(step, direction)
-    if transform:
-        text += " " + transform
-    if step.limits is not None:
-        text += f" limits [{fmt_number(step.limits[0])}, {fmt_number(step.limits[1])}]"
+    limits = "" if step.limits is None else f" limits [{fmt_number(step.limits[0])}, {fmt_number(step.limits[1])}]"
+    if transform and limits and not to_ros:  # limits are in ROS units: they come first
+        text += limits + " " + transform
+    else:
+        text += (" " + transform if transform else "") + limits
     change = _width_change(src_elem, dst_elem)
     if change in ("narrowed", "rounded"):
         notes.append(change + (", saturating" if saturate else ", out of range rejected"))
@@ -365,12 +366,14 @@ def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
 
 def emit(resolved: Resolved) -> dict[str, str]:
     """The documentation files, by path under generated/."""
-    from .docs_markdown import markdown_context  # they import this module's helpers
+    from .docs_dronecan import dronecan_context  # they import this module's helpers
+    from .docs_markdown import markdown_context
     from .docs_svg import svg_context
 
     graph = build_graph(resolved)
     return {
-        MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph)).rstrip("\n") + "\n",
+        MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph),
+                        **dronecan_context(resolved)).rstrip("\n") + "\n",
         SVG_PATH: render("docs/dataflow.svg.j2", **svg_context(resolved, graph)),
     }
 

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from .emit_ros import build_order
-from .filters import one_line, py_str
+from .filters import natural_key, one_line, py_str
 from .model import Parameter, Qos, Spec
 from .templating import environment, render
 from .validate import Resolved
@@ -149,7 +149,7 @@ class _Imports:
             by_module.setdefault(f"{package}.msg", []).append(name if local == name else f"{name} as {local}")
         lines = []
         for module in sorted(by_module):
-            names = sorted(by_module[module], key=lambda n: (n.split(" ")[0].lower(), n))
+            names = sorted(by_module[module], key=lambda n: (natural_key(n.split(" ")[0]), n))
             line = f"from {module} import {', '.join(names)}"
             if len(line) <= 110:
                 lines.append(line)

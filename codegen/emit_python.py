@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import emit_nodes  # the tables' QoS, transforms and nodes
-from .filters import py_str
+from .filters import natural_key, py_str
 from .mapping_rules import ResolvedMapping, Step, format_path
 from .model import DsdlStruct, Port, RosMessage, Scalar
 from .templating import render
@@ -440,22 +440,14 @@ class _MappingEmitter:
             [f"Mapping {self.name!r}, UAVCAN -> ROS.", "", f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"],
         )
         steps = list(rm.steps)
-        # Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one .tolist() each.
-        listed: dict[tuple, str] = {}
-        for s in steps:
-            if s.kind in ("number", "table") and s.uavcan_path and s.uavcan_path[-1][1] is not None:
-                array_path = (*s.uavcan_path[:-1], (s.uavcan_path[-1][0], None))
-                if array_path not in listed:
-                    listed[array_path] = names.new(format_path(list(array_path)))
-                    fn.binds.append(_st("assign", target=listed[array_path],
-                                        expr=_access("src", array_path, py_attr) + ".tolist()"))
+        listed = self.bind_uavcan_arrays(fn, names, steps)
 
         def uav_read(path: tuple) -> str:
             if path[-1][1] is not None:
                 array_path = (*path[:-1], (path[-1][0], None))
                 if array_path in listed:
                     return f"{listed[array_path]}[{path[-1][1]}]"
-            return _access("src", path, py_attr)
+            return self.uav_access("src", path)
 
         root = self.module.ros_ctor(rm.ros_message)
         if rm.has_header and self.mapping.frame_id is not None:
@@ -469,6 +461,28 @@ class _MappingEmitter:
                 self.module.insert(root, path, value)
         fn.result = self.module.format_return(root)
         return fn
+
+    def bind_uavcan_arrays(self, fn: _Function, names: _Names, steps: list[Step],
+                           listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
+        """Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one list each (beside those
+        in `listed` already)."""
+        listed = {} if listed is None else listed
+        for s in steps:
+            if s.kind in ("number", "table") and s.uavcan_path and s.uavcan_path[-1][1] is not None:
+                array_path = (*s.uavcan_path[:-1], (s.uavcan_path[-1][0], None))
+                if array_path not in listed:
+                    listed[array_path] = names.new(format_path(list(array_path)))
+                    fn.binds.append(_st("assign", target=listed[array_path],
+                                        expr=self.uav_list(self.uav_access("src", array_path))))
+        return listed
+
+    def uav_access(self, base: str, path: tuple) -> str:
+        """The expression reading a field of a received UAVCAN object."""
+        return _access(base, path, py_attr)
+
+    def uav_list(self, expr: str) -> str:
+        """A UAVCAN array as a list of plain Python values (pycyphal keeps them in numpy arrays)."""
+        return f"{expr}.tolist()"
 
     def step_to_ros(self, s: Step, names: _Names, uav_read, statements: list[dict[str, Any]]
                     ) -> list[tuple[tuple, str]]:
@@ -503,6 +517,13 @@ class _MappingEmitter:
         overflow = self.to_ros_float32_overflow(s, uav, ros_base)
         if s.kind == "number":
             expr = expr_of(read)
+            if uav.kind == "float" and ros_base in ROS_INT_RANGES:  # `round: true`
+                var = names.new(s.ros)
+                statements.append(_st("assign", target=var, expr=expr))
+                lo, hi = ROS_INT_RANGES[ros_base]
+                as_dsdl = DsdlType("int" if lo < 0 else "uint", (hi - lo).bit_length())
+                statements.extend(_number_checks(var, True, None, as_dsdl, None, pol))
+                return [(s.ros_path, var)]
             if overflow:
                 var = names.new(s.ros)
                 statements.append(_st("assign", target=var, expr=expr))
@@ -513,7 +534,7 @@ class _MappingEmitter:
             return [(s.ros_path, expr)]
         # array
         elem = expr_of("x")
-        base_list = f"{read}.tolist()"
+        base_list = self.uav_list(read)
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
         pad = s.ros_type.array == "fixed" and s.uavcan_type.array == "bounded"
         if not pad and not overflow:
@@ -627,7 +648,7 @@ class _MappingEmitter:
         for s in steps:
             value = self.step_to_uavcan(s, names, ros_read, fn.statements)
             self.module.insert(root, s.uavcan_path, value)
-        for path, leaf_type, value in rm.uavcan_values:
+        for path, leaf_type, value in [*rm.uavcan_values, *rm.select]:  # (select: DroneCAN's)
             self.module.insert(root, path,
                                _typed_literal(value, "float" if leaf_type.kind == "float" else leaf_type.kind))
         fn.result = self.module.format_return(root)
@@ -672,6 +693,17 @@ class _MappingEmitter:
             return var
         ros_base = s.ros_type.base
         if s.kind == "number":
+            if s.limits is not None and (s.scale is not None or s.offset is not None):
+                # limits are in ROS units: checked before the inverse scale/offset
+                var = names.new(s.uavcan)
+                statements.append(_st("assign", target=var, expr=read))
+                ros_is_float, ros_range, _ = self.to_uavcan_scalar(s, ros_base, var, transform=False)
+                limit_type = DsdlType("float", 64) if ros_is_float else DsdlType("int", 64)
+                statements.extend(_number_checks(var, ros_is_float, ros_range, limit_type, s.limits, pol))
+                value_is_float, value_range, expr = self.to_uavcan_scalar(s, ros_base, var)
+                statements.append(_st("assign", target=var, expr=expr))
+                statements.extend(_number_checks(var, value_is_float, value_range, uav, None, pol))
+                return var
             value_is_float, value_range, expr = self.to_uavcan_scalar(s, ros_base, read)
             if not _number_checks("x", value_is_float, value_range, uav, s.limits, pol):
                 return expr
@@ -707,14 +739,17 @@ class _MappingEmitter:
             statements.append(_st("helper", var=var, helper=helper, args=args))
         return var
 
-    def to_uavcan_scalar(self, s: Step, ros_base: str, read: str) -> tuple[bool, tuple[float, float] | None, str]:
+    def to_uavcan_scalar(self, s: Step, ros_base: str, read: str, transform: bool = True
+                         ) -> tuple[bool, tuple[float, float] | None, str]:
         """(float-valued, range of the value if known, expression) of a ROS-side element after the inverse
-        scale/offset."""
+        scale/offset (without them unless `transform`)."""
         value_range = _ros_range(ros_base)
         value_is_float = ros_base in ROS_FLOAT_BITS
         expr = read
         if ros_base == "byte" and s.kind == "number":
             expr = f"{read}[0]"
+        if not transform:
+            return value_is_float, value_range if value_range and math.isfinite(value_range[1]) else None, expr
         if s.offset is not None:
             off = float(s.offset)
             expr = f"{expr} - {_num(off)}" if off >= 0 else f"{expr} + {_num(-off)}"
@@ -782,7 +817,7 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
         "name": py_str(d.name), "node_id": str(d.node_id), "description": _text(d.description, 8),
         "publishes": [_port_info(resolved, p, 12) for p in d.publishes],
         "subscribes": [_port_info(resolved, p, 12) for p in d.subscribes],
-    } for d in spec.devices.values()]
+    } for d in spec.devices.values() if "cyphal" in d.protocols]
     topics = []
     for topic in spec.topics.values():
         ros_type, module, cls = _ros_type_parts(topic.type)
@@ -837,10 +872,10 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
 # ---- convert.py ----------------------------------------------------------------------------------------------
 
 
-def _ros_closure(resolved: Resolved) -> list[str]:
+def _ros_closure(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> list[str]:
     """Every ROS message type the converters build: the mapped ones and, transitively, their nested types."""
     seen: set[str] = set()
-    todo = [rm.ros_message.full_name for rm in resolved.mappings]
+    todo = [rm.ros_message.full_name for rm in (resolved.mappings if mappings is None else mappings)]
     while todo:
         full = todo.pop()
         if full in seen:
@@ -852,9 +887,9 @@ def _ros_closure(resolved: Resolved) -> list[str]:
     return sorted(seen)
 
 
-def _ros_aliases(resolved: Resolved) -> dict[str, str]:
+def _ros_aliases(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> dict[str, str]:
     """A local class name per ROS message type the converters use; package-qualified when names clash."""
-    used = _ros_closure(resolved)
+    used = _ros_closure(resolved, mappings)
     by_name: dict[str, list[str]] = {}
     for full in used:
         by_name.setdefault(full.split("/")[1], []).append(full)
@@ -1022,10 +1057,10 @@ def _referenced_roots(resolved: Resolved) -> set[str]:
     return roots
 
 
-def _isort_key(name: str) -> tuple[int, str]:
+def _isort_key(name: str) -> tuple[int, list[Any]]:
     """isort's (and ruff's) order of imported names: CONSTANTS, then Classes, then variables, case-insensitive."""
     kind = 0 if len(name) > 1 and name.isupper() else 1 if name[0].isupper() else 2
-    return kind, name.lower()
+    return kind, natural_key(name)
 
 
 def _convert_context(resolved: Resolved) -> dict[str, Any]:
@@ -1057,7 +1092,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         for name in sorted(set(module.dsdl_factories) - done):
             factories.append(_dsdl_factory(module, module.dsdl_factories[name]))
             done.add(name)
-    if module.dsdl_factories:
+    if any("_np." in str(f["fields"]) for f in factories):
         module.dsdl_modules.add("numpy as _np")
     return {
         "factories": factories,
@@ -1072,6 +1107,8 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
 
 def emit(resolved: Resolved) -> dict[str, str]:
     """Render the bridge package: {path under generated/: text}."""
+    from . import emit_python_v0  # (it builds on this module)
+
     spec = resolved.spec
     package = f"{spec.vehicle}_bridge"
     common = {"spec_name": Path(spec.file).name, "package": package, "vehicle": spec.vehicle}
@@ -1079,7 +1116,7 @@ def emit(resolved: Resolved) -> dict[str, str]:
     return {
         f"{root}/__init__.py": render("python/__init__.py.j2", **common),
         f"{root}/tables.py": render("python/tables.py.j2", **common, **_tables_context(resolved),
-                                    **emit_nodes.tables_context(resolved)),
+                                    **emit_nodes.tables_context(resolved), **emit_python_v0.tables_context(resolved)),
         f"{root}/convert.py": render("python/convert.py.j2", **common, **_convert_context(resolved)),
     }
 

@@ -105,3 +105,12 @@ FILTERS = {
     "py_number": py_number,
     "xml_text": xml_text,
 }
+
+
+def natural_key(text: str) -> list[int | str]:
+    """Case-insensitive, with digit runs compared as numbers (ruff's isort order): Int8 before Int16.
+
+    >>> sorted(["UInt16", "Int16", "Int8MultiArray", "uint8"], key=natural_key)
+    ['Int8MultiArray', 'Int16', 'uint8', 'UInt16']
+    """
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", text.lower())]

@@ -25,10 +25,29 @@ from .typesys import (
 TIME = "builtin_interfaces/Time"
 HEADER = "std_msgs/Header"
 SYNC_TIMESTAMP = "uavcan.time.SynchronizedTimestamp.1.0"
+V0_TIMESTAMP = "uavcan.Timestamp"
+# The microsecond timestamps (0 = unknown) of both protocols: type -> its microsecond field (truncated uint56).
+TIMESTAMPS = {SYNC_TIMESTAMP: "microsecond", V0_TIMESTAMP: "usec"}
 FLOAT16_MAX = 65504.0
 
-PathSeg = tuple[str, int | None]
-_SEGMENT = re.compile(r"^(?P<name>[A-Za-z_][A-Za-z0-9_]*)(?:\[(?P<index>[0-9]+)\])?$")
+
+@dataclass(frozen=True)
+class Key:
+    """`[field=value]` in a DroneCAN path: the item of an array of composites whose `field` equals `value` (the
+    `actuator_id` of uavcan.equipment.actuator.Command in ArrayCommand.commands)."""
+
+    field: str
+    value: int
+
+    def __str__(self) -> str:
+        return f"{self.field}={self.value}"
+
+
+PathSeg = tuple[str, "int | Key | None"]
+_SEGMENT = re.compile(
+    r"^(?P<name>[A-Za-z_][A-Za-z0-9_]*)"
+    r"(?:\[(?:(?P<index>[0-9]+)|(?P<key>[A-Za-z_][A-Za-z0-9_]*)=(?P<value>-?[0-9]+))\])?$"
+)
 
 
 class RuleError(ValueError):
@@ -36,17 +55,22 @@ class RuleError(ValueError):
 
 
 def parse_path(text: str) -> list[PathSeg]:
-    """`a.b[2].c` -> [("a", None), ("b", 2), ("c", None)].
+    """`a.b[2].c` -> [("a", None), ("b", 2), ("c", None)]; `commands[actuator_id=3]` selects an item by key.
 
     >>> parse_path("linear_acceleration.x"), parse_path("rate_gyro_latest[0]")
     ([('linear_acceleration', None), ('x', None)], [('rate_gyro_latest', 0)])
+    >>> format_path(parse_path("commands[actuator_id=3].command_value"))
+    'commands[actuator_id=3].command_value'
     """
     segments: list[PathSeg] = []
     for part in text.split("."):
         match = _SEGMENT.fullmatch(part)
         if not match:
-            raise RuleError(f"{text!r} is not a field path (name, name.sub or name[index])")
-        segments.append((match["name"], int(match["index"]) if match["index"] is not None else None))
+            raise RuleError(f"{text!r} is not a field path (name, name.sub, name[index] or name[key=value])")
+        if match["key"] is not None:
+            segments.append((match["name"], Key(match["key"], int(match["value"]))))
+        else:
+            segments.append((match["name"], int(match["index"]) if match["index"] is not None else None))
     return segments
 
 
@@ -82,7 +106,7 @@ def derive_ros_type(t: DsdlType) -> RosType:
         base = "float64" if t.bits == 64 else "float32"
     elif t.kind == "utf8":
         return RosType("string", string_bound=t.capacity)
-    elif t.kind == "composite" and t.composite == SYNC_TIMESTAMP and not t.array:
+    elif t.kind == "composite" and t.composite in TIMESTAMPS and not t.array:
         base = TIME
     else:
         raise RuleError(f"a {t} field cannot be derived automatically; declare the ROS message by hand")
@@ -90,7 +114,8 @@ def derive_ros_type(t: DsdlType) -> RosType:
 
 
 def _is_sync_timestamp(t: DsdlType) -> bool:
-    return t.kind == "composite" and t.composite == SYNC_TIMESTAMP and not t.array
+    """A microsecond timestamp of either protocol (a scalar field)."""
+    return t.kind == "composite" and t.composite in TIMESTAMPS and not t.array
 
 
 def derive_message(struct: DsdlStruct, package: str, name: str, description: str, pos: Pos) -> RosMessage:
@@ -124,7 +149,7 @@ def auto_links(struct: DsdlStruct, pos: Pos) -> list[FieldLink]:
         assert isinstance(f.type, DsdlType)
         if _is_sync_timestamp(f.type) and not stamp_taken:
             stamp_taken = True
-            links.append(FieldLink("header.stamp", f"{f.name}.microsecond", pos=pos))
+            links.append(FieldLink("header.stamp", f"{f.name}.{TIMESTAMPS[f.type.composite or '']}", pos=pos))
         else:
             links.append(FieldLink(f.name, f.name, pos=pos))
     return links
@@ -166,6 +191,10 @@ class ResolvedMapping:
     uavcan_values: list[tuple[tuple[PathSeg, ...], DsdlType, Scalar]] = field(default_factory=list)
     has_header: bool = False
     rate_hz: float = 0.0
+    # DroneCAN: the fields a message must have to be this mapping's (UAVCAN->ROS), or that it sets (ROS->UAVCAN)
+    select: list[tuple[tuple[PathSeg, ...], DsdlType, Scalar]] = field(default_factory=list)
+    # DroneCAN arrays of which the mapping names elements: array path -> positions (int) or items (Key), in order
+    elements: dict[tuple[PathSeg, ...], list] = field(default_factory=dict)
 
     @property
     def stamp_from_source(self) -> bool:
@@ -181,6 +210,8 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
     """Check one scalar pair; returns (step kind, exact round trip). Raises RuleError."""
     ros_base = ros.base
     transformed = link.scale is not None or link.offset is not None
+    if link.round and (uav.kind != "float" or ros_base not in ROS_INT_RANGES or link.table is not None):
+        raise RuleError(f"`round` takes a UAVCAN float into a ROS integer, not {uav.base_name} into {ros_base}")
     if link.table is not None:
         if uav.kind not in ("int", "uint") or ros_base not in ROS_INT_RANGES:
             raise RuleError(f"a table maps integers to integers, not {uav} to {ros_base}")
@@ -225,9 +256,13 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
                 exact = reach < 2 ** (mantissa - 2)
             return "number", exact
         raise RuleError(f"a UAVCAN {uav.base_name} cannot map to ROS {ros_base}")
+    if uav.kind == "float" and link.round:
+        # rounded half to even; NaN is rejected and values beyond the integer saturate (counted)
+        return "number", False
     if uav.kind == "float":
         if ros_base not in ROS_FLOAT_BITS:
-            raise RuleError(f"a UAVCAN {uav.base_name} maps to a ROS float, not {ros_base}")
+            raise RuleError(f"a UAVCAN {uav.base_name} maps to a ROS float, not {ros_base}"
+                            + (" (or to an integer with `round: true`)" if ros_base in ROS_INT_RANGES else ""))
         if ROS_FLOAT_BITS[ros_base] < uav.bits:
             expected = "float32" if uav.bits <= 32 else "float64"
             raise RuleError(f"ROS {ros_base} is narrower than the UAVCAN {uav.base_name} it receives; "
@@ -275,6 +310,8 @@ def check_arrays(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:
     """Check an array pair; returns whether the round trip is exact (it is not when padding hides a length)."""
     if link.table is not None:
         raise RuleError("a table applies to scalars, not arrays")
+    if link.round:
+        raise RuleError("`round` applies to scalars, not arrays")
     if not ros.array:
         raise RuleError(f"ROS field {ros} is not an array but UAVCAN {uav} is")
     if not uav.array:

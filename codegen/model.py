@@ -97,6 +97,32 @@ class DsdlStruct:
         return next((f for f in self.fields if f.name == name), None)
 
 
+@dataclass
+class V0Struct(DsdlStruct):
+    """A UAVCAN v0 (DroneCAN) composite type: one of the spec's `dronecan_types` or a standard one of dronecan's
+    definitions. Its name has no version (`uavcan.equipment.ahrs.RawIMU`); fields hold v0 types (composites by
+    full name)."""
+
+    data_type_id: int | None = None  # None: only nested in other types (e.g. uavcan.Timestamp)
+    signature: int = 0  # the data type signature (CRC-64-WE), which seeds a transfer's CRC
+    service: bool = False
+    source: str = ""  # the definition file of a standard type
+
+    @property
+    def full_name(self) -> str:
+        return self.name
+
+    @property
+    def version(self) -> tuple[int, int]:
+        return 0, 0
+
+    @property
+    def file_name(self) -> str:
+        """`<data type id>.<Name>.uavcan`, or `<Name>.uavcan` for a type without id."""
+        prefix = f"{self.data_type_id}." if self.data_type_id is not None else ""
+        return f"{prefix}{self.short_name}.uavcan"
+
+
 @dataclass(frozen=True)
 class Qos:
     """The QoS of a topic's endpoints: reliability, durability and keep-last history depth."""
@@ -194,12 +220,41 @@ class Port:
 
 
 @dataclass
+class V0Port:
+    """A UAVCAN v0 (DroneCAN) message a device broadcasts or receives: no subject id, the data type says it all."""
+
+    type: str  # full name, e.g. uavcan.equipment.ahrs.RawIMU
+    rate_hz: float
+    pos: Pos = NOWHERE
+
+
+PROTOCOLS = ("cyphal", "dronecan")
+
+
+@dataclass
 class Device:
     name: str
     node_id: int
     description: str = ""
-    publishes: list[Port] = field(default_factory=list)
+    publishes: list[Port] = field(default_factory=list)  # its Cyphal ports
     subscribes: list[Port] = field(default_factory=list)
+    pos: Pos = NOWHERE
+    protocol: str = "cyphal"  # what it speaks in the default layout
+    protocols: tuple[str, ...] = ("cyphal",)  # every protocol it has ports for (firmware it can run)
+    dronecan_publishes: list[V0Port] = field(default_factory=list)  # its DroneCAN ports
+    dronecan_subscribes: list[V0Port] = field(default_factory=list)
+    protocol_pos: dict[str, Pos] = field(default_factory=dict)  # where each protocol's ports are declared
+
+
+@dataclass
+class Layout:
+    """Which protocol each device speaks: the vehicle as one firmware set (a bus may carry both protocols)."""
+
+    name: str
+    description: str = ""
+    protocol: str | None = None  # every device that has ports for it; None: each device's own `protocol`
+    devices: dict[str, str] = field(default_factory=dict)  # per-device overrides
+    device_pos: dict[str, Pos] = field(default_factory=dict)
     pos: Pos = NOWHERE
 
 
@@ -216,6 +271,7 @@ class FieldLink:
     value: Scalar | None = None
     limits: tuple[float, float] | None = None
     pos: Pos = NOWHERE
+    round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
 
 
 @dataclass
@@ -233,14 +289,26 @@ class Mapping:
     auto: bool = False
     on_out_of_range: OutOfRange = "saturate"
     pos: Pos = NOWHERE
+    protocol: str = "cyphal"
+    # DroneCAN only: messages carry no subject id (the data type is the key) and no destination (they are
+    # broadcast); `select` keeps the messages whose fields have these values (UAVCAN->ROS) and sets them (ROS->UAVCAN).
+    data_type: str = ""
+    destination_node_ids: list[int] = field(default_factory=list)
+    select: dict[str, Scalar] = field(default_factory=dict)
+    select_pos: Pos = NOWHERE
 
 
 @dataclass
 class Bridge:
     name: str
     node_id: int
-    mappings: list[Mapping] = field(default_factory=list)
+    mappings: list[Mapping] = field(default_factory=list)  # Cyphal
     pos: Pos = NOWHERE
+    dronecan_mappings: list[Mapping] = field(default_factory=list)
+
+    @property
+    def all_mappings(self) -> list[Mapping]:
+        return [*self.mappings, *self.dronecan_mappings]
 
 
 @dataclass(frozen=True)
@@ -328,6 +396,8 @@ class Spec:
     devices: dict[str, Device] = field(default_factory=dict)
     bridge: Bridge | None = None
     nodes: dict[str, Node] = field(default_factory=dict)
+    dronecan_types: dict[str, V0Struct] = field(default_factory=dict)  # the spec's own v0 types, by full name
+    layouts: dict[str, Layout] = field(default_factory=dict)  # the named layouts beside the implicit default
 
     def devices_by_node_id(self) -> dict[int, Device]:
         return {d.node_id: d for d in self.devices.values()}

@@ -10,6 +10,7 @@ from typing import Any, TypeVar
 from .diagnostics import Diagnostics, Pos, SpecError
 from .model import (
     DURABILITIES,
+    PROTOCOLS,
     QOS_PROFILES,
     RELIABILITIES,
     Bridge,
@@ -19,6 +20,7 @@ from .model import (
     Field,
     FieldLink,
     Frame,
+    Layout,
     Mapping,
     Node,
     NodeParameter,
@@ -34,8 +36,10 @@ from .model import (
     Spec,
     Topic,
     Transform,
+    V0Port,
+    V0Struct,
 )
-from .typesys import DsdlType, parse_dsdl_type, parse_ros_type
+from .typesys import DsdlType, parse_dsdl_type, parse_ros_type, parse_v0_type
 from .yaml_source import YMap, YNode, YScalar, YSeq, load_yaml
 
 T = TypeVar("T")
@@ -160,7 +164,7 @@ def _fields(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Di
         r = _Reader(item, f"a field of {what}", diag, _FIELD_KEYS)
         type_text = r.get("type", str)
         type_ = _parse_type(type_text, r.key_pos("type"), parse, diag)
-        if type_ is None and parse is parse_dsdl_type and str(type_text).strip().startswith("void"):
+        if type_ is None and parse in (parse_dsdl_type, parse_v0_type) and str(type_text).strip().startswith("void"):
             continue  # padding with a bad type (reported): it has no name to miss
         if isinstance(type_, DsdlType) and type_.kind == "void":
             # DSDL padding has no name (`void3`); it is kept for the layout and mapped by no one.
@@ -243,10 +247,10 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
     if isinstance(node, YScalar):
         path = scalar(node, str, what, diag)
         return FieldLink(ros_path, path, pos=pos) if path is not None else None
-    r = _Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits"))
+    r = _Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round"))
     if not r.ok:
         return None
-    link = FieldLink(ros_path, r.get("from", str, None), pos=pos)
+    link = FieldLink(ros_path, r.get("from", str, None), pos=pos, round=bool(r.get("round", bool, False)))
     link.scale = _number(r.node("scale"), f"'scale' of {what}", diag)
     link.offset = _number(r.node("offset"), f"'offset' of {what}", diag)
     if link.scale == 0:
@@ -287,11 +291,17 @@ _MAPPING_KEYS = (
     "direction", "topic", "subject_id", "source_node_ids", "destination_node_id", "frame_id",
     "fields", "ignore", "uavcan_values", "on_out_of_range",
 )
+# A DroneCAN message is keyed by its data type (no subject id) and broadcast (destinations, not one destination).
+_DRONECAN_MAPPING_KEYS = (
+    "direction", "topic", "data_type", "select", "source_node_ids", "destination_node_ids", "frame_id",
+    "fields", "ignore", "uavcan_values", "on_out_of_range",
+)
 
 
-def _mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -> Mapping | None:
-    what = f"mapping {name!r}"
-    r = _Reader(node, what, diag, _MAPPING_KEYS)
+def _mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol: str = "cyphal") -> Mapping | None:
+    dronecan = protocol == "dronecan"
+    what = f"DroneCAN mapping {name!r}" if dronecan else f"mapping {name!r}"
+    r = _Reader(node, what, diag, _DRONECAN_MAPPING_KEYS if dronecan else _MAPPING_KEYS)
     if not r.ok:
         return None
     direction = r.get("direction", str)
@@ -304,12 +314,20 @@ def _mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -> Mapping | N
         diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range {policy!r} of {what} is unknown",
                    "saturate or reject")
     mapping = Mapping(
-        name, direction or "uavcan_to_ros", r.get("topic", str) or "", r.get("subject_id", int) or 0,
-        [n for n in (scalar(i, int, f"a source node id of {what}", diag)
-                     for i in _list(r.node("source_node_ids"), f"source_node_ids of {what}", diag)) if n is not None],
-        r.get("destination_node_id", int, None), r.get("frame_id", str, None),
-        on_out_of_range=policy if policy in ("saturate", "reject") else "saturate", pos=pos,
+        name, direction or "uavcan_to_ros", r.get("topic", str) or "",
+        0 if dronecan else r.get("subject_id", int) or 0,
+        _int_list(r.node("source_node_ids"), "source_node_ids", what, diag),
+        None if dronecan else r.get("destination_node_id", int, None), r.get("frame_id", str, None),
+        on_out_of_range=policy if policy in ("saturate", "reject") else "saturate", pos=pos, protocol=protocol,
     )
+    if dronecan:
+        mapping.data_type = r.get("data_type", str) or ""
+        mapping.destination_node_ids = _int_list(r.node("destination_node_ids"), "destination_node_ids", what, diag)
+        mapping.select_pos = r.key_pos("select")
+        for path, _, value_node in _items(r.node("select"), f"select of {what}", diag):
+            value = scalar(value_node, (bool, int), f"select value {path!r} of {what}", diag)
+            if value is not None:
+                mapping.select[path] = value
     fields = r.node("fields")
     if isinstance(fields, YScalar) and fields.value == "auto":
         mapping.auto = True
@@ -325,17 +343,25 @@ def _mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -> Mapping | N
         value = scalar(value_node, (bool, int, float), f"uavcan value {path!r} of {what}", diag)
         if value is not None:
             mapping.uavcan_values[path] = value
-    if direction == "uavcan_to_ros" and mapping.destination_node_id is not None:
-        diag.error(r.key_pos("destination_node_id"), f"{what} goes UAVCAN->ROS: it has sources, not a destination",
+    destination = "destination_node_ids" if dronecan else "destination_node_id"
+    if direction == "uavcan_to_ros" and r.node(destination) is not None:
+        diag.error(r.key_pos(destination), f"{what} goes UAVCAN->ROS: it has sources, not a destination",
                    "source_node_ids")
     if direction == "ros_to_uavcan" and r.node("source_node_ids") is not None:
         diag.error(r.key_pos("source_node_ids"), f"{what} goes ROS->UAVCAN: it has a destination, not sources",
-                   "destination_node_id")
+                   destination)
     if direction == "uavcan_to_ros" and not mapping.source_node_ids:
         diag.error(pos, f"{what} needs source_node_ids: the node ids whose messages it accepts")
-    if direction == "ros_to_uavcan" and mapping.destination_node_id is None:
+    if direction == "ros_to_uavcan" and not dronecan and mapping.destination_node_id is None:
         diag.error(pos, f"{what} needs destination_node_id: the node its commands are meant for")
+    if direction == "ros_to_uavcan" and dronecan and not mapping.destination_node_ids:
+        diag.error(pos, f"{what} needs destination_node_ids: the nodes its broadcast commands are meant for")
     return mapping
+
+
+def _int_list(node: YNode | None, key: str, what: str, diag: Diagnostics) -> list[int]:
+    items = (scalar(i, int, f"an entry of {key} of {what}", diag) for i in _list(node, f"{key} of {what}", diag))
+    return [n for n in items if n is not None]
 
 
 def _ports(node: YNode | None, what: str, diag: Diagnostics) -> list[Port]:
@@ -353,9 +379,89 @@ def _ports(node: YNode | None, what: str, diag: Diagnostics) -> list[Port]:
     return ports
 
 
+def _v0_ports(node: YNode | None, what: str, diag: Diagnostics) -> list[V0Port]:
+    ports = []
+    for item in _list(node, what, diag):
+        r = _Reader(item, f"a DroneCAN port of {what}", diag, ("type", "rate_hz"))
+        type_ = r.get("type", str)
+        rate = _number(r.node("rate_hz"), f"rate_hz of {what}", diag) if r.node("rate_hz") else None
+        if r.ok and r.node("rate_hz") is None:
+            diag.error(item.pos, f"missing field 'rate_hz' in a DroneCAN port of {what}", "the nominal rate in Hz")
+        if rate is not None and rate <= 0:
+            diag.error(r.key_pos("rate_hz"), f"rate_hz of {what} must be positive")
+        if type_ is not None:
+            ports.append(V0Port(type_, float(rate or 0.0), item.pos))
+    return ports
+
+
+_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes", *PROTOCOLS)
+
+
+def _device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
+    """A device: its ports in its `protocol` (cyphal by default), and under the other protocol's name the ports of
+    its firmware for that protocol."""
+    what = f"device {key!r}"
+    r = _Reader(node, what, diag, _DEVICE_KEYS)
+    node_id = r.get("node_id", int)
+    protocol = r.get("protocol", str, "cyphal")
+    device = Device(key, node_id if node_id is not None else -1, _text(r, "description"), pos=pos,
+                    protocol=protocol, protocol_pos={protocol: pos}, protocols=())
+    if protocol not in PROTOCOLS:
+        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+        return device  # its ports would be read in the wrong protocol
+    sides = [(protocol, r.map)]
+    if r.node(protocol) is not None:
+        diag.error(r.key_pos(protocol), f"{what} speaks {protocol}: its {protocol} ports are its `publishes` and "
+                   "`subscribes`", f"a section for the other protocol ({', '.join(set(PROTOCOLS) - {protocol})})")
+    for other in PROTOCOLS:
+        section = r.node(other)
+        if other != protocol and section is not None:
+            sub = _Reader(section, f"the {other} ports of {what}", diag, ("publishes", "subscribes"))
+            sides.append((other, sub.map))
+            device.protocol_pos[other] = r.key_pos(other)
+    for side, ports in sides:
+        if side == "cyphal":
+            device.publishes = _ports(ports.entries.get("publishes"), what, diag)
+            device.subscribes = _ports(ports.entries.get("subscribes"), what, diag)
+        else:
+            device.dronecan_publishes = _v0_ports(ports.entries.get("publishes"), what, diag)
+            device.dronecan_subscribes = _v0_ports(ports.entries.get("subscribes"), what, diag)
+    device.protocols = tuple(side for side, _ in sides)
+    return device
+
+
+def _dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V0Struct:
+    what = f"DroneCAN type {key!r}"
+    r = _Reader(node, what, diag, ("id", "description", "fields", "constants"))
+    layout = _fields(r.node("fields"), what, parse_v0_type, diag)
+    fields = [f for f in layout if f.name]
+    return V0Struct(
+        key, fields, _constants(r.node("constants"), what, parse_v0_type, diag), _text(r, "description"),
+        pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int, None),
+    )
+
+
+def _layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
+    what = f"layout {key!r}"
+    r = _Reader(node, what, diag, ("description", "protocol", "devices"))
+    layout = Layout(key, _text(r, "description"), r.get("protocol", str, None), pos=pos)
+    if layout.protocol is not None and layout.protocol not in PROTOCOLS:
+        diag.error(r.key_pos("protocol"), f"protocol {layout.protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+        layout.protocol = None
+    for device, device_pos, value in _items(r.node("devices"), f"the devices of {what}", diag):
+        protocol = scalar(value, str, f"the protocol of device {device!r} in {what}", diag)
+        if protocol is not None and protocol not in PROTOCOLS:
+            diag.error(value.pos, f"protocol {protocol!r} of device {device!r} in {what} is unknown",
+                       " or ".join(PROTOCOLS))
+        elif protocol is not None:
+            layout.devices[device] = protocol
+            layout.device_pos[device] = device_pos
+    return layout
+
+
 _TOP_KEYS = (
-    "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "frames",
-    "transforms", "topics", "parameters", "parameter_rules", "devices", "bridge", "nodes",
+    "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "dronecan_types",
+    "frames", "transforms", "topics", "parameters", "parameter_rules", "devices", "layouts", "bridge", "nodes",
 )
 
 
@@ -428,22 +534,24 @@ def parse_spec(root: YNode, file: str) -> Spec:
             diag.error(r.key_pos("op"), f"parameter rule operator {op!r} is unknown", "<, <=, > or >=")
         elif left and op and right:
             spec.parameter_rules.append(ParameterRule(left, op, right, _text(r, "description"), item.pos))
+    for key, pos, node in _items(top.node("dronecan_types"), "dronecan_types", diag):
+        spec.dronecan_types[key] = _dronecan_type(key, pos, node, diag)
     for key, pos, node in _items(top.node("devices"), "devices", diag):
-        r = _Reader(node, f"device {key!r}", diag, ("node_id", "description", "publishes", "subscribes"))
-        node_id = r.get("node_id", int)
-        spec.devices[key] = Device(
-            key, node_id if node_id is not None else -1, _text(r, "description"),
-            _ports(r.node("publishes"), f"device {key!r}", diag),
-            _ports(r.node("subscribes"), f"device {key!r}", diag), pos,
-        )
+        spec.devices[key] = _device(key, pos, node, diag)
+    for key, pos, node in _items(top.node("layouts"), "layouts", diag):
+        spec.layouts[key] = _layout(key, pos, node, diag)
     bridge_node = top.node("bridge")
     if bridge_node is not None:
-        r = _Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings"))
+        r = _Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings"))
         bridge = Bridge(r.get("name", str) or "bridge", r.get("node_id", int) or 0, pos=bridge_node.pos)
         for key, pos, node in _items(r.node("mappings"), "bridge mappings", diag):
             mapping = _mapping(key, pos, node, diag)
             if mapping is not None:
                 bridge.mappings.append(mapping)
+        for key, pos, node in _items(r.node("dronecan_mappings"), "bridge dronecan_mappings", diag):
+            mapping = _mapping(key, pos, node, diag, "dronecan")
+            if mapping is not None:
+                bridge.dronecan_mappings.append(mapping)
         spec.bridge = bridge
     for key, pos, node in _items(top.node("nodes"), "nodes", diag):
         _node(spec, key, pos, node, diag)

@@ -245,3 +245,92 @@ def parse_dsdl_type(text: str) -> DsdlType:
     if capacity < 1:
         raise ValueError(f"array capacity of {text!r} must be at least 1")
     return DsdlType(kind, bits, composite, "bounded" if bounded else "fixed", capacity, cast == "truncated")
+
+
+# ---- UAVCAN v0 (DroneCAN) ------------------------------------------------------------------------------------
+# v0 DSDL has no versions in type names, no byte/utf8 (text is uint8[<=N]), integers of 2..64 bits (bool, not
+# uint1), floats of 16/32/64 bits, and a cast mode on any primitive. `[<N]` is `[<=N-1]`.
+V0_NAMESPACE_COMPONENT = re.compile(r"^[a-z][a-z0-9_]*$")
+V0_SHORT_NAME = re.compile(r"^[A-Z][A-Za-z0-9_]*$")
+V0_MAX_FULL_NAME = 80  # dronecan's parser refuses longer type and namespace names
+_V0_TYPE = re.compile(
+    r"^(?:(?P<cast>saturated|truncated)\s+)?"
+    r"(?P<base>bool|u?int[0-9]+|float[0-9]+|void[0-9]+|(?:[a-z][a-z0-9_]*\.)+[A-Z][A-Za-z0-9_]*)"
+    r"(?:\[(?P<array><=?[0-9]+|[0-9]+)\])?$"
+)
+
+
+def parse_v0_type(text: str) -> DsdlType:
+    """Parse a UAVCAN v0 (DroneCAN) field type; a composite is named by its full name, without version.
+
+    >>> str(parse_v0_type("float16[<=36]")), str(parse_v0_type("uint8[<32]")), parse_v0_type("int18").range
+    ('float16[<=36]', 'uint8[<=31]', (-131072, 131071))
+    >>> t = parse_v0_type("uavcan.Timestamp"); (t.kind, t.composite)
+    ('composite', 'uavcan.Timestamp')
+    >>> parse_v0_type("uint1")
+    Traceback (most recent call last):
+    ...
+    ValueError: uint1: a v0 integer has 2..64 bits (a single bit is a bool)
+    """
+    match = _V0_TYPE.fullmatch(" ".join(text.split()))
+    if not match:
+        raise ValueError(f"{text!r} is not a UAVCAN v0 field type")
+    base, cast = match["base"], match["cast"]
+    kind: DsdlKind
+    bits, composite = 0, None
+    if base == "bool":
+        kind, bits = "bool", 1
+    elif base.startswith("float"):
+        kind, bits = "float", int(base[5:])
+        if bits not in (16, 32, 64):
+            raise ValueError(f"{base}: a v0 float has 16, 32 or 64 bits")
+    elif base.startswith("void"):
+        kind, bits = "void", int(base[4:])
+        if not 1 <= bits <= 64:
+            raise ValueError(f"{base}: void bit length must be 1..64")
+    elif base.startswith(("uint", "int")):
+        kind = "uint" if base.startswith("uint") else "int"
+        bits = int(base[len(kind):])
+        if not 2 <= bits <= 64:
+            raise ValueError(f"{base}: a v0 integer has 2..64 bits (a single bit is a bool)")
+    else:
+        kind, composite = "composite", base
+        if len(base) > V0_MAX_FULL_NAME:
+            raise ValueError(f"{base}: a v0 type name has at most {V0_MAX_FULL_NAME} characters")
+    if cast and kind in ("void", "composite"):
+        raise ValueError(f"cast mode {cast!r} applies only to primitive types, not {base}")
+    array = match["array"]
+    if array is None:
+        return DsdlType(kind, bits, composite, truncated=cast == "truncated")
+    if kind == "void":
+        raise ValueError("void cannot be an array element")
+    if array.startswith("<="):
+        capacity, mode = int(array[2:]), "bounded"
+    elif array.startswith("<"):
+        capacity, mode = int(array[1:]) - 1, "bounded"
+    else:
+        capacity, mode = int(array), "fixed"
+    if capacity < 1:
+        raise ValueError(f"array capacity of {text!r} must be at least 1")
+    return DsdlType(kind, bits, composite, mode, capacity, cast == "truncated")  # type: ignore[arg-type]
+
+
+def v0_normalized(t: DsdlType) -> str:
+    """The type as the v0 signature sees it (the normalized definition): the cast mode spelled out.
+
+    >>> v0_normalized(parse_v0_type("float16[<=36]")), v0_normalized(parse_v0_type("truncated uint56"))
+    ('saturated float16[<=36]', 'truncated uint56')
+    >>> v0_normalized(parse_v0_type("uavcan.equipment.actuator.Command[<=15]")), v0_normalized(DsdlType("void", 3))
+    ('uavcan.equipment.actuator.Command[<=15]', 'void3')
+    """
+    if t.kind == "composite":
+        text = t.composite or ""
+    elif t.kind == "void":
+        text = f"void{t.bits}"
+    else:
+        text = ("truncated " if t.truncated else "saturated ") + t.base_name
+    if t.array == "fixed":
+        text += f"[{t.capacity}]"
+    elif t.array == "bounded":
+        text += f"[<={t.capacity}]"
+    return text

@@ -7,9 +7,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .diagnostics import Diagnostics, Pos
+from .dronecan_catalog import V0Catalog
 from .dsdl_catalog import DsdlCatalog
 from .mapping_rules import ResolvedMapping, RuleError, derive_message
-from .model import Constant, DsdlStruct, Field, RosMessage, Spec
+from .model import Constant, DsdlStruct, Field, RosMessage, Spec, V0Struct
 from .ros_catalog import RosCatalog
 from .typesys import (
     DSDL_NAMESPACE_COMPONENT,
@@ -24,6 +25,7 @@ from .typesys import (
     is_dsdl_identifier,
     split_composite_name,
 )
+from .validate_dronecan import DronecanValidator, ResolvedLayout
 from .validate_mappings import MappingValidator
 from .validate_nodes import check_nodes
 from .validate_values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value
@@ -43,7 +45,11 @@ class Resolved:
     dsdl: DsdlCatalog
     messages: list[RosMessage] = field(default_factory=list)  # the spec's package, sorted by name
     dsdl_types: list[DsdlStruct] = field(default_factory=list)  # the spec's root namespace, sorted by name
-    mappings: list[ResolvedMapping] = field(default_factory=list)
+    mappings: list[ResolvedMapping] = field(default_factory=list)  # Cyphal
+    dronecan: V0Catalog | None = None
+    dronecan_types: list[V0Struct] = field(default_factory=list)  # the spec's own, sorted by name
+    dronecan_mappings: list[ResolvedMapping] = field(default_factory=list)
+    layouts: list[ResolvedLayout] = field(default_factory=list)  # the implicit "default" first
 
 
 class _Validator:
@@ -264,7 +270,7 @@ class _Validator:
         for device in s.devices.values():
             if not re.fullmatch(r"[a-z][a-z0-9_]*", device.name):
                 self.error(device.pos, f"device name {device.name!r} is not valid", "lower_case")
-            if device.node_id not in CAN_NODE_IDS:
+            if device.node_id not in CAN_NODE_IDS and "cyphal" in device.protocols:
                 self.error(device.pos, f"node id {device.node_id} of device {device.name} is out of range for "
                            "Cyphal/CAN", "0..127")
             elif device.node_id in owners:
@@ -291,15 +297,15 @@ class _Validator:
                     publishers[port.subject_id] = f"device {device.name}"
         self.publishers = publishers
 
-    def resolve_mappings(self) -> list[ResolvedMapping]:
+    def mapping_validator(self, v0: V0Catalog) -> MappingValidator:
         return MappingValidator(self.spec, self.ros, self.dsdl, self.diag, self.publishers,
-                                self.bad_dsdl_fields, self.failed_messages).resolve_mappings()
+                                self.bad_dsdl_fields, self.failed_messages, v0)
 
 
-def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots: list[Path] | None = None
-             ) -> Resolved:
+def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots: list[Path] | None = None,
+             dronecan_roots: list[Path] | None = None) -> Resolved:
     """Check a parsed spec; raises SpecError with every problem, or returns the resolved interface."""
-    ros, dsdl = RosCatalog(spec, ros_share_dirs), DsdlCatalog(spec, dsdl_roots)
+    ros, dsdl, v0 = RosCatalog(spec, ros_share_dirs), DsdlCatalog(spec, dsdl_roots), V0Catalog(spec, dronecan_roots)
     v = _Validator(spec, ros, dsdl)
     v.check_header()
     for struct in spec.dsdl_types.values():
@@ -309,9 +315,17 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     v.check_topics_and_nodes()
     check_nodes(spec, ros, v.diag)  # nodes, QoS, TF topics, external packages (validate_nodes)
     v.check_devices()
-    mappings = v.resolve_mappings()
+    dronecan = DronecanValidator(spec, v0, v.diag, v.mapping_validator(v0))
+    dronecan.check_types()
+    dronecan.check_devices()
+    mappings = dronecan.mappings.resolve_mappings()
+    dronecan_mappings = dronecan.resolve_mappings()
+    layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
+    for error in v0.errors:
+        v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")
     v.diag.check()
-    return Resolved(spec, ros, dsdl, messages, sorted(spec.dsdl_types.values(), key=lambda t: t.name), mappings)
+    return Resolved(spec, ros, dsdl, messages, sorted(spec.dsdl_types.values(), key=lambda t: t.name), mappings,
+                    v0, sorted(spec.dronecan_types.values(), key=lambda t: t.name), dronecan_mappings, layouts)
 
 
 __all__ = ["CAN_NODE_IDS", "SUBJECT_IDS", "Constant", "Field", "Resolved", "validate"]

@@ -114,7 +114,7 @@ def bridge_published_topics(spec: Spec) -> set[str]:
     """Topics the bridge publishes from UAVCAN (its uavcan_to_ros mappings)."""
     if spec.bridge is None:
         return set()
-    return {m.topic for m in spec.bridge.mappings if m.direction == "uavcan_to_ros"}
+    return {m.topic for m in spec.bridge.all_mappings if m.direction == "uavcan_to_ros"}
 
 
 def default_qos(topic: Topic, bridged: set[str]) -> tuple[Qos, str]:
@@ -174,7 +174,7 @@ def publishers(spec: Spec) -> dict[str, list[Endpoint]]:
         if node.transform_items:
             result.setdefault(TF_TOPIC, []).append(Endpoint(f"node {node.name}", node.transform_items[0].pos))
     if spec.bridge is not None:
-        for m in spec.bridge.mappings:
+        for m in spec.bridge.all_mappings:
             if m.direction == "uavcan_to_ros":
                 result.setdefault(m.topic, []).append(Endpoint(f"the bridge (mapping {m.name})", m.pos))
     static = [f for f in spec.frames.values() if f.parent is not None]
@@ -397,7 +397,7 @@ class _NodeChecks:
         if self.spec.bridge is None:
             return
         seen: set[str] = set()
-        for m in self.spec.bridge.mappings:
+        for m in self.spec.bridge.all_mappings:
             if m.direction != "ros_to_uavcan" or m.topic in seen or m.topic not in self.spec.topics:
                 continue
             seen.add(m.topic)

@@ -71,7 +71,7 @@ CASES: tuple[Case, ...] = (
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
         (
-            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, frames, transforms, topics, parameters, parameter_rules, devices, bridge, nodes)",
+            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes)",
         ),
     ),
     Case(
@@ -421,6 +421,332 @@ CASES: tuple[Case, ...] = (
         '      - {name: header, type: std_msgs/Headr}',
         (
             "minimal.yaml:10:9: error: unknown ROS type 'std_msgs/Headr' in message buoy_msgs/Level (expected a primitive, a message of this spec or an installed ROS message)",
+        ),
+    ),
+)
+
+
+# DroneCAN cases: each breaks tests/specs/minimal_v0.yaml one way (tests/test_v0_bad_specs.py runs them).
+V0_CASES: tuple[Case, ...] = (
+    Case(
+        'v0_unknown_standard_type',
+        '{type: uavcan.equipment.esc.RPMCommand, rate_hz: 10}',
+        '{type: uavcan.equipment.esc.RPMCmd, rate_hz: 10}',
+        (
+            "minimal_v0.yaml:37:9: error: unknown DroneCAN type 'uavcan.equipment.esc.RPMCmd' of device esc (expected a type of dronecan_types or a standard one, e.g. uavcan.equipment.ahrs.RawIMU)",
+            "minimal_v0.yaml:66:5: error: destination node id 20 of DroneCAN mapping 'motors' does not subscribe to uavcan.equipment.esc.RPMCommand on DroneCAN (it is device esc) (expected a device with `uavcan.equipment.esc.RPMCommand` in its DroneCAN subscribes)",
+        ),
+    ),
+    Case(
+        'v0_service_type_port',
+        '{type: uavcan.equipment.esc.RPMCommand, rate_hz: 10}',
+        '{type: uavcan.protocol.GetNodeInfo, rate_hz: 10}',
+        (
+            "minimal_v0.yaml:37:9: error: DroneCAN type 'uavcan.protocol.GetNodeInfo' of device esc is a service type (expected a message type)",
+            "minimal_v0.yaml:66:5: error: destination node id 20 of DroneCAN mapping 'motors' does not subscribe to uavcan.equipment.esc.RPMCommand on DroneCAN (it is device esc) (expected a device with `uavcan.equipment.esc.RPMCommand` in its DroneCAN subscribes)",
+        ),
+    ),
+    Case(
+        'v0_nested_type_port',
+        '{type: skiff.Bilge, rate_hz: 2}',
+        '{type: uavcan.Timestamp, rate_hz: 2}',
+        (
+            "minimal_v0.yaml:32:11: error: DroneCAN type 'uavcan.Timestamp' of device gauge has no data type id: it can only be nested in other types (expected a message type with a data type id)",
+            "minimal_v0.yaml:57:5: error: source node id 10 of DroneCAN mapping 'bilge' does not publish skiff.Bilge on DroneCAN (it is device gauge) (expected a device with `skiff.Bilge` in its DroneCAN publishes)",
+        ),
+    ),
+    Case(
+        'v0_node_id_out_of_range',
+        '    node_id: 20\n',
+        '    node_id: 126\n',
+        (
+            'minimal_v0.yaml:33:3: error: node id 126 of device esc is out of range for DroneCAN (expected 1..125)',
+            "minimal_v0.yaml:66:5: error: destination node id 20 of DroneCAN mapping 'motors' does not subscribe to uavcan.equipment.esc.RPMCommand on DroneCAN (expected the node id of a device that does: 126)",
+        ),
+    ),
+    Case(
+        'v0_bridge_node_id',
+        '  node_id: 100\n',
+        '  node_id: 127\n',
+        (
+            'minimal_v0.yaml:46:3: error: bridge node id 127 is out of range for DroneCAN (expected 1..125)',
+        ),
+    ),
+    Case(
+        'v0_type_id_taken',
+        'id: 20120',
+        'id: 20100',
+        (
+            'minimal_v0.yaml:12:3: error: data type id 20100 of DroneCAN type skiff.Bilge is taken by the standard type com.hobbywing.esc.RawCommand (expected a free vendor-specific id, e.g. in 20101..20199)',
+        ),
+    ),
+    Case(
+        'v0_type_id_not_vendor',
+        'id: 20120',
+        'id: 1003',
+        (
+            'minimal_v0.yaml:12:3: error: data type id 1003 of DroneCAN type skiff.Bilge is outside the vendor-specific range (expected 20000..20999)',
+        ),
+    ),
+    Case(
+        'v0_type_in_standard_root',
+        '  skiff.Bilge:\n    id:',
+        '  uavcan.Bilge:\n    id:',
+        (
+            "minimal_v0.yaml:12:3: error: DroneCAN type uavcan.Bilge is in the root namespace 'uavcan' of the standard definitions (expected a root namespace of your own, e.g. the vehicle's)",
+            "minimal_v0.yaml:32:11: error: unknown DroneCAN type 'skiff.Bilge' of device gauge (expected a type of dronecan_types or a standard one, e.g. uavcan.equipment.ahrs.RawIMU)",
+            "minimal_v0.yaml:57:5: error: unknown DroneCAN type 'skiff.Bilge' of DroneCAN mapping 'bilge' (expected a type of dronecan_types or a standard one, e.g. uavcan.equipment.ahrs.RawIMU)",
+        ),
+    ),
+    Case(
+        'v0_type_uint1',
+        '{name: pump_id, type: uint4}',
+        '{name: pump_id, type: uint1}',
+        (
+            'minimal_v0.yaml:16:25: error: uint1: a v0 integer has 2..64 bits (a single bit is a bool)',
+        ),
+    ),
+    Case(
+        'v0_type_unknown_nested',
+        '{name: timestamp, type: uavcan.Timestamp}',
+        '{name: timestamp, type: uavcan.Time}',
+        (
+            "minimal_v0.yaml:15:9: error: unknown DroneCAN type 'uavcan.Time' in DroneCAN type skiff.Bilge (expected a type of dronecan_types or a standard one, by its full name (e.g. uavcan.Timestamp))",
+        ),
+    ),
+    Case(
+        'v0_type_keyword_field',
+        '      - {name: level_mm, type: int13}\n',
+        '      - {name: level_mm, type: int13}\n      - {name: class, type: bool}\n',
+        (
+            "minimal_v0.yaml:18:9: error: 'class' is not a valid DroneCAN field name in DroneCAN type skiff.Bilge (expected a letter, then letters, digits and underscores; not a Python keyword)",
+        ),
+    ),
+    Case(
+        'v0_type_self',
+        '      - {name: level_mm, type: int13}\n',
+        '      - {name: level_mm, type: int13}\n      - {name: next, type: "skiff.Bilge[<=2]"}\n',
+        (
+            'minimal_v0.yaml:12:3: error: DroneCAN type skiff.Bilge contains itself: skiff.Bilge -> skiff.Bilge',
+        ),
+    ),
+    Case(
+        'v0_mapping_subject_id',
+        '      data_type: skiff.Bilge\n',
+        '      data_type: skiff.Bilge\n      subject_id: 7\n',
+        (
+            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+        ),
+    ),
+    Case(
+        'v0_mapping_unknown_data_type',
+        '      data_type: skiff.Bilge\n',
+        '      data_type: skiff.Bilges\n',
+        (
+            "minimal_v0.yaml:57:5: error: unknown DroneCAN type 'skiff.Bilges' of DroneCAN mapping 'bilge' (expected a type of dronecan_types or a standard one, e.g. uavcan.equipment.ahrs.RawIMU)",
+        ),
+    ),
+    Case(
+        'v0_source_not_publisher',
+        '      source_node_ids: [10]\n      fields:\n        data: level_mm\n      ignore',
+        '      source_node_ids: [20]\n      fields:\n        data: level_mm\n      ignore',
+        (
+            "minimal_v0.yaml:57:5: error: source node id 20 of DroneCAN mapping 'bilge' does not publish skiff.Bilge on DroneCAN (it is device esc) (expected the node id of a device that does: 10)",
+        ),
+    ),
+    Case(
+        'v0_destination_not_subscriber',
+        '      destination_node_ids: [20]',
+        '      destination_node_ids: [21]',
+        (
+            "minimal_v0.yaml:66:5: error: destination node id 21 of DroneCAN mapping 'motors' does not subscribe to uavcan.equipment.esc.RPMCommand on DroneCAN (it is device servo) (expected the node id of a device that does: 20)",
+        ),
+    ),
+    Case(
+        'v0_destination_missing',
+        '      destination_node_ids: [20]\n',
+        '',
+        (
+            "minimal_v0.yaml:66:5: error: DroneCAN mapping 'motors' needs destination_node_ids: the nodes its broadcast commands are meant for",
+        ),
+    ),
+    Case(
+        'v0_select_unknown_field',
+        'select: {pump_id: 1}',
+        'select: {pump: 1}',
+        (
+            "minimal_v0.yaml:57:5: error: required field left unmapped: UAVCAN field 'pump_id' (uint4) of skiff.Bilge is neither mapped nor ignored in DroneCAN mapping 'bilge' (expected a `ros_field: pump_id` line or `pump_id` in ignore)",
+            "minimal_v0.yaml:60:7: error: select of DroneCAN mapping 'bilge': skiff.Bilge has no field 'pump'",
+        ),
+    ),
+    Case(
+        'v0_select_out_of_range',
+        'select: {pump_id: 1}',
+        'select: {pump_id: 16}',
+        (
+            "minimal_v0.yaml:60:7: error: select value 'pump_id' of DroneCAN mapping 'bilge' = 16 does not fit uint4 (expected an integer in [0, 15])",
+        ),
+    ),
+    Case(
+        'v0_select_composite',
+        'select: {pump_id: 1}',
+        'select: {timestamp: 1}',
+        (
+            "minimal_v0.yaml:57:5: error: required field left unmapped: UAVCAN field 'pump_id' (uint4) of skiff.Bilge is neither mapped nor ignored in DroneCAN mapping 'bilge' (expected a `ros_field: pump_id` line or `pump_id` in ignore)",
+            "minimal_v0.yaml:60:7: error: select of DroneCAN mapping 'bilge': timestamp is uavcan.Timestamp; a selection compares an integer or bool field",
+        ),
+    ),
+    Case(
+        'v0_select_in_cyphal',
+        '      source_node_ids: [10]\n      fields:\n        data: level_mm\n  dronecan',
+        '      source_node_ids: [10]\n      select: {level_mm: 1}\n      fields:\n        data: level_mm\n  dronecan',
+        (
+            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+        ),
+    ),
+    Case(
+        'v0_select_also_mapped',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: pump_id\n      ignore: [timestamp, level_mm]',
+        (
+            "minimal_v0.yaml:57:5: error: UAVCAN field 'pump_id' is set by `select` in DroneCAN mapping 'bilge'; it cannot also be mapped (expected the field in select only)",
+        ),
+    ),
+    Case(
+        'v0_index_beyond_capacity',
+        '        y: rpm[1]',
+        '        y: rpm[20]',
+        (
+            "minimal_v0.yaml:73:9: error: DroneCAN mapping 'motors', field 'y': rpm[20]: index out of range, rpm holds at most 20 elements",
+        ),
+    ),
+    Case(
+        'v0_missing_element',
+        '        x: rpm[0]\n        y: rpm[1]',
+        '        y: rpm[1]',
+        (
+            "minimal_v0.yaml:66:5: error: required field left unmapped: UAVCAN field 'rpm[0]' (int18) of uavcan.equipment.esc.RPMCommand gets no value in DroneCAN mapping 'motors' (expected a `ros_field: rpm[0]` line or an entry in uavcan_values)",
+        ),
+    ),
+    Case(
+        'v0_key_unknown_field',
+        'commands[actuator_id=2].command_value"',
+        'commands[actuator=2].command_value"',
+        (
+            "minimal_v0.yaml:80:9: error: DroneCAN mapping 'rudder', field 'data': commands[actuator=2]: the key must be an integer field of uavcan.equipment.actuator.Command, which has no field 'actuator'",
+        ),
+    ),
+    Case(
+        'v0_key_out_of_range',
+        'commands[actuator_id=2].command_value"',
+        'commands[actuator_id=256].command_value"',
+        (
+            "minimal_v0.yaml:80:9: error: DroneCAN mapping 'rudder', field 'data': commands[actuator_id=256]: 256 is outside the range of actuator_id (uint8) [0, 255]",
+        ),
+    ),
+    Case(
+        'v0_key_on_scalar_array',
+        '        y: rpm[1]',
+        '        y: rpm[esc=1]',
+        (
+            "minimal_v0.yaml:73:9: error: DroneCAN mapping 'motors', field 'y': rpm[esc=1]: an item is chosen by key in an array of composites, rpm is int18[<=20]",
+        ),
+    ),
+    Case(
+        'v0_key_in_cyphal',
+        '      fields:\n        data: level_mm\n  dronecan',
+        '      fields:\n        data: "level_mm[id=1]"\n  dronecan',
+        (
+            "minimal_v0.yaml:55:9: error: mapping 'level', field 'data': level_mm[id=1]: an item is chosen by key only in the arrays of a DroneCAN message",
+        ),
+    ),
+    Case(
+        'v0_position_and_key',
+        '{"commands[actuator_id=2].command_type": 1}',
+        '{"commands[actuator_id=2].command_type": 1, "commands[0].command_type": 1}',
+        (
+            "minimal_v0.yaml:74:5: error: DroneCAN mapping 'rudder' names elements of commands both by position and by key (expected one way for one array)",
+        ),
+    ),
+    Case(
+        'v0_two_key_fields',
+        '{"commands[actuator_id=2].command_type": 1}',
+        '{"commands[command_type=1].actuator_id": 2}',
+        (
+            "minimal_v0.yaml:74:5: error: DroneCAN mapping 'rudder' chooses items of commands by more than one key field (actuator_id, command_type) (expected one key field per array)",
+        ),
+    ),
+    Case(
+        'v0_broadcast_conflict',
+        'nodes:\n',
+        '    rudder_2:\n      direction: ros_to_uavcan\n      data_type: uavcan.equipment.actuator.ArrayCommand\n      topic: /rudder\n      destination_node_ids: [21]\n      fields:\n        data: "commands[actuator_id=2].command_value"\n      uavcan_values: {"commands[actuator_id=2].command_type": 0}\nnodes:\n',
+        (
+            "minimal_v0.yaml:82:5: error: DroneCAN mappings 'rudder' and 'rudder_2' both command uavcan.equipment.actuator.ArrayCommand (commands[actuator_id=2]) (expected distinct `select` values or distinct items chosen by key, or one mapping that writes every element)",
+        ),
+    ),
+    Case(
+        'v0_round_on_integer',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {from: level_mm, round: true}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:9: error: DroneCAN mapping 'bilge', field 'data': `round` takes a UAVCAN float into a ROS integer, not int13 into int16",
+        ),
+    ),
+    Case(
+        'v0_float_into_integer',
+        '{name: level_mm, type: int13}',
+        '{name: level_mm, type: float16}',
+        (
+            "minimal_v0.yaml:64:9: error: DroneCAN mapping 'bilge', field 'data': a UAVCAN float16 maps to a ROS float, not int16 (or to an integer with `round: true`)",
+        ),
+    ),
+    Case(
+        'v0_layout_unknown_device',
+        'protocol: dronecan}\n',
+        'protocol: dronecan, devices: {boat: cyphal}}\n',
+        (
+            "minimal_v0.yaml:44:86: error: layout 'all_dronecan' names unknown device 'boat' (expected a device of `devices`)",
+        ),
+    ),
+    Case(
+        'v0_layout_without_ports',
+        'protocol: dronecan}\n',
+        'protocol: dronecan, devices: {esc: cyphal}}\n',
+        (
+            "minimal_v0.yaml:44:86: error: device esc has no cyphal ports for layout 'all_dronecan' (expected a `cyphal:` section in device esc)",
+        ),
+    ),
+    Case(
+        'v0_layout_named_default',
+        '  all_dronecan: {',
+        '  default: {',
+        (
+            "minimal_v0.yaml:44:3: error: layout name 'default' is reserved: it is every device on its own `protocol` (expected another name)",
+        ),
+    ),
+    Case(
+        'v0_protocol_unknown',
+        '    protocol: dronecan\n    subscribes:\n      - {type: uavcan.equipment.esc.RPMCommand',
+        '    protocol: can\n    subscribes:\n      - {type: uavcan.equipment.esc.RPMCommand',
+        (
+            "minimal_v0.yaml:35:5: error: protocol 'can' of device 'esc' is unknown (expected cyphal or dronecan)",
+        ),
+    ),
+    Case(
+        'v0_section_of_own_protocol',
+        '    dronecan:\n      publishes:\n        - {type: skiff.Bilge',
+        '    cyphal:\n      publishes:\n        - {type: skiff.Bilge',
+        (
+            "minimal_v0.yaml:30:5: error: device 'gauge' speaks cyphal: its cyphal ports are its `publishes` and `subscribes` (expected a section for the other protocol (dronecan))",
+        ),
+    ),
+    Case(
+        'v0_type_without_id',
+        '    id: 20120\n',
+        '',
+        (
+            "minimal_v0.yaml:31:11: error: DroneCAN type 'skiff.Bilge' of device gauge has no data type id: it can only be nested in other types (expected a message type with a data type id)",
+            "minimal_v0.yaml:56:5: error: DroneCAN type 'skiff.Bilge' of DroneCAN mapping 'bilge' has no data type id: it can only be nested in other types (expected a message type with a data type id)",
         ),
     ),
 )

@@ -77,6 +77,72 @@ class MappingInfo:
 
 
 @dataclass(frozen=True)
+class DroneCanTypeInfo:
+    """A UAVCAN v0 (DroneCAN) message type: its name in dronecan, and what its transfers are checked with."""
+
+    name: str  # full name, e.g. "uavcan.equipment.ahrs.RawIMU"
+    data_type_id: int
+    signature: int  # the data type signature (CRC-64-WE); it seeds the CRC of a multi-frame transfer
+    custom: bool  # one of the spec's dronecan_types: dronecan knows it after load_dsdl(DRONECAN_DSDL_DIRS)
+
+
+@dataclass(frozen=True)
+class DroneCanPortInfo:
+    """A DroneCAN message a device broadcasts or receives (no subject id: the data type is the key)."""
+
+    data_type: DroneCanTypeInfo
+    rate_hz: float
+
+
+@dataclass(frozen=True)
+class DroneCanDeviceInfo:
+    """A device's DroneCAN firmware: its node and the messages it broadcasts and receives."""
+
+    name: str
+    node_id: int
+    description: str
+    publishes: tuple[DroneCanPortInfo, ...]
+    subscribes: tuple[DroneCanPortInfo, ...]
+
+
+@dataclass(frozen=True)
+class DroneCanMappingInfo:
+    """A DroneCAN mapping of the bridge between a v0 data type and a ROS topic (converters: convert_v0.py)."""
+
+    name: str
+    direction: str  # "uavcan_to_ros" | "ros_to_uavcan"
+    topic: TopicInfo
+    data_type: DroneCanTypeInfo
+    # (field path, value): UAVCAN->ROS takes only the messages with these values (convert_v0.MATCHES checks
+    # them and the elements); ROS->UAVCAN sets them
+    select: tuple[tuple[str, int | bool], ...]
+    elements: tuple[str, ...]  # broadcast-array elements read or written: "rpm[1]", "commands[actuator_id=4]"
+    source_node_ids: frozenset[int]  # UAVCAN->ROS: the nodes whose messages are accepted
+    destination_node_ids: frozenset[int]  # ROS->UAVCAN: the nodes its broadcast commands are meant for
+    frame_id: str | None
+    rate_hz: float
+    on_out_of_range: str  # "saturate" | "reject"
+    to_ros: str  # name of the converter function in convert_v0.py
+    to_uavcan: str
+    exact_uavcan_fields: tuple[str, ...]  # as MappingInfo's
+    linked_uavcan_fields: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class LayoutInfo:
+    """A firmware set of the vehicle: the protocol of each device, and the mappings the bridge runs then."""
+
+    name: str
+    description: str
+    protocols: tuple[tuple[str, str], ...]  # (device, "cyphal" | "dronecan"), in spec order
+    cyphal_mappings: tuple[str, ...]  # names in MAPPINGS
+    dronecan_mappings: tuple[str, ...]  # names in DRONECAN_MAPPINGS
+
+    def devices(self, protocol: str) -> tuple[str, ...]:
+        return tuple(device for device, p in self.protocols if p == protocol)
+
+
+@dataclass(frozen=True)
 class ParameterInfo:
     """A ROS parameter of the vehicle's nodes."""
 
@@ -152,6 +218,7 @@ PARAMS_FILE = 'params/sam.params.yaml'
 # The generated ROS packages (generated/ros/<name>), each after those it depends on.
 ROS_PACKAGES: tuple[str, ...] = ('sam_msgs', 'tf2_msgs')
 
+# The devices with Cyphal firmware and their Cyphal ports (LAYOUTS say which run Cyphal).
 DEVICES: tuple[DeviceInfo, ...] = (
     DeviceInfo(
         name='imu',
@@ -851,6 +918,632 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
     ),
 )
+
+# Under the generated folder: the spec's own DroneCAN types, for dronecan.load_dsdl() (convert_v0.load_types).
+DRONECAN_DSDL_DIRS: tuple[str, ...] = ('dsdl_v0/sam',)
+
+# The DroneCAN message types of the devices and mappings, by name.
+DRONECAN_TYPES: tuple[DroneCanTypeInfo, ...] = (
+    DroneCanTypeInfo('sam.actuator.PositionFeedback', 20102, 0x4F9415770AF42BD6, True),
+    DroneCanTypeInfo('sam.actuator.ThrustVectorFeedback', 20101, 0x05FD0D1CC24F4B59, True),
+    DroneCanTypeInfo('sam.sensor.Altitude', 20103, 0x48A1C8047B5312FA, True),
+    DroneCanTypeInfo('uavcan.equipment.actuator.ArrayCommand', 1010, 0xD8A7486238EC3AF3, False),
+    DroneCanTypeInfo('uavcan.equipment.ahrs.MagneticFieldStrength', 1001, 0xE2A7D4A9460BC2F2, False),
+    DroneCanTypeInfo('uavcan.equipment.ahrs.RawIMU', 1003, 0x8280632C40E574B5, False),
+    DroneCanTypeInfo('uavcan.equipment.air_data.StaticPressure', 1028, 0xCDC7C43412BDC89A, False),
+    DroneCanTypeInfo('uavcan.equipment.esc.RPMCommand', 1031, 0xCE0F9F621CF7E70B, False),
+    DroneCanTypeInfo('uavcan.equipment.esc.Status', 1034, 0xA9AF28AEA2FBB254, False),
+    DroneCanTypeInfo('uavcan.equipment.gnss.Fix2', 1063, 0xCA41E7000F37435F, False),
+    DroneCanTypeInfo('uavcan.equipment.power.BatteryInfo', 1092, 0x249C26548A711966, False),
+)
+
+_DRONECAN_TYPE = {t.name: t for t in DRONECAN_TYPES}
+
+# The devices with DroneCAN firmware and their DroneCAN ports.
+DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
+    DroneCanDeviceInfo(
+        name='imu',
+        node_id=11,
+        description='Inertial measurement unit.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.ahrs.RawIMU'], 100.0),
+        ),
+        subscribes=(),
+    ),
+    DroneCanDeviceInfo(
+        name='magnetometer',
+        node_id=12,
+        description='Three-axis magnetometer.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.ahrs.MagneticFieldStrength'], 50.0),
+        ),
+        subscribes=(),
+    ),
+    DroneCanDeviceInfo(
+        name='gps',
+        node_id=13,
+        description='GPS receiver, usable at the surface.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.gnss.Fix2'], 5.0),
+        ),
+        subscribes=(),
+    ),
+    DroneCanDeviceInfo(
+        name='pressure',
+        node_id=14,
+        description='Water pressure sensor.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.air_data.StaticPressure'], 20.0),
+        ),
+        subscribes=(),
+    ),
+    DroneCanDeviceInfo(
+        name='battery',
+        node_id=15,
+        description='Battery management system.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.power.BatteryInfo'], 1.0),
+        ),
+        subscribes=(),
+    ),
+    DroneCanDeviceInfo(
+        name='altimeter',
+        node_id=16,
+        description='Altimeter looking down at the sea floor (an addition to the document).',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['sam.sensor.Altitude'], 10.0),
+        ),
+        subscribes=(),
+    ),
+    DroneCanDeviceInfo(
+        name='thruster_1',
+        node_id=21,
+        description='Thruster 1 motor controller.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.Status'], 10.0),
+        ),
+        subscribes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'], 10.0),
+        ),
+    ),
+    DroneCanDeviceInfo(
+        name='thruster_2',
+        node_id=22,
+        description='Thruster 2 motor controller.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.Status'], 10.0),
+        ),
+        subscribes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'], 10.0),
+        ),
+    ),
+    DroneCanDeviceInfo(
+        name='thrust_vector',
+        node_id=23,
+        description='Thrust vectoring nozzle servos.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['sam.actuator.ThrustVectorFeedback'], 10.0),
+        ),
+        subscribes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
+        ),
+    ),
+    DroneCanDeviceInfo(
+        name='ballast',
+        node_id=24,
+        description='The two ballast weights.',
+        publishes=(),
+        subscribes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
+        ),
+    ),
+    DroneCanDeviceInfo(
+        name='longitudinal_weight',
+        node_id=25,
+        description='Longitudinal trim weight.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['sam.actuator.PositionFeedback'], 10.0),
+        ),
+        subscribes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
+        ),
+    ),
+    DroneCanDeviceInfo(
+        name='buoyancy_piston',
+        node_id=26,
+        description='Variable buoyancy piston.',
+        publishes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['sam.actuator.PositionFeedback'], 10.0),
+        ),
+        subscribes=(
+            DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
+        ),
+    ),
+)
+
+DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
+    DroneCanMappingInfo(
+        name='imu',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/imu'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.ahrs.RawIMU'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({11}),
+        destination_node_ids=frozenset(),
+        frame_id='imu_link',
+        rate_hz=100.0,
+        on_out_of_range='saturate',
+        to_ros='imu_to_ros',
+        to_uavcan='imu_to_uavcan',
+        exact_uavcan_fields=(
+            'timestamp.usec',
+            'rate_gyro_latest[0]',
+            'rate_gyro_latest[1]',
+            'rate_gyro_latest[2]',
+            'accelerometer_latest[0]',
+            'accelerometer_latest[1]',
+            'accelerometer_latest[2]',
+        ),
+        linked_uavcan_fields=(
+            'timestamp.usec',
+            'rate_gyro_latest[0]',
+            'rate_gyro_latest[1]',
+            'rate_gyro_latest[2]',
+            'accelerometer_latest[0]',
+            'accelerometer_latest[1]',
+            'accelerometer_latest[2]',
+        ),
+    ),
+    DroneCanMappingInfo(
+        name='magnetic_field',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/magnetic_field'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.ahrs.MagneticFieldStrength'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({12}),
+        destination_node_ids=frozenset(),
+        frame_id='magnetometer_link',
+        rate_hz=50.0,
+        on_out_of_range='saturate',
+        to_ros='magnetic_field_to_ros',
+        to_uavcan='magnetic_field_to_uavcan',
+        exact_uavcan_fields=('magnetic_field_ga[0]', 'magnetic_field_ga[1]', 'magnetic_field_ga[2]'),
+        linked_uavcan_fields=(
+            'magnetic_field_ga[0]',
+            'magnetic_field_ga[1]',
+            'magnetic_field_ga[2]',
+            'magnetic_field_covariance',
+        ),
+    ),
+    DroneCanMappingInfo(
+        name='gps_fix',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/gps_fix'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.gnss.Fix2'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({13}),
+        destination_node_ids=frozenset(),
+        frame_id='gps_link',
+        rate_hz=5.0,
+        on_out_of_range='saturate',
+        to_ros='gps_fix_to_ros',
+        to_uavcan='gps_fix_to_uavcan',
+        exact_uavcan_fields=(
+            'timestamp.usec',
+            'latitude_deg_1e8',
+            'longitude_deg_1e8',
+            'height_ellipsoid_mm',
+        ),
+        linked_uavcan_fields=(
+            'timestamp.usec',
+            'latitude_deg_1e8',
+            'longitude_deg_1e8',
+            'height_ellipsoid_mm',
+            'status',
+        ),
+    ),
+    DroneCanMappingInfo(
+        name='pressure',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/pressure'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.air_data.StaticPressure'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({14}),
+        destination_node_ids=frozenset(),
+        frame_id='pressure_link',
+        rate_hz=20.0,
+        on_out_of_range='saturate',
+        to_ros='pressure_to_ros',
+        to_uavcan='pressure_to_uavcan',
+        exact_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+        linked_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+    ),
+    DroneCanMappingInfo(
+        name='battery_state',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/battery_state'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.power.BatteryInfo'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({15}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=1.0,
+        on_out_of_range='saturate',
+        to_ros='battery_state_to_ros',
+        to_uavcan='battery_state_to_uavcan',
+        exact_uavcan_fields=('voltage', 'current', 'state_of_charge_pct'),
+        linked_uavcan_fields=('voltage', 'current', 'temperature', 'state_of_charge_pct'),
+    ),
+    DroneCanMappingInfo(
+        name='battery_info',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/battery_info'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.power.BatteryInfo'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({15}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=1.0,
+        on_out_of_range='saturate',
+        to_ros='battery_info_to_ros',
+        to_uavcan='battery_info_to_uavcan',
+        exact_uavcan_fields=(
+            'temperature',
+            'voltage',
+            'current',
+            'average_power_10sec',
+            'remaining_capacity_wh',
+            'full_charge_capacity_wh',
+            'hours_to_full_charge',
+            'status_flags',
+            'state_of_health_pct',
+            'state_of_charge_pct',
+            'state_of_charge_pct_stdev',
+            'battery_id',
+            'model_instance_id',
+            'model_name',
+        ),
+        linked_uavcan_fields=(
+            'temperature',
+            'voltage',
+            'current',
+            'average_power_10sec',
+            'remaining_capacity_wh',
+            'full_charge_capacity_wh',
+            'hours_to_full_charge',
+            'status_flags',
+            'state_of_health_pct',
+            'state_of_charge_pct',
+            'state_of_charge_pct_stdev',
+            'battery_id',
+            'model_instance_id',
+            'model_name',
+        ),
+    ),
+    DroneCanMappingInfo(
+        name='altitude',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/altitude'],
+        data_type=_DRONECAN_TYPE['sam.sensor.Altitude'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({16}),
+        destination_node_ids=frozenset(),
+        frame_id='altimeter_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='altitude_to_ros',
+        to_uavcan='altitude_to_uavcan',
+        exact_uavcan_fields=('timestamp.usec', 'altitude', 'altitude_variance'),
+        linked_uavcan_fields=('timestamp.usec', 'altitude', 'altitude_variance'),
+    ),
+    DroneCanMappingInfo(
+        name='thruster_rpms',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/thruster_rpms'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'],
+        select=(),
+        elements=('rpm[0]', 'rpm[1]'),
+        source_node_ids=frozenset(),
+        destination_node_ids=frozenset({21, 22}),
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_rpms_to_ros',
+        to_uavcan='thruster_rpms_to_uavcan',
+        exact_uavcan_fields=('rpm[0]', 'rpm[1]'),
+        linked_uavcan_fields=('rpm[0]', 'rpm[1]'),
+    ),
+    DroneCanMappingInfo(
+        name='thrust_vector',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/thruster_angles'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'],
+        select=(),
+        elements=('commands[actuator_id=0]', 'commands[actuator_id=1]'),
+        source_node_ids=frozenset(),
+        destination_node_ids=frozenset({23}),
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thrust_vector_to_ros',
+        to_uavcan='thrust_vector_to_uavcan',
+        exact_uavcan_fields=(
+            'commands[actuator_id=0].command_value',
+            'commands[actuator_id=1].command_value',
+        ),
+        linked_uavcan_fields=(
+            'commands[actuator_id=0].command_value',
+            'commands[actuator_id=1].command_value',
+        ),
+    ),
+    DroneCanMappingInfo(
+        name='ballast',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/ballast_angles'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'],
+        select=(),
+        elements=('commands[actuator_id=2]', 'commands[actuator_id=3]'),
+        source_node_ids=frozenset(),
+        destination_node_ids=frozenset({24}),
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='ballast_to_ros',
+        to_uavcan='ballast_to_uavcan',
+        exact_uavcan_fields=(
+            'commands[actuator_id=2].command_value',
+            'commands[actuator_id=3].command_value',
+        ),
+        linked_uavcan_fields=(
+            'commands[actuator_id=2].command_value',
+            'commands[actuator_id=3].command_value',
+        ),
+    ),
+    DroneCanMappingInfo(
+        name='longitudinal_weight',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/longitudinal_weight_position'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'],
+        select=(),
+        elements=('commands[actuator_id=4]',),
+        source_node_ids=frozenset(),
+        destination_node_ids=frozenset({25}),
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='longitudinal_weight_to_ros',
+        to_uavcan='longitudinal_weight_to_uavcan',
+        exact_uavcan_fields=('commands[actuator_id=4].command_value',),
+        linked_uavcan_fields=('commands[actuator_id=4].command_value',),
+    ),
+    DroneCanMappingInfo(
+        name='buoyancy_piston',
+        direction='ros_to_uavcan',
+        topic=_TOPICS_BY_NAME['/buoyancy_piston_position'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'],
+        select=(),
+        elements=('commands[actuator_id=5]',),
+        source_node_ids=frozenset(),
+        destination_node_ids=frozenset({26}),
+        frame_id=None,
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='buoyancy_piston_to_ros',
+        to_uavcan='buoyancy_piston_to_uavcan',
+        exact_uavcan_fields=('commands[actuator_id=5].command_value',),
+        linked_uavcan_fields=('commands[actuator_id=5].command_value',),
+    ),
+    DroneCanMappingInfo(
+        name='thruster_1_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/thruster_1/feedback'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.esc.Status'],
+        select=(('esc_index', 0),),
+        elements=(),
+        source_node_ids=frozenset({21}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_1_feedback_to_ros',
+        to_uavcan='thruster_1_feedback_to_uavcan',
+        exact_uavcan_fields=('rpm', 'current'),
+        linked_uavcan_fields=('rpm', 'current', 'temperature'),
+    ),
+    DroneCanMappingInfo(
+        name='thruster_2_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/thruster_2/feedback'],
+        data_type=_DRONECAN_TYPE['uavcan.equipment.esc.Status'],
+        select=(('esc_index', 1),),
+        elements=(),
+        source_node_ids=frozenset({22}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thruster_2_feedback_to_ros',
+        to_uavcan='thruster_2_feedback_to_uavcan',
+        exact_uavcan_fields=('rpm', 'current'),
+        linked_uavcan_fields=('rpm', 'current', 'temperature'),
+    ),
+    DroneCanMappingInfo(
+        name='thrust_vector_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/thrust_vector/feedback'],
+        data_type=_DRONECAN_TYPE['sam.actuator.ThrustVectorFeedback'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({23}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='thrust_vector_feedback_to_ros',
+        to_uavcan='thrust_vector_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.usec', 'vertical_mrad', 'horizontal_mrad'),
+        linked_uavcan_fields=('timestamp.usec', 'vertical_mrad', 'horizontal_mrad'),
+    ),
+    DroneCanMappingInfo(
+        name='longitudinal_weight_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/longitudinal_weight/feedback'],
+        data_type=_DRONECAN_TYPE['sam.actuator.PositionFeedback'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({25}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='longitudinal_weight_feedback_to_ros',
+        to_uavcan='longitudinal_weight_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+        linked_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+    ),
+    DroneCanMappingInfo(
+        name='buoyancy_piston_feedback',
+        direction='uavcan_to_ros',
+        topic=_TOPICS_BY_NAME['/buoyancy_piston/feedback'],
+        data_type=_DRONECAN_TYPE['sam.actuator.PositionFeedback'],
+        select=(),
+        elements=(),
+        source_node_ids=frozenset({26}),
+        destination_node_ids=frozenset(),
+        frame_id='base_link',
+        rate_hz=10.0,
+        on_out_of_range='saturate',
+        to_ros='buoyancy_piston_feedback_to_ros',
+        to_uavcan='buoyancy_piston_feedback_to_uavcan',
+        exact_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+        linked_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+    ),
+)
+
+# The layouts: "default" (every device on its own `protocol`) first, then the spec's; the bridge runs one.
+LAYOUTS: tuple[LayoutInfo, ...] = (
+    LayoutInfo(
+        name='default',
+        description='Every device on its own `protocol`.',
+        protocols=(
+            ('imu', 'cyphal'),
+            ('magnetometer', 'cyphal'),
+            ('gps', 'cyphal'),
+            ('pressure', 'cyphal'),
+            ('battery', 'cyphal'),
+            ('altimeter', 'cyphal'),
+            ('thruster_1', 'cyphal'),
+            ('thruster_2', 'cyphal'),
+            ('thrust_vector', 'cyphal'),
+            ('ballast', 'cyphal'),
+            ('longitudinal_weight', 'cyphal'),
+            ('buoyancy_piston', 'cyphal'),
+        ),
+        cyphal_mappings=(
+            'imu',
+            'magnetic_field',
+            'gps_fix',
+            'pressure',
+            'battery_state',
+            'altitude',
+            'battery_info',
+            'thruster_1_rpm',
+            'thruster_2_rpm',
+            'thrust_vector',
+            'ballast',
+            'longitudinal_weight',
+            'buoyancy_piston',
+            'thruster_1_feedback',
+            'thruster_2_feedback',
+            'thrust_vector_feedback',
+            'longitudinal_weight_feedback',
+            'buoyancy_piston_feedback',
+        ),
+        dronecan_mappings=(),
+    ),
+    LayoutInfo(
+        name='dronecan',
+        description='SAM as it runs today, every Teensy on DroneCAN (UAVCAN v0).',
+        protocols=(
+            ('imu', 'dronecan'),
+            ('magnetometer', 'dronecan'),
+            ('gps', 'dronecan'),
+            ('pressure', 'dronecan'),
+            ('battery', 'dronecan'),
+            ('altimeter', 'dronecan'),
+            ('thruster_1', 'dronecan'),
+            ('thruster_2', 'dronecan'),
+            ('thrust_vector', 'dronecan'),
+            ('ballast', 'dronecan'),
+            ('longitudinal_weight', 'dronecan'),
+            ('buoyancy_piston', 'dronecan'),
+        ),
+        cyphal_mappings=(),
+        dronecan_mappings=(
+            'imu',
+            'magnetic_field',
+            'gps_fix',
+            'pressure',
+            'battery_state',
+            'battery_info',
+            'altitude',
+            'thruster_rpms',
+            'thrust_vector',
+            'ballast',
+            'longitudinal_weight',
+            'buoyancy_piston',
+            'thruster_1_feedback',
+            'thruster_2_feedback',
+            'thrust_vector_feedback',
+            'longitudinal_weight_feedback',
+            'buoyancy_piston_feedback',
+        ),
+    ),
+    LayoutInfo(
+        name='mixed',
+        description=(
+            'Half way, on one CAN bus - the navigation sensors on Cyphal v1, the battery and actuators on '
+            'DroneCAN.'
+        ),
+        protocols=(
+            ('imu', 'cyphal'),
+            ('magnetometer', 'cyphal'),
+            ('gps', 'cyphal'),
+            ('pressure', 'cyphal'),
+            ('battery', 'dronecan'),
+            ('altimeter', 'cyphal'),
+            ('thruster_1', 'dronecan'),
+            ('thruster_2', 'dronecan'),
+            ('thrust_vector', 'dronecan'),
+            ('ballast', 'dronecan'),
+            ('longitudinal_weight', 'dronecan'),
+            ('buoyancy_piston', 'dronecan'),
+        ),
+        cyphal_mappings=('imu', 'magnetic_field', 'gps_fix', 'pressure', 'altitude'),
+        dronecan_mappings=(
+            'battery_state',
+            'battery_info',
+            'thruster_rpms',
+            'thrust_vector',
+            'ballast',
+            'longitudinal_weight',
+            'buoyancy_piston',
+            'thruster_1_feedback',
+            'thruster_2_feedback',
+            'thrust_vector_feedback',
+            'longitudinal_weight_feedback',
+            'buoyancy_piston_feedback',
+        ),
+    ),
+)
+DEFAULT_LAYOUT = "default"
 
 PARAMETERS: tuple[ParameterInfo, ...] = (
     ParameterInfo(
