@@ -224,9 +224,10 @@ if WORKER:
             elif s.limits is not None and s.kind == "number":
                 scale, offset = s.scale or 1.0, s.offset or 0.0
                 lo, hi = sorted(((s.limits[0] - offset) / scale, (s.limits[1] - offset) / scale))
-                overrides[s.uavcan] = (float_strategy(t.bits, lo, hi) if t.kind == "float"
-                                       else st.integers(max(t.range[0], math.ceil(lo)), min(t.range[1], math.floor(hi))))
-        for path, leaf, value in rm.select:
+                overrides[s.uavcan] = (
+                    float_strategy(t.bits, lo, hi) if t.kind == "float"
+                    else st.integers(max(t.range[0], math.ceil(lo)), min(t.range[1], math.floor(hi))))
+        for path, _leaf, value in rm.select:
             overrides[".".join(n for n, _ in path)] = st.just(value)
         for array_path, uses in rm.elements.items():
             name = ".".join(n for n, _ in array_path)
@@ -445,7 +446,7 @@ if WORKER:
     if SPEC_NAME == "sam":
         from sam_msgs.msg import BallastAngles, PercentStamped, ThrusterAngles, ThrusterRPMs
 
-        def T(name: str) -> Any:  # noqa: N802 - a type, as dronecan names them
+        def T(name: str) -> Any:  # a type, as dronecan names them
             return dronecan.TYPENAMES[name]
 
         def test_rpm_saturates_to_int18_in_one_command_of_two_escs() -> None:
