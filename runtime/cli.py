@@ -246,6 +246,15 @@ def _serve(prog: str, body: Any, errors: tuple[type[BaseException], ...]) -> int
 
 
 # ============================================================================================ bridge
+def _add_layout_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--layout", default=None, metavar="NAME",
+                   help="the spec's layout: which firmware (cyphal, dronecan) each device runs (default: the "
+                        "spec's default layout, every device on its own protocol)")
+    p.add_argument("--dronecan-iface", default="mcast-lo:", metavar="URI",
+                   help="DroneCAN interface: mcast-lo:[BUS[:PORT]] (127.0.0.1 only), socketcan:IFNAME, "
+                        "slcan:DEVICE (default mcast-lo:)")
+
+
 def _bridge_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="sam-bridge", description="The UAVCAN (Cyphal) <-> ROS 2 bridge of the spec.")
     _add_generated_args(p)
@@ -264,6 +273,14 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
     p.add_argument("--stats-file", type=Path, default=None,
                    help="write the counters as JSON here every second and at exit")
+    _add_layout_args(p)
+    p.add_argument("--protocol", choices=("cyphal", "dronecan"), default=None,
+                   help="the half of a mixed layout this bridge serves (one bridge per protocol; default: the "
+                        "layout's only protocol)")
+    p.add_argument("--time-sync", action="store_true",
+                   help="DroneCAN: be the bus's GlobalTimeSync master (1 Hz)")
+    p.add_argument("--dna-server", action="store_true",
+                   help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
     p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
     return p
 
@@ -288,9 +305,13 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             command_reliability=args.command_qos,
             **({} if args.rx_queue_size is None else {"rx_queue_size": args.rx_queue_size}),
             **({} if args.log_interval is None else {"log_interval": args.log_interval}),
+            layout=args.layout,
+            protocol=args.protocol,
+            dronecan_iface=args.dronecan_iface,
+            dronecan_options={"time_sync": args.time_sync, "dna_server": args.dna_server},
         )
         await bridge.start()
-        print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.transport_config.describe()}",
+        print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()}",
               flush=True)
         try:
             deadline = None if args.duration is None else time.monotonic() + args.duration

@@ -38,7 +38,8 @@ def subscription_names(mappings: Iterable[Any]) -> dict[int, str]:
     out: dict[int, str] = {}
     for m in mappings:
         if m.direction == "uavcan_to_ros":
-            out.setdefault(int(m.port.subject_id), str(m.name))
+            pid = m.data_type.data_type_id if hasattr(m, "data_type") else m.port.subject_id  # DroneCAN: by type
+            out.setdefault(int(pid), str(m.name))
     return out
 
 

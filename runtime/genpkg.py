@@ -83,6 +83,7 @@ class GeneratedPackage:
         self.package = _find_python_package(self.python_dir, self.package)
         self._tables: ModuleType | None = None
         self._convert: ModuleType | None = None
+        self._convert_v0: ModuleType | None = None
 
     # -------------------------------------------------------------------- locations
     @property
@@ -146,6 +147,25 @@ class GeneratedPackage:
                     ) from ex
                 raise
         return self._convert
+
+    def convert_v0(self) -> ModuleType:
+        """``<pkg>.convert_v0`` (the DroneCAN converters), with the spec's own v0 types loaded into dronecan and
+        every type checked against the generated converters (data type id and signature). dronecan's load_dsdl()
+        replaces every type object: call this before any dronecan node registers handlers."""
+        if self._convert_v0 is None:
+            try:
+                mod = self._import("convert_v0")
+            except ModuleNotFoundError as ex:
+                if ex.name and ex.name.split(".")[-1] == "convert_v0":
+                    raise GeneratedPackageError(f"{self.root} has no DroneCAN converters (the spec declares no "
+                                                f"dronecan mappings)") from None
+                raise
+            try:
+                mod.load_types(self.root)
+            except Exception as ex:  # a broken or stale dsdl_v0 folder, or another dronecan version
+                raise GeneratedPackageError(f"the DroneCAN types of {self.root}: {ex}") from None
+            self._convert_v0 = mod
+        return self._convert_v0
 
     # -------------------------------------------------------------------- types
     @staticmethod

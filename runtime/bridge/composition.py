@@ -11,10 +11,12 @@ from typing import Any
 
 from sam_runtime.genpkg import GeneratedPackage
 
+from .backend import Backend
 from .counters import DEFAULT_LOG_INTERVAL_S, MappingStats, RateLimitedLog, log
 from .cyphal_backend import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig, quiet_late_media_completions
 from .health import DeviceHealth
 from .inbound import Inbound
+from .layout import select
 from .lifetime import Lifetime
 from .link import LinkSupervisor
 from .loss import TransferLoss
@@ -46,6 +48,13 @@ class Bridge:
     :param queue_size: bound of each ROS -> UAVCAN mapping's publish queue (beyond: ``queue_full``).
     :param rx_queue_size: bound of each subject's pycyphal receive queue (beyond: ``overrun``); 0 = unbounded.
     :param log_interval: seconds between two log lines of one (mapping, reason); the first is immediate.
+    :param layout: the spec's layout (which firmware each device runs; default: the spec's default layout).
+    :param protocol: ``cyphal`` or ``dronecan``: the half of a mixed layout this bridge serves (see
+        :mod:`.layout`); default: the layout's only protocol.
+    :param dronecan_iface: the DroneCAN interface (sam_runtime.dronecan_io: ``mcast-lo:`` between processes on this
+        machine, ``socketcan:can0``, ``slcan:/dev/ttyACM0``).
+    :param dronecan_services: the DroneCAN node duties of :mod:`.dronecan_duties` (GetNodeInfo and RestartNode of
+        the devices as ROS services, Panic both ways; options ``time_sync`` and ``dna_server``).
     """
 
     def __init__(
@@ -62,21 +71,35 @@ class Bridge:
         diagnostics_period: float = 1.0,
         rx_queue_size: int = DEFAULT_RX_QUEUE_SIZE,
         log_interval: float = DEFAULT_LOG_INTERVAL_S,
+        layout: str | None = None,
+        protocol: str | None = None,
+        dronecan_iface: str = "mcast-lo:",
+        dronecan_options: Mapping[str, Any] | None = None,
     ) -> None:
         self.gen = gen
         self.tables = tables = gen.tables()
+        self.selection = sel = select(tables, layout, protocol)
         self.transport_config = transport or TransportConfig()
         self.node_id = self.transport_config.node_id(tables.BRIDGE_NODE_ID) if node_id is None else int(node_id)
         self.log = RateLimitedLog(log, log_interval)
         self.lifetime = Lifetime(self.name, self.log)
         lock = threading.Lock()
-        self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in tables.MAPPINGS}
-        self.backend = CyphalBackend(f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.transport_config,
-                                     rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
+        self.mappings = sel.mappings
+        self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in sel.mappings}
+        self.backend: Backend
+        if sel.protocol == "dronecan":
+            from .dronecan_backend import DroneCanBackend
+
+            self.backend = DroneCanBackend(dronecan_iface, self.node_id, rlog=self.log, errors=self.lifetime.errors,
+                                           name=f"org.{tables.VEHICLE}.{self.name}")
+        else:
+            self.backend = CyphalBackend(f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.transport_config,
+                                         rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
+        self._dronecan_options = dict(dronecan_options or {})
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
                            rules=getattr(tables, "PARAMETER_RULES", ()), overrides=parameter_overrides,
                            qos_depth=qos_depth, command_reliability=command_reliability)
-        self.health = DeviceHealth({d.node_id: d.name for d in tables.DEVICES}, self.node_id)
+        self.health = DeviceHealth(sel.devices, self.node_id)
         self.backend.on_device_status(self.health.on_status)
         self.link = LinkSupervisor(self.lifetime, self.backend)
         self._queue_size = int(queue_size)
@@ -84,17 +107,24 @@ class Bridge:
         self.inbound: Inbound | None = None
         self.outbound: Outbound | None = None
         self.reporter: Reporter | None = None
+        self.duties: Any = None  # DroneCAN: sam_runtime.bridge.dronecan_duties
 
     @property
     def name(self) -> str:
-        return str(self.tables.BRIDGE_NAME)
+        """The ROS node's name: the spec's bridge name; with the protocol appended for one half of a mixed
+        layout (two bridges)."""
+        base = str(self.tables.BRIDGE_NAME)
+        return f"{base}_{self.selection.protocol}" if self.selection.shared else base
 
     async def start(self) -> None:
         """Import the converters, assemble the parts, start them in order."""
         if self.lifetime.loop is not None or self.inbound is not None:
             raise RuntimeError("Bridge.start() called twice")
-        quiet_late_media_completions(asyncio.get_running_loop())
-        convert = self.gen.convert()  # compiles the DSDL first (before uavcan/pycyphal.application)
+        if self.selection.protocol == "dronecan":
+            convert = self.gen.convert_v0()  # loads the spec's v0 types into dronecan first
+        else:
+            quiet_late_media_completions(asyncio.get_running_loop())
+            convert = self.gen.convert()  # compiles the DSDL first (before uavcan/pycyphal.application)
         try:
             self._assemble(convert)
         except BaseException:
@@ -108,23 +138,25 @@ class Bridge:
 
     def _assemble(self, convert: Any) -> None:
         tables, lifetime, backend, health, link = self.tables, self.lifetime, self.backend, self.health, self.link
-        check_destinations(tables)
-        rates = nominal_rates(tables)
+        sel = self.selection
+        check_destinations(tables, sel.mappings, sel.device_infos)
+        rates = nominal_rates(tables, sel.device_infos)
 
         def loss(port_id: int) -> TransferLoss:
             return TransferLoss(port_id, rates, lambda: backend.transfer_id_modulo, health.uptime_of,
                                 lambda: link.outage_windows, self._forget_stamps)
 
-        self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss), self.ros, backend)
-        self.outbound = outbound = Outbound(lifetime, out_mappings(self.gen, convert, self.counters),
+        self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss, sel.mappings),
+                                         self.ros, backend)
+        self.outbound = outbound = Outbound(lifetime, out_mappings(self.gen, convert, self.counters, sel.mappings),
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
                                             backend=backend)
-        silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in tables.MAPPINGS
+        silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in sel.mappings
                                 if m.direction == "uavcan_to_ros"], health.devices,
                                alive_since=health.alive_since, last_message=inbound.last_message,
                                listening_since=lambda: link.up_since)
         self.reporter = reporter = Reporter(
-            lifetime, self.name, tables.MAPPINGS, self.counters, backend=backend, health=health, link=link,
+            lifetime, self.name, sel.mappings, self.counters, backend=backend, health=health, link=link,
             inbound=inbound, outbound=outbound, silence=silence, ros=self.ros, period=self._diagnostics_period)
         health.add_handler(self._on_health)
         link.add_handler(lambda _event: reporter.publish_now())
@@ -137,6 +169,11 @@ class Bridge:
         lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
+        if sel.protocol == "dronecan":
+            from .dronecan_duties import DroneCanDuties
+
+            self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **self._dronecan_options)
+            self.duties.attach()
         link.attach()
         reporter.attach()
         self.ros.attach_spinner()

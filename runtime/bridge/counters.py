@@ -19,7 +19,7 @@ log = logging.getLogger("sam_runtime.bridge")
 
 DEFAULT_LOG_INTERVAL_S = 10.0
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
-                "queue_full", "link_down", "shutdown", "lost", "lost_link_down")
+                "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected")
 
 
 class RateLimitedLog:

@@ -28,6 +28,11 @@ class Naming:
     stack: str
 
 
+def _port(m: Mapping[str, Any]) -> dict[str, Any]:
+    """A mapping's port: its Cyphal subject id, or its DroneCAN data type id."""
+    return {k: m[k] for k in ("subject_id", "data_type_id") if k in m}
+
+
 def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any:
     from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
@@ -55,7 +60,7 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
     ))
     for name, m in snap["mappings"].items():
         values: dict[str, Any] = {
-            "direction": m["direction"], "topic": m["topic"], "subject_id": m["subject_id"], "port": m["port"],
+            "direction": m["direction"], "topic": m["topic"], **_port(m), "port": m["port"],
             "received": m["received"], "published": m["published"], "dropped": m["dropped_total"],
         }
         values.update({f"dropped.{k}": v for k, v in sorted(m["dropped"].items())})
@@ -90,7 +95,8 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
                 values.update(silent_s=live["silent_s"], grace_s=live["grace_s"],
                               nominal_rate_hz=live["nominal_rate_hz"])
         arr.status.append(DiagnosticStatus(
-            level=level, name=f"{naming.bridge}/mapping/{name}", hardware_id=f"subject {m['subject_id']}",
+            level=level, name=f"{naming.bridge}/mapping/{name}",
+            hardware_id=" ".join(f"{k.replace('_id', '').replace('_', ' ')} {v}" for k, v in _port(m).items()),
             message=msg, values=kv(values)))
     for name, d in snap["devices"].items():
         if not d["seen"]:

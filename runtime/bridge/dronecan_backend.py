@@ -2,7 +2,7 @@
 the asyncio loop's thread by a NodeLoop (every exception out of dronecan's ``spin()`` counted, never raised), on any
 interface URI of dronecan_io (``mcast-lo:`` between processes on this machine, ``slcan:``, ``socketcan:``).
 
-Not wired to the spec yet (the v0 spec and converters are generated elsewhere); what it does for the core:
+Wired to the spec by the composition root (``Bridge(layout=..., protocol="dronecan")``); what it does for the core:
 
 - subscriptions by data type id: every transfer of that type from any node goes to the core's handler with its
   source node id, transfer id (5 bits: modulo 32) and receive time; the core filters the sources per mapping
@@ -138,6 +138,7 @@ class DroneCanBackend(Backend):
         self._subs: list[_Subscription] = []
         self._pubs: list[_Publication] = []
         self._status_handlers: list[Callable[[DeviceStatus], None]] = []
+        self._open_hooks: list[Callable[[Any, Any], None]] = []
         self.node: Any = None
         self.node_loop: Any = None
         self._suspect: str | None = None
@@ -160,6 +161,11 @@ class DroneCanBackend(Backend):
 
     def on_device_status(self, handler: Callable[[DeviceStatus], None]) -> None:
         self._status_handlers.append(handler)
+
+    def on_open(self, hook: Callable[[Any, Any], None]) -> None:
+        """``hook(node, node_loop)`` whenever a node is opened (at start and at every reopening), before it runs:
+        for the parts that register handlers of their own (sam_runtime.bridge.dronecan_duties)."""
+        self._open_hooks.append(hook)
 
     # -------------------------------------------------------------------------------------------- the link
     @property
@@ -205,6 +211,8 @@ class DroneCanBackend(Backend):
                 sub.transfers, sub.seen = 0, {}
                 loop.add_handler(t, sub.on_event)
             loop.add_handler(dronecan.uavcan.protocol.NodeStatus, self._on_status)
+            for hook in self._open_hooks:
+                hook(node, loop)
             loop.start()
         except BaseException:
             node.close()

@@ -6,7 +6,9 @@ thread-safe).
 Several mappings may share one port (one subscription): each gets every transfer and counts it. Drops per mapping:
 ``unknown_source``, ``lost`` / ``lost_link_down`` (counted when the next transfer of the source arrives),
 ``convert_error``, ``rejected``, ``publish_error``, ``handler_error`` (a bug in this path; never raised into the
-backend's receive loop).
+backend's receive loop), ``unselected`` (DroneCAN: a broadcast from an accepted device that no mapping of the port
+selects, e.g. an esc.Status with an ESC index no mapping reads; counted on the first mapping accepting the device).
+A transfer from a device that another mapping of the shared port accepts is that mapping's alone.
 
 Stamps: a device stamp of 0 (unknown) becomes the receive time; an empty frame id the mapping's; a stamp older than
 the previous one of the same source on the same mapping is published anyway, in arrival order, and counted as
@@ -39,6 +41,9 @@ class InMapping:
     ros_cls: Any = None  # the topic's ROS message class
     ros_publisher: Any = None
     has_header: bool = False
+    # DroneCAN: whether a message is this mapping's (its `select` values, the broadcast-array elements it reads);
+    # None: every message of the port from an accepted source is
+    matches: Callable[[Any], bool] | None = None
     last_stamp_ns: dict[int, int] = field(default_factory=dict)  # per source: stamp of the last published message
 
 
@@ -108,16 +113,24 @@ class Inbound:
     def _bridge_transfer(self, group: PortGroup, msg: Any, src: int | None, tid: int, now: float) -> None:
         rlog = self.lifetime.rlog
         receive_ns: int | None = None
-        lost, lost_est = group.loss.track(src, tid, now) if src in group.accepted_sources else (0, 0)
+        known = src in group.accepted_sources
+        lost, lost_est = group.loss.track(src, tid, now) if known else (0, 0)
+        taken = False
         for im in group.mappings:
             st = im.stats
-            st.receive()
             name = im.info.name
             if src is None or src not in im.info.source_node_ids:
+                if known:
+                    continue  # another mapping's device on the shared port: that mapping counts it
+                st.receive()
                 st.drop("unknown_source")
                 rlog.note((name, "unknown_source"), logging.WARNING,
                           "dropped a transfer from node %s (accepted: %s)", src, sorted(im.info.source_node_ids))
                 continue
+            if im.matches is not None and not im.matches(msg):
+                continue  # a broadcast for another mapping of the same device (another ESC index, actuator id)
+            taken = True
+            st.receive()
             if lost:
                 st.drop("lost", lost)
                 rlog.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "
@@ -158,3 +171,9 @@ class Inbound:
                 rlog.note((name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s", type(ex).__name__, ex)
                 continue
             st.publish()
+        if known and not taken:  # from an accepted device, but what no mapping selects: never a silent loss
+            im = next(im for im in group.mappings if src in im.info.source_node_ids)
+            im.stats.receive()
+            im.stats.drop("unselected")
+            rlog.note((im.info.name, "unselected"), logging.WARNING, "node %s sent a message no mapping of port %d "
+                      "selects (select / elements)", src, group.port_id)

@@ -20,6 +20,7 @@ from typing import Any
 from .backend import Backend, LinkDownError, Outlet
 from .counters import MappingStats, count_handler_error, log
 from .handoff import Handoff
+from .layout import port_id_of
 from .lifetime import Lifetime, cancel_and_wait
 
 __all__ = ["DEFAULT_QUEUE_SIZE", "OutMapping", "Outbound"]
@@ -69,7 +70,7 @@ class Outbound:
     def _start(self) -> None:
         if self._backend is not None:
             for om in self.mappings.values():
-                om.outlet = self._backend.advertise(om.info.name, om.info.port.subject_id, om.dtype)
+                om.outlet = self._backend.advertise(om.info.name, port_id_of(om.info), om.dtype)
         if self._ros is not None:
             for oms in self.by_topic.values():
                 self._ros.subscribe(oms[0].info.topic, oms[0].ros_cls, lambda msg, oms=oms: self.on_ros(oms, msg))

@@ -15,6 +15,7 @@ from .counters import MappingStats, RateLimitedLog
 from .diagnostics import Naming, diagnostic_array
 from .health import DeviceHealth
 from .inbound import Inbound
+from .layout import destinations_of, port_id_of
 from .lifetime import Lifetime
 from .link import LinkSupervisor
 from .outbound import Outbound
@@ -79,7 +80,9 @@ class Reporter:
         mappings: dict[str, Any] = {}
         for m in self.mappings:
             st = self.counters.get(m.name)
-            entry = {"direction": m.direction, "topic": m.topic.name, "subject_id": m.port.subject_id,
+            port_key = "data_type_id" if hasattr(m, "data_type") else "subject_id"
+            entry = {"direction": m.direction, "topic": m.topic.name, port_key: port_id_of(m),
+                     **({"data_type": m.data_type.name} if hasattr(m, "data_type") else {}),
                      **(st.snapshot() if st else empty)}
             if m.direction == "uavcan_to_ros":
                 entry["source_node_ids"] = sorted(m.source_node_ids)
@@ -88,7 +91,7 @@ class Reporter:
                 entry["port"] = inlet.port_name if inlet is not None else (
                     f"uavcan.sub.{group.port_name}" if group is not None else None)
                 if inlet is not None and inlet.port_id is not None:
-                    entry["subject_id"] = inlet.port_id  # the register's value (the spec's by default)
+                    entry[port_key] = inlet.port_id  # the register's value (the spec's by default)
                 entry["liveness"] = self.silence.entry(m.name)
                 if inlet is not None:
                     totals, kinds, last_problem = inlet.below.snapshot()
@@ -101,12 +104,15 @@ class Reporter:
                     entry[proto] = below
                 entry["ros_subscribers"] = self.ros.matched(m.topic.name)
             else:
-                entry["destination_node_id"] = m.destination_node_id
+                if hasattr(m, "destination_node_ids"):
+                    entry["destination_node_ids"] = list(destinations_of(m))
+                else:
+                    entry["destination_node_id"] = m.destination_node_id
                 om = self.outbound.mappings.get(m.name)
                 outlet = om.outlet if om is not None else None
                 entry["port"] = outlet.port_name if outlet is not None else f"uavcan.pub.{m.name}"
                 if outlet is not None and outlet.port_id is not None:
-                    entry["subject_id"] = outlet.port_id
+                    entry[port_key] = outlet.port_id
                 entry["queued"] = om.queue.qsize() if om is not None and om.queue is not None else 0
                 entry["ros_publishers"] = self.ros.matched(m.topic.name)
             mappings[m.name] = entry

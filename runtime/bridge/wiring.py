@@ -5,7 +5,7 @@ devices."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from sam_runtime.cyphal_ports import subscription_names
@@ -13,6 +13,7 @@ from sam_runtime.cyphal_ports import subscription_names
 from .backend import BridgeConfigError
 from .counters import MappingStats, log
 from .inbound import InMapping, PortGroup
+from .layout import destinations_of, port_id_of
 from .loss import TransferLoss
 from .outbound import OutMapping
 
@@ -31,54 +32,79 @@ def find_converter(convert: Any, m: Any, which: int) -> Callable[..., Any]:
     return fn
 
 
-def check_destinations(tables: Any) -> None:
-    """Warn about a ROS -> UAVCAN mapping whose destination is no device, or does not subscribe to its subject."""
-    devices = {d.node_id: d for d in tables.DEVICES}
-    for m in tables.MAPPINGS:
-        if m.direction == "ros_to_uavcan" and m.destination_node_id is not None:
-            dev = devices.get(m.destination_node_id)
+def check_destinations(tables: Any, mappings: Sequence[Any] | None = None, devices: Sequence[Any] | None = None
+                       ) -> None:
+    """Warn about a ROS -> UAVCAN mapping whose destination is no device, or does not subscribe to its port (the
+    subject, or the DroneCAN data type)."""
+    by_id = {d.node_id: d for d in (tables.DEVICES if devices is None else devices)}
+    for m in tables.MAPPINGS if mappings is None else mappings:
+        if m.direction != "ros_to_uavcan":
+            continue
+        port, what = (m.data_type.name, "data type") if hasattr(m, "data_type") else (m.port.subject_id, "subject")
+        for nid in destinations_of(m):
+            dev = by_id.get(nid)
             if dev is None:
-                log.warning("mapping %s: destination node %s is no device of the spec", m.name, m.destination_node_id)
-            elif all(p.subject_id != m.port.subject_id for p in dev.subscribes):
-                log.warning("mapping %s: destination %s (node %d) does not subscribe to subject %d",
-                            m.name, dev.name, dev.node_id, m.port.subject_id)
+                log.warning("mapping %s: destination node %s is no device of the spec", m.name, nid)
+            elif all(_port_key(p) != port for p in dev.subscribes):
+                log.warning("mapping %s: destination %s (node %d) does not subscribe to %s %s",
+                            m.name, dev.name, dev.node_id, what, port)
 
 
-def nominal_rates(tables: Any) -> dict[tuple[int, int], float]:
-    """(device node id, subject id) -> the spec's nominal rate of what the device publishes."""
-    return {(d.node_id, p.subject_id): float(p.rate_hz) for d in tables.DEVICES for p in d.publishes
-            if getattr(p, "rate_hz", None)}
+def _port_key(p: Any) -> Any:
+    return p.data_type.name if hasattr(p, "data_type") else p.subject_id
+
+
+def _port_id(p: Any) -> int:
+    return int(p.data_type.data_type_id) if hasattr(p, "data_type") else int(p.subject_id)
+
+
+def nominal_rates(tables: Any, devices: Sequence[Any] | None = None) -> dict[tuple[int, int], float]:
+    """(device node id, port id) -> the spec's nominal rate of what the device publishes (port id: the subject id,
+    or the DroneCAN data type id)."""
+    return {(d.node_id, _port_id(p)): float(p.rate_hz) for d in (tables.DEVICES if devices is None else devices)
+            for p in d.publishes if getattr(p, "rate_hz", None)}
 
 
 def _has_header(ros_cls: Any) -> bool:
     return "header" in getattr(ros_cls, "get_fields_and_field_types", dict)()
 
 
+def _dtype(gen: Any, m: Any) -> Any:
+    """The port's type: the pycyphal class, or the DroneCAN type's full name (the backend looks it up at every open:
+    dronecan.load_dsdl replaces the type objects)."""
+    return m.data_type.name if hasattr(m, "data_type") else gen.dsdl_class(m.port)
+
+
 def in_groups(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
-              make_loss: Callable[[int], TransferLoss]) -> list[PortGroup]:
+              make_loss: Callable[[int], TransferLoss], mappings: Sequence[Any] | None = None) -> list[PortGroup]:
     """The UAVCAN -> ROS mappings, one group per port, in the tables' order."""
     tables = gen.tables()
-    names = subscription_names(tables.MAPPINGS)
+    mappings = tables.MAPPINGS if mappings is None else mappings
+    names = subscription_names(mappings)
+    matches = getattr(convert, "MATCHES", {})
     groups: dict[int, PortGroup] = {}
-    for m in tables.MAPPINGS:
+    for m in mappings:
         if m.direction not in ("uavcan_to_ros", "ros_to_uavcan"):
             raise BridgeConfigError(f"mapping {m.name}: unknown direction {m.direction!r}")
         if m.direction != "uavcan_to_ros":
             continue
-        dtype = gen.dsdl_class(m.port)
-        sid = m.port.subject_id
-        group = groups.get(sid)
+        dtype = _dtype(gen, m)
+        pid = port_id_of(m)
+        group = groups.get(pid)
         if group is None:
-            group = groups[sid] = PortGroup(sid, names[sid], dtype, [], make_loss(sid))
-        elif group.dtype is not dtype:
-            raise BridgeConfigError(f"subject {sid} has two types: {group.dtype} and {m.port.dsdl_type}")
+            group = groups[pid] = PortGroup(pid, names[pid], dtype, [], make_loss(pid))
+        elif group.dtype is not dtype and group.dtype != dtype:
+            raise BridgeConfigError(f"port {pid} has two types: {group.dtype} and {dtype}")
         ros_cls = gen.ros_class(m.topic)
+        match = matches.get(m.name)
         group.mappings.append(InMapping(m, find_converter(convert, m, 0), counters[m.name], ros_cls,
-                                        has_header=_has_header(ros_cls)))
+                                        has_header=_has_header(ros_cls),
+                                        matches=None if match is None or match.__name__ == "_always" else match))
     return list(groups.values())
 
 
-def out_mappings(gen: Any, convert: Any, counters: Mapping[str, MappingStats]) -> list[OutMapping]:
+def out_mappings(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
+                 mappings: Sequence[Any] | None = None) -> list[OutMapping]:
     """The ROS -> UAVCAN mappings, in the tables' order."""
-    return [OutMapping(m, find_converter(convert, m, 1), counters[m.name], gen.ros_class(m.topic),
-                       gen.dsdl_class(m.port)) for m in gen.tables().MAPPINGS if m.direction == "ros_to_uavcan"]
+    return [OutMapping(m, find_converter(convert, m, 1), counters[m.name], gen.ros_class(m.topic), _dtype(gen, m))
+            for m in (gen.tables().MAPPINGS if mappings is None else mappings) if m.direction == "ros_to_uavcan"]
