@@ -539,6 +539,7 @@ def _run_parser() -> argparse.ArgumentParser:
     _add_generated_args(p, "the generated folder (default: generated/ in the project of --spec when it is given, "
                            "else $SAM_GENERATED_DIR, else generated/ of the project the working directory is in)")
     p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface of sim and bridge (default 127.0.0.1)")
+    _add_layout_args(p)
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until Ctrl-C)")
     p.add_argument("--no-build", action="store_true", help="use generated/ as it is")
     p.add_argument("--no-demo-commands", dest="demo_commands", action="store_false",
@@ -593,7 +594,7 @@ def run_main(argv: Sequence[str] | None = None) -> int:
         duration=args.duration, build=not args.no_build, demo_commands=args.demo_commands,
         window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
         argv=list(sys.argv[1:] if argv is None else argv), nodes=args.nodes, node_args=node_args,
-        sim_args=sim_args, truth_file=args.truth_file,
+        sim_args=sim_args, truth_file=args.truth_file, layout=args.layout, dronecan_iface=args.dronecan_iface,
     ))
 
 

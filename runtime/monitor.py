@@ -69,6 +69,8 @@ class RunOptions:
     node_args: list[str] | None = None  # for `sam-nodes` (--goal, --mission, --params-file)
     sim_args: list[str] | None = None  # for `sam-sim` (the vehicle options)
     truth_file: Path | None = None  # the sim's truth file (default: truth.json in the log folder)
+    layout: str | None = None  # the spec's layout (which firmware each device runs); a mixed one: two bridges
+    dronecan_iface: str = "mcast-lo:"
 
 
 # ============================================================================================ formatting
@@ -210,7 +212,13 @@ class TopicMonitor:
         self.executor.add_node(self.node)
 
     def _on_diag(self, arr: Any) -> None:
+        bridge = str(self.tables.BRIDGE_NAME)
         for s in arr.status:
+            head, sep, rest = s.name.partition("/")
+            if head in (f"{bridge}_cyphal", f"{bridge}_dronecan"):  # the two bridges of a mixed layout
+                if not sep and head in self.diagnostics:
+                    continue  # one status line for the bridges: keep the first one's
+                s.name = bridge + sep + rest
             self.diagnostics[s.name] = {
                 "level": int(s.level[0]) if isinstance(s.level, bytes | bytearray) else int(s.level),
                 "message": s.message, "hardware_id": s.hardware_id,
@@ -431,7 +439,8 @@ def run(opts: RunOptions) -> int:
         env["PYTHONUNBUFFERED"] = "1"
         env.setdefault("SAM_GENERATED_DIR", str(gen_dir))
         log_dir = (opts.log_dir or state / "run-logs").resolve()
-        common = ["--generated", str(gen_dir), "--transport", "udp", "--iface", opts.iface]
+        common = ["--generated", str(gen_dir), "--transport", "udp", "--iface", opts.iface,
+                  "--dronecan-iface", opts.dronecan_iface, *(["--layout", opts.layout] if opts.layout else [])]
         if opts.package:
             common += ["--package", opts.package]
         py = [sys.executable, "-m", "sam_runtime.cli"]
@@ -444,7 +453,14 @@ def run(opts: RunOptions) -> int:
         truth = (opts.truth_file or log_dir / "truth.json").resolve()
         children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth)],
                                env, log_dir / "sim.log"))
-        children.append(_Child("bridge", [*py, "bridge", *common], env, log_dir / "bridge.log"))
+        from sam_runtime.bridge.layout import protocols_in_use
+
+        layout = opts.layout or getattr(tables, "DEFAULT_LAYOUT", "default")
+        protocols = protocols_in_use(tables, layout)
+        for proto in protocols if len(protocols) > 1 else [None]:
+            name = "bridge" if proto is None else f"bridge_{proto}"
+            children.append(_Child(name, [*py, "bridge", *common, *(["--protocol", proto] if proto else [])], env,
+                                   log_dir / f"{name}.log"))
         if hosted:
             gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
             children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
