@@ -16,8 +16,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import queue
-import threading
 import time
 from typing import Any
 
@@ -27,7 +25,7 @@ dronecan = pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_peer import raw_imu_fields, raw_imu_message  # noqa: E402
-from helpers.dronecan_support import private_iface, until  # noqa: E402
+from helpers.dronecan_support import PlainPeer, private_iface, until  # noqa: E402
 from helpers.ros_probe import ThreadedProbe  # noqa: E402
 from helpers.runtime_support import generated_or_skip  # noqa: E402
 
@@ -35,47 +33,6 @@ pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 BRIDGE_ID, IMU_ID, ESC1_ID, STRANGER = 100, 11, 21, 42
 BRIDGE = "uavcan_ros_bridge"
-
-
-class PlainPeer:
-    """A plain dronecan node in its own thread (dronecan nodes are single-threaded): broadcasts what it is given,
-    records every message it receives as (type name, source node id, message)."""
-
-    def __init__(self, iface: str, node_id: int) -> None:
-        from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
-
-        it = parse_iface(iface)
-        self.node = dronecan.node.Node(LoopbackMulticastDriver(it.bus, it.port), node_id=node_id)
-        self.node.node_info.name = f"org.test.peer{node_id}".encode()
-        self.received: list[tuple[str, int, Any]] = []
-        self._todo: queue.Queue[Any] = queue.Queue()
-        self._stop = threading.Event()
-        for name in ("uavcan.equipment.esc.RPMCommand", "uavcan.equipment.actuator.ArrayCommand",
-                     "uavcan.protocol.Panic", "uavcan.protocol.GlobalTimeSync"):
-            self.node.add_handler(dronecan.TYPENAMES[name], lambda e, n=name: self.received.append(
-                (n, e.transfer.source_node_id, e.message)))
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        while not self._stop.is_set():
-            self.node.spin(0.01)
-            while True:
-                try:
-                    self.node.broadcast(self._todo.get_nowait())
-                except queue.Empty:
-                    break
-
-    def broadcast(self, msg: Any) -> None:
-        self._todo.put(msg)
-
-    def got(self, name: str) -> list[tuple[int, Any]]:
-        return [(src, m) for n, src, m in list(self.received) if n == name]
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.node.close()
 
 
 class Probe(ThreadedProbe):

@@ -6,6 +6,7 @@ import asyncio
 import itertools
 import json
 import os
+import queue
 import signal
 import subprocess
 import sys
@@ -104,3 +105,52 @@ class Child:
             os.killpg(self.proc.pid, signal.SIGKILL)
         if self.proc.poll() is None:
             self.proc.wait(timeout=10)
+
+
+class PlainPeer:
+    """A plain dronecan node in its own thread (dronecan nodes are single-threaded): broadcasts what it is given,
+    records every message it receives as (type name, source node id, message)."""
+
+    def __init__(self, iface: str, node_id: int) -> None:
+        import dronecan
+
+        from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
+
+        it = parse_iface(iface)
+        self.node = dronecan.node.Node(LoopbackMulticastDriver(it.bus, it.port), node_id=node_id)
+        self.node.node_info.name = f"org.test.peer{node_id}".encode()
+        self.received: list[tuple[str, int, Any]] = []
+        self._todo: queue.Queue[Any] = queue.Queue()
+        self._stop = threading.Event()
+        for name in ("uavcan.equipment.esc.RPMCommand", "uavcan.equipment.actuator.ArrayCommand",
+                     "uavcan.protocol.Panic", "uavcan.protocol.GlobalTimeSync"):
+            self.watch(name)
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            self.node.spin(0.01)
+            while True:
+                try:
+                    self.node.broadcast(self._todo.get_nowait())
+                except queue.Empty:
+                    break
+
+    def broadcast(self, msg: Any) -> None:
+        self._todo.put(msg)
+
+    def got(self, name: str) -> list[tuple[int, Any]]:
+        return [(src, m) for n, src, m in list(self.received) if n == name]
+
+    def watch(self, name: str) -> None:
+        """Record the messages of one more data type (before anything of it is sent)."""
+        import dronecan
+
+        self.node.add_handler(dronecan.TYPENAMES[name], lambda e: self.received.append(
+            (name, e.transfer.source_node_id, e.message)))
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5)
+        self.node.close()
