@@ -380,7 +380,7 @@ class Rig:
         p1, t1 = process_cpu(), thread_cpu()
         delta = {tid: v - t0["threads"].get(tid, 0.0) for tid, v in t1.items()}
         main_tid = threading.main_thread().native_id
-        spin = getattr(getattr(self.bridge, "_spin_thread", None), "native_id", None)
+        spin = getattr(getattr(self.bridge.ros, "_spin_thread", None), "native_id", None)
         return {
             "process": p1 - t0["process"],
             "main (asyncio loop)": delta.get(main_tid, 0.0),
@@ -639,8 +639,8 @@ def per_message_costs(rig: Rig, n: int = 2000) -> dict[str, float]:
     stats = conv.ConversionStats()
     msg = conv.imu_to_ros(src, 1, stats)
     raw = list(pycyphal.dsdl.serialize(src))
-    pub = getattr(rig.bridge, "_ros_pubs", {}).get(IMU_TOPIC)
-    clock = getattr(rig.bridge, "_clock", None)
+    pub = getattr(rig.bridge.ros, "_publishers", {}).get(IMU_TOPIC)
+    clock = getattr(rig.bridge.ros, "clock", None)
 
     def t(fn: Any) -> float:
         return round(min(timeit.repeat(fn, number=n, repeat=3)) / n * 1e6, 2)
@@ -651,7 +651,7 @@ def per_message_costs(rig: Rig, n: int = 2000) -> dict[str, float]:
         "generated imu_to_ros": t(lambda: conv.imu_to_ros(src, 1, stats)),
         "  for comparison: sensor_msgs/Imu() (the class; the converter builds with its own constructor)": t(type(msg)),
     }
-    receive_ns = getattr(rig.bridge, "_receive_ns", None)
+    receive_ns = getattr(rig.bridge.ros, "receive_ns", None)
     if receive_ns is not None:
         out["bridge: receive stamp per message (system clock unless use_sim_time)"] = t(receive_ns)
     if clock is not None:

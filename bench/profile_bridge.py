@@ -1,9 +1,10 @@
 """Profile one bridge path with cProfile, every thread (py-spy cannot attach on these machines: ptrace fails).
 
-    python -m bench.profile_bridge [u2r_bridge|r2u_bridge|u2r_raw|r2u_raw] [udp|can] [seconds] [experiment ...]
+    python -m bench.profile_bridge [u2r_bridge|r2u_bridge|u2r_raw|r2u_raw] [udp|can|dronecan] [seconds] [experiment ...]
     python -m bench.profile_bridge ab [udp|can] [seconds] [reps] [variant ...]     (see A/B below)
 
-Runs the flow-controlled throughput measurement of bench/bridge.py on that path and prints, per thread, the
+Runs the flow-controlled throughput measurement of bench/bridge.py (``dronecan``: bench/bridge_dronecan.py, the
+bridge on DroneCAN with plain dronecan nodes) on that path and prints, per thread, the
 functions by own time and the top cumulative entries (PROFILE_FILTER=regex restricts the listing; PROFILE=0 runs
 without the profiler, for the plain figure). Not part of `nox -s bench`.
 
@@ -198,8 +199,13 @@ async def main(path_name: str, kind: str, seconds: float) -> None:
     gen.convert()
     _experiments(EXPERIMENTS)
     pid = os.getpid()
-    rig = (Rig(gen, "udp", "127.0.0.1", "127.0.0.1", None) if kind == "udp"
-           else Rig(gen, "can", f"virtual:pb{pid}", f"virtual:pr{pid}", 64))
+    if kind == "dronecan":  # bench/bridge_dronecan.py: the DroneCAN bridge and plain dronecan nodes
+        from bench.bridge_dronecan import DroneCanRig, private_ifaces
+
+        rig: Any = DroneCanRig(gen, *private_ifaces())
+    else:
+        rig = (Rig(gen, "udp", "127.0.0.1", "127.0.0.1", None) if kind == "udp"
+               else Rig(gen, "can", f"virtual:pb{pid}", f"virtual:pr{pid}", 64))
     profile = os.environ.get("PROFILE", "1") != "0"
     if profile:
         threading.setprofile(_thread_hook)

@@ -334,9 +334,16 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
 
 # ============================================================================================ sim
 def _sim_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="sam-sim", description="Simulated devices of the spec, one Cyphal node each.")
+    p = argparse.ArgumentParser(prog="sam-sim", description="Simulated devices of the spec, one node each (Cyphal or "
+                                "DroneCAN, as the layout says).")
     _add_generated_args(p)
     _add_transport_args(p)
+    p.add_argument("--layout", default="default", metavar="NAME",
+                   help="the spec's layout: which firmware (cyphal, dronecan) each device runs (default: default, "
+                        "every device on its own protocol)")
+    p.add_argument("--dronecan-iface", default="mcast-lo:", metavar="URI",
+                   help="the DroneCAN devices' bus: mcast-lo:[BUS[:PORT]] (127.0.0.1 only), socketcan:IFNAME, "
+                        "slcan:DEVICE (default mcast-lo:)")
     p.add_argument("--devices", default=None, help="comma-separated subset of device names (default: all)")
     p.add_argument("--rate-scale", type=float, default=1.0, help="multiply every nominal rate (default 1)")
     p.add_argument("--bridge-node-id", type=int, default=None,
@@ -419,7 +426,8 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
             kind=kind, iface=args.iface, mtu=args.mtu, environ=dict(os.environ) if kind == "env" else None,
             bridge_node_id=args.bridge_node_id,
             devices=None if not args.devices else [d.strip() for d in args.devices.split(",") if d.strip()],
-            rate_scale=args.rate_scale, record=args.record, **_vehicle_options(args),
+            rate_scale=args.rate_scale, record=args.record, layout=args.layout, dronecan_iface=args.dronecan_iface,
+            **_vehicle_options(args),
         )
         sim = Simulator(_generated(args), cfg)
         await sim.start()

@@ -168,16 +168,22 @@ def _set(obj: Any, name: str, value: Any) -> None:
 
 
 def _stamp(obj: Any, name: str, us: int) -> None:
+    """A timestamp field: Cyphal's SynchronizedTimestamp (``microsecond``) or UAVCAN v0's Timestamp (``usec``)."""
     sub = getattr(obj, name, None)
-    if sub is not None and hasattr(sub, "microsecond"):
+    if sub is None:
+        return
+    if hasattr(sub, "microsecond"):
         sub.microsecond = us
+    elif hasattr(sub, "usec"):
+        sub.usec = us
 
 
 # ============================================================================================ SAM physics
 PhysicsFn = Callable[[Any, DeviceState, VehicleState, float, float, random.Random], None]
 
 
-def _imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+def _imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random, *,
+         full_covariance: bool = True) -> None:
     veh.sync(t)
     m = veh.model.sensors.imu()
     _stamp(obj, "timestamp", veh.now_us())
@@ -186,10 +192,14 @@ def _imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng
     _set(obj, "rate_gyro_integral", [g * dt for g in m.gyro])
     _set(obj, "accelerometer_latest", list(m.accel))
     _set(obj, "accelerometer_integral", [a * dt for a in m.accel])
-    # Full 6x6 covariance of [gyro, accel], row major: makes the transfer multi-frame on CAN FD too.
+    # Full 6x6 covariance of [gyro, accel], row major: makes the transfer multi-frame on CAN FD too; or its diagonal
+    # (UAVCAN v0: on classic CAN, 36 float16 would more than double the frames of every sample).
     n = veh.model.sensors.noise
-    _set(obj, "covariance", [(n.gyro ** 2 if i < 3 else n.accel ** 2) if i == j else 0.0
-                             for i in range(6) for j in range(6)])
+    if full_covariance:
+        _set(obj, "covariance", [(n.gyro ** 2 if i < 3 else n.accel ** 2) if i == j else 0.0
+                                 for i in range(6) for j in range(6)])
+    else:
+        _set(obj, "covariance", [n.gyro ** 2] * 3 + [n.accel ** 2] * 3)
 
 
 def _magnetometer(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:

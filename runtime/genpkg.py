@@ -149,9 +149,9 @@ class GeneratedPackage:
         return self._convert
 
     def convert_v0(self) -> ModuleType:
-        """``<pkg>.convert_v0`` (the DroneCAN converters), with the spec's own v0 types loaded into dronecan and
-        every type checked against the generated converters (data type id and signature). dronecan's load_dsdl()
-        replaces every type object: call this before any dronecan node registers handlers."""
+        """``<pkg>.convert_v0`` (the DroneCAN converters), with the spec's own v0 types added to dronecan
+        (sam_runtime.dronecan_io.types: beside the loaded ones, never reloading them) and every type checked against
+        the generated converters (data type id and signature)."""
         if self._convert_v0 is None:
             try:
                 mod = self._import("convert_v0")
@@ -160,10 +160,15 @@ class GeneratedPackage:
                     raise GeneratedPackageError(f"{self.root} has no DroneCAN converters (the spec declares no "
                                                 f"dronecan mappings)") from None
                 raise
-            try:
-                mod.load_types(self.root)
+            from sam_runtime.dronecan_io.types import ensure_types
+
+            try:  # beside the types loaded already (dronecan.load_dsdl would replace them all: see that module)
+                ensure_types(self)
+                problems = mod.check_types()
             except Exception as ex:  # a broken or stale dsdl_v0 folder, or another dronecan version
-                raise GeneratedPackageError(f"the DroneCAN types of {self.root}: {ex}") from None
+                problems = [f"{type(ex).__name__}: {ex}"]
+            if problems:
+                raise GeneratedPackageError(f"the DroneCAN types of {self.root}: {'; '.join(problems)}")
             self._convert_v0 = mod
         return self._convert_v0
 

@@ -1,5 +1,9 @@
-"""Simulated devices: one Cyphal node per device of the spec, with the spec's node id, in one asyncio loop.
+"""Simulated devices: one node per device of the spec, with the spec's node id, in one asyncio loop.
 
+- Protocols: the layout (``SimConfig.layout``, one of the spec's ``layouts``; :func:`layout_protocols`) says which
+  firmware each device runs: a pycyphal node on ``kind``/``iface``, or a dronecan (UAVCAN v0) node on
+  ``dronecan_iface`` (:mod:`sam_runtime.sim_dronecan`). The node, its ports, the messages' generic values and closing
+  are one small adapter per protocol; the schedule, physics, command policy, counters and faults are shared.
 - Every published port runs at its nominal rate (``rate_hz`` of the spec, optionally scaled), on an
   absolute schedule (no drift; a late tick is published late, never twice).
 - Values (:mod:`sam_runtime.device_models`): generic in-range values for any DSDL type; where the type is
@@ -17,10 +21,14 @@
 - Ground truth: ``Simulator.truth()`` in process, and ``truth_file`` (JSON lines when it ends in ``.jsonl``,
   else one JSON object replaced atomically) at ``truth_rate_hz`` of vehicle time.
 
-``Simulator.report()`` gives counts per device and subject (published, commands accepted/rejected, the
-last command); ``record`` writes every transmitted and received message (as transmitted) as JSON lines.
+``Simulator.report()`` gives counts per device and port (published, commands accepted/rejected, the last command):
+a Cyphal port is keyed by its subject id (``"1100"``), a DroneCAN one by ``"dronecan:<data type name>"``
+(``"dronecan:uavcan.equipment.ahrs.RawIMU"``); a DroneCAN command port also counts ``not_addressed`` (broadcasts
+without this device's element). ``record`` writes every transmitted and received message (as transmitted) as JSON
+lines (``subject`` for Cyphal, ``protocol``/``data_type``/``data_type_id`` for DroneCAN).
 For fault tests: ``power_off(name)``/``power_on(name)`` (a device that stops - its heartbeat too - and
-reboots) and ``pause()``/``resume()`` (hold every publication, heartbeats go on, nothing left in flight).
+reboots; ``restart(name)``: both, as DroneCAN's RestartNode) and ``pause()``/``resume()`` (hold every publication,
+heartbeats go on, nothing left in flight).
 """
 
 from __future__ import annotations
@@ -51,7 +59,7 @@ from sam_runtime.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, Vehicle
 
 # The device models live in sam_runtime.device_models; re-exported here, where the tests and benchmarks import them.
 __all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState", "generic_fill",
-           "physics_key"]
+           "layout_protocols", "physics_key"]
 
 _log = logging.getLogger("sam_runtime.sim")
 
@@ -66,6 +74,8 @@ class SimConfig:
     iface: str | None = None
     mtu: int | None = None
     environ: Mapping[str, str] | None = None
+    layout: str = "default"  # one of the spec's layouts: which devices run Cyphal, which DroneCAN
+    dronecan_iface: str = "mcast-lo:"  # the DroneCAN devices' bus (a sam_runtime.dronecan_io interface URI)
     bridge_node_id: int | None = None  # commands accepted only from it; default: the spec's bridge
     devices: Iterable[str] | None = None  # subset of device names; default all
     rate_scale: float = 1.0
@@ -94,39 +104,154 @@ class SimConfig:
     log_interval: float = 10.0  # failed publications: the first logged at once, then a count per interval
 
 
+def layout_protocols(tables: Any, layout: str = "default") -> dict[str, str]:
+    """Device name -> ``"cyphal"`` | ``"dronecan"`` under a layout of the spec (the generated ``LAYOUTS``, in spec
+    order; ``default``: every device on its own ``protocol``, or on Cyphal for tables without layouts). ValueError
+    names the spec's layouts."""
+    layouts = {lay.name: lay for lay in getattr(tables, "LAYOUTS", ())}
+    lay = layouts.get(layout)
+    if lay is not None:
+        return dict(lay.protocols)
+    if layout == "default" and not layouts:
+        return {d.name: "cyphal" for d in tables.DEVICES}
+    raise ValueError(f"the spec has no layout {layout!r}; its layouts: {', '.join(sorted(layouts) or ['default'])}")
+
+
 @dataclass
 class _PubPort:
-    port: Any
-    dtype: type
+    port: Any  # PortInfo (Cyphal) or DroneCanPortInfo
+    dtype: Any  # the pycyphal class, or the v0 type's full name
     physics: PhysicsFn | None
+    key: str = ""  # in report(): the subject id (Cyphal), "dronecan:<data type name>"
+    ident: int = 0  # the subject id or data type id: the schedule's offset, the generic values' seed
     publisher: Any = None
     task: asyncio.Task[None] | None = None
     sent: int = 0
     late: int = 0
     failed: int = 0
     busy: bool = False  # a publish in flight
+    extra: Any = None  # the protocol adapter's
+
+    def __post_init__(self) -> None:
+        if not self.key:
+            self.key, self.ident = str(self.port.subject_id), int(self.port.subject_id)
 
 
 @dataclass
 class _SubPort:
     port: Any
-    dtype: type
+    dtype: Any
     subscriber: Any = None
     accepted: int = 0
     rejected: int = 0
     rejected_sources: Counter[int] = field(default_factory=Counter)
     last: dict[str, Any] | None = None
+    key: str = ""
+    ident: int = 0
+    not_addressed: int = 0  # DroneCAN: broadcasts without this device's element
+    extra: Any = None
+
+    def __post_init__(self) -> None:
+        if not self.key:
+            self.key, self.ident = str(self.port.subject_id), int(self.port.subject_id)
 
 
 @dataclass
 class _SimDevice:
-    info: Any
+    info: Any  # DeviceInfo (Cyphal) or DroneCanDeviceInfo
     state: DeviceState
     node: Any = None
     pubs: list[_PubPort] = field(default_factory=list)
     subs: list[_SubPort] = field(default_factory=list)
     powered: bool = False
     power_cycles: int = 0
+    protocol: str = "cyphal"
+    extra: Any = None  # the protocol adapter's (DroneCAN: the NodeLoop)
+
+
+class _CyphalDevices:
+    """The Cyphal adapter: a pycyphal node per device, a publisher per port, a subscriber per command subject."""
+
+    protocol = "cyphal"
+
+    def __init__(self, sim: Simulator) -> None:
+        self.sim = sim
+
+    def prepare(self) -> None:
+        from sam_runtime.bridge import quiet_late_media_completions
+
+        self.sim.gen.compile_dsdl()
+        quiet_late_media_completions(asyncio.get_running_loop())
+
+    def ports(self, dev: _SimDevice) -> None:
+        gen = self.sim.gen
+        dev.subs += [_SubPort(port, gen.dsdl_class(port)) for port in dev.info.subscribes]
+        dev.pubs += [_PubPort(port, gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type)))
+                     for port in dev.info.publishes]
+
+    def open(self, dev: _SimDevice) -> None:
+        """The device's node (heartbeats start at once) and its ports."""
+        import uavcan.node
+
+        from sam_runtime.transport import make_node, transport_from_env
+
+        cfg = self.sim.config
+        name = f"org.{self.sim.tables.VEHICLE}.sim.{dev.info.name}"[:50]
+        if cfg.kind == "env":
+            env = dict(cfg.environ or {})
+            env["UAVCAN__NODE__ID"] = str(dev.info.node_id)
+            dev.node = make_node(name, dev.info.node_id, transport=transport_from_env(env))
+        else:
+            dev.node = make_node(name, dev.info.node_id, cfg.kind, iface=cfg.iface, mtu=cfg.mtu)
+        dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+        for sp in dev.subs:
+            sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
+            sp.subscriber.receive_in_background(
+                lambda msg, tr, dev=dev, sp=sp: self.sim._on_command(dev, sp, msg, tr))
+        for pp in dev.pubs:
+            pp.publisher = dev.node.make_publisher(pp.dtype, pp.port.subject_id)
+            pp.publisher.send_timeout = 1.0
+
+    async def close(self, devices: list[_SimDevice]) -> None:
+        """Close the devices' ports, then their nodes (never raises)."""
+        from sam_runtime.transport import aclose
+
+        ports = [p.publisher for d in devices for p in d.pubs] + [s.subscriber for d in devices for s in d.subs]
+        nodes = [d.node for d in devices]
+        for d in devices:
+            d.node = None
+            for pp in d.pubs:
+                pp.publisher = None
+            for sp in d.subs:
+                sp.subscriber = None
+        try:
+            await aclose(*[p for p in ports if p is not None])
+            await aclose(*[n for n in nodes if n is not None])
+        except Exception as ex:
+            _log.warning("closing the simulated Cyphal nodes: %s: %s", type(ex).__name__, ex)
+
+    def blank(self, pp: _PubPort, t: float, now_us: int) -> Any:
+        return generic_fill(pp.dtype(), t, now_us, seed=pp.ident)
+
+    def finish(self, dev: _SimDevice, pp: _PubPort, obj: Any, t: float, now_us: int) -> None:
+        pass
+
+    def command_values(self, dev: _SimDevice, sp: _SubPort, msg: Any) -> dict[str, Any] | None:
+        import pycyphal.dsdl
+
+        return pycyphal.dsdl.to_builtin(msg)  # type: ignore[no-any-return]
+
+    def apply(self, dev: _SimDevice, values: dict[str, Any]) -> dict[str, float]:
+        dev.state.command.update(values)
+        inputs = SAM_ACTUATORS.get(dev.info.name, {})
+        return {inputs[k]: float(v) for k, v in values.items() if k in inputs}
+
+    def record(self, port: Any, obj: Any, transmitted: bool) -> dict[str, Any]:
+        import pycyphal.dsdl
+
+        if transmitted:  # the values as transmitted (float16 rounding etc.)
+            obj = pycyphal.dsdl.deserialize(type(obj), list(pycyphal.dsdl.serialize(obj)))
+        return {"subject": port.port.subject_id, "value": pycyphal.dsdl.to_builtin(obj)}
 
 
 class Simulator:
@@ -146,14 +271,28 @@ class Simulator:
         self.truth_written = 0
         self.bridge_node_id = int(self.config.bridge_node_id if self.config.bridge_node_id is not None
                                   else self.tables.BRIDGE_NODE_ID)
+        protocols = layout_protocols(self.tables, self.config.layout)
         wanted = None if self.config.devices is None else set(self.config.devices)
-        names = {d.name for d in self.tables.DEVICES}
-        if wanted is not None and wanted - names:
-            raise ValueError(f"unknown device(s) {sorted(wanted - names)}; the spec has {sorted(names)}")
-        self.devices = [
-            _SimDevice(d, DeviceState(d.name, d.node_id)) for d in self.tables.DEVICES
-            if wanted is None or d.name in wanted
-        ]
+        if wanted is not None and wanted - set(protocols):
+            raise ValueError(f"unknown device(s) {sorted(wanted - set(protocols))}; the spec has {sorted(protocols)}")
+        firmware = {"cyphal": {d.name: d for d in self.tables.DEVICES},
+                    "dronecan": {d.name: d for d in getattr(self.tables, "DRONECAN_DEVICES", ())}}
+        self.devices = []
+        for name, protocol in protocols.items():
+            info = firmware.get(protocol, {}).get(name)
+            if info is None:
+                raise ValueError(f"layout {self.config.layout!r} puts {name} on {protocol}, but the spec gives it no "
+                                 f"{protocol} firmware")
+            if wanted is None or name in wanted:
+                self.devices.append(_SimDevice(info, DeviceState(name, info.node_id), protocol=protocol))
+        self._adapters: dict[str, Any] = {}
+        for protocol in {d.protocol for d in self.devices}:
+            if protocol == "dronecan":
+                from sam_runtime.sim_dronecan import DroneCanDevices
+
+                self._adapters[protocol] = DroneCanDevices(self)
+            else:
+                self._adapters[protocol] = _CyphalDevices(self)
         self._go: asyncio.Event | None = None  # created in start() (inside the loop)
         self._running: asyncio.Event | None = None  # cleared by pause()
         self._record: TextIO | None = None
@@ -168,11 +307,8 @@ class Simulator:
     async def start(self, *, publish_now: bool = False) -> None:
         """Create every device's node (heartbeats start at once) and its ports; sensors wait for
         :meth:`start_publishing` unless ``publish_now``."""
-        self.gen.compile_dsdl()
-
-        from sam_runtime.bridge import quiet_late_media_completions
-
-        quiet_late_media_completions(asyncio.get_running_loop())
+        for adapter in self._adapters.values():
+            adapter.prepare()
         self._go = asyncio.Event()
         self._running = asyncio.Event()
         self._running.set()
@@ -180,10 +316,7 @@ class Simulator:
             self._record = open(self.config.record, "w", buffering=1)
         try:
             for dev in self.devices:
-                for port in dev.info.subscribes:
-                    dev.subs.append(_SubPort(port, self.gen.dsdl_class(port)))
-                for port in dev.info.publishes:
-                    dev.pubs.append(_PubPort(port, self.gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type))))
+                self._adapter(dev).ports(dev)
                 self._open_device(dev)
             for dev in self.devices:
                 self._start_device_tasks(dev)
@@ -195,33 +328,17 @@ class Simulator:
         if publish_now:
             self.start_publishing()
 
+    def _adapter(self, dev: _SimDevice) -> Any:
+        return self._adapters[dev.protocol]
+
     def _open_device(self, dev: _SimDevice) -> None:
         """The device's node (heartbeats start at once) and its ports."""
-        import uavcan.node
-
-        from sam_runtime.transport import make_node, transport_from_env
-
-        name = f"org.{self.tables.VEHICLE}.sim.{dev.info.name}"[:50]
-        if self.config.kind == "env":
-            env = dict(self.config.environ or {})
-            env["UAVCAN__NODE__ID"] = str(dev.info.node_id)
-            dev.node = make_node(name, dev.info.node_id, transport=transport_from_env(env))
-        else:
-            dev.node = make_node(name, dev.info.node_id, self.config.kind, iface=self.config.iface,
-                                 mtu=self.config.mtu)
-        dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
-        for sp in dev.subs:
-            sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
-            sp.subscriber.receive_in_background(lambda msg, tr, dev=dev, sp=sp: self._on_command(dev, sp, msg, tr))
-        for pp in dev.pubs:
-            pp.publisher = dev.node.make_publisher(pp.dtype, pp.port.subject_id)
-            pp.publisher.send_timeout = 1.0
+        self._adapter(dev).open(dev)
         dev.powered = True
 
     def _start_device_tasks(self, dev: _SimDevice, restart: bool = False) -> None:
         for pp in dev.pubs:
-            pp.task = asyncio.create_task(self._publish_loop(dev, pp, restart),
-                                          name=f"sim-{dev.info.name}-{pp.port.subject_id}")
+            pp.task = asyncio.create_task(self._publish_loop(dev, pp, restart), name=f"sim-{dev.info.name}-{pp.key}")
 
     def device(self, name: str) -> _SimDevice:
         for dev in self.devices:
@@ -233,7 +350,6 @@ class Simulator:
         """Cut the device's power: its node closes, so its heartbeats and publications stop (a device that stops
         sending, for heartbeat-timeout tests). Its counters are kept."""
         from sam_runtime.bridge import cancel_and_wait
-        from sam_runtime.transport import aclose
 
         dev = self.device(name)
         if not dev.powered:
@@ -243,15 +359,9 @@ class Simulator:
             self.vehicle.sync(self.vehicle.t())
             self.vehicle.vehicle.command(**{SAM_ACTUATORS[name]["rpm"]: 0.0})
         await cancel_and_wait([pp.task for pp in dev.pubs if pp.task is not None])
-        ports = [pp.publisher for pp in dev.pubs] + [sp.subscriber for sp in dev.subs]
         for pp in dev.pubs:
-            pp.task, pp.publisher = None, None
-        for sp in dev.subs:
-            sp.subscriber = None
-        node, dev.node = dev.node, None
-        await aclose(*[p for p in ports if p is not None])
-        if node is not None:
-            await aclose(node)
+            pp.task = None
+        await self._adapter(dev).close([dev])
         dev.power_cycles += 1
 
     async def power_on(self, name: str) -> None:
@@ -262,6 +372,13 @@ class Simulator:
             return
         self._open_device(dev)
         self._start_device_tasks(dev, restart=True)
+
+    async def restart(self, name: str) -> None:
+        """A reboot (DroneCAN's RestartNode): power off, then on again (uptime and transfer ids from 0)."""
+        if self._closed:
+            return
+        await self.power_off(name)
+        await self.power_on(name)
 
     def start_publishing(self, duration: float | None = None) -> None:
         """Open the gate: every publisher starts its schedule now; with ``duration``, stops after it."""
@@ -300,7 +417,6 @@ class Simulator:
             return
         self._closed = True
         from sam_runtime.bridge import cancel_and_wait
-        from sam_runtime.transport import aclose
 
         stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None]
                                       + ([self._truth_task] if self._truth_task is not None else []))
@@ -308,13 +424,11 @@ class Simulator:
             self._write_truth()
         if stuck:
             _log.warning("%d publish tasks did not stop", len(stuck))
-        ports = [p.publisher for d in self.devices for p in d.pubs] + [s.subscriber for d in self.devices
-                                                                       for s in d.subs]
-        try:
-            await aclose(*[p for p in ports if p is not None])
-            await aclose(*[d.node for d in self.devices if d.node is not None])
-        except Exception as ex:
-            _log.warning("closing the simulated nodes: %s: %s", type(ex).__name__, ex)
+        for protocol, adapter in self._adapters.items():
+            try:
+                await adapter.close([d for d in self.devices if d.protocol == protocol and d.node is not None])
+            except Exception as ex:  # the adapters log their own; never raise out of close()
+                _log.warning("closing the simulated %s nodes: %s: %s", protocol, type(ex).__name__, ex)
         if self._record is not None:
             self._record.close()
             self._record = None
@@ -323,11 +437,12 @@ class Simulator:
     # ---------------------------------------------------------------------------------- publishing
     def make_sample(self, dev: _SimDevice, pp: _PubPort, dt: float) -> Any:
         """One message of the port: generic values, then the device's physics (if known)."""
-        t = self.vehicle.t()
-        obj = pp.dtype()
-        generic_fill(obj, t, self.vehicle.now_us(), seed=pp.port.subject_id)
+        t, now_us = self.vehicle.t(), self.vehicle.now_us()
+        adapter = self._adapter(dev)
+        obj = adapter.blank(pp, t, now_us)
         if pp.physics is not None:
             pp.physics(obj, dev.state, self.vehicle, t, dt * self.vehicle.time_scale, self.vehicle.rng)
+        adapter.finish(dev, pp, obj, t, now_us)
         dev.state.last_update = t
         return obj
 
@@ -339,7 +454,7 @@ class Simulator:
             return
         period = 1.0 / rate
         # Align every port to the gate, offset a little per subject so that not all fire at once.
-        offset = (pp.port.subject_id % 17) * period / 17.0
+        offset = (pp.ident % 17) * period / 17.0
         started = self._publishing_since if self._publishing_since is not None else time.monotonic()
         if restart:  # powered on again: a new schedule from now
             started = time.monotonic() - offset
@@ -375,7 +490,7 @@ class Simulator:
                 raise
             except Exception as ex:
                 pp.failed += 1
-                self.log.note((dev.info.name, f"publish on {pp.port.subject_id}"), logging.WARNING, "failed: %s: %s",
+                self.log.note((dev.info.name, f"publish on {pp.key}"), logging.WARNING, "failed: %s: %s",
                               type(ex).__name__, ex)
                 ok = None
             finally:
@@ -383,10 +498,10 @@ class Simulator:
             if ok:
                 pp.sent += 1
                 if self._record is not None:
-                    self._write_record("tx", dev, pp.port.subject_id, obj, seq=pp.sent)
+                    self._write_record("tx", dev, pp, obj, seq=pp.sent)
             elif ok is False:
                 pp.failed += 1
-                self.log.note((dev.info.name, f"publish on {pp.port.subject_id}"), logging.WARNING,
+                self.log.note((dev.info.name, f"publish on {pp.key}"), logging.WARNING,
                               "not every frame sent within %.1f s", pub.send_timeout)
             if pp.failed:
                 self.log.flush()  # a count whose interval has passed, also when the failures have stopped
@@ -394,24 +509,25 @@ class Simulator:
 
     # ---------------------------------------------------------------------------------- commands
     def _on_command(self, dev: _SimDevice, sp: _SubPort, msg: Any, transfer: Any) -> None:
-        import pycyphal.dsdl
-
+        adapter = self._adapter(dev)
+        values = adapter.command_values(dev, sp, msg)
+        if values is None:  # a broadcast without this device's element: not a command for it
+            sp.not_addressed += 1
+            return
         src = transfer.source_node_id
         accepted = src == self.bridge_node_id
         if accepted:
             sp.accepted += 1
-            values = pycyphal.dsdl.to_builtin(msg)
             sp.last = values
-            dev.state.command.update(values)
-            inputs = SAM_ACTUATORS.get(dev.info.name)
+            inputs = adapter.apply(dev, values)
             if inputs:  # from now on (the model first catches up with the time of arrival)
                 self.vehicle.sync(self.vehicle.t())
-                self.vehicle.vehicle.command(**{inputs[k]: float(v) for k, v in values.items() if k in inputs})
+                self.vehicle.vehicle.command(**inputs)
         else:
             sp.rejected += 1
             sp.rejected_sources[-1 if src is None else int(src)] += 1
         if self._record is not None:
-            self._write_record("rx", dev, sp.port.subject_id, msg, source=src, accepted=accepted,
+            self._write_record("rx", dev, sp, msg, source=src, accepted=accepted,
                                seq=sp.accepted if accepted else sp.rejected)
 
     # ---------------------------------------------------------------------------------- truth
@@ -450,31 +566,32 @@ class Simulator:
             await asyncio.sleep(max(0.0, start + k * period - time.monotonic()))
 
     # ---------------------------------------------------------------------------------- reporting
-    def _write_record(self, direction: str, dev: _SimDevice, subject: int, obj: Any, **extra: Any) -> None:
-        import pycyphal.dsdl
-
-        if direction == "tx":  # the values as transmitted (float16 rounding etc.)
-            obj = pycyphal.dsdl.deserialize(type(obj), list(pycyphal.dsdl.serialize(obj)))
+    def _write_record(self, direction: str, dev: _SimDevice, port: _PubPort | _SubPort, obj: Any,
+                      **extra: Any) -> None:
+        fields = self._adapter(dev).record(port, obj, direction == "tx")
+        value = fields.pop("value")
         assert self._record is not None
-        line = {"dir": direction, "device": dev.info.name, "node_id": dev.info.node_id, "subject": subject,
-                "wall_ns": time.time_ns(), **extra, "value": pycyphal.dsdl.to_builtin(obj)}
+        line = {"dir": direction, "device": dev.info.name, "node_id": dev.info.node_id, **fields,
+                "wall_ns": time.time_ns(), **extra, "value": value}
         self._record.write(json.dumps(line, default=_json_default) + "\n")
 
     def report(self) -> dict[str, Any]:
         devices: dict[str, Any] = {}
         for d in self.devices:
             devices[d.info.name] = {
+                "protocol": d.protocol,
                 "node_id": d.info.node_id,
                 "powered": d.powered,
                 "power_cycles": d.power_cycles,
-                "published": {str(p.port.subject_id): p.sent for p in d.pubs},
-                "late": {str(p.port.subject_id): p.late for p in d.pubs if p.late},
-                "failed": {str(p.port.subject_id): p.failed for p in d.pubs if p.failed},
+                "published": {p.key: p.sent for p in d.pubs},
+                "late": {p.key: p.late for p in d.pubs if p.late},
+                "failed": {p.key: p.failed for p in d.pubs if p.failed},
                 "commands": {
-                    str(s.port.subject_id): {
+                    s.key: {
                         "accepted": s.accepted, "rejected": s.rejected,
                         "rejected_sources": {str(k): v for k, v in s.rejected_sources.items()},
                         "last": s.last,
+                        **({"not_addressed": s.not_addressed} if d.protocol == "dronecan" else {}),
                     } for s in d.subs
                 },
                 "position": dict(d.state.position),
@@ -482,6 +599,7 @@ class Simulator:
         truth = self.truth()
         since = self._publishing_since
         return {
+            "layout": self.config.layout,
             "bridge_node_id": self.bridge_node_id,
             "publishing_s": None if since is None else round(
                 (min(time.monotonic(), self._publishing_until or math.inf)) - since, 3),

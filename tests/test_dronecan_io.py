@@ -288,6 +288,36 @@ def _driver_pair() -> tuple[LoopbackMulticastDriver, LoopbackMulticastDriver]:
     return LoopbackMulticastDriver(spec.bus, spec.port), LoopbackMulticastDriver(spec.bus, spec.port)
 
 
+def test_loopback_acceptance_filter_takes_only_its_services_and_data_types() -> None:
+    """A node that listens to little (a simulated device): the kernel passes the service frames addressed to it and
+    the broadcasts of its data types, and drops the rest before it takes buffer space or wakes the process."""
+    from sam_runtime.dronecan_io import Acceptance
+
+    spec = parse_iface(private_iface())
+    sender = LoopbackMulticastDriver(spec.bus, spec.port)
+    picky = LoopbackMulticastDriver(spec.bus, spec.port, accept=Acceptance(21, frozenset({1031, 20101})))
+    deaf = LoopbackMulticastDriver(spec.bus, spec.port, accept=Acceptance(None))
+    with sender, picky, deaf:
+        assert picky.kernel_self_filter and deaf.kernel_self_filter
+        ids = [0x1403EB0A,  # RawIMU (1003) from node 10: not taken
+               0x1404071F,  # RPMCommand (1031) from node 31: taken
+               0x1401958B,  # a request to node 21: taken
+               0x1401968B,  # a request to node 22: not taken
+               0x14040700,  # RPMCommand bits from an anonymous node: not taken
+               0x144E851F]  # data type 20101 from node 31: taken
+        for can_id in ids:
+            sender.send(can_id, b"\x01\xc0", extended=True)
+        picky.send(0x1404071F, b"\x02\xc1", extended=True)  # its own: never back
+        got = []
+        deadline = time.monotonic() + 5
+        while len(got) < 3 and time.monotonic() < deadline:
+            frame = picky.receive(0.1)
+            if frame is not None:
+                got.append(frame.id)
+        assert got == [0x1404071F, 0x1401958B, 0x144E851F] and picky.receive(0.2) is None
+        assert deaf.receive(0.2) is None
+
+
 def test_loopback_driver_delivers_to_others_only() -> None:
     a, b = _driver_pair()
     with a, b:

@@ -57,7 +57,9 @@ def test_every_standard_type_as_dronecan_reads_it() -> None:
     catalog = V0Catalog(_empty_spec())
     assert {r.name for r in catalog.roots} == set(DRONECAN_ROOTS)
     names = set(catalog.files())
-    assert names == set(dronecan.TYPENAMES)
+    # The bundled roots only: a spec's own types (sam.*, ferry.*) may have been added in this process by the
+    # bridge or the simulator (sam_runtime.dronecan_io.types).
+    assert names == {n for n in dronecan.TYPENAMES if n.split(".")[0] in DRONECAN_ROOTS}
     assert len(names) > 100
     for name in sorted(names):
         theirs = dronecan.TYPENAMES[name]

@@ -1,6 +1,7 @@
 """DroneCAN (UAVCAN v0) transport groundwork: drivers, the receive path, an asyncio runner, bus accounting.
 
-- :class:`LoopbackMulticastDriver` (``mcast-lo:``): dronecan's ``mcast:`` packet format on 127.0.0.1 only.
+- :class:`LoopbackMulticastDriver` (``mcast-lo:``): dronecan's ``mcast:`` packet format on 127.0.0.1 only; an
+  :class:`Acceptance` filter in the kernel for nodes that listen to little.
 - :class:`FrameGate`: between any dronecan driver and its Node; passes whole v0 transfers, counts the rest.
 - :class:`NodeLoop`: runs a Node in the asyncio loop's thread; every ``spin()`` exception counted, never raised.
 - :class:`DropCounter` / :class:`DropReason`: what was dropped and why.
@@ -15,12 +16,13 @@ from .bus_load import BusLoadMeter, TransferCost, frame_bits, payload_length, tr
 from .drops import DropCounter, DropKey, DropReason, RateLimitedLog
 from .frame_gate import FrameGate
 from .iface import Iface, IfaceError, make_driver, make_node, parse_iface
-from .loopback import LoopbackMulticastDriver
+from .loopback import Acceptance, LoopbackMulticastDriver
 from .mcast_packet import MCAST_PORT, group_for_bus
 from .node_loop import HandlerError, NodeLoop, classify_spin_error
 
 __all__ = [
     "MCAST_PORT",
+    "Acceptance",
     "BusLoadMeter",
     "DropCounter",
     "DropKey",

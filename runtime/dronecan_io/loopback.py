@@ -12,6 +12,11 @@ Like dronecan's SocketCAN and ``mcast:`` drivers it does not hand a node its own
 no loopback handling: an echo would be received as a transfer from itself); on Linux a socket filter drops them in
 the kernel. Frames of other drivers on the same bus in the same process are delivered. Datagrams the kernel drops
 because the node did not read in time are counted, not lost silently.
+
+An :class:`Acceptance` filter (a CAN controller's acceptance filter: the service transfers addressed to one node and
+the broadcasts of some data types) drops every other frame in the kernel, so a node that listens to little (a
+simulated sensor) is not woken by every frame of the bus. The kernel counts the datagrams a socket filter drops
+together with those it drops for a full buffer: under an acceptance filter ``rx_overflow`` is not counted.
 """
 
 from __future__ import annotations
@@ -22,16 +27,36 @@ import select
 import socket
 import struct
 import time
+from dataclasses import dataclass
 
 from dronecan.driver.common import AbstractDriver, CANFrame, DriverError, TxQueueFullError
 
 from .drops import DropCounter, DropReason
 from .mcast_packet import MCAST_PORT, PacketError, decode_packet, encode_packet, group_for_bus
 
-__all__ = ["LOOPBACK_ADDRESS", "LoopbackMulticastDriver"]
+__all__ = ["LOOPBACK_ADDRESS", "Acceptance", "LoopbackMulticastDriver"]
 
 LOOPBACK_ADDRESS = "127.0.0.1"
 _RECV_SIZE = 2048  # more than the largest valid packet (74 bytes), so an oversized one is seen whole and rejected
+
+
+@dataclass(frozen=True)
+class Acceptance:
+    """Which frames a node takes: service frames (requests and responses) addressed to ``node_id`` and message
+    frames of ``data_type_ids`` (from any source node but the anonymous one).
+
+    >>> a = Acceptance(21, frozenset({1031}))
+    >>> a.accepts(0x1404071F), a.accepts(0x1403EB0A), a.accepts(0x1401958B), a.accepts(0x1401968B)
+    (True, False, True, False)
+    """
+
+    node_id: int | None
+    data_type_ids: frozenset[int] = frozenset()
+
+    def accepts(self, can_id: int) -> bool:
+        if can_id & 0x80:  # a service frame: to whom
+            return self.node_id is not None and (can_id >> 8) & 0x7F == self.node_id
+        return can_id & 0x7F != 0 and (can_id >> 8) & 0xFFFF in self.data_type_ids
 
 
 class LoopbackMulticastDriver(AbstractDriver):
@@ -44,7 +69,7 @@ class LoopbackMulticastDriver(AbstractDriver):
     """
 
     def __init__(self, bus: int = 0, port: int = MCAST_PORT, *, drops: DropCounter | None = None,
-                 rcvbuf: int = 1 << 21, send_timeout: float = 0.1) -> None:
+                 rcvbuf: int = 1 << 21, send_timeout: float = 0.1, accept: Acceptance | None = None) -> None:
         super().__init__()
         if not 1 <= port <= 65535:
             raise ValueError(f"UDP port must be 1..65535, got {port}")
@@ -52,6 +77,7 @@ class LoopbackMulticastDriver(AbstractDriver):
         self.port = port
         self.group = group_for_bus(bus)
         self.drops = drops if drops is not None else DropCounter()
+        self.accept = accept
         self._rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         self._tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         try:
@@ -77,11 +103,12 @@ class LoopbackMulticastDriver(AbstractDriver):
         # drops them before they take receive-buffer space (half the buffer on a bus where this node sends as much
         # as it receives) when the filter can be attached; the check in receive() stays for when it cannot.
         self._own_address = self._tx.getsockname()
-        self.kernel_self_filter = _attach_self_filter(self._rx, self._own_address)
+        self.kernel_self_filter = _attach_self_filter(self._rx, self._own_address, accept)
         self.own_frames_skipped = 0
         # The kernel counts the datagrams it dropped for this socket (full buffer), and this driver's own ones the
-        # filter above dropped: one per frame sent. Read when the socket is empty (SO_MEMINFO).
-        self._count_drops = _kernel_drops(self._rx) is not None
+        # filter above dropped: one per frame sent. Read when the socket is empty (SO_MEMINFO). The frames an
+        # acceptance filter drops are counted there too, indistinguishably.
+        self._count_drops = _kernel_drops(self._rx) is not None and not (accept and self.kernel_self_filter)
         self._sent = 0
         self._overflow_reported = 0
         self._poll = select.poll()
@@ -123,6 +150,9 @@ class LoopbackMulticastDriver(AbstractDriver):
             except PacketError as ex:
                 self.drops.add(DropReason.BAD_PACKET, detail=f"datagram from {source[0]}:{source[1]}: {ex}")
                 continue
+            if self.accept is not None and not self.kernel_self_filter and not (
+                    frame.extended and self.accept.accepts(frame.id)):
+                continue  # what the kernel filter would have dropped
             self._rx_hook(frame)
             return frame
 
@@ -197,25 +227,71 @@ _SKF_NET_OFF = -0x100000
 _BPF = struct.Struct("HBBI")
 
 
-def _attach_self_filter(sock: socket.socket, own: tuple[str, int]) -> bool:
-    """A classic BPF socket filter dropping datagrams from ``own`` (address, port); False where unsupported.
+def _attach_self_filter(sock: socket.socket, own: tuple[str, int], accept: Acceptance | None = None) -> bool:
+    """A classic BPF socket filter dropping datagrams from ``own`` (address, port) and, with ``accept``, the frames
+    it does not accept; False where unsupported (or the acceptance list is too long for one program).
 
     A UDP socket's filter sees the packet at its UDP header; the IP source address is reached through
-    SKF_NET_OFF. Loads of header fields are in network order and compared as numbers.
+    SKF_NET_OFF. Loads of header fields are in network order and compared as numbers. The CAN id is the
+    little-endian u32 at byte 6 of the datagram's payload (:mod:`.mcast_packet`): bytes 14..17 from the UDP header.
     """
     address = struct.unpack("!I", socket.inet_aton(own[0]))[0]
-    program = [
+    drop, keep = "drop", "accept"
+    program: list[tuple[int, int | str, int | str, int] | str] = [
         (0x20, 0, 0, (_SKF_NET_OFF + 12) & 0xFFFFFFFF),  # A = IP source address
-        (0x15, 0, 3, address),                            # A != own address: accept
+        (0x15, 0, 2, address),                            # A != own address: not this driver's own
         (0x28, 0, 0, 0),                                  # A = UDP source port
-        (0x15, 0, 1, own[1]),                             # A == own port: drop, else accept
-        (0x06, 0, 0, 0),                                  # drop
-        (0x06, 0, 0, 0xFFFFFFFF),                         # accept all of it
+        (0x15, drop, 0, own[1]),                          # A == own port: drop
     ]
-    code = ctypes.create_string_buffer(b"".join(_BPF.pack(*ins) for ins in program))
-    fprog = struct.pack("HL", len(program), ctypes.addressof(code))
+    if accept is None:
+        program.append((0x06, 0, 0, 0xFFFFFFFF))
+    else:
+        program += [
+            (0x30, 0, 0, 14),                             # A = CAN id bits 0..7: service flag, source node
+            (0x45, 0, "message", 0x80),                   # not a service frame: a message
+            (0x30, 0, 0, 15),                             # A = bits 8..15: request flag, destination node
+            (0x54, 0, 0, 0x7F),                           # A &= 0x7F
+            (0x15, keep, drop, accept.node_id) if accept.node_id is not None else (0x06, 0, 0, 0),
+            "message",
+            (0x30, 0, 0, 14),
+            (0x54, 0, 0, 0x7F),                           # the source node
+            (0x15, drop, 0, 0),                           # anonymous: drop (only 2 bits of its data type id)
+            (0x28, 0, 0, 15),                             # A = bytes 15, 16: the data type id, byte-swapped
+        ]
+        for dtid in sorted(accept.data_type_ids):
+            program.append((0x15, keep, 0, ((dtid & 0xFF) << 8) | (dtid >> 8)))
+        program.append((0x06, 0, 0, 0))
+    program += [drop, (0x06, 0, 0, 0), keep, (0x06, 0, 0, 0xFFFFFFFF)]
+    code = _assemble(program)
+    if code is None:
+        return False
+    buf = ctypes.create_string_buffer(b"".join(_BPF.pack(*ins) for ins in code))
+    fprog = struct.pack("HL", len(code), ctypes.addressof(buf))
     try:
         sock.setsockopt(socket.SOL_SOCKET, _SO_ATTACH_FILTER, fprog)
     except OSError:
         return False
     return True
+
+
+def _assemble(program: list[tuple[int, int | str, int | str, int] | str]) -> list[tuple[int, int, int, int]] | None:
+    """Instructions with jump targets given as labels (strings in the list) -> relative jumps; None if a jump is
+    longer than a classic BPF jump can be (255 instructions)."""
+    labels: dict[str, int] = {}
+    n = 0
+    for item in program:
+        if isinstance(item, str):
+            labels[item] = n
+        else:
+            n += 1
+    out: list[tuple[int, int, int, int]] = []
+    for item in program:
+        if isinstance(item, str):
+            continue
+        code, jt, jf, k = item
+        here = len(out) + 1  # jumps are relative to the next instruction
+        rel = [labels[j] - here if isinstance(j, str) else j for j in (jt, jf)]
+        if not all(0 <= r <= 255 for r in rel):
+            return None
+        out.append((code, rel[0], rel[1], k))
+    return out
