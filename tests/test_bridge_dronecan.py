@@ -27,7 +27,7 @@ pytest.importorskip("rclpy")
 from helpers.dronecan_peer import raw_imu_fields, raw_imu_message  # noqa: E402
 from helpers.dronecan_support import PlainPeer, private_iface, until  # noqa: E402
 from helpers.ros_probe import ThreadedProbe  # noqa: E402
-from helpers.runtime_support import generated_or_skip  # noqa: E402
+from helpers.runtime_support import domain_id, generated_or_skip  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -72,7 +72,9 @@ def run() -> dict[str, Any]:
     """One bridge on a private bus; the scenario's outcomes, measured."""
     gen = generated_or_skip()
     iface = private_iface()
-    return asyncio.run(_scenario(gen, iface))
+    with pytest.MonkeyPatch.context() as mp:  # a private ROS domain: no other ROS graph on this machine joins in
+        mp.setenv("ROS_DOMAIN_ID", domain_id(43))
+        return asyncio.run(_scenario(gen, iface))
 
 
 async def _scenario(gen: Any, iface: str) -> dict[str, Any]:

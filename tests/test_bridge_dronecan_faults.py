@@ -24,7 +24,7 @@ pytest.importorskip("rclpy")
 from dronecan.driver.common import CANFrame  # noqa: E402
 from helpers.dronecan_peer import raw_imu_message  # noqa: E402
 from helpers.dronecan_support import PlainPeer, frames_of, private_iface, until  # noqa: E402
-from helpers.runtime_support import generated_or_skip  # noqa: E402
+from helpers.runtime_support import domain_id, generated_or_skip  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -38,7 +38,9 @@ def _imu(bridge: Any) -> dict[str, Any]:
 
 @pytest.fixture(scope="module")
 def run() -> dict[str, Any]:
-    return asyncio.run(_scenario(generated_or_skip(), private_iface()))
+    with pytest.MonkeyPatch.context() as mp:  # a private ROS domain: no other ROS graph on this machine joins in
+        mp.setenv("ROS_DOMAIN_ID", domain_id(44))
+        return asyncio.run(_scenario(generated_or_skip(), private_iface()))
 
 
 async def _scenario(gen: Any, iface: str) -> dict[str, Any]:

@@ -45,7 +45,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     if tables.VEHICLE != "sam":
         pytest.skip("written for the SAM spec's dronecan layout")
     d = tmp_path_factory.mktemp("dronecan_e2e")
-    env = child_env(ros_prefix_for(gen), domain_id(41), {"SAM_GENERATED_DIR": str(gen.root)})
+    env = child_env(ros_prefix_for(gen), domain_id(45), {"SAM_GENERATED_DIR": str(gen.root)})
     iface = private_iface()
     dc = ["--layout", "dronecan", "--dronecan-iface", iface]
     in_maps = [m for m in tables.DRONECAN_MAPPINGS if m.direction == "uavcan_to_ros"]

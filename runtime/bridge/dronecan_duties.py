@@ -23,7 +23,7 @@ import json
 import logging
 import threading
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from .counters import log
@@ -164,38 +164,38 @@ class DroneCanDuties:
             self.counts["request_timeouts"] += 1
         return box[0]
 
-    def _get_node_info(self, nid: int, resp: Any) -> Any:
-        import dronecan
-
+    def _serve(self, request: Any, nid: int, resp: Any, answer: Callable[[Any], tuple[bool, str]]) -> Any:
+        """A Trigger response from the device's answer to ``request``: ``answer(response)`` -> (success, message);
+        a link down or no answer within the timeout is a refusal that says so."""
         try:
-            r = self._request(dronecan.uavcan.protocol.GetNodeInfo.Request(), nid)
+            r = self._request(request, nid)
         except RuntimeError as ex:
             resp.success, resp.message = False, str(ex)
             return resp
         if r is None:
             resp.success, resp.message = False, f"node {nid} did not answer within {self.timeout:.1f} s"
         else:
-            resp.success, resp.message = True, node_info_json(nid, r)
+            resp.success, resp.message = answer(r)
         return resp
+
+    def _get_node_info(self, nid: int, resp: Any) -> Any:
+        import dronecan
+
+        return self._serve(dronecan.uavcan.protocol.GetNodeInfo.Request(), nid, resp,
+                           lambda r: (True, node_info_json(nid, r)))
 
     def _restart(self, nid: int, resp: Any) -> Any:
         import dronecan
 
         req = dronecan.uavcan.protocol.RestartNode.Request()
         req.magic_number = req.MAGIC_NUMBER
-        try:
-            r = self._request(req, nid)
-        except RuntimeError as ex:
-            resp.success, resp.message = False, str(ex)
-            return resp
-        if r is None:
-            resp.success, resp.message = False, f"node {nid} did not answer within {self.timeout:.1f} s"
-        else:
-            resp.success = bool(r.ok)
-            resp.message = f"node {nid} " + ("restarts" if r.ok else "refused to restart")
-            log.warning("restart of node %d (%s) requested over ROS: %s", nid, self.devices.get(nid, "?"),
-                        resp.message)
-        return resp
+
+        def answer(r: Any) -> tuple[bool, str]:
+            message = f"node {nid} " + ("restarts" if r.ok else "refused to restart")
+            log.warning("restart of node %d (%s) requested over ROS: %s", nid, self.devices.get(nid, "?"), message)
+            return bool(r.ok), message
+
+        return self._serve(req, nid, resp, answer)
 
     # ------------------------------------------------------------------------------------------------ panic
     def _on_ros_panic(self, msg: Any) -> None:
