@@ -130,7 +130,7 @@ def test_safe_depth_clamps_the_plan_rules_refuse_updates_and_a_lowered_critical_
 
         accepted = wait_for(lower_critical_depth, 10, "critical_depth 2.0 accepted once the monitor mirrors safe_depth")
         crossing_depth = s.truth.at(accepted)["depth"]
-        abort = wait_for(lambda: first_abort(s), 5, "an active /abort")
+        abort = wait_for(lambda: first_abort(s), 15, "an active /abort")  # how fast: asserted below
         up = surfaced(s, abort[0], 60)
         truth = s.truth.latest()
         commands = truth["commands"]
@@ -230,20 +230,25 @@ def test_the_controller_stops_on_a_stale_an_empty_or_a_foreign_plan(tmp_path: Pa
         here = p.world_pose().translation
         line = [(here[0] + d, here[1], -1.0) for d in range(0, 60, 2)]
         stamp = p.send_plan(line)
-        following = wait_for(lambda: _rpm_after(s, stamp, lambda r: r[1] > 0), 5, "the controller following")
+        # A plan is followed while it is younger than its timeout: that bounds the wait (a loaded machine may take
+        # seconds to deliver the plan, the transforms and the first command); the stops below are measured.
+        follow_s = timeout - 1.0
+        following = wait_for(lambda: _rpm_after(s, stamp, lambda r: r[1] > 0), follow_s, "the controller following")
         stopped = wait_for(lambda: _rpm_after(s, following[0], lambda r: r[1] == 0 and r[2] == 0), timeout + 10,
                            "zero RPM on the stale plan", interval=0.1)
         stale_status = p.status("controller")
         after: dict[str, float] = {}
         for kind, poses, frame in (("empty", [], "world"), ("foreign", line, "odom")):
             fresh = p.send_plan(line)
-            go = wait_for(lambda fresh=fresh: _rpm_after(s, fresh, lambda r: r[1] > 0), 5, "following again")
+            go = wait_for(lambda fresh=fresh: _rpm_after(s, fresh, lambda r: r[1] > 0), follow_s,
+                          "following again")
             sent = p.send_plan(poses, frame)
-            stop = wait_for(lambda sent=sent: _rpm_after(s, sent, lambda r: r[1] == 0), 5, f"a stop on the {kind} plan")
+            stop = wait_for(lambda sent=sent: _rpm_after(s, sent, lambda r: r[1] == 0), 10,
+                            f"a stop on the {kind} plan")
             after[kind] = (stop[0] - sent) / S
             assert go[0] < sent
         controller = wait_for(lambda: (st := p.status("controller")) and "plans_refused.frame" in st.values and st,
-                              5, "the controller's count of refused plans")
+                              10, "the controller's count of refused plans")
         imu = p.tf.lookup("base_link", "imu_link")  # /tf_static from the host, latched: sent before we started
         altimeter = p.tf.lookup("base_link", "altimeter_link")
     stale_after = (stopped[0] - stamp) / S
@@ -277,7 +282,7 @@ def test_bad_goals_are_refused_counted_and_ignored(tmp_path: Path) -> None:
         rpms = [r for r in p.rec.rpms if r[0] >= first]
         end = s.truth.latest()
         good = p.send_goal(10.0, 0.0, -2.0)
-        wait_for(lambda: any(t >= good for t, *_ in p.rec.plans), 5, "a plan for the good goal")
+        wait_for(lambda: any(t >= good for t, *_ in p.rec.plans), 15, "a plan for the good goal")
     moved = math.hypot(end["x"] - start["x"], end["y"] - start["y"])
     figures(tmp_path, "bad goals", {"refused": planner.values["refused"], "moved_m": moved})
     assert planner.level == 1 and "goal refused" in planner.message
