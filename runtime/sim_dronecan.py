@@ -41,6 +41,7 @@ from sam_runtime.device_models_v0 import (
     sam_command_fields,
     to_builtin_v0,
 )
+from sam_runtime.dronecan_io.node_loop import close_node
 from sam_runtime.dronecan_io.types import ensure_types, type_problems
 
 if TYPE_CHECKING:
@@ -245,13 +246,7 @@ class DroneCanDevices:
                 pp.publisher = None
             for sp in dev.subs:
                 sp.subscriber = None
-            try:
-                if loop is not None:
-                    loop.stop()
-                if node is not None:
-                    node.close()
-            except Exception as ex:  # a dead driver may refuse to close cleanly
-                _log.warning("%s: closing its DroneCAN node: %s: %s", dev.info.name, type(ex).__name__, ex)
+            close_node(loop, node, _log, f"{dev.info.name}: closing its DroneCAN node")
 
     # ------------------------------------------------------------------------------------------ messages
     def blank(self, pp: _PubPort, t: float, now_us: int) -> Any:

@@ -223,13 +223,9 @@ class DroneCanBackend(Backend):
         self.poll_statistics()
         loop, node = self.node_loop, self.node
         self.node_loop = self.node = None
-        try:
-            if loop is not None:
-                loop.stop()
-            if node is not None:
-                node.close()
-        except Exception as ex:  # a dead driver may refuse to close cleanly
-            log.warning("closing the DroneCAN node: %s: %s", type(ex).__name__, ex)
+        from sam_runtime.dronecan_io import close_node
+
+        close_node(loop, node, log, "closing the DroneCAN node")
 
     def _on_status(self, event: Any) -> None:
         nid = event.transfer.source_node_id

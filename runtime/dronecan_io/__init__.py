@@ -18,7 +18,7 @@ from .frame_gate import FrameGate
 from .iface import Iface, IfaceError, make_driver, make_node, parse_iface
 from .loopback import Acceptance, LoopbackMulticastDriver
 from .mcast_packet import MCAST_PORT, group_for_bus
-from .node_loop import HandlerError, NodeLoop, classify_spin_error
+from .node_loop import HandlerError, NodeLoop, classify_spin_error, close_node
 
 __all__ = [
     "MCAST_PORT",
@@ -36,6 +36,7 @@ __all__ = [
     "RateLimitedLog",
     "TransferCost",
     "classify_spin_error",
+    "close_node",
     "frame_bits",
     "group_for_bus",
     "make_driver",

@@ -271,3 +271,15 @@ class NodeLoop:
 
     def _on_drop(self, key: DropKey, detail: str) -> None:
         self._log.report(key, detail if len(detail) <= _DETAIL_MAX else detail[:_DETAIL_MAX] + "...")
+
+
+def close_node(loop: NodeLoop | None, node: Any, logger: logging.Logger, what: str) -> None:
+    """Stop a node's NodeLoop, then close the node; never raises (a dead driver may refuse to close cleanly: logged
+    as ``<what>: ...``)."""
+    try:
+        if loop is not None:
+            loop.stop()
+        if node is not None:
+            node.close()
+    except Exception as ex:
+        logger.warning("%s: %s: %s", what, type(ex).__name__, ex)
