@@ -281,6 +281,9 @@ def _bridge_parser() -> argparse.ArgumentParser:
                    help="DroneCAN: be the bus's GlobalTimeSync master (1 Hz)")
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
+    p.add_argument("--wire", choices=("codec", "object"), default="codec",
+                   help="codec (default): the generated wire codecs, UAVCAN payload bytes <-> ROS CDR; object: the "
+                        "object converters (the protocol library's messages <-> ROS messages)")
     p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
     return p
 
@@ -309,10 +312,11 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             protocol=args.protocol,
             dronecan_iface=args.dronecan_iface,
             dronecan_options={"time_sync": args.time_sync, "dna_server": args.dna_server},
+            wire=args.wire,
         )
         await bridge.start()
-        print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()}",
-              flush=True)
+        print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
+              f"wire={bridge.wire}", flush=True)
         try:
             deadline = None if args.duration is None else time.monotonic() + args.duration
             while not stop.is_set():

@@ -84,6 +84,7 @@ class GeneratedPackage:
         self._tables: ModuleType | None = None
         self._convert: ModuleType | None = None
         self._convert_v0: ModuleType | None = None
+        self._codecs: dict[str, ModuleType | None] = {}
 
     # -------------------------------------------------------------------- locations
     @property
@@ -171,6 +172,19 @@ class GeneratedPackage:
                 raise GeneratedPackageError(f"the DroneCAN types of {self.root}: {'; '.join(problems)}")
             self._convert_v0 = mod
         return self._convert_v0
+
+    def codec(self, protocol: str = "cyphal") -> ModuleType | None:
+        """The generated wire codecs of ``protocol``: ``<pkg>.codec`` (Cyphal) or ``<pkg>.codec_v0`` (DroneCAN),
+        standard library only; None when the package has none (built by an older sam-codegen)."""
+        sub = "codec_v0" if protocol == "dronecan" else "codec"
+        if sub not in self._codecs:
+            try:
+                self._codecs[sub] = self._import(sub)
+            except ModuleNotFoundError as ex:
+                if not ex.name or ex.name.split(".")[-1] != sub:
+                    raise
+                self._codecs[sub] = None
+        return self._codecs[sub]
 
     # -------------------------------------------------------------------- types
     @staticmethod

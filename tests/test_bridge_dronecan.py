@@ -67,23 +67,25 @@ def _ready(pub_or_sub: Any) -> bool:
             else pub_or_sub.get_publisher_count()) > 0
 
 
-@pytest.fixture(scope="module")
-def run() -> dict[str, Any]:
-    """One bridge on a private bus; the scenario's outcomes, measured."""
+@pytest.fixture(scope="module", params=["codec", "object"])
+def run(request: pytest.FixtureRequest) -> dict[str, Any]:
+    """One bridge on a private bus, on the wire path (generated codecs) or the object path; the scenario's
+    outcomes, measured."""
     gen = generated_or_skip()
     iface = private_iface()
     with pytest.MonkeyPatch.context() as mp:  # a private ROS domain: no other ROS graph on this machine joins in
         mp.setenv("ROS_DOMAIN_ID", domain_id(43))
-        return asyncio.run(_scenario(gen, iface))
+        return asyncio.run(_scenario(gen, iface, request.param))
 
 
-async def _scenario(gen: Any, iface: str) -> dict[str, Any]:
+async def _scenario(gen: Any, iface: str, wire: str) -> dict[str, Any]:
     from sam_runtime.bridge import Bridge
 
-    out: dict[str, Any] = {}
+    out: dict[str, Any] = {"asked": wire}
     bridge = Bridge(gen, layout="dronecan", dronecan_iface=iface, diagnostics_period=0.5,
-                    dronecan_options={"time_sync": True})
+                    dronecan_options={"time_sync": True}, wire=wire)
     await bridge.start()
+    out["wire"] = bridge.wire  # (start falls back to the object path when the package has no codecs)
     peers: list[PlainPeer] = []
     probe = None
     try:
@@ -152,6 +154,10 @@ async def _scenario(gen: Any, iface: str) -> dict[str, Any]:
             probe.close()
         await bridge.close()
     return out
+
+
+def test_the_bridge_took_the_path_asked_for(run: dict[str, Any]) -> None:
+    assert run["wire"] == run["asked"]
 
 
 def test_raw_imu_of_the_imu_node_reaches_ros_with_its_values(run: dict[str, Any]) -> None:

@@ -10,10 +10,12 @@ backend whose link failed is closed and opened again by the core (``sam_runtime.
 without the core declaring anything again.
 
 - UAVCAN -> ROS: ``handler(msg, source_node_id, transfer_id, monotonic_s)`` for every transfer of a subscribed
-  port, from any source (the core filters sources and counts the gaps in transfer ids: ``transfer_id_modulo``).
-  Plain arguments, no object per transfer: this is the hot path.
-- ROS -> UAVCAN: ``await outlet.publish(obj)`` -> True when sent, False when not every frame was sent in time;
-  raises on a transport error (counted by the core), :class:`LinkDownError` when the port is not open.
+  port (``msg``: the deserialized message, or on a raw port its payload bytes), from any source (the core filters
+  sources and counts the gaps in transfer ids: ``transfer_id_modulo``). Plain arguments, no object per transfer:
+  this is the hot path.
+- ROS -> UAVCAN: ``await outlet.publish(obj)`` (on a raw port: the payload bytes) -> True when sent, False when not
+  every frame was sent in time; raises on a transport error (counted by the core), :class:`LinkDownError` when the
+  port is not open.
 - Device health: ``on_device_status(handler)``; the handler gets a :class:`DeviceStatus` for every heartbeat
   (Cyphal ``uavcan.node.Heartbeat``, DroneCAN ``uavcan.protocol.NodeStatus``) of any node. The core keeps the
   records, the offline timeouts and the restarts (``sam_runtime.bridge.health``).
@@ -91,6 +93,11 @@ class Inlet(abc.ABC):
     port_id: int | None  # the subject (Cyphal) or data type id (DroneCAN) it listens on; None before open
     below: BelowBridge
 
+    def malformed(self, src: int | None, detail: str) -> None:
+        """A payload of the wire path that the generated codec refused (what the protocol library's deserializer
+        refuses and counts on the object path): counted below the bridge like the library's own refusals."""
+        self.below.count("deserialization_failures", 1, True)
+
 
 class Outlet(abc.ABC):
     """An advertised port (handle)."""
@@ -122,12 +129,14 @@ class Backend(abc.ABC):
         """The transport, for logs and reports (``udp:127.0.0.1``)."""
 
     @abc.abstractmethod
-    def subscribe(self, name: str, port_id: int, dtype: Any, handler: TransferHandler) -> Inlet:
-        """Declare a subscription (before open): ``name`` for registers/reports, the spec's port id."""
+    def subscribe(self, name: str, port_id: int, dtype: Any, handler: TransferHandler, *, raw: bool = False
+                  ) -> Inlet:
+        """Declare a subscription (before open): ``name`` for registers/reports, the spec's port id. ``raw``: the
+        handler gets each transfer's payload bytes instead of a deserialized message (the wire path)."""
 
     @abc.abstractmethod
-    def advertise(self, name: str, port_id: int, dtype: Any) -> Outlet:
-        """Declare a publication (before open)."""
+    def advertise(self, name: str, port_id: int, dtype: Any, *, raw: bool = False) -> Outlet:
+        """Declare a publication (before open). ``raw``: ``publish`` takes the payload bytes (the wire path)."""
 
     @abc.abstractmethod
     def on_device_status(self, handler: Callable[[DeviceStatus], None]) -> None:

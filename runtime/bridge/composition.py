@@ -11,7 +11,7 @@ from typing import Any
 
 from sam_runtime.genpkg import GeneratedPackage
 
-from .backend import Backend
+from .backend import Backend, BridgeConfigError
 from .counters import DEFAULT_LOG_INTERVAL_S, MappingStats, RateLimitedLog, log
 from .cyphal_backend import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig, quiet_late_media_completions
 from .health import DeviceHealth
@@ -24,11 +24,12 @@ from .outbound import DEFAULT_QUEUE_SIZE, Outbound
 from .reporting import Reporter
 from .ros_side import RosSide
 from .silence import SilenceWatch
-from .wiring import check_destinations, in_groups, nominal_rates, out_mappings
+from .wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 
 __all__ = ["Bridge"]
 
 HOUSEKEEPING_PERIOD_S = 0.2
+WIRE_PATHS = ("codec", "object")
 
 
 class Bridge:
@@ -55,6 +56,10 @@ class Bridge:
         machine, ``socketcan:can0``, ``slcan:/dev/ttyACM0``).
     :param dronecan_services: the DroneCAN node duties of :mod:`.dronecan_duties` (GetNodeInfo and RestartNode of
         the devices as ROS services, Panic both ways; options ``time_sync`` and ``dna_server``).
+    :param wire: ``codec`` (default): the generated wire codecs, from the UAVCAN payload bytes straight to the ROS
+        message's CDR and back, with raw ROS publishers and subscriptions and the backend's transport-level ports;
+        ``object``: the object converters between the protocol library's message objects and ROS messages (the
+        readable reference; also taken, with a warning, when the generated package has no codecs).
     """
 
     def __init__(
@@ -75,7 +80,11 @@ class Bridge:
         protocol: str | None = None,
         dronecan_iface: str = "mcast-lo:",
         dronecan_options: Mapping[str, Any] | None = None,
+        wire: str = "codec",
     ) -> None:
+        if wire not in WIRE_PATHS:
+            raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
+        self.wire = wire
         self.gen = gen
         self.tables = tables = gen.tables()
         self.selection = sel = select(tables, layout, protocol)
@@ -125,18 +134,34 @@ class Bridge:
         else:
             quiet_late_media_completions(asyncio.get_running_loop())
             convert = self.gen.convert()  # compiles the DSDL first (before uavcan/pycyphal.application)
+        codec = self._codec()
         try:
-            self._assemble(convert)
+            self._assemble(convert, codec)
         except BaseException:
             await self.lifetime.close()
             raise
         await self.lifetime.start()
         assert self.inbound is not None and self.outbound is not None
-        log.info("%s started: %s node %d on %s, %d UAVCAN->ROS and %d ROS->UAVCAN mappings", self.name,
+        log.info("%s started: %s node %d on %s, %d UAVCAN->ROS and %d ROS->UAVCAN mappings, %s path", self.name,
                  self.backend.label, self.node_id, self.backend.describe(),
-                 sum(len(g.mappings) for g in self.inbound.groups.values()), len(self.outbound.mappings))
+                 sum(len(g.mappings) for g in self.inbound.groups.values()), len(self.outbound.mappings), self.wire)
 
-    def _assemble(self, convert: Any) -> None:
+    def _codec(self) -> Any:
+        """The generated wire codecs of this bridge's protocol, when the wire path is ``codec`` and they cover every
+        selected mapping; else None (the object path)."""
+        if self.wire != "codec":
+            return None
+        codec = self.gen.codec(self.selection.protocol)
+        missing = missing_codecs(codec, self.selection.mappings)
+        if missing:
+            log.warning("%s: the generated package has no wire codecs for %s (built by an older sam-codegen? run "
+                        "`sam-codegen build`): using the object converters", self.name,
+                        "any mapping" if codec is None else ", ".join(missing))
+            self.wire = "object"
+            return None
+        return codec
+
+    def _assemble(self, convert: Any, codec: Any = None) -> None:
         tables, lifetime, backend, health, link = self.tables, self.lifetime, self.backend, self.health, self.link
         sel = self.selection
         check_destinations(tables, sel.mappings, sel.device_infos)
@@ -146,9 +171,10 @@ class Bridge:
             return TransferLoss(port_id, rates, lambda: backend.transfer_id_modulo, health.uptime_of,
                                 lambda: link.outage_windows, self._forget_stamps)
 
-        self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss, sel.mappings),
-                                         self.ros, backend)
-        self.outbound = outbound = Outbound(lifetime, out_mappings(self.gen, convert, self.counters, sel.mappings),
+        self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss, sel.mappings,
+                                                             codec), self.ros, backend)
+        self.outbound = outbound = Outbound(lifetime, out_mappings(self.gen, convert, self.counters, sel.mappings,
+                                                                   codec),
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
                                             backend=backend)
         silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in sel.mappings

@@ -30,6 +30,7 @@ from sam_runtime.cyphal_ports import PortConfigError, register_environment, regi
 
 from .backend import Backend, BelowBridge, BridgeConfigError, DeviceStatus, Inlet, LinkDownError, Outlet
 from .counters import RateLimitedLog, log
+from .cyphal_wire import RawReceiver, RawSender
 
 __all__ = ["DEFAULT_RX_QUEUE_SIZE", "CyphalBackend", "TransportConfig", "quiet_late_media_completions"]
 
@@ -144,27 +145,46 @@ def _monotonic(transfer: Any) -> float:
 
 
 class _Subscription(Inlet):
-    def __init__(self, name: str, spec_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None]
-                 ) -> None:
-        self.name, self.spec_id, self.dtype, self.handler = name, spec_id, dtype, handler
+    def __init__(self, name: str, spec_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
+                 raw: bool = False) -> None:
+        self.name, self.spec_id, self.dtype, self.handler, self.raw = name, spec_id, dtype, handler, raw
         self.port_name = f"uavcan.sub.{name}"
         self.port_id: int | None = None
         self.below = BelowBridge()
-        self.subscriber: Any = None
+        self.subscriber: Any = None  # a pycyphal Subscriber, or on the wire path a RawReceiver
         self.seen: dict[str, int] = {}  # pycyphal's counters of the current subscriber already accumulated
+        self.rlog: RateLimitedLog | None = None
+
+    def malformed(self, src: int | None, detail: str) -> None:
+        super().malformed(src, detail)
+        if self.rlog is not None:
+            self.rlog.note((f"subject {self.spec_id}", "cyphal.deserialization_failures"), logging.WARNING,
+                           "a transfer from node %s does not deserialize: %s", src, detail)
+
+    def statistics(self) -> tuple[dict[str, int], Any]:
+        """pycyphal's counters of the current port (cumulative since it opened) and its transport session's
+        statistics."""
+        if self.raw:  # deserialization failures are counted as they happen (malformed)
+            ts = self.subscriber.statistics()
+            return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops}, ts
+        s = self.subscriber.sample_statistics()
+        ts = s.transport_session
+        return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
+                "deserialization_failures": s.deserialization_failures, "overruns": s.overruns}, ts
 
     def on_transfer(self, msg: Any, transfer: Any) -> None:
         self.handler(msg, transfer.source_node_id, transfer.transfer_id, _monotonic(transfer))
 
 
 class _Publication(Outlet):
-    def __init__(self, backend: CyphalBackend, name: str, spec_id: int, dtype: Any) -> None:
+    def __init__(self, backend: CyphalBackend, name: str, spec_id: int, dtype: Any, raw: bool = False) -> None:
         self._backend = backend
         self.name, self.spec_id, self.dtype = name, spec_id, dtype
         self.port_name = f"uavcan.pub.{name}"
         self.port_id: int | None = None
         self.send_timeout = SEND_TIMEOUT_S
-        self.publisher: Any = None
+        self.publisher: Any = None  # a pycyphal Publisher, or on the wire path a RawSender with its session open
+        self.raw_sender = RawSender() if raw else None
 
     @property
     def ready(self) -> bool:
@@ -177,6 +197,8 @@ class _Publication(Outlet):
         if pub is None:
             raise LinkDownError(self.port_name)
         try:
+            if pub is self.raw_sender:
+                return await pub.send(obj, self.send_timeout)
             return bool(await pub.publish(obj))
         except pycyphal.transport.ResourceClosedError as ex:
             if self.publisher is pub:  # not replaced by a reopened one meanwhile: the transport is gone
@@ -212,14 +234,15 @@ class CyphalBackend(Backend):
         return self.transport_config.describe()
 
     # -------------------------------------------------------------------------------------------- declarations
-    def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None]
-                  ) -> Inlet:
-        sub = _Subscription(name, port_id, dtype, handler)
+    def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
+                  *, raw: bool = False) -> Inlet:
+        sub = _Subscription(name, port_id, dtype, handler, raw)
+        sub.rlog = self._rlog
         self._subs.append(sub)
         return sub
 
-    def advertise(self, name: str, port_id: int, dtype: Any) -> Outlet:
-        pub = _Publication(self, name, port_id, dtype)
+    def advertise(self, name: str, port_id: int, dtype: Any, *, raw: bool = False) -> Outlet:
+        pub = _Publication(self, name, port_id, dtype, raw)
         self._pubs.append(pub)
         return pub
 
@@ -263,7 +286,7 @@ class CyphalBackend(Backend):
     async def open(self) -> None:
         """The Cyphal node and every port (at start and whenever the transport is reopened)."""
         try:
-            self._open()
+            self._open()  # (in the loop: the wire path's receive tasks start there)
         except PortConfigError as ex:
             raise BridgeConfigError(str(ex)) from None
 
@@ -287,17 +310,28 @@ class CyphalBackend(Backend):
             rxq = self.rx_queue_size if self.rx_queue_size > 0 else None
             for pub in self._pubs:
                 pub.port_id = resolve_subject(node.registry, "pub", pub.name, pub.dtype, pub.spec_id)
+                if pub.raw_sender is not None:
+                    pub.raw_sender.reopen(transport, pub.port_id, pub.dtype)
+                    pub.publisher = pub.raw_sender
+                    continue
                 p = node.presentation.make_publisher(pub.dtype, pub.port_id)
                 p.send_timeout = pub.send_timeout
                 pub.publisher = p
             for sub in self._subs:
                 sub.port_id = resolve_subject(node.registry, "sub", sub.name, sub.dtype, sub.spec_id)
-                sub.subscriber = node.presentation.make_subscriber(sub.dtype, sub.port_id, rxq)
                 sub.seen = {}
+                if sub.raw:
+                    sub.subscriber = RawReceiver(transport, sub.port_id, sub.dtype, sub.handler)
+                    continue
+                sub.subscriber = node.presentation.make_subscriber(sub.dtype, sub.port_id, rxq)
                 sub.subscriber.receive_in_background(sub.on_transfer)
             self._hb_sub = node.make_subscriber(uavcan.node.Heartbeat_1_0)
             self._hb_sub.receive_in_background(self._on_heartbeat)
         except BaseException:
+            for sub in self._subs:
+                if isinstance(sub.subscriber, RawReceiver):
+                    sub.subscriber.task.cancel()
+                    sub.subscriber = None
             node.close()
             raise
         self._node = node
@@ -308,14 +342,20 @@ class CyphalBackend(Backend):
         from sam_runtime.transport import aclose
 
         self.poll_statistics()
-        ports: list[Any] = [s.subscriber for s in self._subs] + [p.publisher for p in self._pubs] + [self._hb_sub]
+        receivers = [s.subscriber for s in self._subs if isinstance(s.subscriber, RawReceiver)]
+        ports: list[Any] = [s.subscriber for s in self._subs if not isinstance(s.subscriber, RawReceiver)]
+        ports += [p.publisher for p in self._pubs if not isinstance(p.publisher, RawSender)] + [self._hb_sub]
         for s in self._subs:
             s.subscriber = None
         for p in self._pubs:
+            if p.raw_sender is not None:
+                p.raw_sender.close()
             p.publisher = None
         self._hb_sub = None
         node, self._node = self._node, None
         try:
+            for receiver in receivers:
+                await receiver.close()
             await aclose(*[p for p in ports if p is not None])
             if node is not None:
                 await aclose(node)
@@ -347,12 +387,9 @@ class CyphalBackend(Backend):
                 if subscriber is None:
                     continue
                 try:
-                    s = subscriber.sample_statistics()
+                    now, ts = sub.statistics()
                 except Exception:  # closed meanwhile
                     continue
-                ts = s.transport_session
-                now = {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
-                       "deserialization_failures": s.deserialization_failures, "overruns": s.overruns}
                 kinds = _error_kinds(ts)
                 below = sub.below
                 for key, value in now.items():

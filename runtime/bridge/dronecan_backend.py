@@ -70,20 +70,35 @@ def _resolve(dtype: Any, port_id: int) -> Any:
 
 
 class _Subscription(Inlet):
-    def __init__(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None]
-                 ) -> None:
-        self.name, self.dtype, self.handler = name, dtype, handler
+    def __init__(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
+                 raw: bool = False) -> None:
+        self.name, self.dtype, self.handler, self.raw = name, dtype, handler, raw
         self.port_name = f"dronecan.sub.{name}"
         self.spec_id = port_id
         self.port_id: int | None = port_id
         self.below = BelowBridge()
         self.transfers = 0  # of the current node
         self.seen: dict[str, int] = {}  # what was accumulated into ``below`` of the current node
+        self.drops: Any = None  # the current node's DropCounter
 
     def on_event(self, event: Any) -> None:
         self.transfers += 1
         t = event.transfer
         self.handler(event.message, t.source_node_id, int(t.transfer_id), float(t.ts_monotonic))
+
+    def on_payload(self, payload: bytes, src: int, transfer_id: int, monotonic_s: float) -> None:
+        self.transfers += 1
+        self.handler(payload, src, transfer_id, monotonic_s)
+
+    def malformed(self, src: int | None, detail: str) -> None:
+        """Counted where dronecan's failures to unpack are (NodeLoop: ``malformed_payload``), so below the bridge
+        both paths report the same reason."""
+        from sam_runtime.dronecan_io import DropReason
+
+        if self.drops is None:
+            super().malformed(src, detail)
+            return
+        self.drops.add(DropReason.MALFORMED_PAYLOAD, data_type_id=self.port_id, source_node_id=src, detail=detail)
 
 
 class _Publication(Outlet):
@@ -94,6 +109,8 @@ class _Publication(Outlet):
         self.spec_id = port_id
         self.port_id: int | None = port_id
         self.send_timeout = 0.1  # the loopback driver's; a broadcast is sent (or raises) before it returns
+        self.raw = False
+        self.crc_base = 0  # the wire path: the data type's CRC seed, from dronecan's type at each open
 
     @property
     def ready(self) -> bool:
@@ -102,11 +119,16 @@ class _Publication(Outlet):
     async def publish(self, obj: Any) -> bool:
         from dronecan.driver.common import DriverError, TxQueueFullError
 
+        from sam_runtime.dronecan_io.wire import broadcast_payload
+
         node = self._backend.node
         if node is None:
             raise LinkDownError(self.port_name)
         try:
-            node.broadcast(obj)
+            if self.raw:
+                broadcast_payload(node, self.spec_id, self.crc_base, obj)
+            else:
+                node.broadcast(obj)
         except TxQueueFullError:
             raise  # the bus is full: counted by the core, the next one goes
         except DriverError as ex:
@@ -148,14 +170,15 @@ class DroneCanBackend(Backend):
         return f"dronecan:{self.iface}"
 
     # -------------------------------------------------------------------------------------------- declarations
-    def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None]
-                  ) -> Inlet:
-        sub = _Subscription(name, port_id, dtype, handler)
+    def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
+                  *, raw: bool = False) -> Inlet:
+        sub = _Subscription(name, port_id, dtype, handler, raw)
         self._subs.append(sub)
         return sub
 
-    def advertise(self, name: str, port_id: int, dtype: Any) -> Outlet:
+    def advertise(self, name: str, port_id: int, dtype: Any, *, raw: bool = False) -> Outlet:
         pub = _Publication(self, name, port_id, dtype)
+        pub.raw = raw
         self._pubs.append(pub)
         return pub
 
@@ -191,10 +214,11 @@ class DroneCanBackend(Backend):
 
         from sam_runtime.dronecan_io import IfaceError, NodeLoop
         from sam_runtime.dronecan_io import make_node as default_make_node
+        from sam_runtime.dronecan_io.wire import TransferTaps
 
         types = [(sub, _resolve(sub.dtype, sub.spec_id)) for sub in self._subs]
         for pub in self._pubs:
-            _resolve(pub.dtype, pub.spec_id)
+            pub.crc_base = int(_resolve(pub.dtype, pub.spec_id).base_crc)
         info = dronecan.uavcan.protocol.GetNodeInfo.Response()
         info.name = self.name[:80]
         try:
@@ -207,9 +231,14 @@ class DroneCanBackend(Backend):
             node.mode = dronecan.uavcan.protocol.NodeStatus().MODE_OPERATIONAL
             node.health = dronecan.uavcan.protocol.NodeStatus().HEALTH_OK
             loop = NodeLoop(node, logger=log)
+            taps = TransferTaps(loop.drops)
             for sub, t in types:
-                sub.transfers, sub.seen = 0, {}
-                loop.add_handler(t, sub.on_event)
+                sub.transfers, sub.seen, sub.drops = 0, {}, loop.drops
+                if sub.raw:
+                    taps.add(sub.spec_id, int(t.base_crc), sub.on_payload)
+                else:
+                    loop.add_handler(t, sub.on_event)
+            loop.gate.taps = taps
             loop.add_handler(dronecan.uavcan.protocol.NodeStatus, self._on_status)
             for hook in self._open_hooks:
                 hook(node, loop)

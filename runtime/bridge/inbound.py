@@ -14,6 +14,12 @@ Stamps: a device stamp of 0 (unknown) becomes the receive time; an empty frame i
 the previous one of the same source on the same mapping is published anyway, in arrival order, and counted as
 ``out_of_order``. A source that restarted (:meth:`Inbound.forget_stamps`) may have restarted its clock: its next
 stamp is compared with nothing.
+
+Two paths, one accounting: the object path gets the protocol library's message object and converts it with
+``<mapping>_to_ros`` into a ROS message; the wire path (``InMapping.raw``) gets the transfer's payload bytes and the
+generated codec (``<mapping>_wire_to_ros``) turns them straight into the ROS message's CDR, published raw. A payload
+the codec refuses (``ValueError``: what the protocol library's deserializer would have refused) is counted below the
+bridge by the inlet (``Inlet.malformed``) and goes no further, as the library's own refusals do on the object path.
 """
 
 from __future__ import annotations
@@ -44,6 +50,8 @@ class InMapping:
     # DroneCAN: whether a message is this mapping's (its `select` values, the broadcast-array elements it reads);
     # None: every message of the port from an accepted source is
     matches: Callable[[Any], bool] | None = None
+    # the wire path: to_ros / matches take payload bytes, to_ros returns (CDR bytes, header stamp ns or -1) or None
+    raw: bool = False
     last_stamp_ns: dict[int, int] = field(default_factory=dict)  # per source: stamp of the last published message
 
 
@@ -58,6 +66,11 @@ class PortGroup:
     loss: TransferLoss
     accepted_sources: frozenset[int] = frozenset()
     inlet: Inlet | None = None
+
+    @property
+    def raw(self) -> bool:
+        """Whether the port's transfers come as payload bytes (every mapping of a port takes the same path)."""
+        return any(im.raw for im in self.mappings)
 
 
 class Inbound:
@@ -82,7 +95,8 @@ class Inbound:
         for group in self.groups.values():
             for im in group.mappings:
                 im.ros_publisher = self._ros.publisher(im.info.topic, im.ros_cls)
-            group.inlet = self._backend.subscribe(group.port_name, group.port_id, group.dtype, self.handler(group))
+            group.inlet = self._backend.subscribe(group.port_name, group.port_id, group.dtype, self.handler(group),
+                                                  raw=group.raw)
 
     def group_of(self, mapping: str) -> PortGroup | None:
         return self._group_of.get(mapping)
@@ -110,70 +124,103 @@ class Inbound:
         group = self._group_of.get(mapping)
         return None if group is None else group.loss.last_message(nid)
 
+    def _takers(self, group: PortGroup, msg: Any, src: int) -> list[InMapping] | None:
+        """The mappings a transfer from the accepted source ``src`` is for (None: a payload the codec refuses,
+        counted below the bridge)."""
+        try:
+            return [im for im in group.mappings
+                    if src in im.info.source_node_ids and (im.matches is None or im.matches(msg))]
+        except ValueError as ex:  # only the wire path's matches parse bytes
+            if not group.raw:
+                raise
+            self._malformed(group, src, ex)
+            return None
+
+    def _malformed(self, group: PortGroup, src: int | None, ex: Exception) -> None:
+        if group.inlet is not None:
+            group.inlet.malformed(src, f"{type(ex).__name__}: {ex}")
+
     def _bridge_transfer(self, group: PortGroup, msg: Any, src: int | None, tid: int, now: float) -> None:
         rlog = self.lifetime.rlog
-        receive_ns: int | None = None
         known = src in group.accepted_sources
-        lost, lost_est = group.loss.track(src, tid, now) if known else (0, 0)
-        taken = False
-        for im in group.mappings:
-            st = im.stats
-            name = im.info.name
-            if src is None or src not in im.info.source_node_ids:
-                if known:
-                    continue  # another mapping's device on the shared port: that mapping counts it
-                st.receive()
-                st.drop("unknown_source")
-                rlog.note((name, "unknown_source"), logging.WARNING,
+        if not known:
+            for im in group.mappings:  # no mapping's device: each mapping of the port counts it
+                im.stats.receive()
+                im.stats.drop("unknown_source")
+                rlog.note((im.info.name, "unknown_source"), logging.WARNING,
                           "dropped a transfer from node %s (accepted: %s)", src, sorted(im.info.source_node_ids))
-                continue
-            if im.matches is not None and not im.matches(msg):
-                continue  # a broadcast for another mapping of the same device (another ESC index, actuator id)
-            taken = True
-            st.receive()
-            if lost:
-                st.drop("lost", lost)
-                rlog.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "
-                          "(transfer id gap before %d)", lost, src, tid, count=lost)
-            if lost_est:
-                st.drop("lost_link_down", lost_est)
-                rlog.note((name, "lost_link_down"), logging.WARNING, "about %d transfers from node %s missed "
-                          "while the link was down (estimated from the nominal rate)", lost_est, src, count=lost_est)
-            if receive_ns is None:
-                receive_ns = self._receive_ns()
+            return
+        assert src is not None
+        takers = self._takers(group, msg, src)
+        if takers is None:
+            return
+        receive_ns = self._receive_ns() if takers else 0
+        results: list[tuple[InMapping, Any, Exception | None]] = []
+        for im in takers:
             try:
-                ros_msg = im.to_ros(msg, receive_ns, st)
+                results.append((im, im.to_ros(msg, receive_ns, im.stats), None))
+            except ValueError as ex:
+                if not im.raw:
+                    results.append((im, None, ex))
+                    continue
+                self._malformed(group, src, ex)  # the whole payload is refused, before any counter moved
+                return
             except Exception as ex:
-                st.drop("convert_error")
-                rlog.note((name, "convert_error"), logging.ERROR, "conversion failed: %s: %s", type(ex).__name__, ex)
-                continue
-            if ros_msg is None:
-                st.drop("rejected")
-                continue
-            if im.has_header:
-                hdr = ros_msg.header
-                if not hdr.frame_id and im.info.frame_id:
-                    hdr.frame_id = im.info.frame_id
-                if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
-                    hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
-                stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec
-                last = im.last_stamp_ns.get(src)
-                im.last_stamp_ns[src] = stamp
-                if last is not None and stamp < last:  # published anyway, in arrival order (see the docstring)
-                    st.reorder()
-                    rlog.note((name, "out_of_order"), logging.WARNING,
-                              "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
-                              src, stamp * 1e-9, last * 1e-9)
-            try:
-                im.ros_publisher.publish(ros_msg)
-            except Exception as ex:
-                st.drop("publish_error")
-                rlog.note((name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s", type(ex).__name__, ex)
-                continue
-            st.publish()
-        if known and not taken:  # from an accepted device, but what no mapping selects: never a silent loss
+                results.append((im, None, ex))
+        lost, lost_est = group.loss.track(src, tid, now)
+        for im, out, error in results:
+            self._account(im, src, tid, lost, lost_est, receive_ns, out, error)
+        if not takers:  # from an accepted device, but what no mapping selects: never a silent loss
             im = next(im for im in group.mappings if src in im.info.source_node_ids)
             im.stats.receive()
             im.stats.drop("unselected")
             rlog.note((im.info.name, "unselected"), logging.WARNING, "node %s sent a message no mapping of port %d "
                       "selects (select / elements)", src, group.port_id)
+
+    def _account(self, im: InMapping, src: int, tid: int, lost: int, lost_est: int, receive_ns: int, out: Any,
+                 error: Exception | None) -> None:
+        """Count, check the stamp of and publish one mapping's conversion of one transfer."""
+        rlog, st, name = self.lifetime.rlog, im.stats, im.info.name
+        st.receive()
+        if lost:
+            st.drop("lost", lost)
+            rlog.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "
+                      "(transfer id gap before %d)", lost, src, tid, count=lost)
+        if lost_est:
+            st.drop("lost_link_down", lost_est)
+            rlog.note((name, "lost_link_down"), logging.WARNING, "about %d transfers from node %s missed "
+                      "while the link was down (estimated from the nominal rate)", lost_est, src, count=lost_est)
+        if error is not None:
+            st.drop("convert_error")
+            rlog.note((name, "convert_error"), logging.ERROR, "conversion failed: %s: %s", type(error).__name__,
+                      error)
+            return
+        if out is None:
+            st.drop("rejected")
+            return
+        if im.raw:
+            out, stamp = out  # the codec resolved the frame id and an unknown stamp already
+        elif im.has_header:
+            hdr = out.header
+            if not hdr.frame_id and im.info.frame_id:
+                hdr.frame_id = im.info.frame_id
+            if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
+                hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
+            stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec
+        else:
+            stamp = -1
+        if im.has_header and stamp >= 0:
+            last = im.last_stamp_ns.get(src)
+            im.last_stamp_ns[src] = stamp
+            if last is not None and stamp < last:  # published anyway, in arrival order (see the docstring)
+                st.reorder()
+                rlog.note((name, "out_of_order"), logging.WARNING,
+                          "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
+                          src, stamp * 1e-9, last * 1e-9)
+        try:
+            im.ros_publisher.publish(out)  # CDR bytes on the wire path: rclpy publishes them raw
+        except Exception as ex:
+            st.drop("publish_error")
+            rlog.note((name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s", type(ex).__name__, ex)
+            return
+        st.publish()

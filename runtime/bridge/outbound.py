@@ -1,6 +1,7 @@
 """The ROS -> UAVCAN path: a ROS message of a command topic, converted in the rclpy executor thread by each of the
-topic's mappings (``<mapping>_to_uavcan``), handed to the asyncio loop (:mod:`.handoff`), queued per mapping in a
-bounded queue, and published in order by one worker task per mapping on its backend port.
+topic's mappings (``<mapping>_to_uavcan``; on the wire path the generated codec, from the CDR bytes of a raw
+subscription to the payload bytes the backend sends as they are), handed to the asyncio loop (:mod:`.handoff`),
+queued per mapping in a bounded queue, and published in order by one worker task per mapping on its backend port.
 
 Every message that is not published is counted once per mapping: ``convert_error``, ``rejected``, ``queue_full``
 (the bounded queue), ``link_down`` (the backend's link is being reopened), ``publish_error`` (the send raised),
@@ -40,6 +41,8 @@ class OutMapping:
     outlet: Outlet | None = None
     queue: asyncio.Queue[Any] | None = None
     worker: asyncio.Task[None] | None = None
+    # the wire path: to_uavcan is the generated codec (CDR bytes of a raw subscription -> UAVCAN payload bytes)
+    raw: bool = False
 
 
 class Outbound:
@@ -70,10 +73,11 @@ class Outbound:
     def _start(self) -> None:
         if self._backend is not None:
             for om in self.mappings.values():
-                om.outlet = self._backend.advertise(om.info.name, port_id_of(om.info), om.dtype)
+                om.outlet = self._backend.advertise(om.info.name, port_id_of(om.info), om.dtype, raw=om.raw)
         if self._ros is not None:
             for oms in self.by_topic.values():
-                self._ros.subscribe(oms[0].info.topic, oms[0].ros_cls, lambda msg, oms=oms: self.on_ros(oms, msg))
+                self._ros.subscribe(oms[0].info.topic, oms[0].ros_cls, lambda msg, oms=oms: self.on_ros(oms, msg),
+                                    raw=all(om.raw for om in oms))
         self.handoff.loop = self.lifetime.loop
         for om in self.mappings.values():
             om.queue = asyncio.Queue(maxsize=self.queue_size)

@@ -161,10 +161,11 @@ class RosSide:
             pub = self._publishers[topic.name] = self.node.create_publisher(cls, topic.name, self.qos(topic))
         return pub
 
-    def subscribe(self, topic: Any, cls: Any, callback: Callable[[Any], None]) -> Any:
-        """A command subscription of ``topic``."""
+    def subscribe(self, topic: Any, cls: Any, callback: Callable[[Any], None], *, raw: bool = False) -> Any:
+        """A command subscription of ``topic``; ``raw``: the callback gets each message's CDR bytes (the wire
+        path: rclpy does not deserialize them)."""
         sub = self._subscriptions[topic.name] = self.node.create_subscription(
-            cls, topic.name, callback, self.qos(topic, command=True))
+            cls, topic.name, callback, self.qos(topic, command=True), raw=raw)
         return sub
 
     def matched(self, topic: str) -> int | None:

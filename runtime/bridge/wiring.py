@@ -17,7 +17,7 @@ from .layout import destinations_of, port_id_of
 from .loss import TransferLoss
 from .outbound import OutMapping
 
-__all__ = ["check_destinations", "find_converter", "in_groups", "nominal_rates", "out_mappings"]
+__all__ = ["check_destinations", "find_converter", "in_groups", "missing_codecs", "nominal_rates", "out_mappings"]
 
 
 def find_converter(convert: Any, m: Any, which: int) -> Callable[..., Any]:
@@ -75,13 +75,22 @@ def _dtype(gen: Any, m: Any) -> Any:
     return m.data_type.name if hasattr(m, "data_type") else gen.dsdl_class(m.port)
 
 
+def missing_codecs(codec: Any, mappings: Sequence[Any]) -> list[str]:
+    """The mappings the generated codec module has no codecs for (all of them when there is no module)."""
+    have = getattr(codec, "CODECS", {})
+    return [m.name for m in mappings if m.name not in have]
+
+
 def in_groups(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
-              make_loss: Callable[[int], TransferLoss], mappings: Sequence[Any] | None = None) -> list[PortGroup]:
-    """The UAVCAN -> ROS mappings, one group per port, in the tables' order."""
+              make_loss: Callable[[int], TransferLoss], mappings: Sequence[Any] | None = None, codec: Any = None
+              ) -> list[PortGroup]:
+    """The UAVCAN -> ROS mappings, one group per port, in the tables' order; with ``codec`` (the generated wire
+    codecs) on the wire path."""
     tables = gen.tables()
     mappings = tables.MAPPINGS if mappings is None else mappings
     names = subscription_names(mappings)
     matches = getattr(convert, "MATCHES", {})
+    wire_matches = getattr(codec, "WIRE_MATCHES", {})
     groups: dict[int, PortGroup] = {}
     for m in mappings:
         if m.direction not in ("uavcan_to_ros", "ros_to_uavcan"):
@@ -96,6 +105,11 @@ def in_groups(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
         elif group.dtype is not dtype and group.dtype != dtype:
             raise BridgeConfigError(f"port {pid} has two types: {group.dtype} and {dtype}")
         ros_cls = gen.ros_class(m.topic)
+        if codec is not None:
+            group.mappings.append(InMapping(m, codec.CODECS[m.name][0], counters[m.name], ros_cls,
+                                            has_header=_has_header(ros_cls), matches=wire_matches.get(m.name),
+                                            raw=True))
+            continue
         match = matches.get(m.name)
         group.mappings.append(InMapping(m, find_converter(convert, m, 0), counters[m.name], ros_cls,
                                         has_header=_has_header(ros_cls),
@@ -104,7 +118,9 @@ def in_groups(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
 
 
 def out_mappings(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
-                 mappings: Sequence[Any] | None = None) -> list[OutMapping]:
-    """The ROS -> UAVCAN mappings, in the tables' order."""
-    return [OutMapping(m, find_converter(convert, m, 1), counters[m.name], gen.ros_class(m.topic), _dtype(gen, m))
+                 mappings: Sequence[Any] | None = None, codec: Any = None) -> list[OutMapping]:
+    """The ROS -> UAVCAN mappings, in the tables' order; with ``codec`` (the generated wire codecs) on the wire
+    path."""
+    return [OutMapping(m, codec.CODECS[m.name][1] if codec is not None else find_converter(convert, m, 1),
+                       counters[m.name], gen.ros_class(m.topic), _dtype(gen, m), raw=codec is not None)
             for m in (gen.tables().MAPPINGS if mappings is None else mappings) if m.direction == "ros_to_uavcan"]

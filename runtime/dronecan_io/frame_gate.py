@@ -10,6 +10,8 @@ raise a toggle error. :class:`FrameGate` sits between the CAN driver and the nod
 - the frames of a multi-frame v0 transfer are held until its last frame arrives and then passed on together, so
   dronecan never holds a partial transfer; one that does not end within ``transfer_timeout`` (or is restarted by a
   new first frame with the same CAN id and transfer id) is counted as ``incomplete_transfer``;
+- completed transfers of the data types in :attr:`taps` (the bridge's wire path, :mod:`.wire`) go to their
+  handlers as payload bytes instead of to the node;
 - :meth:`limit_batch` bounds how many frames one ``node.spin(0)`` takes, so an event loop stays responsive under a
   flood, and :attr:`last_frame` tells which frame a ``spin()`` exception came from.
 
@@ -28,6 +30,7 @@ from dronecan.driver.common import AbstractDriver, CANFrame
 
 from .can_id import Tail, V0Id
 from .drops import DropCounter, DropReason
+from .wire import TransferTaps
 
 __all__ = ["FrameGate"]
 
@@ -67,6 +70,8 @@ class FrameGate(AbstractDriver):
         self.last_frame: CANFrame | None = None
         # The last receive() found the driver empty (not just a batch limit): held transfers are really waiting.
         self.drained = False
+        # The wire path: completed transfers of the tapped data types go to their handlers, not to dronecan.
+        self.taps: TransferTaps | None = None
 
     def __repr__(self) -> str:
         return f"FrameGate({self.inner!r})"
@@ -153,7 +158,7 @@ class FrameGate(AbstractDriver):
             if key in self._partial:
                 self._drop_partial(key, "restarted by a new first frame")
             if tail.end:
-                return frame
+                return None if self.taps is not None and self.taps.take([frame]) else frame
             if len(self._partial) >= self._max_partial:
                 self._drop_partial(next(iter(self._partial)), "too many unfinished transfers")
             self._partial[key] = _Partial([frame], now)
@@ -164,6 +169,8 @@ class FrameGate(AbstractDriver):
             partial.last_seen = now
             if tail.end:
                 del self._partial[key]
+                if self.taps is not None and self.taps.take(partial.frames):
+                    return None
                 self._ready.extend(partial.frames[1:])
                 return partial.frames[0]
             if len(partial.frames) > MAX_FRAMES_PER_TRANSFER:

@@ -3,6 +3,7 @@
 
 python can_scenario.py --iface virtual:bus1 --mtu 8 --rate-scale 0.25 --duration 4 --out OUT.json
     [--bridge-env]   (configure the bridge through UAVCAN__CAN__IFACE / UAVCAN__CAN__MTU instead of arguments)
+    [--wire object]  (the bridge's object converters instead of the generated wire codecs)
 Writes OUT.json: counts, the bridge's stats, the sim's report, sent/received value pairs, parameter checks.
 """
 
@@ -95,7 +96,7 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
         tcfg = TransportConfig("env", environ=env)
     else:
         tcfg = TransportConfig("can", args.iface, args.mtu)
-    bridge = Bridge(gen, transport=tcfg)
+    bridge = Bridge(gen, transport=tcfg, wire=args.wire)
     await bridge.start()
     record = Path(args.out).with_suffix(".sim.jsonl")
     sim = Simulator(gen, SimConfig("can", args.iface, args.mtu, rate_scale=args.rate_scale, record=record))
@@ -104,7 +105,8 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
     in_topics = sorted({m.topic.name for m in in_maps})
     out_topics = sorted({m.topic.name for m in tables.MAPPINGS if m.direction == "ros_to_uavcan"})
     probe = Probe(gen, in_topics, out_topics)
-    result: dict[str, Any] = {"iface": args.iface, "mtu": args.mtu, "rate_scale": args.rate_scale}
+    result: dict[str, Any] = {"iface": args.iface, "mtu": args.mtu, "rate_scale": args.rate_scale,
+                              "wire": bridge.wire}
     rogue = None
     try:
         # Discovery both ways, polled: the probe sees the bridge's publishers and the bridge sees the probe.
@@ -194,6 +196,7 @@ if __name__ == "__main__":
     p.add_argument("--duration", type=float, default=3.0)
     p.add_argument("--commands", type=int, default=20)
     p.add_argument("--bridge-env", action="store_true")
+    p.add_argument("--wire", choices=("codec", "object"), default="codec")
     p.add_argument("--out", type=Path, required=True)
     a = p.parse_args()
     res = asyncio.run(main(a))
