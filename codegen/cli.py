@@ -92,6 +92,9 @@ def _cmd_ros_install(args: argparse.Namespace) -> int:
         print(f"sam-codegen: {exc}", file=sys.stderr)
         return 1
     if not packages:
+        if any(ros_dir.glob("*/package.xml")):  # the spec's ROS side uses upstream messages only
+            print(f"sam-codegen: the ROS packages under {ros_dir} define no messages: nothing to build")
+            return 0
         print(f"sam-codegen: no ROS package under {ros_dir}; run `sam-codegen build` first", file=sys.stderr)
         return 1
     prefix = Path(args.prefix or sys.prefix).absolute()

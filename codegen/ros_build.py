@@ -221,15 +221,22 @@ def package_dependencies(package_dir: Path) -> tuple[str, set[str]]:
     return name, deps - {"", name}
 
 
+def has_interfaces(package_dir: Path) -> bool:
+    """Whether a package folder defines any interface (msg, srv or action file): rosidl refuses to build a package
+    without one, and a spec whose ROS side uses upstream messages only generates its own package empty."""
+    return any(any((Path(package_dir) / kind).glob(f"*.{kind}")) for kind in ("msg", "srv", "action"))
+
+
 def ros_packages_in_order(ros_dir: Path) -> list[Path]:
-    """The package folders under ``ros_dir`` (each holding a package.xml), every package after the ones of the same
-    folder it depends on; otherwise by name. Raises RosBuildError on a dependency cycle or a repeated name."""
+    """The package folders under ``ros_dir`` (each holding a package.xml and at least one interface: an empty one has
+    nothing to build), every package after the ones of the same folder it depends on; otherwise by name. Raises
+    RosBuildError on a dependency cycle or a repeated name."""
     ros_dir = Path(ros_dir)
     if not ros_dir.is_dir():
         return []
     folders: dict[str, Path] = {}
     needs: dict[str, set[str]] = {}
-    for folder in sorted(p for p in ros_dir.iterdir() if (p / "package.xml").is_file()):
+    for folder in sorted(p for p in ros_dir.iterdir() if (p / "package.xml").is_file() and has_interfaces(p)):
         name, deps = package_dependencies(folder)
         if name in folders:
             raise RosBuildError(f"two packages named {name} under {ros_dir}: {folders[name].name}, {folder.name}")

@@ -21,7 +21,13 @@ from pathlib import Path
 import jinja2
 import pytest
 
-from sam_codegen.ros_build import RosBuildError, build_ros_package, is_installed, ros_runtime_env
+from sam_codegen.ros_build import (
+    RosBuildError,
+    build_ros_package,
+    is_installed,
+    ros_packages_in_order,
+    ros_runtime_env,
+)
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "templates" / "ros"
 PKG = "samtest_msgs"
@@ -292,3 +298,23 @@ def test_broken_msg_raises_ros_build_error(tmp_path: Path) -> None:
     assert "configure failed" in text
     assert "float33" in text
     assert not is_installed("samtest_broken_msgs", tmp_path / "install")
+
+
+def test_a_package_without_messages_is_not_built(tmp_path: Path) -> None:
+    """A spec whose ROS side uses upstream messages only (the ferry) generates its own package empty: rosidl would
+    refuse it ("called without any interface files"), so ros-install leaves it out and says so."""
+    from sam_codegen.cli import main
+    from sam_codegen.emit_ros import emit
+    from sam_codegen.ros_build import has_interfaces
+    from sam_codegen.spec_loader import load_spec_file
+    from sam_codegen.validate import validate
+
+    resolved = validate(load_spec_file(Path(__file__).parent / "specs" / "ferry.yaml"))
+    assert not resolved.messages
+    for rel, text in emit(resolved).items():
+        (tmp_path / "generated" / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / "generated" / rel).write_text(text)
+    own = tmp_path / "generated" / "ros" / resolved.spec.ros.name
+    assert (own / "package.xml").is_file() and not has_interfaces(own)
+    assert ros_packages_in_order(tmp_path / "generated" / "ros") == []  # (the ferry needs no other package either)
+    assert main(["ros-install", "--out", str(tmp_path / "generated")]) == 0  # says so; no CMake run
