@@ -255,6 +255,13 @@ def _add_layout_args(p: argparse.ArgumentParser) -> None:
                         "slcan:DEVICE (default mcast-lo:)")
 
 
+def _add_wire_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--wire", choices=("codec", "object"), default="codec",
+                   help="the bridge's path: codec (default), the generated wire codecs from UAVCAN payload bytes to "
+                        "ROS CDR and back; object, the object converters (the protocol library's messages <-> ROS "
+                        "messages)")
+
+
 def _bridge_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="sam-bridge", description="The UAVCAN (Cyphal) <-> ROS 2 bridge of the spec.")
     _add_generated_args(p)
@@ -281,9 +288,7 @@ def _bridge_parser() -> argparse.ArgumentParser:
                    help="DroneCAN: be the bus's GlobalTimeSync master (1 Hz)")
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
-    p.add_argument("--wire", choices=("codec", "object"), default="codec",
-                   help="codec (default): the generated wire codecs, UAVCAN payload bytes <-> ROS CDR; object: the "
-                        "object converters (the protocol library's messages <-> ROS messages)")
+    _add_wire_arg(p)
     p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
     return p
 
@@ -552,6 +557,7 @@ def _run_parser() -> argparse.ArgumentParser:
                            "else $SAM_GENERATED_DIR, else generated/ of the project the working directory is in)")
     p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface of sim and bridge (default 127.0.0.1)")
     _add_layout_args(p)
+    _add_wire_arg(p)
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until Ctrl-C)")
     p.add_argument("--no-build", action="store_true", help="use generated/ as it is")
     p.add_argument("--no-demo-commands", dest="demo_commands", action="store_false",
@@ -607,6 +613,7 @@ def run_main(argv: Sequence[str] | None = None) -> int:
         window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
         argv=list(sys.argv[1:] if argv is None else argv), nodes=args.nodes, node_args=node_args,
         sim_args=sim_args, truth_file=args.truth_file, layout=args.layout, dronecan_iface=args.dronecan_iface,
+        wire=args.wire,
     ))
 
 

@@ -71,6 +71,7 @@ class RunOptions:
     truth_file: Path | None = None  # the sim's truth file (default: truth.json in the log folder)
     layout: str | None = None  # the spec's layout (which firmware each device runs); a mixed one: two bridges
     dronecan_iface: str = "mcast-lo:"
+    wire: str = "codec"  # the bridges' path: the generated wire codecs, or "object" (the object converters)
 
 
 # ============================================================================================ formatting
@@ -459,8 +460,8 @@ def run(opts: RunOptions) -> int:
         protocols = protocols_in_use(tables, layout)
         for proto in protocols if len(protocols) > 1 else [None]:
             name = "bridge" if proto is None else f"bridge_{proto}"
-            children.append(_Child(name, [*py, "bridge", *common, *(["--protocol", proto] if proto else [])], env,
-                                   log_dir / f"{name}.log"))
+            children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire,
+                                          *(["--protocol", proto] if proto else [])], env, log_dir / f"{name}.log"))
         if hosted:
             gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
             children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
