@@ -153,20 +153,19 @@ class _Subscription(Inlet):
         self.below = BelowBridge()
         self.subscriber: Any = None  # a pycyphal Subscriber, or on the wire path a RawReceiver
         self.seen: dict[str, int] = {}  # pycyphal's counters of the current subscriber already accumulated
-        self.rlog: RateLimitedLog | None = None
+        self.refused = 0  # the wire path: payloads the codec refused since the port opened
 
     def malformed(self, src: int | None, detail: str) -> None:
-        super().malformed(src, detail)
-        if self.rlog is not None:
-            self.rlog.note((f"subject {self.spec_id}", "cyphal.deserialization_failures"), logging.WARNING,
-                           "a transfer from node %s does not deserialize: %s", src, detail)
+        # Reported like pycyphal's deserialization_failures of a presentation-layer port (poll_statistics).
+        self.refused += 1
 
     def statistics(self) -> tuple[dict[str, int], Any]:
         """pycyphal's counters of the current port (cumulative since it opened) and its transport session's
         statistics."""
-        if self.raw:  # deserialization failures are counted as they happen (malformed)
+        if self.raw:
             ts = self.subscriber.statistics()
-            return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops}, ts
+            return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
+                    "deserialization_failures": self.refused, "overruns": 0}, ts
         s = self.subscriber.sample_statistics()
         ts = s.transport_session
         return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
@@ -237,7 +236,6 @@ class CyphalBackend(Backend):
     def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
                   *, raw: bool = False) -> Inlet:
         sub = _Subscription(name, port_id, dtype, handler, raw)
-        sub.rlog = self._rlog
         self._subs.append(sub)
         return sub
 
@@ -319,7 +317,7 @@ class CyphalBackend(Backend):
                 pub.publisher = p
             for sub in self._subs:
                 sub.port_id = resolve_subject(node.registry, "sub", sub.name, sub.dtype, sub.spec_id)
-                sub.seen = {}
+                sub.seen, sub.refused = {}, 0
                 if sub.raw:
                     sub.subscriber = RawReceiver(transport, sub.port_id, sub.dtype, sub.handler)
                     continue
