@@ -1,9 +1,10 @@
 """Simulated devices: one node per device of the spec, with the spec's node id, in one asyncio loop.
 
 - Protocols: the layout (``SimConfig.layout``, one of the spec's ``layouts``; :func:`layout_protocols`) says which
-  firmware each device runs: a pycyphal node on ``kind``/``iface``, or a dronecan (UAVCAN v0) node on
-  ``dronecan_iface`` (:mod:`sam_runtime.sim_cyphal`, :mod:`sam_runtime.sim_dronecan`). The node, its ports, the messages' generic values and closing
-  are one small adapter per protocol; the schedule, physics, command policy, counters and faults are shared.
+  firmware each device runs: a pycyphal node on ``kind``/``iface`` (:mod:`sam_runtime.sim_cyphal`), or a dronecan
+  (UAVCAN v0) node on ``dronecan_iface`` (:mod:`sam_runtime.sim_dronecan`). The node, its ports, the messages'
+  generic values and closing are one small adapter per protocol; the schedule, physics, command policy, counters
+  and faults are shared.
 - Every published port runs at its nominal rate (``rate_hz`` of the spec, optionally scaled), on an
   absolute schedule (no drift; a late tick is published late, never twice).
 - Values (:mod:`sam_runtime.device_models`): generic in-range values for any DSDL type; where the type is
