@@ -198,6 +198,8 @@ def _package(folder: Path, name: str, *deps: str, tag: str = "depend") -> None:
     lines = "".join(f"  <{tag}>{d}</{tag}>\n" for d in deps)
     (folder / "package.xml").write_text(f'<?xml version="1.0"?>\n<package format="3">\n  <name>{name}</name>\n'
                                         f"{lines}</package>\n")
+    (folder / "msg").mkdir()
+    (folder / "msg" / "Thing.msg").write_text("int32 value\n")
 
 
 def test_ros_packages_are_built_in_dependency_order(tmp_path: Path) -> None:
@@ -207,6 +209,8 @@ def test_ros_packages_are_built_in_dependency_order(tmp_path: Path) -> None:
     _package(ros / "m_msgs", "m_msgs", "a_msgs", tag="exec_depend")
     _package(ros / "b_msgs", "b_msgs")
     (ros / "notes").mkdir()  # not a package
+    (ros / "empty_msgs").mkdir()  # a package without interfaces: nothing to build
+    (ros / "empty_msgs" / "package.xml").write_text((ros / "b_msgs" / "package.xml").read_text())
     assert [p.name for p in ros_packages_in_order(ros)] == ["b_msgs", "z_msgs", "a_msgs", "m_msgs"]
     assert ros_packages_in_order(tmp_path / "none") == []
     _package(ros / "y_msgs", "y_msgs", "m_msgs")
