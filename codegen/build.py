@@ -29,10 +29,20 @@ class OutputError(OutDirError):
 
 
 def emitters() -> list[Emitter]:
-    from . import emit_docs, emit_dsdl, emit_dsdl_v0, emit_nodes, emit_python, emit_python_v0, emit_ros
+    from . import (
+        emit_codec,
+        emit_codec_v0,
+        emit_docs,
+        emit_dsdl,
+        emit_dsdl_v0,
+        emit_nodes,
+        emit_python,
+        emit_python_v0,
+        emit_ros,
+    )
 
     return [emit_ros.emit, emit_dsdl.emit, emit_dsdl_v0.emit, emit_python.emit, emit_python_v0.emit, emit_nodes.emit,
-            emit_docs.emit]
+            emit_docs.emit, emit_codec.emit, emit_codec_v0.emit]
 
 
 # pydsdl reads about this many of the spec's types per call. Its namespace-wide passes are O(N^2) in the

@@ -37,9 +37,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
     for rm in resolved.dronecan_mappings:
         m = rm.mapping
         to_ros = m.direction == UAVCAN_TO_ROS
-        rows = _field_rows(rm)
-        rows[0:0] = [{"ros": None, "arrow": "", "uavcan": format_path(list(path)), "conversion": f"select {value}"}
-                     for path, _, value in rm.select]
+        rows = _field_rows(rm)  # select rows first
         mappings.append({
             "name": m.name, "to_ros": to_ros, "direction": "UAVCAN → ROS" if to_ros else "ROS → UAVCAN",
             "data_type": m.data_type, "topic": m.topic, "ros_type": rm.ros_message.full_name,

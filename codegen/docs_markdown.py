@@ -5,19 +5,20 @@ from __future__ import annotations
 from collections.abc import Hashable, Iterable
 from pathlib import Path
 
+from .conversion_plan import Constant, LinkPlan, ReceiveTime, lower_mapping
 from .emit_docs import (
     ROS_TO_UAVCAN,
     SVG_NAME,
     UAVCAN_TO_ROS,
     Graph,
     PortIndex,
-    describe_step,
+    describe_link,
     fmt_number,
     fmt_rate,
     mermaid_context,
 )
 from .emit_nodes import nodes_package, params_file
-from .mapping_rules import ResolvedMapping, Step, format_path
+from .mapping_rules import ResolvedMapping, format_path
 from .model import QOS_PROFILES, Node, Port, Qos, Spec
 from .validate import Resolved
 from .validate_nodes import (
@@ -65,30 +66,34 @@ def _range(minimum: float | None, maximum: float | None) -> str:
 
 
 def _field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
-    """The field table of a mapping: the header the bridge fills, then each link, constants and ignored fields."""
+    """The field table of a mapping, worded from its conversion plan in the mapping's direction: DroneCAN's select,
+    the header the bridge fills, then each link, the constants it sets and the ignored fields."""
     m = rm.mapping
-    rows: list[dict[str, object]] = []
-    arrow = "←" if m.direction == UAVCAN_TO_ROS else "→"
+    plan = lower_mapping(rm)
+    to_ros = m.direction == UAVCAN_TO_ROS
+    arrow = "←" if to_ros else "→"
+    rows: list[dict[str, object]] = [
+        {"ros": None, "arrow": "", "uavcan": format_path(list(fs.path)), "conversion": f"select {fs.op.value}"}
+        for fs in plan.uavcan_fields if isinstance(fs.op, Constant) and fs.op.select]
 
-    def step_row(step: Step) -> dict[str, object]:
-        return {"ros": step.ros, "arrow": arrow, "uavcan": step.uavcan or None,
-                "conversion": describe_step(step, m.direction, m.on_out_of_range)}
+    def link_row(link: LinkPlan) -> dict[str, object]:
+        return {"ros": link.step.ros, "arrow": arrow, "uavcan": link.step.uavcan or None,
+                "conversion": describe_link(link)}
 
-    steps = list(rm.steps)
-    if m.direction == UAVCAN_TO_ROS and rm.has_header:
-        stamp = next((s for s in steps if s.ros == "header.stamp"), None)
+    links = list(plan.to_ros if to_ros else plan.to_uavcan)
+    if to_ros and rm.has_header:
+        stamp = next((link for link in links if link.step.ros == "header.stamp"), None)
         if stamp is not None:
-            steps.remove(stamp)
-            rows.append(step_row(stamp))
-        else:
-            rows.append({"ros": "header.stamp", "arrow": arrow, "uavcan": None, "conversion": "receive time"})
-        if m.frame_id is not None:
-            rows.append({"ros": "header.frame_id", "arrow": arrow, "uavcan": None,
-                         "conversion": f"constant {m.frame_id}"})
-    rows.extend(step_row(step) for step in steps)
-    for path, _, value in rm.uavcan_values:
-        rows.append({"ros": None, "arrow": arrow, "uavcan": format_path(list(path)),
-                     "conversion": f"constant {fmt_number(value)}"})
+            links.remove(stamp)
+            rows.append(link_row(stamp))
+        for fs in plan.ros_fields:  # the receive-time stamp (when no link sets it), the frame id
+            text = "receive time" if isinstance(fs.op, ReceiveTime) else f"constant {fs.op.value}"
+            rows.append({"ros": format_path(list(fs.path)), "arrow": arrow, "uavcan": None, "conversion": text})
+    rows.extend(link_row(link) for link in links)
+    for fs in plan.uavcan_fields:
+        if isinstance(fs.op, Constant) and not fs.op.select:
+            rows.append({"ros": None, "arrow": arrow, "uavcan": format_path(list(fs.path)),
+                         "conversion": f"constant {fmt_number(fs.op.value)}"})
     for ignored in m.ignore:
         rows.append({"ros": None, "arrow": "", "uavcan": ignored, "conversion": "ignored"})
     return rows
@@ -256,11 +261,6 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
             "topic": m.topic,
             "ros_type": topic.type if topic is not None else "",
             "nodes": nodes,
-        "nodes_package": nodes_package(spec),
-        "params_file": params_file(spec),
-        "qos_profiles": [{"name": name, "text": Qos(q.reliability, q.durability, q.depth).describe()}
-                         for name, q in QOS_PROFILES.items()],
-        "external_packages": sorted({m.package for m in spec.external_messages.values()}),
             "nodes_note": nodes_note,
             "frame_id": m.frame_id,
             "rate": fmt_rate(rm.rate_hz) if rm is not None else "",

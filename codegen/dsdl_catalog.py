@@ -55,16 +55,14 @@ def from_pydsdl(data_type: pydsdl.Any) -> DsdlType:
 
 def _to_struct(composite: pydsdl.CompositeType) -> DsdlStruct:
     name = f"{composite.full_name}.{composite.version.major}.{composite.version.minor}"
-    fields = [
-        Field(f.name, from_pydsdl(f.data_type), f.doc or "")
-        for f in composite.fields
-        if not isinstance(f, pydsdl.PaddingField)
-    ]
+    layout = [Field(f.name, from_pydsdl(f.data_type), f.doc or "") for f in composite.fields]
+    fields = [f for f in layout if f.name]  # void padding has no name
     constants = [Constant(c.name, from_pydsdl(c.data_type), c.value.native_value, c.doc or "")
                  for c in composite.constants]
     sealed = not isinstance(composite, pydsdl.DelimitedType)
     return DsdlStruct(name, fields, constants, composite.doc or "", sealed, None if sealed else composite.extent // 8,
-                      standard=True, union=isinstance(composite.inner_type, pydsdl.UnionType))
+                      standard=True, union=isinstance(composite.inner_type, pydsdl.UnionType),
+                      layout=layout if len(fields) < len(layout) else [])
 
 
 class DsdlCatalog:

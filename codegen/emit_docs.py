@@ -19,6 +19,26 @@ import re
 from dataclasses import dataclass, field
 from decimal import Decimal
 
+from .conversion_plan import (
+    TO_ROS,
+    TO_UAVCAN,
+    Clamp,
+    Constant,
+    Convert,
+    DecodeUtf8,
+    FixedLength,
+    Limits,
+    LinkPlan,
+    MaxLength,
+    Offset,
+    Pad,
+    Scale,
+    Table,
+    TimestampFromRos,
+    TimestampToRos,
+    Utf8Length,
+    lower_link,
+)
 from .mapping_rules import Step
 from .model import Device, Mapping, Scalar, Spec
 from .templating import render
@@ -85,97 +105,80 @@ def fmt_rate(rate: float) -> str:
     return f"{int(rate) if float(rate).is_integer() else rate} Hz"
 
 
-def _bits(type_name: str) -> int:
-    match = re.search(r"(\d+)$", type_name)
-    return int(match[1]) if match else 0
-
-
-def _is_int(type_name: str) -> bool:
-    return bool(re.match(r"^u?int\d+$", type_name)) or type_name in ("byte", "char")
-
-
-def _is_float(type_name: str) -> bool:
-    return type_name.startswith("float")
-
-
-def _width_change(src: str, dst: str) -> str:
-    """'widened', 'narrowed' or '' for a scalar going from type src to type dst."""
-    if src == dst:
-        return ""
-    if _is_int(src) and _is_float(dst):
-        return "as float"
-    if _is_float(src) and _is_int(dst):
-        return "rounded"
-    if _bits(dst) > _bits(src):
-        return "widened"
-    if _bits(dst) < _bits(src):
-        return "narrowed"
-    return ""
-
-
-def _transform(step: Step, direction: str) -> str:
+def _arithmetic(op: Scale | Offset) -> str:
     """Scale and offset as the bridge applies them: ros = uavcan × scale + offset, and the inverse."""
-    if direction == UAVCAN_TO_ROS:
-        parts = [f"× {fmt_number(step.scale)}"] if step.scale is not None else []
-        if step.offset is not None:
-            parts.append(("- " if step.offset < 0 else "+ ") + fmt_number(abs(step.offset)))
-        return " ".join(parts)
-    parts = [("+ " if step.offset < 0 else "- ") + fmt_number(abs(step.offset))] if step.offset is not None else []
-    if step.scale is not None:
-        parts.append(f"÷ {fmt_number(step.scale)}")
-    return ", then ".join(parts)
+    if isinstance(op, Scale):
+        return f"{'÷' if op.inverse else '×'} {fmt_number(op.factor)}"
+    subtract = (op.amount < 0) != op.inverse
+    return ("- " if subtract else "+ ") + fmt_number(abs(op.amount))
 
 
-def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
-    """The conversion of one field link in words, in the direction the bridge runs it.
+def _policy(link: LinkPlan, saturated: str) -> str:
+    return "rejected" if link.reject else saturated
 
-    Out-of-range handling (narrowing, rounding, lengths) follows the mapping's on_out_of_range.
-    """
-    if step.kind == "value":
-        return f"constant {fmt_number(step.value)}"
+
+def describe_link(link: LinkPlan) -> str:
+    """The conversion of one field link in words, from its planned operations (conversion_plan), in the
+    direction the bridge runs it. Out-of-range handling follows the mapping's on_out_of_range."""
+    step, ops, to_ros = link.step, link.ops, link.to_ros
+    first = ops[0] if ops else None
+    if isinstance(first, Constant):
+        return f"constant {fmt_number(first.value)}"
     ros = step.ros_type
     uav = step.uavcan_type
     assert uav is not None
-    to_ros = direction == UAVCAN_TO_ROS
-    saturate = on_out_of_range == "saturate"
-    if step.kind == "time":
-        return f"usec → {ros.base} (0 = receive time)" if to_ros else f"{ros.base} → usec"
+    if isinstance(first, TimestampToRos):
+        return f"usec → {ros.base} (0 = receive time)"
+    if isinstance(first, TimestampFromRos):
+        return f"{ros.base} → usec"
     src, dst = (str(uav), str(ros)) if to_ros else (str(ros), str(uav))
-    if step.kind == "string":
-        note = "invalid UTF-8 replaced" if to_ros else \
-            f"longer than {uav.capacity} bytes {'cut' if saturate else 'rejected'}"
-        return f"{src} → {dst} ({note})"
+    if isinstance(first, DecodeUtf8):
+        return f"{src} → {dst} (invalid UTF-8 replaced)"
+    cut = link.first(Utf8Length)
+    if isinstance(cut, Utf8Length):
+        return f"{src} → {dst} (longer than {cut.capacity} bytes {_policy(link, 'cut')})"
     src_elem, dst_elem = (uav.base_name, ros.base) if to_ros else (ros.base, uav.base_name)
     text = f"{src} → {dst}" if step.kind == "array" else f"{src_elem} → {dst_elem}"
     notes: list[str] = []
-    if step.kind == "table":
-        pairs = ", ".join(f"{k}: {v}" for k, v in step.table)
-        if to_ros and step.table_default is not None:  # the inverse rejects what has no key
-            pairs += f", default: {step.table_default}"
-        text += f" table {{{pairs}}}" if to_ros else f" inverse of table {{{pairs}}}"
+    if isinstance(first, Table):
+        pairs = ", ".join(f"{k}: {v}" for k, v in first.pairs)
+        if first.default is not None:  # the inverse rejects what has no key
+            pairs += f", default: {first.default}"
+        text += f" inverse of table {{{pairs}}}" if first.inverse else f" table {{{pairs}}}"
         if not step.exact:
             notes.append("not one to one")
         return text + (f" ({', '.join(notes)})" if notes else "")
-    transform = _transform(step, direction)
-    limits = "" if step.limits is None else f" limits [{fmt_number(step.limits[0])}, {fmt_number(step.limits[1])}]"
-    if transform and limits and not to_ros:  # limits are in ROS units: they come first
-        text += limits + " " + transform
-    else:
-        text += (" " + transform if transform else "") + limits
-    change = _width_change(src_elem, dst_elem)
-    if change in ("narrowed", "rounded"):
-        notes.append(change + (", saturating" if saturate else ", out of range rejected"))
-    elif change and not transform:
+    arithmetic: list[str] = []
+    for op in [*ops, None]:
+        if isinstance(op, (Scale, Offset)):
+            arithmetic.append(_arithmetic(op))
+            continue
+        if arithmetic:  # a run of scale / offset: "× s + o" to ROS, "- o, then ÷ s" to UAVCAN
+            text += " " + (" " if to_ros else ", then ").join(arithmetic)
+            arithmetic = []
+        if isinstance(op, Limits):  # in ROS units, before the inverse scale / offset
+            text += f" limits [{fmt_number(op.declared[0])}, {fmt_number(op.declared[1])}]"
+    convert = link.first(Convert)
+    change = convert.change if isinstance(convert, Convert) else ""
+    if change in ("narrowed", "rounded") or (change and not link.has(Scale, Offset)):
         notes.append(change)
-    if step.kind == "array":
-        cap = uav.capacity or 0
-        if to_ros and uav.array == "bounded" and ros.array == "fixed":
-            notes.append(f"padded to {ros.capacity}")
-        elif not to_ros and uav.array == "fixed" and ros.array != "fixed":
-            notes.append(f"other lengths {'padded or cut' if saturate else 'rejected'}")
-        elif not to_ros and uav.array == "bounded" and (ros.array != "fixed" or (ros.capacity or 0) > cap):
-            notes.append(f"over {cap} elements {'cut' if saturate else 'rejected'}")
+    if link.has(Limits, Clamp):  # values beyond the limits or the target's range
+        policy = "out of range rejected" if link.reject else "saturating"
+        notes = [f"{notes[0]}, {policy}"] if notes else [policy]
+    for op in ops:
+        if isinstance(op, Pad):
+            notes.append(f"padded to {op.size}")
+        elif isinstance(op, FixedLength):
+            notes.append(f"other lengths {_policy(link, 'padded or cut')}")
+        elif isinstance(op, MaxLength):
+            notes.append(f"over {op.capacity} elements {_policy(link, 'cut')}")
     return text + (f" ({', '.join(notes)})" if notes else "")
+
+
+def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
+    """The conversion of one field link in words, in the direction the bridge runs it (its plan, described)."""
+    plan_direction = TO_ROS if direction == UAVCAN_TO_ROS else TO_UAVCAN
+    return describe_link(lower_link(step, plan_direction, "", on_out_of_range == "reject"))
 
 
 # ---- the graph (shared by the Mermaid block and the SVG) -----------------------------------------------
@@ -378,4 +381,4 @@ def emit(resolved: Resolved) -> dict[str, str]:
     }
 
 
-__all__ = ["MD_PATH", "SVG_PATH", "describe_step", "emit", "fmt_number"]
+__all__ = ["MD_PATH", "SVG_PATH", "describe_link", "describe_step", "emit", "fmt_number"]

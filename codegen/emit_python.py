@@ -7,264 +7,108 @@ Output, under generated/:
 - ``python/<vehicle>_bridge/convert.py``: per mapping ``<name>_to_ros(src, receive_ns, stats)`` and
   ``<name>_to_uavcan(src, stats)``, straight-line code with every range decided here, at generation time.
 
-This module decides *what* each converter does (names, literals, which checks a value needs); the templates in
-templates/python/ decide how the files look. Everything is deterministic: no timestamps, no absolute paths,
-and every text from the spec reaches the output as a Python literal (repr).
+What each converter does to each value is decided once, in the conversion plan (conversion_plan.lower_mapping);
+this module renders the plan's operations as Python (through python_statements: names, literals, statements) and
+the templates in templates/python/ decide how the files look. Everything is deterministic: no timestamps, no
+absolute paths, and every text from the spec reaches the output as a Python literal (repr).
 """
 
 from __future__ import annotations
 
-import builtins
-import keyword
-import math
-import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from . import emit_nodes  # the tables' QoS, transforms and nodes
-from .filters import natural_key, py_str
+from . import python_statements as pys
+from .conversion_plan import (  # the constants stay importable from here (tests use them)
+    CHECK_OPS,
+    FLOAT16_MAX,
+    FLOAT32_MAX,
+    INT32_MAX,
+    TIME_US_MAX_FROM_ROS,
+    TIME_US_MAX_TO_ROS,
+    TIME_US_MIN,
+    TO_ROS,
+    TO_UAVCAN,
+    Clamp,
+    Constant,
+    DecodeUtf8,
+    EncodeUtf8,
+    FixedLength,
+    LinkPlan,
+    MaxLength,
+    Offset,
+    Pad,
+    ReceiveTime,
+    Scale,
+    StaticFrameId,
+    Table,
+    TimestampFromRos,
+    TimestampToRos,
+    Utf8Length,
+    dsdl_range,
+    is_int_dsdl,
+    lower_link,
+    lower_mapping,
+    range_ops,
+    ros_range,
+    ros_value,
+)
 from .mapping_rules import ResolvedMapping, Step, format_path
-from .model import DsdlStruct, Port, RosMessage, Scalar
+from .model import DsdlStruct, RosMessage
+from .python_factories import (
+    _dsdl_factory,
+    _ros_factory,
+    dsdl_factory_name,
+    dsdl_factory_supported,
+    ros_factory_name,
+)
+from .python_names import (
+    LINE_LIMIT,
+    _access,
+    _identifier,
+    _isort_key,
+    _Names,
+    _referenced_roots,
+    _ros_aliases,
+    dict_literal,
+    py_attr,
+    py_class_ref,
+    py_module,
+)
+from .python_names import _ros_closure as _ros_closure
+from .python_names import py_class_name as py_class_name  # re-exported (tests)
+from .python_statements import dsdl_literal, py_literal
+from .python_statements import typed_literal as _typed_literal
+from .python_tables import _tables_context
+from .python_tables import _text as _text  # re-exported: emit_nodes, emit_python_v0
+from .python_tables import _tuple as _tuple
 from .templating import render
-from .typesys import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from .typesys import DsdlType, RosType
 from .validate import Resolved
 
-__all__ = ["emit", "py_attr", "py_class_ref", "py_literal"]
+__all__ = ["FLOAT16_MAX", "FLOAT32_MAX", "INT32_MAX", "TIME_US_MAX_FROM_ROS", "TIME_US_MAX_TO_ROS", "TIME_US_MIN",
+           "emit", "py_attr", "py_class_ref", "py_literal"]
 
-# Names pycyphal (nunavut 2.3, Python target) appends "_" to: Python keywords and builtins
-# (nunavut.lang.py.Language.PYTHON_RESERVED_IDENTIFIERS). Soft keywords (match, case, type) are not keywords there.
-_NUNAVUT_RESERVED = frozenset([*keyword.kwlist, *dir(builtins)])
-# Names no generated local may take: keywords, builtins (the converters call round, len, float ...), parameters.
-_LOCAL_RESERVED = _NUNAVUT_RESERVED | frozenset(keyword.softkwlist) | {"src", "stats", "receive_ns", "msg"}
+# ---- the plan's value ranges and statements, under the names the codec emitters know ------------------------
 
-FLOAT16_MAX = 65504.0
-FLOAT32_MAX = 3.4028234663852886e38
-INT32_MAX = 2**31 - 1
-# builtin_interfaces/Time holds sec as int32 and nanosec as uint32.
-TIME_US_MIN = -(2**31) * 1_000_000
-TIME_US_MAX_TO_ROS = INT32_MAX * 1_000_000 + 999_999  # the last microsecond a Time can hold
-TIME_US_MAX_FROM_ROS = INT32_MAX * 1_000_000 + (2**32 - 1) // 1000  # nanosec may exceed 1e9 in a bad message
-LINE_LIMIT = 110
-
-
-# ---- names -------------------------------------------------------------------------------------------------
-
-
-def py_attr(name: str) -> str:
-    """The attribute (and keyword argument) name pycyphal gives a DSDL field or namespace component.
-
-    >>> py_attr("rpm"), py_attr("id"), py_attr("type"), py_attr("match")
-    ('rpm', 'id_', 'type_', 'match')
-    """
-    return name + "_" if name in _NUNAVUT_RESERVED else name
-
-
-def py_module(namespace: str) -> str:
-    """The Python module of a DSDL namespace.
-
-    >>> py_module("sam.sensor")
-    'sam.sensor'
-    """
-    return ".".join(py_attr(part) for part in namespace.split("."))
-
-
-def py_class_name(struct: DsdlStruct) -> str:
-    """The pycyphal class of a DSDL type: `<ShortName>_<major>_<minor>`."""
-    major, minor = struct.version
-    return f"{struct.short_name}_{major}_{minor}"
-
-
-def py_class_ref(struct: DsdlStruct) -> str:
-    """The qualified reference used in generated code, e.g. `sam.sensor.RawIMU_0_1`."""
-    return f"{py_module(struct.namespace)}.{py_class_name(struct)}"
-
-
-def dict_literal(prefix: str, pairs: list[tuple[str, str]], width: int = 110) -> str:
-    """``prefix{k: v, ...}`` on one line when it fits in `width`, else wrapped with four spaces of indent.
-
-    >>> dict_literal("T = ", [("0", "1"), ("2", "3")])
-    'T = {0: 1, 2: 3}'
-    >>> print(dict_literal("T = ", [(str(k), "3") for k in range(8)], width=30))
-    T = {
-        0: 3, 1: 3, 2: 3, 3: 3,
-        4: 3, 5: 3, 6: 3, 7: 3,
-    }
-    """
-    one = prefix + "{" + ", ".join(f"{k}: {v}" for k, v in pairs) + "}"
-    if len(one) <= width:
-        return one
-    lines, line = [prefix + "{"], ""
-    for k, v in pairs:
-        item = f"{k}: {v},"
-        if line and 4 + len(line) + 1 + len(item) > width:
-            lines.append("    " + line)
-            line = ""
-        line = f"{line} {item}" if line else item
-    if line:
-        lines.append("    " + line)
-    return "\n".join([*lines, "}"])
-
-
-def py_literal(value: Scalar) -> str:
-    """A Python literal; non-finite floats refer to the module constants _NAN and _INF of convert.py.
-
-    >>> py_literal(1.0), py_literal(float("nan")), py_literal(-float("inf")), py_literal("a'b"), py_literal(2)
-    ('1.0', '_NAN', '-_INF', '"a\\'b"', '2')
-    """
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "_NAN"
-        if math.isinf(value):
-            return "_INF" if value > 0 else "-_INF"
-    return repr(value)
-
-
-def _typed_literal(value: Scalar, base: str) -> str:
-    """A literal of the Python type rclpy / pycyphal keep for a field of primitive type `base`."""
-    if base in ROS_FLOAT_BITS or base.startswith("float"):
-        return py_literal(float(value))
-    if base == "bool":
-        return py_literal(bool(value))
-    if base == "byte":
-        return repr(bytes((int(value),)))
-    if base in ("string", "wstring"):
-        return py_literal(str(value))
-    return py_literal(int(value))
-
-
-def _identifier(text: str) -> str:
-    """A lower-case identifier from a path: `rate_gyro_latest[0]` -> `rate_gyro_latest_0`."""
-    ident = re.sub(r"[^0-9A-Za-z_]+", "_", text).strip("_").lower()
-    return ident if ident and not ident[0].isdigit() else f"v_{ident}"
-
-
-class _Names:
-    """Local variable names of one function: readable, unique, never shadowing a module name or builtin."""
-
-    def __init__(self, reserved: set[str]) -> None:
-        self.reserved = reserved  # the module's names: shared, not copied (one _Names per function)
-        self.taken = set(_LOCAL_RESERVED)
-
-    def new(self, hint: str) -> str:
-        base = _identifier(hint)
-        name, n = base, 2
-        while name in self.taken or name in self.reserved:
-            name, n = f"{base}_{n}", n + 1
-        self.taken.add(name)
-        return name
-
-
-def _access(base: str, path: tuple[tuple[str, int | None], ...], attr=lambda n: n) -> str:
-    text = base
-    for name, index in path:
-        text += f".{attr(name)}"
-        if index is not None:
-            text += f"[{index}]"
-    return text
-
-
-# ---- value ranges ------------------------------------------------------------------------------------------
-
-
-def _dsdl_range(t: DsdlType) -> tuple[float, float] | None:
-    """Finite value range of a primitive DSDL scalar (None for bool)."""
-    if t.kind in ("int", "uint", "byte"):
-        return t.range
-    if t.kind == "float":
-        return {16: (-FLOAT16_MAX, FLOAT16_MAX), 32: (-FLOAT32_MAX, FLOAT32_MAX)}.get(t.bits, (-math.inf, math.inf))
-    return None
-
-
-def _ros_range(base: str) -> tuple[float, float] | None:
-    if base in ROS_INT_RANGES:
-        return ROS_INT_RANGES[base]
-    if base == "float32":
-        return -FLOAT32_MAX, FLOAT32_MAX
-    if base == "float64":
-        return -math.inf, math.inf
-    return None
-
-
-def _is_int_dsdl(t: DsdlType) -> bool:
-    return t.kind in ("int", "uint", "byte")
-
-
-def _num(value: float) -> str:
-    """A numeric literal in generated code (ints stay ints)."""
-    return py_literal(value)
-
-
-# ---- statements (rendered by templates/python/statements.j2) -----------------------------------------------
-
-
-def _st(kind: str, **kw: Any) -> dict[str, Any]:
-    return {"kind": kind, **kw}
-
-
-@dataclass
-class _Policy:
-    key: str  # the stats key literal
-    reject: bool  # on_out_of_range == "reject"
-
-
-def _bound_statement(var: str, checks: list[tuple[str, str]], policy: _Policy, otherwise: str | None = None
-                     ) -> dict[str, Any]:
-    """if/elif chain: each (condition, saturated value) saturates or rejects; `otherwise` runs when none hit."""
-    return _st("bound", var=var, checks=checks, key=policy.key, reject=policy.reject, otherwise=otherwise)
+_dsdl_range = dsdl_range
+_ros_range = ros_range
+_is_int_dsdl = is_int_dsdl
+_num = py_literal  # a numeric literal in generated code (ints stay ints)
+_st = pys.st  # one statement for templates/python/statements.j2
+_Policy = pys.Policy
+_bound_statement = pys.bound_statement
 
 
 def _number_checks(var: str, value_is_float: bool, value_range: tuple[float, float] | None, target: DsdlType,
                    limits: tuple[float, float] | None, policy: _Policy) -> list[dict[str, Any]]:
-    """The statements that make `var` (a ROS-side value) acceptable to a DSDL scalar of type `target`.
-
-    `value_range` is the finite range the value is known to lie in (None: unknown); a float value may also be
-    NaN or infinite. Nothing is emitted for what cannot happen (e.g. a ROS uint8 into a DSDL uint8).
-    """
-    out: list[dict[str, Any]] = []
-    if target.kind == "bool":
-        return out
-    integer = _is_int_dsdl(target)
-    nonfinite = value_is_float
-    if value_is_float and (integer or limits is not None):
-        out.append(_st("nan_reject", var=var, key=policy.key))
-    if limits is not None:
-        low, high = (float(v) if not integer or not float(v).is_integer() else int(v) for v in limits)
-        out.append(_bound_statement(var, [(f"{var} < {_num(low)}", _num(low)), (f"{var} > {_num(high)}", _num(high))],
-                                    policy))
-        value_range = (low, high) if value_range is None else (max(low, value_range[0]), min(high, value_range[1]))
-        nonfinite = False
-        value_is_float = value_is_float or isinstance(low, float) or isinstance(high, float)
-    rng = _dsdl_range(target)
-    assert rng is not None
-    lo, hi = rng
-    beyond = value_range is None or value_range[0] < lo or value_range[1] > hi
-    if integer:
-        lo, hi = int(lo), int(hi)
-        if value_is_float:
-            if value_range is not None and not nonfinite and lo - 0.5 < value_range[0] and value_range[1] < hi + 0.5:
-                out.append(_st("assign", target=var, expr=f"round({var})"))
-            else:  # round half to even, but only what rounds into the range: round() would raise on inf
-                out.append(_bound_statement(var, [(f"{var} >= {_num(hi + 0.5)}", _num(hi)),
-                                                  (f"{var} <= {_num(lo - 0.5)}", _num(lo))],
-                                            policy, otherwise=f"{var} = round({var})"))
-        elif beyond:
-            checks = []
-            if value_range is None or value_range[1] > hi:
-                checks.append((f"{var} > {_num(hi)}", _num(hi)))
-            if value_range is None or value_range[0] < lo:
-                checks.append((f"{var} < {_num(lo)}", _num(lo)))
-            out.append(_bound_statement(var, checks, policy))
-    elif target.bits == 16:
-        # float16: beyond the largest finite value, infinities included, saturates to +-65504; NaN passes.
-        if nonfinite or beyond:
-            out.append(_bound_statement(var, [(f"{var} > {_num(hi)}", _num(hi)), (f"{var} < {_num(lo)}", _num(lo))],
-                                        policy))
-    elif target.bits == 32 and beyond:
-        # float32: finite values beyond its range saturate; infinities and NaN are float32 values and pass.
-        out.append(_bound_statement(var, [(f"{_num(hi)} < {var} < _INF", _num(hi)),
-                                          (f"-_INF < {var} < {_num(lo)}", _num(lo))], policy))
-    return out
+    """The statements that make `var` (a ROS-side value) acceptable to a DSDL scalar of type `target`: the plan's
+    range operations (conversion_plan.range_ops), rendered."""
+    return pys.check_statements(var, range_ops(value_is_float, value_range, target, limits, policy.reject),
+                                policy.key)
 
 
 # ---- one mapping ---------------------------------------------------------------------------------------------
@@ -424,9 +268,18 @@ class _MappingEmitter:
         self.reject = rm.mapping.on_out_of_range == "reject"
         self.ros_class = module.ros_aliases[rm.ros_message.full_name]
         self.dsdl_ref = module.dsdl_ref(rm.dsdl_struct)
+        self.plan = lower_mapping(rm)  # what both converters do; the methods below only say it in Python
+        self._links = {(id(link.step), link.direction): link for link in (*self.plan.to_ros, *self.plan.to_uavcan)}
 
     def policy(self, path: str) -> _Policy:
         return _Policy(repr(f"{self.name}.{path}"), self.reject)
+
+    def link(self, s: Step, direction: str) -> LinkPlan:
+        """The plan of one link (lowered here for a step that is not the mapping's own)."""
+        found = self._links.get((id(s), direction))
+        if found is not None and found.step == s:
+            return found
+        return lower_link(s, direction, self.name, self.reject)  # type: ignore[arg-type]
 
     # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
     def to_ros(self) -> _Function:
@@ -450,12 +303,12 @@ class _MappingEmitter:
             return self.uav_access("src", path)
 
         root = self.module.ros_ctor(rm.ros_message)
-        if rm.has_header and self.mapping.frame_id is not None:
-            self.module.insert(root, (("header", None), ("frame_id", None)), py_literal(self.mapping.frame_id))
-        if rm.has_header and not rm.stamp_from_source:
-            stamp = (("header", None), ("stamp", None))
-            self.module.insert(root, (*stamp, ("sec", None)), "receive_ns // 1_000_000_000")
-            self.module.insert(root, (*stamp, ("nanosec", None)), "receive_ns % 1_000_000_000")
+        for fs in self.plan.ros_fields:
+            if isinstance(fs.op, StaticFrameId):
+                self.module.insert(root, fs.path, py_literal(fs.op.value))
+            elif isinstance(fs.op, ReceiveTime):
+                self.module.insert(root, (*fs.path, ("sec", None)), "receive_ns // 1_000_000_000")
+                self.module.insert(root, (*fs.path, ("nanosec", None)), "receive_ns % 1_000_000_000")
         for s in steps:
             for path, value in self.step_to_ros(s, names, uav_read, fn.statements):
                 self.module.insert(root, path, value)
@@ -486,116 +339,64 @@ class _MappingEmitter:
 
     def step_to_ros(self, s: Step, names: _Names, uav_read, statements: list[dict[str, Any]]
                     ) -> list[tuple[tuple, str]]:
-        """Append the statements of one link; return the (ROS path, expression) pairs it sets."""
-        pol = self.policy(s.ros)
-        if s.kind == "value":
-            return [(s.ros_path, _typed_literal(s.value, s.ros_type.base))]  # type: ignore[arg-type]
+        """Append the statements of one link (its planned operations); return the (ROS path, expression) pairs
+        it sets."""
+        link = self.link(s, TO_ROS)
+        ops = link.ops
+        key = repr(link.key)
+        first = ops[0] if ops else None
+        if isinstance(first, Constant):
+            return [(s.ros_path, _typed_literal(first.value, s.ros_type.base))]
         assert s.uavcan_type is not None
         read = uav_read(s.uavcan_path)
-        if s.kind == "time":
+        if isinstance(first, TimestampToRos):
             us, sec, nanosec = names.new("us"), names.new("sec"), names.new("nanosec")
-            lo, hi = s.uavcan_type.range
-            checks = []
-            if hi > TIME_US_MAX_TO_ROS:
-                checks.append((f"{us} > {TIME_US_MAX_TO_ROS}", str(INT32_MAX), "999_999_999"))
-            if lo < TIME_US_MIN:
-                checks.append((f"{us} < {TIME_US_MIN}", str(-(2**31)), "0"))
-            statements.append(_st("time_to_ros", us=us, read=read, sec=sec, nanosec=nanosec, checks=checks,
-                                  key=pol.key, reject=pol.reject))
+            statements.append(pys.timestamp_to_ros(first, us, read, sec, nanosec, key))
             return [((*s.ros_path, ("sec", None)), sec), ((*s.ros_path, ("nanosec", None)), nanosec)]
-        if s.kind == "table":
+        if isinstance(first, Table):
             var = names.new(s.ros)
-            table = self.module_table(s, "to_ros")
-            default = None if s.table_default is None else py_literal(s.table_default)
-            statements.append(_st("table", var=var, table=table, read=read, key=pol.key, default=default))
+            table = self.module_table(s, TO_ROS)
+            default = None if first.default is None else py_literal(first.default)
+            statements.append(_st("table", var=var, table=table, read=read, key=key, default=default))
             return [(s.ros_path, var)]
-        if s.kind == "string":
+        if isinstance(first, DecodeUtf8):
             return [(s.ros_path, f"{read}.tobytes().decode(errors='replace')")]
         ros_base = s.ros_type.base
-        uav = s.uavcan_type.element if s.kind == "array" else s.uavcan_type
-        expr_of = self.to_ros_scalar_expr(s, uav, ros_base)
-        overflow = self.to_ros_float32_overflow(s, uav, ros_base)
         if s.kind == "number":
-            expr = expr_of(read)
-            if uav.kind == "float" and ros_base in ROS_INT_RANGES:  # `round: true`
-                var = names.new(s.ros)
-                statements.append(_st("assign", target=var, expr=expr))
-                lo, hi = ROS_INT_RANGES[ros_base]
-                as_dsdl = DsdlType("int" if lo < 0 else "uint", (hi - lo).bit_length())
-                statements.extend(_number_checks(var, True, None, as_dsdl, None, pol))
-                return [(s.ros_path, var)]
-            if overflow:
-                var = names.new(s.ros)
-                statements.append(_st("assign", target=var, expr=expr))
-                statements.append(_bound_statement(var, [(f"{_num(FLOAT32_MAX)} < {var} < _INF", _num(FLOAT32_MAX)),
-                                                         (f"-_INF < {var} < {_num(-FLOAT32_MAX)}",
-                                                          _num(-FLOAT32_MAX))], pol))
-                return [(s.ros_path, var)]
-            return [(s.ros_path, expr)]
-        # array
-        elem = expr_of("x")
+            expr = pys.to_ros_expr(read, ops, ros_base)
+            if not link.has(*CHECK_OPS):
+                return [(s.ros_path, expr)]
+            var = names.new(s.ros)
+            statements.append(_st("assign", target=var, expr=expr))
+            statements.extend(pys.check_statements(var, ops, key))
+            return [(s.ros_path, var)]
+        # array: the elements, their float32 range, then the padding
+        elem = pys.to_ros_expr("x", ops, ros_base)
         base_list = self.uav_list(read)
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
-        pad = s.ros_type.array == "fixed" and s.uavcan_type.array == "bounded"
-        if not pad and not overflow:
+        pad = link.first(Pad)
+        overflow = link.has(Clamp)
+        if pad is None and not overflow:
             return [(s.ros_path, expr)]
         var = names.new(s.ros)
         statements.append(_st("assign", target=var, expr=expr))
         if overflow:
-            statements.append(_st("helper", var=var, helper="_clamp_finite_floats",
-                                  args=[var, _num(FLOAT32_MAX), "stats", pol.key, str(pol.reject)]))
-        if pad:
-            zero = _typed_literal(0, ros_base)
-            statements.append(_st("pad", var=var, size=s.ros_type.capacity, zero=zero))
+            statements.append(pys.float32_helper(var, link))
+        if isinstance(pad, Pad):
+            statements.append(_st("pad", var=var, size=pad.size, zero=_typed_literal(0, ros_base)))
         return [(s.ros_path, var)]
 
-    def to_ros_scalar_expr(self, s: Step, uav: DsdlType, ros_base: str):
-        """A function from a UAVCAN-side element expression to the ROS-side one."""
-        scale = None if s.scale is None else _num(float(s.scale))
-        offset = None if s.offset is None else float(s.offset)
-
-        def expr(x: str) -> str:
-            text = x
-            if scale is not None:
-                text = f"{text} * {scale}"
-            if offset is not None:
-                text = f"{text} + {_num(offset)}" if offset >= 0 else f"{text} - {_num(-offset)}"
-            if scale is None and offset is None:
-                if ros_base in ROS_FLOAT_BITS and uav.kind != "float":
-                    text = f"float({x})"
-                elif ros_base == "byte":
-                    text = f"bytes(({x},))"
-            return text
-
-        return expr
-
-    def to_ros_float32_overflow(self, s: Step, uav: DsdlType, ros_base: str) -> bool:
-        if ros_base != "float32" or (s.scale is None and s.offset is None):
-            return False
-        rng = _dsdl_range(uav)
-        if rng is None:
-            return False
-        bound = max(abs(rng[0]), abs(rng[1])) * abs(s.scale if s.scale is not None else 1.0) + abs(s.offset or 0.0)
-        return bound > FLOAT32_MAX
-
     def module_table(self, s: Step, direction: str) -> str:
-        const = f"_{self.name}_{_identifier(s.ros)}".upper()
-        if direction == "to_ros":
-            items = list(s.table)
-            const += "_TO_ROS"
-        else:
-            inverse: dict[int, int] = {}
-            for key, value in s.table:
-                inverse.setdefault(value, key)  # first key per value
-            items = sorted(inverse.items())
-            const += "_TO_UAVCAN"
+        """The module constant holding a link's table in `direction` (one per link and direction)."""
+        const = f"_{self.name}_{_identifier(s.ros)}".upper() + ("_TO_ROS" if direction == TO_ROS else "_TO_UAVCAN")
         if not any(t["name"] == const for t in self.module.tables):
-            pairs = [(py_literal(k), py_literal(v)) for k, v in items]
+            pairs = [(py_literal(k), py_literal(v))
+                     for k, v in Table(s.table, s.table_default, direction != TO_ROS).lookup()]
             self.module.tables.append({
                 "name": const,
                 "items": pairs,
                 "literal": dict_literal(f"{const}: dict[int, int] = ", pairs),
-                "what": f"{self.name}: {s.uavcan} -> {s.ros}" if direction == "to_ros"
+                "what": f"{self.name}: {s.uavcan} -> {s.ros}" if direction == TO_ROS
                 else f"{self.name}: {s.ros} -> {s.uavcan} (first key per value)",
             })
         return const
@@ -611,6 +412,21 @@ class _MappingEmitter:
             [f"Mapping {self.name!r}, ROS -> UAVCAN.", "", f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"],
         )
         steps = [s for s in rm.steps if s.uavcan_path]
+        ros_read = self.ros_reader(fn, names, steps)
+        root = self.module.dsdl_ctor(rm.dsdl_struct)
+        for s in steps:
+            value = self.step_to_uavcan(s, names, ros_read, fn.statements)
+            self.module.insert(root, s.uavcan_path, value)
+        for fs in self.plan.uavcan_fields:  # uavcan_values, then DroneCAN's select
+            assert isinstance(fs.op, Constant) and isinstance(fs.type, DsdlType)
+            self.module.insert(root, fs.path, dsdl_literal(fs.op.value, fs.type))
+        fn.result = self.module.format_return(root)
+        return fn
+
+    def ros_reader(self, fn: _Function, names: _Names, steps: list[Step]) -> Callable[[tuple], str]:
+        """The to_uavcan read helper: binds what the steps read (appended to fn.binds) and returns the function
+        from a ROS path to the expression reading it (a Time path: an expression with .sec and .nanosec).
+        Overridden by the wire codecs (emit_codec), which read from CDR bytes."""
         # Locals for ROS parents read more than once, and one .tolist() per ROS array read by index.
         reads: dict[tuple, int] = {}
         for s in steps:
@@ -644,15 +460,7 @@ class _MappingEmitter:
                 return _access(parent_local[parent], path[-1:])
             return _access("src", path)
 
-        root = self.module.dsdl_ctor(rm.dsdl_struct)
-        for s in steps:
-            value = self.step_to_uavcan(s, names, ros_read, fn.statements)
-            self.module.insert(root, s.uavcan_path, value)
-        for path, leaf_type, value in [*rm.uavcan_values, *rm.select]:  # (select: DroneCAN's)
-            self.module.insert(root, path,
-                               _typed_literal(value, "float" if leaf_type.kind == "float" else leaf_type.kind))
-        fn.result = self.module.format_return(root)
-        return fn
+        return ros_read
 
     def ros_array_read(self, expr: str, ros_type: RosType) -> str:
         """A ROS array field as a list of plain Python values."""
@@ -664,403 +472,93 @@ class _MappingEmitter:
         return f"{expr}.tolist()"
 
     def step_to_uavcan(self, s: Step, names: _Names, ros_read, statements: list[dict[str, Any]]) -> str:
+        """Append the statements of one link (its planned operations); return the expression of the UAVCAN
+        value."""
         assert s.uavcan_type is not None
-        pol = self.policy(s.uavcan)
+        link = self.link(s, TO_UAVCAN)
+        ops = link.ops
+        key = repr(link.key)
         uav = s.uavcan_type
-        if s.kind == "time":
+        first = ops[0] if ops else None
+        if isinstance(first, TimestampFromRos):
             stamp = ros_read(s.ros_path)
             var = names.new("us")
-            statements.append(_st("assign", target=var, expr=f"{stamp}.sec * 1_000_000 + {stamp}.nanosec // 1000"))
-            lo, hi = uav.range
-            checks = []
-            if TIME_US_MAX_FROM_ROS > hi:
-                checks.append((f"{var} > {hi}", str(hi)))
-            if TIME_US_MIN < lo:
-                checks.append((f"{var} < {lo}", str(lo)))
-            if checks:
-                statements.append(_bound_statement(var, checks, pol))
+            statements.extend(pys.timestamp_from_ros(first, var, self.ros_time_us(stamp), key))
             return var
         read = ros_read(s.ros_path)
-        if s.kind == "table":
+        if isinstance(first, Table):
             var = names.new(s.uavcan)
-            table = self.module_table(s, "to_uavcan")
-            statements.append(_st("table", var=var, table=table, read=read, key=pol.key, default=None))
+            table = self.module_table(s, TO_UAVCAN)
+            statements.append(_st("table", var=var, table=table, read=read, key=key, default=None))
             return var
-        if s.kind == "string":
+        if isinstance(first, EncodeUtf8):
             var = names.new(s.uavcan)
+            cut = ops[1]
+            assert isinstance(cut, Utf8Length)
             statements.append(_st("assign", target=var, expr=f"{read}.encode(errors='replace')"))
-            statements.append(_st("utf8_length", var=var, cap=uav.capacity, key=pol.key, reject=pol.reject))
+            statements.append(_st("utf8_length", var=var, cap=cut.capacity, key=key, reject=cut.reject))
             return var
-        ros_base = s.ros_type.base
         if s.kind == "number":
-            if s.limits is not None and (s.scale is not None or s.offset is not None):
-                # limits are in ROS units: checked before the inverse scale/offset
-                var = names.new(s.uavcan)
-                statements.append(_st("assign", target=var, expr=read))
-                ros_is_float, ros_range, _ = self.to_uavcan_scalar(s, ros_base, var, transform=False)
-                limit_type = DsdlType("float", 64) if ros_is_float else DsdlType("int", 64)
-                statements.extend(_number_checks(var, ros_is_float, ros_range, limit_type, s.limits, pol))
-                value_is_float, value_range, expr = self.to_uavcan_scalar(s, ros_base, var)
-                statements.append(_st("assign", target=var, expr=expr))
-                statements.extend(_number_checks(var, value_is_float, value_range, uav, None, pol))
-                return var
-            value_is_float, value_range, expr = self.to_uavcan_scalar(s, ros_base, read)
-            if not _number_checks("x", value_is_float, value_range, uav, s.limits, pol):
-                return expr
-            var = names.new(s.uavcan)
-            statements.append(_st("assign", target=var, expr=expr))
-            statements.extend(_number_checks(var, value_is_float, value_range, uav, s.limits, pol))
-            return var
-        # array
+            return self.scalar_to_uavcan(link, names, read, statements)
+        # array: the elements' arithmetic, the length, then the elements' range
         elem_uav = uav.element
-        value_is_float, value_range, elem = self.to_uavcan_scalar(s, ros_base, "x")
         var = names.new(s.uavcan)
+        elem = pys.to_uavcan_expr("x", ops)
         base_list = self.ros_array_read(read, s.ros_type)
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
         statements.append(_st("assign", target=var, expr=expr))
-        # Length: the ROS array may be longer (or, for a fixed DSDL array, shorter) than the DSDL one.
-        cap = uav.capacity or 0
-        ros_fixed = s.ros_type.array == "fixed"
-        if uav.array == "fixed":
-            if not ros_fixed:
-                zero = _typed_literal(0, "float" if elem_uav.kind == "float" else elem_uav.kind)
-                statements.append(_st("fixed_length", var=var, cap=cap, zero=zero, key=pol.key, reject=pol.reject))
-        elif s.ros_type.array == "dynamic" or (s.ros_type.capacity or 0) > cap:
-            # A fixed ROS array longer than the bound holds zero padding: only non-zero elements count.
-            statements.append(_st("max_length", var=var, cap=cap, key=pol.key, reject=pol.reject, padded=ros_fixed))
-        if _number_checks("x", value_is_float, value_range, elem_uav, None, pol):
-            if _is_int_dsdl(elem_uav):
-                lo, hi = elem_uav.range
-                helper = "_round_ints" if value_is_float else "_clamp_ints"
-                args = [var, str(lo), str(hi), "stats", pol.key, str(pol.reject)]
-            else:  # float16 saturates infinities too, float32 keeps them (as for scalars)
-                helper = "_clamp_floats" if elem_uav.bits == 16 else "_clamp_finite_floats"
-                args = [var, _num(_dsdl_range(elem_uav)[1]), "stats", pol.key, str(pol.reject)]  # type: ignore[index]
-            statements.append(_st("helper", var=var, helper=helper, args=args))
+        for op in ops:
+            if isinstance(op, FixedLength):
+                statements.append(_st("fixed_length", var=var, cap=op.size, zero=dsdl_literal(0, elem_uav), key=key,
+                                      reject=op.reject))
+            elif isinstance(op, MaxLength):  # a longer fixed ROS array: only non-zero elements count
+                statements.append(_st("max_length", var=var, cap=op.capacity, key=key, reject=op.reject,
+                                      padded=op.padded))
+        helper = pys.array_check_helper(var, link, elem_uav)
+        if helper is not None:
+            statements.append(helper)
+        return var
+
+    def ros_time_us(self, stamp: str) -> str:
+        """Microseconds of a builtin_interfaces/Time read as `stamp` (the expression ros_read gave)."""
+        return f"{stamp}.sec * 1_000_000 + {stamp}.nanosec // 1000"
+
+    def scalar_to_uavcan(self, link: LinkPlan, names: _Names, read: str, statements: list[dict[str, Any]]) -> str:
+        """A number link's operations in order: its arithmetic builds an expression, the first check binds it to a
+        local (limits come before the inverse scale/offset: they are in ROS units)."""
+        s = link.step
+        expr = f"{read}[0]" if s.ros_type.base == "byte" else read
+        var: str | None = None
+        pending: list = []  # arithmetic not yet applied to var
+        for op in link.ops:
+            if isinstance(op, (Offset, Scale)):
+                pending.append(op)
+            elif isinstance(op, CHECK_OPS):
+                if var is None or pending:
+                    target = var if var is not None else names.new(s.uavcan)
+                    statements.append(_st("assign", target=target, expr=pys.to_uavcan_expr(var or expr, pending)))
+                    var, pending = target, []
+                statements.extend(pys.check_statements(var, [op], repr(link.key)))
+        if var is None:
+            return pys.to_uavcan_expr(expr, pending)
+        if pending:
+            statements.append(_st("assign", target=var, expr=pys.to_uavcan_expr(var, pending)))
         return var
 
     def to_uavcan_scalar(self, s: Step, ros_base: str, read: str, transform: bool = True
                          ) -> tuple[bool, tuple[float, float] | None, str]:
         """(float-valued, range of the value if known, expression) of a ROS-side element after the inverse
         scale/offset (without them unless `transform`)."""
-        value_range = _ros_range(ros_base)
-        value_is_float = ros_base in ROS_FLOAT_BITS
-        expr = read
-        if ros_base == "byte" and s.kind == "number":
-            expr = f"{read}[0]"
-        if not transform:
-            return value_is_float, value_range if value_range and math.isfinite(value_range[1]) else None, expr
-        if s.offset is not None:
-            off = float(s.offset)
-            expr = f"{expr} - {_num(off)}" if off >= 0 else f"{expr} + {_num(-off)}"
-        if s.scale is not None:
-            expr = f"({expr}) / {_num(float(s.scale))}" if s.offset is not None else f"{expr} / {_num(float(s.scale))}"
-        if s.scale is not None or s.offset is not None:
-            value_is_float, value_range = True, None
-        if value_range is not None and not math.isfinite(value_range[1]):
-            value_range = None
+        transformed = transform and (s.scale is not None or s.offset is not None)
+        value_is_float, value_range = ros_value(ros_base, transformed)
+        expr = f"{read}[0]" if ros_base == "byte" and s.kind == "number" else read
+        if transform:
+            arithmetic = [op for op in self.link(s, TO_UAVCAN).ops if isinstance(op, (Offset, Scale))]
+            expr = pys.to_uavcan_expr(expr, arithmetic)
         return value_is_float, value_range, expr
 
 
-# ---- tables.py -----------------------------------------------------------------------------------------------
-
-
-def _ros_type_parts(full: str) -> tuple[str, str, str]:
-    """`sensor_msgs/Imu` -> ("sensor_msgs/msg/Imu", "sensor_msgs.msg", "Imu")."""
-    package, name = full.split("/")
-    return f"{package}/msg/{name}", f"{package}.msg", name
-
-
-def _text(text: str, indent: int) -> str:
-    """A string literal (py_str: repr, inert) at `indent`; long text becomes implicitly concatenated chunks."""
-    literal = py_str(text)
-    if indent + len(literal) <= LINE_LIMIT - 10:
-        return literal
-    chunks: list[str] = []
-    for word in re.findall(r"\S*\s*", text):
-        if chunks and len(py_str(chunks[-1] + word)) + indent + 4 <= LINE_LIMIT - 2:
-            chunks[-1] += word
-        elif word:
-            chunks.append(word)
-    pad = " " * (indent + 4)
-    return "(\n" + "".join(f"{pad}{py_str(c)}\n" for c in chunks) + " " * indent + ")"
-
-
-def _tuple(items: list[str], indent: int) -> str:
-    """A tuple literal of rendered items, on one line if it fits."""
-    if not items:
-        return "()"
-    one = "(" + ", ".join(items) + ("," if len(items) == 1 else "") + ")"
-    if indent + len(one) <= LINE_LIMIT - 30:
-        return one
-    pad = " " * (indent + 4)
-    return "(\n" + "".join(f"{pad}{item},\n" for item in items) + " " * indent + ")"
-
-
-def _port_info(resolved: Resolved, port: Port, indent: int, prefix: int = 0) -> str:
-    """A PortInfo(...) at `indent`, after `prefix` characters on its line and before a comma."""
-    struct = resolved.dsdl.get(port.type)
-    assert struct is not None, port.type
-    args = [str(port.subject_id), py_str(port.type), py_str(py_module(struct.namespace)),
-            py_str(py_class_name(struct)), py_literal(float(port.rate_hz))]
-    one = "PortInfo(" + ", ".join(args) + ")"
-    if indent + prefix + len(one) + 1 <= LINE_LIMIT:
-        return one
-    names = ("subject_id", "dsdl_type", "dsdl_module", "dsdl_class", "rate_hz")
-    pad = " " * (indent + 4)
-    return "PortInfo(\n" + "".join(f"{pad}{k}={v},\n" for k, v in zip(names, args, strict=True)) + " " * indent + ")"
-
-
-def _tables_context(resolved: Resolved) -> dict[str, Any]:
-    spec = resolved.spec
-    devices = [{
-        "name": py_str(d.name), "node_id": str(d.node_id), "description": _text(d.description, 8),
-        "publishes": [_port_info(resolved, p, 12) for p in d.publishes],
-        "subscribes": [_port_info(resolved, p, 12) for p in d.subscribes],
-    } for d in spec.devices.values() if "cyphal" in d.protocols]
-    topics = []
-    for topic in spec.topics.values():
-        ros_type, module, cls = _ros_type_parts(topic.type)
-        topics.append({"name": py_str(topic.name), "ros_type": py_str(ros_type), "ros_module": py_str(module),
-                       "ros_class": py_str(cls), "description": _text(topic.description, 8)})
-    ports = {}
-    for d in spec.devices.values():
-        for p in [*d.publishes, *d.subscribes]:
-            ports.setdefault(p.subject_id, p)
-    mappings = []
-    for rm in resolved.mappings:
-        m = rm.mapping
-        linked = [py_str(s.uavcan) for s in rm.steps if s.uavcan_path]
-        exact = [py_str(s.uavcan) for s in rm.steps if s.uavcan_path and s.exact]
-        sources = sorted(set(m.source_node_ids))
-        mappings.append({
-            "name": py_str(m.name), "direction": py_str(m.direction), "topic": py_str(m.topic),
-            "port": _port_info(resolved, ports[m.subject_id], 8, len("port=")),
-            "source_node_ids": "frozenset({" + ", ".join(map(str, sources)) + "})" if sources else "frozenset()",
-            "destination_node_id": py_literal(m.destination_node_id),
-            "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
-            "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
-            "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
-            "exact_uavcan_fields": _tuple(exact, 8), "linked_uavcan_fields": _tuple(linked, 8),
-        })
-    parameters = []
-    for p in spec.parameters.values():
-        default = p.default
-        if p.type == "double":
-            default = float(default)
-        parameters.append({
-            "name": py_str(p.name), "type": py_str(p.type),
-            "default": _text(default, 8) if isinstance(default, str) else py_literal(default),
-            "minimum": py_literal(None if p.minimum is None else float(p.minimum)),
-            "maximum": py_literal(None if p.maximum is None else float(p.maximum)),
-            "unit": py_str(p.unit), "description": _text(p.description, 8),
-        })
-    rules = [{"left": py_str(r.left), "op": py_str(r.op), "right": py_str(r.right),
-              "description": _text(r.description, 8)} for r in spec.parameter_rules]
-    frames = [(py_str(f.name), py_str(f.parent) if f.parent is not None else "None") for f in spec.frames.values()]
-    bridge = spec.bridge
-    return {
-        "vehicle_literal": py_str(spec.vehicle), "ros_package": py_str(spec.ros.name),
-        "dsdl_root": py_str(spec.dsdl_root),
-        "bridge_name": py_str(bridge.name) if bridge else "None",
-        "bridge_node_id": str(bridge.node_id) if bridge else "None",
-        "devices": devices, "topics": topics,
-        "mappings": mappings, "parameters": parameters, "rules": rules, "frames": frames,
-    }
-
-
 # ---- convert.py ----------------------------------------------------------------------------------------------
-
-
-def _ros_closure(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> list[str]:
-    """Every ROS message type the converters build: the mapped ones and, transitively, their nested types."""
-    seen: set[str] = set()
-    todo = [rm.ros_message.full_name for rm in (resolved.mappings if mappings is None else mappings)]
-    while todo:
-        full = todo.pop()
-        if full in seen:
-            continue
-        seen.add(full)
-        message = resolved.ros.get(full)
-        assert message is not None, full
-        todo.extend(f.type.base for f in message.fields if isinstance(f.type, RosType) and not f.type.is_primitive)
-    return sorted(seen)
-
-
-def _ros_aliases(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> dict[str, str]:
-    """A local class name per ROS message type the converters use; package-qualified when names clash."""
-    used = _ros_closure(resolved, mappings)
-    by_name: dict[str, list[str]] = {}
-    for full in used:
-        by_name.setdefault(full.split("/")[1], []).append(full)
-    reserved = {"ConversionStats", "Callable", "Any"} | _NUNAVUT_RESERVED | set(keyword.softkwlist)
-    aliases = {}
-    for full in used:
-        package, name = full.split("/")
-        aliases[full] = name if len(by_name[name]) == 1 and name not in reserved else f"{package}_{name}"
-    return aliases
-
-
-def ros_factory_name(alias: str) -> str:
-    """The generated constructor of a ROS message class.
-
-    >>> ros_factory_name("Imu")
-    '_new_Imu'
-    """
-    return f"_new_{alias}"
-
-
-# rosidl_generator_py keeps fixed-size arrays of these in numpy arrays (`char` is uint8 in ROS 2 IDL).
-_NUMPY_BASES = frozenset(base for base in [*ROS_INT_RANGES, *ROS_FLOAT_BITS] if base != "byte")
-_PY_TYPES = {"bool": "bool", "byte": "bytes", "string": "str", "wstring": "str"}
-
-
-def _factory_field(slot: str, param: str, default: str, given: list[tuple[str | None, str]] | None = None
-                   ) -> dict[str, Any]:
-    """One field of a generated constructor: `default` when the argument is None, else `given` (if/elif/else
-    branches: (condition or None, statement)); by default the argument goes into the slot as it is."""
-    if given is None:
-        line = f"_m.{slot} = {default} if {param} is None else {param}"
-        if len(line) + 4 <= LINE_LIMIT - 30:
-            return {"line": line}
-        given = [(None, f"_m.{slot} = {param}")]
-    return {"branches": [(f"{param} is None", f"_m.{slot} = {default}"), *given]}
-
-
-def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
-    """What templates/python/convert.py.j2 needs to write the fast constructor of one ROS message class.
-
-    Scalars, strings and nested messages go straight into their slots, as rosidl_generator_py's setters put them
-    when field checks are off; arrays go through the setters (which convert to numpy / array.array), and their
-    defaults are copies of a default instance's.
-    """
-    message = module.ros_message(full)
-    alias = module.ros_aliases[full]
-    prototype = f"_DEFAULT_{alias}"
-    params: list[str] = []
-    fields: list[dict[str, Any]] = []
-    uses_prototype = False
-    for f in message.fields:
-        t = f.type
-        assert isinstance(t, RosType)
-        if t.array:
-            params.append(f"{f.name}: Any = None")
-            if not t.is_primitive:
-                nested = ros_factory_name(module.ros_aliases[t.base])
-                default = f"[{nested}() for _ in range({t.capacity})]" if t.array == "fixed" else "[]"
-            elif t.array == "fixed" and t.base in _NUMPY_BASES:
-                default, uses_prototype = f"{prototype}._{f.name}.copy()", True
-            else:
-                default, uses_prototype = f"_copy({prototype}._{f.name})", True
-            # the setter converts a given sequence to the class's array type
-            fields.append(_factory_field(f"_{f.name}", f.name, default, [(None, f"_m.{f.name} = {f.name}")]))
-        elif not t.is_primitive:
-            params.append(f"{f.name}: {module.ros_aliases[t.base]} | None = None")
-            fields.append(_factory_field(f"_{f.name}", f.name, f"{ros_factory_name(module.ros_aliases[t.base])}()"))
-        else:
-            py_type = _PY_TYPES.get(t.base, "float" if t.base in ROS_FLOAT_BITS else "int")
-            default = _typed_literal(f.default if f.default is not None else 0, t.base)
-            if t.base in ("string", "wstring") and f.default is None:
-                default = "''"
-            params.append(f"{f.name}: {py_type} = {default}")
-            fields.append({"line": f"_m._{f.name} = {f.name}"})
-    return {"name": ros_factory_name(alias), "cls": alias, "ros": True, "params": params, "fields": fields,
-            "prototype": prototype if uses_prototype else None}
-
-
-def dsdl_factory_name(struct: DsdlStruct) -> str:
-    """The generated constructor of a pycyphal class.
-
-    >>> from sam_codegen.model import DsdlStruct
-    >>> dsdl_factory_name(DsdlStruct("uavcan.time.SynchronizedTimestamp.1.0", []))
-    '_new_uavcan_time_SynchronizedTimestamp_1_0'
-    """
-    return "_new_" + py_module(struct.namespace).replace(".", "_") + "_" + py_class_name(struct)
-
-
-def dsdl_factory_supported(struct: DsdlStruct) -> bool:
-    """Structures of primitives, primitive arrays and nested composites get a constructor; unions and arrays of
-    composites (rare in bridged types) are built by their pycyphal class."""
-    return not struct.union and not any(
-        isinstance(f.type, DsdlType) and f.type.array and f.type.kind == "composite" for f in struct.fields)
-
-
-def _numpy_dtype(t: DsdlType) -> str:
-    """The numpy element type pycyphal (nunavut 2.3) keeps a primitive array in.
-
-    >>> [_numpy_dtype(DsdlType(k, b)) for k, b in (("float", 16), ("int", 18), ("uint", 7), ("bool", 1), ("utf8", 8))]
-    ['_np.float16', '_np.int32', '_np.uint8', '_np.bool_', '_np.uint8']
-    """
-    if t.kind == "float":
-        return f"_np.float{t.bits}"
-    if t.kind == "bool":
-        return "_np.bool_"
-    if t.kind in ("byte", "utf8"):
-        return "_np.uint8"
-    bits = next(b for b in (8, 16, 32, 64) if b >= t.bits)
-    return f"_np.{t.kind}{bits}"
-
-
-def _dsdl_factory(module: _Module, struct: DsdlStruct) -> dict[str, Any]:
-    """What templates/python/convert.py.j2 needs to write the fast constructor of one pycyphal class.
-
-    Values go straight into the attributes pycyphal's properties keep them in (`_<name>`), converted as its
-    setters convert them; the converters have already checked ranges and lengths, which the setters check again.
-    """
-    params: list[str] = []
-    fields: list[dict[str, Any]] = []
-    for f in struct.fields:
-        t = f.type
-        assert isinstance(t, DsdlType)
-        if t.kind == "void":
-            continue
-        name = py_attr(f.name)
-        if t.kind == "composite":
-            nested = module.struct(t.composite)  # type: ignore[arg-type]
-            params.append(f"{name}: Any = None")
-            fields.append(_factory_field(f"_{name}", name, f"{module.dsdl_new(nested)}()"))
-        elif t.array or t.kind == "utf8":
-            dtype = _numpy_dtype(t)
-            default = f"_np.zeros({t.capacity}, {dtype})" if t.array == "fixed" else f"_np.array([], {dtype})"
-            given: list[tuple[str | None, str]] = [(None, f"_m._{name} = _np.array({name}, {dtype})")]
-            if dtype == "_np.uint8":  # pycyphal takes bytes for these too (utf8 text, byte strings)
-                given.insert(0, (f"{name}.__class__ is bytes", f"_m._{name} = _np.frombuffer({name}, _np.uint8)"))
-            params.append(f"{name}: Any = None")
-            fields.append(_factory_field(f"_{name}", name, default, given))
-        elif t.kind == "float":
-            params.append(f"{name}: float = 0.0")
-            fields.append({"line": f"_m._{name} = float({name})"})
-        else:
-            params.append(f"{name}: {'bool' if t.kind == 'bool' else 'int'} = {'False' if t.kind == 'bool' else '0'}")
-            fields.append({"line": f"_m._{name} = {name}"})
-    return {"name": dsdl_factory_name(struct), "cls": module.dsdl_ref(struct), "ros": False, "params": params,
-            "fields": fields,
-            "prototype": None}
-
-
-def _referenced_roots(resolved: Resolved) -> set[str]:
-    """Root namespaces of every composite the mapped DSDL types contain (module names locals must not shadow)."""
-    roots: set[str] = set()
-    seen: set[str] = set()
-    todo = [rm.dsdl_struct for rm in resolved.mappings]
-    while todo:
-        struct = todo.pop()
-        if struct.name in seen:
-            continue
-        seen.add(struct.name)
-        roots.add(struct.name.split(".")[0])
-        for f in struct.fields:
-            if isinstance(f.type, DsdlType) and f.type.composite:
-                nested = resolved.dsdl.get(f.type.composite)
-                if nested is not None:
-                    todo.append(nested)
-    return roots
-
-
-def _isort_key(name: str) -> tuple[int, list[Any]]:
-    """isort's (and ruff's) order of imported names: CONSTANTS, then Classes, then variables, case-insensitive."""
-    kind = 0 if len(name) > 1 and name.isupper() else 1 if name[0].isupper() else 2
-    return kind, natural_key(name)
 
 
 def _convert_context(resolved: Resolved) -> dict[str, Any]:

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from . import emit_dsdl_v0
+from .conversion_plan import Constant, RequireItem
 from .emit_python import (
     _Arr,
     _Ctor,
@@ -159,37 +160,39 @@ class _V0MappingEmitter(_MappingEmitter):
         """The elements of DroneCAN arrays the mapping reads: items by key (found, or the message is dropped) and
         positions (present, or dropped); then the fixed arrays read by index, one list each."""
         listed: dict[tuple, str] = {}
-        for array_path, uses in self.rm.elements.items():
-            source = self.uav_access("src", array_path)
-            if uses and isinstance(uses[0], Key):
-                for k in uses:
-                    path = (*array_path[:-1], (array_path[-1][0], k))
-                    local = names.new(format_path(list(path)))
-                    self.items[path] = local
-                    fn.binds.append(_st("required_item", var=local, array=source, field=repr(k.field),
-                                        value=py_literal(k.value), key=repr(f"{self.name}.{format_path(list(path))}")))
+        for need in self.plan.required:
+            source = self.uav_access("src", need.array)
+            if isinstance(need, RequireItem):
+                path = (*need.array[:-1], (need.array[-1][0], need.key))
+                local = names.new(format_path(list(path)))
+                self.items[path] = local
+                fn.binds.append(_st("required_item", var=local, array=source, field=repr(need.key.field),
+                                    value=py_literal(need.key.value),
+                                    key=repr(f"{self.name}.{format_path(list(path))}")))
             else:
-                local = names.new(format_path(list(array_path)))
-                listed[array_path] = local
+                local = names.new(format_path(list(need.array)))
+                listed[need.array] = local
                 fn.binds.append(_st("assign", target=local, expr=self.uav_list(source)))
-                last = f"{self.name}.{format_path(list(array_path))}[{max(uses)}]"
-                fn.binds.append(_st("min_length", var=local, size=max(uses) + 1, key=repr(last)))
+                last = f"{self.name}.{format_path(list(need.array))}[{need.length - 1}]"
+                fn.binds.append(_st("min_length", var=local, size=need.length, key=repr(last)))
         return super().bind_uavcan_arrays(fn, names, steps, listed)
 
     def matches(self) -> dict[str, Any] | None:
         """The predicate of MATCHES: the `select` values, and the elements the mapping reads are there."""
         conditions = []
-        for path, leaf, value in self.rm.select:
-            conditions.append(f"src.{'.'.join(_attr(n) for n, _ in path)} == "
-                              f"{_typed_literal(value, leaf.kind)}")
-        for array_path, uses in self.rm.elements.items():
-            if any(i is not None for _, i in array_path):
+        for fs in self.plan.uavcan_fields:
+            if isinstance(fs.op, Constant) and fs.op.select:
+                assert isinstance(fs.type, DsdlType)
+                conditions.append(f"src.{'.'.join(_attr(n) for n, _ in fs.path)} == "
+                                  f"{_typed_literal(fs.op.value, fs.type.kind)}")
+        for need in self.plan.required:
+            if any(i is not None for _, i in need.array):
                 continue  # inside an item: the converter checks it
-            source = "src." + ".".join(_attr(n) for n, _ in array_path)
-            if uses and isinstance(uses[0], Key):
-                conditions.extend(f"_item({source}, {k.field!r}, {k.value}) is not None" for k in uses)
+            source = "src." + ".".join(_attr(n) for n, _ in need.array)
+            if isinstance(need, RequireItem):
+                conditions.append(f"_item({source}, {need.key.field!r}, {need.key.value}) is not None")
             else:
-                conditions.append(f"len({source}) > {max(uses)}")
+                conditions.append(f"len({source}) > {need.length - 1}")
         if not conditions:
             return None
         return {"name": f"_matches_{self.name}", "conditions": conditions}

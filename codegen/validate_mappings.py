@@ -313,6 +313,9 @@ class MappingValidator:
                 raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one")
             if link.limits is not None and (ros_type.array or ros_type.base not in {*ROS_INT_RANGES, *ROS_FLOAT_BITS}):
                 raise RuleError("limits apply to numeric scalar fields")
+            if link.limits is not None and mapping.direction == "uavcan_to_ros":  # the converters apply none there
+                raise RuleError("limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping "
+                                "passes on what the device measured")
             if uav_type.kind == "utf8" or ros_type.base == "string":
                 exact = check_string(ros_type, uav_type, link)
                 kind = "string"

@@ -423,6 +423,14 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:10:9: error: unknown ROS type 'std_msgs/Headr' in message buoy_msgs/Level (expected a primitive, a message of this spec or an installed ROS message)",
         ),
     ),
+    Case(
+        'limits_on_uavcan_to_ros',  # the converters apply limits only towards the device: never silently ignored
+        '        level: level_mm',
+        '        level: {from: level_mm, limits: [0, 10]}',
+        (
+            "minimal.yaml:53:9: error: mapping 'level', field 'level': limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping passes on what the device measured",
+        ),
+    ),
 )
 
 

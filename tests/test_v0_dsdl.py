@@ -173,8 +173,11 @@ def test_golden_dsdl(resolved: dict[str, Resolved]) -> None:
 
 
 def test_golden_converters(resolved: dict[str, Resolved]) -> None:
-    """SAM's convert_v0.py, byte for byte (its tables are in tests/golden/python with the Cyphal ones)."""
-    _golden(GOLDEN / "python_v0", emit_python_v0.emit(resolved["sam"]))
+    """SAM's convert_v0.py and codec_v0.py, byte for byte (its tables are in tests/golden/python with the Cyphal
+    ones)."""
+    from sam_codegen import emit_codec_v0
+
+    _golden(GOLDEN / "python_v0", {**emit_python_v0.emit(resolved["sam"]), **emit_codec_v0.emit(resolved["sam"])})
 
 
 @pytest.mark.parametrize("spec", ["sam", "ferry"])
