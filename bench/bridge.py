@@ -40,13 +40,16 @@ import multiprocessing
 import os
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from bench.common import REPO, log, median, percentile, ratio, sample_uavcan
 
 WINDOW = 32
+# The bridge's ROS history depth as `sam-bridge` deploys it (its --qos-depth default): a burst of WINDOW commands fits
+# (with the spec's keep-last 10 on /thruster_angles, DDS overwrote the burst's tail before the bridge took it).
+QOS_DEPTH = 100
 UDP_LOCK = Path("/tmp") / "sam-runtime-tests-cyphal-udp.lock"  # the tests' machine-wide Cyphal/UDP lock
 RAW_SUBJECT_U2R = 4001
 RAW_SUBJECT_R2U = 4002
@@ -314,8 +317,10 @@ class CyphalReceiver:
 class Rig:
     """The bridge, the ROS process and the pycyphal nodes of one transport."""
 
-    def __init__(self, gen: Any, kind: str, iface_bridge: str, iface_raw: str, mtu: int | None) -> None:
+    def __init__(self, gen: Any, kind: str, iface_bridge: str, iface_raw: str, mtu: int | None,
+                 wire: str = "codec") -> None:
         self.gen, self.kind, self.iface_b, self.iface_r, self.mtu = gen, kind, iface_bridge, iface_raw, mtu
+        self.wire = wire  # the bridge's path asked for: codec (generated wire codecs) or object (converters)
         self.nodes: list[Any] = []
         self.bridge: Any = None
         self.ros: RosSide | None = None
@@ -329,8 +334,6 @@ class Rig:
         return n
 
     async def start(self, rss: dict[str, int]) -> None:
-        from sam_runtime.bridge import Bridge, TransportConfig
-
         tables = self.gen.tables()
         self.imu_map = next(m for m in tables.MAPPINGS if m.topic.name == IMU_TOPIC)
         self.cmd_map = next(m for m in tables.MAPPINGS if m.topic.name == CMD_TOPIC)
@@ -357,12 +360,24 @@ class Rig:
         self.cmd_sample = cmd_cls()
         await asyncio.sleep(0.2)
         rss["before_bridge_kib"] = rss_kib()
-        tc = TransportConfig("can", self.iface_b, self.mtu) if self.kind == "can" else TransportConfig(
-            "udp", self.iface_b)
-        self.bridge = Bridge(self.gen, transport=tc)
-        await self.bridge.start()
+        await self.start_bridge()
         rss["after_bridge_start_kib"] = rss_kib()
         await self.ros.wait_ready()
+        await self.discovered()
+
+    def make_bridge(self) -> Any:
+        from sam_runtime.bridge import Bridge, TransportConfig
+
+        tc = TransportConfig("can", self.iface_b, self.mtu) if self.kind == "can" else TransportConfig(
+            "udp", self.iface_b)
+        return Bridge(self.gen, transport=tc, wire=self.wire, qos_depth=QOS_DEPTH)
+
+    async def start_bridge(self) -> None:
+        self.bridge = self.make_bridge()
+        await self.bridge.start()
+
+    async def discovered(self) -> None:
+        """Until the bridge's ROS endpoints and the ROS process's have matched."""
         deadline = time.monotonic() + 20.0
         while True:
             s = self.bridge.stats()["mappings"]
@@ -372,6 +387,15 @@ class Rig:
             if time.monotonic() > deadline:
                 raise TimeoutError("the bridge did not discover the ROS process")
             await asyncio.sleep(0.05)
+
+    async def swap_bridge(self, wire: str) -> None:
+        """Close the bridge and start another on ``wire`` (same process, nodes and ROS process)."""
+        await self.bridge.close()
+        self.bridge = None
+        self.wire = wire
+        await self.start_bridge()
+        await self.discovered()
+        await asyncio.sleep(0.3)  # the new endpoints settle before anything is timed
 
     def cpu_start(self) -> dict[str, Any]:
         return {"process": process_cpu(), "threads": thread_cpu()}
@@ -387,6 +411,15 @@ class Rig:
             "bridge rclpy thread": delta.get(spin, 0.0) if spin is not None else 0.0,
             "other threads": sum(v for tid, v in delta.items() if tid not in (main_tid, spin)),
         }
+
+    async def drop_nodes(self, keep: int) -> None:
+        """Close the nodes made after the first ``keep``."""
+        from sam_runtime.transport import aclose
+
+        extra, self.nodes[keep:] = self.nodes[keep:], []
+        with contextlib.suppress(Exception):
+            await aclose(*extra)
+        await asyncio.sleep(0.2)
 
     async def close(self) -> None:
         from sam_runtime.transport import aclose
@@ -659,15 +692,101 @@ def per_message_costs(rig: Rig, n: int = 2000) -> dict[str, float]:
             lambda: clock.now().nanoseconds)
     if pub is not None:
         out["rclpy publish of the Imu (1 subscriber)"] = t(lambda: pub.publish(msg))
+    out.update(wire_steps(rig, pub, t))
     return out
+
+
+def wire_steps(rig: Rig, pub: Any, t: Callable[[Any], float]) -> dict[str, float]:
+    """The wire path's steps of the same IMU message and of a command (what replaces the steps above)."""
+    from rclpy.serialization import serialize_message
+
+    codec = rig.gen.codec("dronecan" if rig.kind == "dronecan" else "cyphal")
+    if codec is None:
+        return {}
+    conv = rig.gen.convert_v0() if rig.kind == "dronecan" else rig.gen.convert()
+    stats = conv.ConversionStats()
+    w2r = codec.CODECS[rig.imu_map.name][0]
+    r2w = codec.CODECS[rig.cmd_map.name][1]
+    payload = imu_payload(rig)
+    cdr, _ = w2r(payload, 1, stats)
+    angles = rig.gen.ros_class(rig.cmd_map.topic)(thruster_vertical_radians=0.25, thruster_horizontal_radians=-0.5)
+    cmd_cdr = serialize_message(angles)
+    out = {f"wire path: generated {rig.imu_map.name}_wire_to_ros (payload {len(payload)} B -> CDR {len(cdr)} B)":
+           t(lambda: w2r(payload, 1, stats))}
+    if pub is not None:
+        out["wire path: rclpy publish of the Imu's CDR bytes (raw, 1 subscriber)"] = t(lambda: pub.publish(cdr))
+    out[f"wire path: generated {rig.cmd_map.name}_ros_to_wire (CDR -> payload)"] = t(lambda: r2w(cmd_cdr, stats))
+    return out
+
+
+def imu_payload(rig: Rig) -> bytes:
+    """The IMU sample's transfer payload (classic CAN with tail array optimisation on DroneCAN)."""
+    if rig.kind == "dronecan":
+        from dronecan import transport
+
+        return bytes(transport.Transfer(payload=rig.imu_sample).payload)
+    import pycyphal.dsdl
+
+    return b"".join(pycyphal.dsdl.serialize(rig.imu_sample))
 
 
 # ----------------------------------------------------------------------------------------------- driver
 PATHS = ("u2r_raw", "u2r_bridge", "r2u_raw", "r2u_bridge")
 
 
+async def run_block(rig: Rig, *, reps: int, window_s: float, latency_reps: int, latency_hz: float, latency_s: float,
+                    paths: tuple[str, ...] = PATHS) -> tuple[dict[str, list[Any]], dict[str, list[Any]], int]:
+    """Throughput (``reps`` repetitions) then latency (``latency_reps``) of the four paths on the running bridge;
+    raw and bridge back to back in alternating order. Returns the runs by path and the messages bridged."""
+    paced = getattr(rig, "paced_cpu", rig.paced)
+    for p in paths:  # warm-up
+        await rig.windowed(p, 0.3, cpu=False)
+    tp: dict[str, list[dict[str, Any]]] = {p: [] for p in PATHS}
+    bridged = 0
+    for r in range(reps):
+        for direction in ("u2r", "r2u"):
+            for which in (("raw", "bridge") if r % 2 == 0 else ("bridge", "raw")):
+                res = await rig.windowed(f"{direction}_{which}", window_s)
+                tp[f"{direction}_{which}"].append(res)
+                bridged += res["received"] if which == "bridge" else 0
+                await asyncio.sleep(0.1)
+    log(f"  {rig.kind} ({rig.bridge.wire} path): throughput " + ", ".join(
+        f"{k} {median([x['msg_per_s'] for x in v]):.0f}/s" for k, v in tp.items()))
+    lat: dict[str, list[dict[str, Any]]] = {p: [] for p in PATHS}
+    for r in range(latency_reps):
+        for direction in ("u2r", "r2u"):
+            for which in (("raw", "bridge") if r % 2 == 0 else ("bridge", "raw")):
+                lat[f"{direction}_{which}"].append(await paced(f"{direction}_{which}", latency_hz, latency_s))
+                bridged += lat[f"{direction}_{which}"][-1]["received"] if which == "bridge" else 0
+                await asyncio.sleep(0.1)
+    return tp, lat, bridged
+
+
+async def object_block(rig: Rig, *, reps: int, window_s: float, latency_reps: int, latency_hz: float,
+                       latency_s: float) -> dict[str, Any]:
+    """The same measurement with the bridge on the object path (``wire="object"``), against raw again."""
+    t0 = time.monotonic()
+    await rig.swap_bridge("object")
+    tp, lat, bridged = await run_block(rig, reps=reps, window_s=window_s, latency_reps=latency_reps,
+                                       latency_hz=latency_hz, latency_s=latency_s, paths=("u2r_bridge", "r2u_bridge"))
+    return {"wire": rig.bridge.wire, "reps": reps, "latency_reps": latency_reps, "bridged_messages": bridged,
+            "throughput": _summarize_tp(tp), "latency": _summarize_lat(lat, latency_hz, latency_s),
+            "wall_s": round(time.monotonic() - t0, 1)}
+
+
+def codec_vs_object(codec: dict[str, Any], obj: dict[str, Any]) -> dict[str, float]:
+    """Bridge msg/s of the codec path over the object path's, each normalised by the raw runs of its own block
+    (the blocks run one after the other: the machine's load may differ).
+
+    >>> codec_vs_object({"u2r_ratio": 1.2, "r2u_ratio": 0.9}, {"u2r_ratio": 0.6, "r2u_ratio": 0.6})
+    {'u2r': 2.0, 'r2u': 1.5}
+    """
+    return {d: round(ratio(codec[f"{d}_ratio"], obj[f"{d}_ratio"]), 2) for d in ("u2r", "r2u")}
+
+
 async def measure_transport(gen: Any, kind: str, *, reps: int, window_s: float, latency_hz: float,
-                            latency_s: float, mix_s: float, drain_s: float, mix: bool = True) -> dict[str, Any]:
+                            latency_s: float, mix_s: float, drain_s: float, mix: bool = True,
+                            object_reps: int = 3, object_latency_reps: int = 1) -> dict[str, Any]:
     from sam_runtime.bridge import quiet_late_media_completions
 
     quiet_late_media_completions(asyncio.get_running_loop())
@@ -682,26 +801,11 @@ async def measure_transport(gen: Any, kind: str, *, reps: int, window_s: float, 
     out: dict[str, Any] = {"transport": label, "kind": kind}
     try:
         await rig.start(rss)
-        for p in PATHS:  # warm-up
-            await rig.windowed(p, 0.3, cpu=False)
-        tp: dict[str, list[dict[str, Any]]] = {p: [] for p in PATHS}
-        bridged = 0
-        for r in range(reps):
-            for direction in ("u2r", "r2u"):
-                for which in (("raw", "bridge") if r % 2 == 0 else ("bridge", "raw")):
-                    res = await rig.windowed(f"{direction}_{which}", window_s)
-                    tp[f"{direction}_{which}"].append(res)
-                    bridged += res["received"] if which == "bridge" else 0
-                    await asyncio.sleep(0.1)
-        log(f"  {kind}: throughput " + ", ".join(
-            f"{k} {median([x['msg_per_s'] for x in v]):.0f}/s" for k, v in tp.items()))
-        lat: dict[str, list[dict[str, Any]]] = {p: [] for p in PATHS}
-        for r in range(max(1, reps - 1)):
-            for direction in ("u2r", "r2u"):
-                for which in (("raw", "bridge") if r % 2 == 0 else ("bridge", "raw")):
-                    lat[f"{direction}_{which}"].append(await rig.paced(f"{direction}_{which}", latency_hz, latency_s))
-                    bridged += lat[f"{direction}_{which}"][-1]["received"] if which == "bridge" else 0
-                    await asyncio.sleep(0.1)
+        out["wire"] = rig.bridge.wire  # "object" when the generated package has no codecs (the bridge warns)
+        if out["wire"] != "codec":
+            log(f"WARNING: the bridge took the {out['wire']} path, not the codec one (no generated codec module?)")
+        tp, lat, bridged = await run_block(rig, reps=reps, window_s=window_s, latency_reps=max(1, reps - 2),
+                                           latency_hz=latency_hz, latency_s=latency_s)
         rss["after_bridged_kib"] = rss_kib()
         out["bridged_messages"] = bridged
         out["throughput"] = _summarize_tp(tp)
@@ -713,10 +817,17 @@ async def measure_transport(gen: Any, kind: str, *, reps: int, window_s: float, 
         out["per_message_us"] = per_message_costs(rig)
         await asyncio.sleep(1.0)  # let the ROS process take those before the sensor mix counts
         if mix:
+            n0 = len(rig.nodes)
             out["sensor_mix"] = await sensor_mix(rig, mix_s, drain_s)
+            await rig.drop_nodes(n0)  # the mix's device nodes: on python-can's virtual bus each costs every frame
         st = rig.bridge.stats()
         out["bridge_errors"] = st["bridge"]["errors"]
         out["bridge_dropped"] = {n: m["dropped"] for n, m in st["mappings"].items() if m["dropped_total"]}
+        if object_reps and out["wire"] == "codec":
+            out["object"] = await object_block(rig, reps=object_reps, window_s=window_s,
+                                               latency_reps=object_latency_reps, latency_hz=latency_hz,
+                                               latency_s=latency_s)
+            out["codec_vs_object"] = codec_vs_object(out["throughput"], out["object"]["throughput"])
     finally:
         await rig.close()
     return out
@@ -756,12 +867,17 @@ def _summarize_lat(lat: dict[str, list[dict[str, Any]]], hz: float, seconds: flo
             "samples": sum(r["samples"] for r in runs),
             "lost": sum(r["lost"] for r in runs),
         }
+        for key in ("cpu_ms_per_1000", "cpu_percent"):  # paced runs that measured the CPU (bench.bridge_dronecan)
+            if runs and key in runs[0]:
+                out[name][key] = {k: round(median([x[key][k] for x in runs]), 1) for k in runs[0][key]}
     return out
 
 
 def run(gen: Any, transports: tuple[str, ...] = ("udp", "can"), *, reps: int = 3, window_s: float = 3.0,
         latency_hz: float = 200.0, latency_s: float = 2.5, mix_s: float = 3.0, drain_s: float = 0.5,
-        mix: bool = True) -> dict[str, Any]:
+        mix: bool = True, object_reps: int = 3, object_latency_reps: int = 1) -> dict[str, Any]:
+    """Per transport: the bridge on its wire path (codec) against raw, then on the object path against raw
+    (``object_reps`` throughput and ``object_latency_reps`` latency repetitions; 0: not measured)."""
     import logging
 
     os.environ.setdefault("ROS_DOMAIN_ID", str(150 + os.getpid() % 60))  # private to this run (tests use 1..101)
@@ -771,11 +887,12 @@ def run(gen: Any, transports: tuple[str, ...] = ("udp", "can"), *, reps: int = 3
     results: dict[str, Any] = {"method": {
         "window_in_flight": WINDOW, "window_s": window_s, "reps": reps, "latency_hz": latency_hz,
         "latency_s": latency_s, "mix_s": mix_s, "drain_s": drain_s, "ros_domain_id": os.environ["ROS_DOMAIN_ID"],
+        "latency_reps": max(1, reps - 2), "object_reps": object_reps, "object_latency_reps": object_latency_reps,
     }}
     for kind in transports:
         t0 = time.monotonic()
         kw = dict(reps=reps, window_s=window_s, latency_hz=latency_hz, latency_s=latency_s, mix_s=mix_s,
-                  drain_s=drain_s, mix=mix)
+                  drain_s=drain_s, mix=mix, object_reps=object_reps, object_latency_reps=object_latency_reps)
         if kind == "udp":
             with cyphal_udp_lock() as locked:
                 res = asyncio.run(measure_transport(gen, kind, **kw))
@@ -796,5 +913,5 @@ if __name__ == "__main__":
 
     args = sys.argv[1:]
     kinds = tuple(a for a in args if a in ("udp", "can")) or ("udp", "can")
-    print(json.dumps(run(generated_package(), kinds, reps=2, window_s=2.0, mix="nomix" not in args), indent=1,
-                     default=str))
+    print(json.dumps(run(generated_package(), kinds, reps=2, window_s=2.0, mix="nomix" not in args,
+                         object_reps=0 if "noobject" in args else 2), indent=1, default=str))

@@ -55,18 +55,23 @@ from typing import Any
 from bench.bridge import (
     CMD_TOPIC,
     IMU_TOPIC,
-    PATHS,
+    QOS_DEPTH,
     WINDOW,
     Rig,
     RosSide,
     _summarize_lat,
     _summarize_tp,
+    codec_vs_object,
+    imu_payload,
     now_us,
+    object_block,
     process_cpu,
     rss_kib,
+    run_block,
     thread_cpu,
+    wire_steps,
 )
-from bench.common import log, median
+from bench.common import log
 
 RAW_IMU = "uavcan.equipment.ahrs.RawIMU"
 ARRAY_COMMAND = "uavcan.equipment.actuator.ArrayCommand"
@@ -257,8 +262,8 @@ def array_command_sample() -> Any:
 class DroneCanRig(Rig):
     """bench.bridge.Rig's measurement (windowed, paced, CPU) on the DroneCAN bridge and plain dronecan nodes."""
 
-    def __init__(self, gen: Any, iface_bridge: str, iface_raw: str) -> None:
-        super().__init__(gen, "dronecan", iface_bridge, iface_raw, None)
+    def __init__(self, gen: Any, iface_bridge: str, iface_raw: str, wire: str = "codec") -> None:
+        super().__init__(gen, "dronecan", iface_bridge, iface_raw, None, wire)
         self.plain: list[PlainNode] = []
 
     def plain_node(self, iface: str, node_id: int, name: str, accept: frozenset[int]) -> PlainNode:
@@ -269,7 +274,6 @@ class DroneCanRig(Rig):
     async def start(self, rss: dict[str, int]) -> None:
         import dronecan
 
-        from sam_runtime.bridge import Bridge
         from sam_runtime.dronecan_io import bus_load
 
         self.gen.convert_v0()  # dronecan.load_dsdl() replaces every type object: before any handler is registered
@@ -303,19 +307,15 @@ class DroneCanRig(Rig):
             n.start()
         await asyncio.sleep(0.2)
         rss["before_bridge_kib"] = rss_kib()
-        self.bridge = Bridge(self.gen, layout="dronecan", dronecan_iface=self.iface_b)
-        await self.bridge.start()
+        await self.start_bridge()
         rss["after_bridge_start_kib"] = rss_kib()
         await self.ros.wait_ready()
-        deadline = time.monotonic() + 20.0
-        while True:
-            s = self.bridge.stats()["mappings"]
-            if ((s[self.imu_map.name].get("ros_subscribers") or 0) > 0
-                    and (s[self.cmd_map.name].get("ros_publishers") or 0) > 0):
-                break
-            if time.monotonic() > deadline:
-                raise TimeoutError("the bridge did not discover the ROS process")
-            await asyncio.sleep(0.05)
+        await self.discovered()
+
+    def make_bridge(self) -> Any:
+        from sam_runtime.bridge import Bridge
+
+        return Bridge(self.gen, layout="dronecan", dronecan_iface=self.iface_b, wire=self.wire, qos_depth=QOS_DEPTH)
 
     def cpu_stop(self, t0: dict[str, Any]) -> dict[str, float]:
         p1, t1 = process_cpu(), thread_cpu()
@@ -571,16 +571,20 @@ def per_message_costs(rig: DroneCanRig, n: int = 1000) -> dict[str, float]:
         # transfer ids and a newer stamp, so that the bridge sees a device going on (no gap, no out_of_order).
         handler, device = inbound.handler(group), rig.imu_node.node
         imu.timestamp.usec = now_us()
-        fresh = decode(frames_of(imu))
+        # on the wire path the handler takes the transfer's payload bytes, else dronecan's decoded message
+        fresh = imu_payload(rig) if group.raw else decode(frames_of(imu))
         src = device.node_id
-        out["the bridge's inbound handler in place (imu_to_ros, publish, checks, counters)"] = t(
+        what = "imu_wire_to_ros" if group.raw else "imu_to_ros"
+        out[f"the bridge's inbound handler in place ({what}, publish, checks, counters; {rig.bridge.wire} path)"] = t(
             lambda: handler(fresh, src, device._next_transfer_id(rig.imu_dtid), time.monotonic()))
+    out.update(wire_steps(rig, pub, t))
     return out
 
 
 # ----------------------------------------------------------------------------------------------- driver
 async def measure(gen: Any, *, reps: int, window_s: float, latency_hz: float, latency_s: float, latency_reps: int,
-                  trial_s: float, drain_s: float, bisect: int) -> dict[str, Any]:
+                  trial_s: float, drain_s: float, bisect: int, object_reps: int = 3,
+                  object_latency_reps: int = 1) -> dict[str, Any]:
     from sam_runtime.dronecan_io import bus_load
 
     iface_b, iface_r = private_ifaces()
@@ -596,37 +600,15 @@ async def measure(gen: Any, *, reps: int, window_s: float, latency_hz: float, la
                          "array_command": {"payload_bytes": bus_load.payload_length(rig.cmd_sample),
                                            "frames": bus_load.transfer_cost(
                                                bus_load.payload_length(rig.cmd_sample)).frames}}
-        for p in PATHS:  # warm-up
-            await rig.windowed(p, 0.3, cpu=False)
-        tp: dict[str, list[dict[str, Any]]] = {p: [] for p in PATHS}
-        bridged = 0
-        for r in range(reps):
-            for direction in ("u2r", "r2u"):
-                for which in (("raw", "bridge") if r % 2 == 0 else ("bridge", "raw")):
-                    res = await rig.windowed(f"{direction}_{which}", window_s)
-                    tp[f"{direction}_{which}"].append(res)
-                    bridged += res["received"] if which == "bridge" else 0
-                    await asyncio.sleep(0.1)
-        log("  dronecan: throughput " + ", ".join(
-            f"{k} {median([x['msg_per_s'] for x in v]):.0f}/s" for k, v in tp.items()))
-        lat: dict[str, list[dict[str, Any]]] = {p: [] for p in PATHS}
-        for r in range(latency_reps):
-            for direction in ("u2r", "r2u"):
-                for which in (("raw", "bridge") if r % 2 == 0 else ("bridge", "raw")):
-                    res = await rig.paced_cpu(f"{direction}_{which}", latency_hz, latency_s)
-                    lat[f"{direction}_{which}"].append(res)
-                    bridged += res["received"] if which == "bridge" else 0
-                    await asyncio.sleep(0.1)
+        out["wire"] = rig.bridge.wire  # "object" when the generated package has no codec_v0 (the bridge warns)
+        if out["wire"] != "codec":
+            log(f"WARNING: the DroneCAN bridge took the {out['wire']} path, not the codec one")
+        tp, lat, bridged = await run_block(rig, reps=reps, window_s=window_s, latency_reps=latency_reps,
+                                           latency_hz=latency_hz, latency_s=latency_s)
         rss["after_bridged_kib"] = rss_kib()
         out["bridged_messages"] = bridged
         out["throughput"] = _summarize_tp(tp)
-        out["latency"] = _summarize_lat(lat, latency_hz, latency_s)
-        for name, runs in lat.items():  # CPU at the paced rate
-            keys = list(runs[0]["cpu_ms_per_1000"])
-            out["latency"][name]["cpu_ms_per_1000"] = {k: round(median([x["cpu_ms_per_1000"][k] for x in runs]), 1)
-                                                       for k in keys}
-            out["latency"][name]["cpu_percent"] = {k: round(median([x["cpu_percent"][k] for x in runs]), 1)
-                                                   for k in keys}
+        out["latency"] = _summarize_lat(lat, latency_hz, latency_s)  # with the CPU at the paced rate
         out["rss"] = dict(rss)
         out["rss"]["bridge_footprint_mib"] = round((rss["after_bridge_start_kib"] - rss["before_bridge_kib"]) / 1024, 1)
         out["rss"]["growth_kib_per_1000_bridged"] = round(
@@ -637,6 +619,11 @@ async def measure(gen: Any, *, reps: int, window_s: float, latency_hz: float, la
         st = rig.bridge.stats()
         out["bridge_errors"] = st["bridge"]["errors"]
         out["bridge_dropped"] = {n: m["dropped"] for n, m in st["mappings"].items() if m["dropped_total"]}
+        if object_reps and out["wire"] == "codec":
+            ob = await object_block(rig, reps=object_reps, window_s=window_s, latency_reps=object_latency_reps,
+                                    latency_hz=latency_hz, latency_s=latency_s)
+            out["object"] = ob
+            out["codec_vs_object"] = codec_vs_object(out["throughput"], ob["throughput"])
         out["plain_node_spin_errors"] = sum(n.spin_errors for n in rig.plain)
         out["foreign_transfers"] = rig.cmd_rx.foreign + rig.raw_u2r_rx.foreign + rig.raw_r2u_rx.foreign
     finally:
@@ -645,7 +632,9 @@ async def measure(gen: Any, *, reps: int, window_s: float, latency_hz: float, la
 
 
 def run(gen: Any, *, reps: int = 4, window_s: float = 2.0, latency_hz: float = 100.0, latency_s: float = 2.0,
-        latency_reps: int = 2, trial_s: float = 2.5, drain_s: float = 0.5, bisect: int = 3) -> dict[str, Any]:
+        latency_reps: int = 2, trial_s: float = 2.5, drain_s: float = 0.5, bisect: int = 3, object_reps: int = 2,
+        object_latency_reps: int = 1) -> dict[str, Any]:
+    """The bridge on its wire path (codec_v0) against raw dronecan, then on the object path against raw again."""
     import logging
 
     os.environ.setdefault("ROS_DOMAIN_ID", str(150 + os.getpid() % 60))  # private to this run (tests use 1..101)
@@ -654,16 +643,18 @@ def run(gen: Any, *, reps: int = 4, window_s: float = 2.0, latency_hz: float = 1
     gen.convert_v0()
     t0 = time.monotonic()
     res = asyncio.run(measure(gen, reps=reps, window_s=window_s, latency_hz=latency_hz, latency_s=latency_s,
-                              latency_reps=latency_reps, trial_s=trial_s, drain_s=drain_s, bisect=bisect))
+                              latency_reps=latency_reps, trial_s=trial_s, drain_s=drain_s, bisect=bisect,
+                              object_reps=object_reps, object_latency_reps=object_latency_reps))
     res["method"] = {"window_in_flight": WINDOW, "window_s": window_s, "reps": reps, "latency_hz": latency_hz,
                      "latency_s": latency_s, "latency_reps": latency_reps, "trial_s": trial_s, "drain_s": drain_s,
-                     "bisect": bisect, "ros_domain_id": os.environ["ROS_DOMAIN_ID"]}
+                     "bisect": bisect, "object_reps": object_reps, "object_latency_reps": object_latency_reps,
+                     "ros_domain_id": os.environ["ROS_DOMAIN_ID"]}
     res["wall_s"] = round(time.monotonic() - t0, 1)
     log(f"dronecan: done in {res['wall_s']} s")
     return res
 
 
-QUICK = dict(reps=2, window_s=1.5, latency_s=1.5, latency_reps=1, trial_s=1.5, bisect=2)
+QUICK = dict(reps=2, window_s=1.5, latency_s=1.5, latency_reps=1, trial_s=1.5, bisect=2, object_reps=2)
 
 
 if __name__ == "__main__":

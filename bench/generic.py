@@ -24,6 +24,15 @@ def _get(obj: Any, path: tuple[PathSeg, ...]) -> Any:
     return obj
 
 
+def _name(path: tuple[PathSeg, ...]) -> str:
+    """``a.b[2]``: the counter key of a path (as convert.py's).
+
+    >>> _name((("a", None), ("b", 2)))
+    'a.b[2]'
+    """
+    return ".".join(name if index is None else f"{name}[{index}]" for name, index in path)
+
+
 def _set(obj: Any, path: tuple[PathSeg, ...], value: Any) -> None:
     for name, index in path[:-1]:
         obj = getattr(obj, name)
@@ -102,7 +111,10 @@ class GenericMapping:
                 stamped = stamped or step.ros_path == (("header", None), ("stamp", None))
                 continue
             if kind == "table":
-                value = dict(step.table)[int(value)]
+                value = dict(step.table).get(int(value), step.table_default)
+                if value is None:  # a key the table does not list, and no default: rejected
+                    stats.reject(f"{self.name}.{_name(step.uavcan_path)}")
+                    return None
             elif step.scale is not None or step.offset is not None:
                 scale, offset = step.scale or 1.0, step.offset or 0.0
                 if hasattr(value, "tolist"):
@@ -131,7 +143,10 @@ class GenericMapping:
                 inverse: dict[int, int] = {}
                 for k, v in step.table:
                     inverse.setdefault(v, k)
-                value = inverse[int(value)]
+                value = inverse.get(int(value))
+                if value is None:  # no key has this value: rejected
+                    stats.reject(f"{self.name}.{_name(step.uavcan_path)}")
+                    return None
             else:
                 if step.scale is not None or step.offset is not None:
                     scale, offset = step.scale or 1.0, step.offset or 0.0

@@ -30,7 +30,7 @@ from sam_msgs.msg import (
     ThrusterRPMs,
     ThrustVectorFeedback,
 )
-from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix
+from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix, Range
 
 NAN = float("nan")
 
@@ -121,10 +121,24 @@ def battery_state_to_ros(uav_msg: Any, receive_ns: int, stats: Any) -> BatterySt
     ros_msg.current = uav_msg.current
     ros_msg.temperature = uav_msg.temperature - 273.15
     ros_msg.percentage = uav_msg.state_of_charge_pct * 0.01
+    pct = uav_msg.state_of_health_pct  # the spec's table: below 30 % DEAD, 127 UNKNOWN, else GOOD
+    ros_msg.power_supply_health = 3 if pct < 30 else 0 if pct == 127 else 1
     ros_msg.charge = NAN
     ros_msg.capacity = NAN
     ros_msg.design_capacity = NAN
     ros_msg.present = True
+    return ros_msg
+
+
+def altitude_to_ros(uav_msg: Any, receive_ns: int, stats: Any) -> Range:
+    ros_msg = Range()
+    ros_msg.header.stamp = convert_timestamp(uav_msg.timestamp, receive_ns)
+    ros_msg.header.frame_id = "altimeter_link"
+    ros_msg.field_of_view = 0.1
+    ros_msg.min_range = 0.3
+    ros_msg.max_range = 100.0
+    ros_msg.range = uav_msg.altitude
+    ros_msg.variance = uav_msg.altitude_variance
     return ros_msg
 
 
@@ -260,6 +274,18 @@ def battery_state_to_uavcan(ros_msg: Any, stats: Any) -> Any:
     uav_msg.current = ros_msg.current
     uav_msg.temperature = ros_msg.temperature + 273.15
     uav_msg.state_of_charge_pct = round(ros_msg.percentage / 0.01)
+    health = {3: 0, 0: 127}.get(ros_msg.power_supply_health)  # the table's inverse: GOOD has no key
+    if health is None:
+        return None
+    uav_msg.state_of_health_pct = health
+    return uav_msg
+
+
+def altitude_to_uavcan(ros_msg: Any, stats: Any) -> Any:
+    uav_msg = sam.sensor.Altitude_0_1()
+    uav_msg.timestamp = convert_stamp(ros_msg.header.stamp)
+    uav_msg.altitude = ros_msg.range
+    uav_msg.altitude_variance = ros_msg.variance
     return uav_msg
 
 
@@ -346,6 +372,7 @@ CONVERTERS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "gps_fix": (gps_fix_to_ros, gps_fix_to_uavcan),
     "pressure": (pressure_to_ros, pressure_to_uavcan),
     "battery_state": (battery_state_to_ros, battery_state_to_uavcan),
+    "altitude": (altitude_to_ros, altitude_to_uavcan),
     "battery_info": (battery_info_to_ros, battery_info_to_uavcan),
     "thruster_1_rpm": (thruster_1_rpm_to_ros, thruster_1_rpm_to_uavcan),
     "thruster_2_rpm": (thruster_2_rpm_to_ros, thruster_2_rpm_to_uavcan),

@@ -6,7 +6,8 @@
 Runs the flow-controlled throughput measurement of bench/bridge.py (``dronecan``: bench/bridge_dronecan.py, the
 bridge on DroneCAN with plain dronecan nodes) on that path and prints, per thread, the
 functions by own time and the top cumulative entries (PROFILE_FILTER=regex restricts the listing; PROFILE=0 runs
-without the profiler, for the plain figure). Not part of `nox -s bench`.
+without the profiler, for the plain figure; PROFILE_WIRE=object profiles the bridge's object path instead of its
+wire path). Not part of `nox -s bench`.
 
 Experiments (monkeypatches in this process only, to size a proposed fix of runtime/bridge/ before anyone makes
 it; nothing is changed on disk):
@@ -206,6 +207,7 @@ async def main(path_name: str, kind: str, seconds: float) -> None:
     else:
         rig = (Rig(gen, "udp", "127.0.0.1", "127.0.0.1", None) if kind == "udp"
                else Rig(gen, "can", f"virtual:pb{pid}", f"virtual:pr{pid}", 64))
+    rig.wire = os.environ.get("PROFILE_WIRE", "codec")  # the bridge's path: codec (wire codecs) or object
     profile = os.environ.get("PROFILE", "1") != "0"
     if profile:
         threading.setprofile(_thread_hook)
@@ -218,7 +220,8 @@ async def main(path_name: str, kind: str, seconds: float) -> None:
             main_prof.enable()
         res = await rig.windowed(path_name, seconds)
         main_prof.disable()
-        print(f"{path_name} on {kind}: {res['msg_per_s']:.0f} msg/s, lost {res['lost']}, CPU s {res['cpu_s']}")
+        print(f"{path_name} on {kind} ({rig.bridge.wire} path): {res['msg_per_s']:.0f} msg/s, lost {res['lost']}, "
+              f"CPU s {res['cpu_s']}")
     finally:
         threading.setprofile(None)
         await rig.close()

@@ -1,14 +1,18 @@
-"""The benchmark session of issue 5 (`nox -s bench`; not part of the tests), with issue 10's DroneCAN part.
+"""The benchmark session of issue 5 (`nox -s bench`; not part of the tests), with issue 10's DroneCAN part and
+issue 12's wire codecs.
 
-    python -m bench.run [--quick] [--parts generator,converters,bridge,dronecan] [--transports udp,can] [--out DIR]
+    python -m bench.run [--quick] [--parts generator,converters,codec,bridge,dronecan] [--transports udp,can]
+                        [--out DIR]
 
 Runs the parts, prints the tables, writes DIR/results.md, DIR/results.json and DIR/scaling.png
 (DIR default bench/results). Every figure is a ratio against a reference measured in the same run, with the
-absolute numbers beside it. About 7-8 minutes on the project's 2-core machine (``--quick``: about 3).
+absolute numbers beside it. About 11 minutes on the project's 2-core machine (``--quick``: about 5).
 
-Parts: ``generator``, ``converters``, ``bridge`` (Cyphal/UDP and Cyphal/CAN FD, bench/bridge.py: ~5 min) and
-``dronecan`` (the bridge on DroneCAN, layout ``dronecan``, against raw dronecan on the loopback multicast bus,
-bench/bridge_dronecan.py: under 2 min, ``--quick`` under 1). One part alone, e.g. the DroneCAN one:
+Parts: ``generator``, ``converters``, ``codec`` (every generated wire codec against the object pipeline it
+replaces, Cyphal and DroneCAN, bench/codec.py: ~15 s), ``bridge`` (Cyphal/UDP and Cyphal/CAN FD, bench/bridge.py:
+the bridge on its wire path, then on its object path, each against raw pycyphal: ~6 min) and ``dronecan`` (the
+bridge on DroneCAN, layout ``dronecan``, both paths against raw dronecan on the loopback multicast bus,
+bench/bridge_dronecan.py: ~2.5 min, ``--quick`` ~1). One part alone, e.g. the DroneCAN one:
 
     python -m bench.run --parts dronecan [--quick] [--out DIR]
 
@@ -19,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -27,8 +30,24 @@ from typing import Any
 
 import bench.common  # noqa: F401  (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST before anything can import rclpy)
 from bench.common import RESULTS, generated_package, log, machine
+from bench.report_fmt import num as _f
+from bench.report_fmt import ok as _ok
+from bench.report_fmt import table
+from bench.report_notes import notes
+from bench.report_wire import (
+    TARGET_CYPHAL,
+    TARGET_DRONECAN,
+    TRANSPORT_HEADER,
+    block_method,
+    blocks,
+    bridge_rows,
+    codec_markdown,
+    codec_rows,
+    cpu_split_rows,
+    transport_rows,
+)
 
-DEFAULT_PARTS = "generator,converters,bridge,dronecan"
+DEFAULT_PARTS = "generator,converters,codec,bridge,dronecan"
 
 
 def loadavg() -> list[float]:
@@ -36,31 +55,6 @@ def loadavg() -> list[float]:
         return [float(x) for x in Path("/proc/loadavg").read_text().split()[:3]]
     except OSError:
         return []
-
-
-def _f(x: Any, digits: int = 2) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "-"
-    if isinstance(x, float):
-        return f"{x:,.{digits}f}"
-    if isinstance(x, int):
-        return f"{x:,}"
-    return str(x)
-
-
-def _spread(runs: list[float] | None) -> str:
-    """` (0.74-0.93)`: the range of the repetitions' ratios, where there are several."""
-    return f" ({min(runs):.2f}-{max(runs):.2f})" if runs and len(runs) > 1 else ""
-
-
-def _range(xs: list[float]) -> str:
-    """`87` or `87-98`."""
-    lo, hi = f"{min(xs):.0f}", f"{max(xs):.0f}"
-    return lo if lo == hi else f"{lo}-{hi}"
-
-
-def _ok(flag: bool | None) -> str:
-    return "-" if flag is None else ("met" if flag else "**missed**")
 
 
 # ----------------------------------------------------------------------------------------------- markdown
@@ -87,7 +81,8 @@ def summary_rows(res: dict[str, Any]) -> list[list[str]]:
     if conv:
         s = conv["summary"]["all"]
         t = conv["targets"]
-        rows.append(["Converters vs hand-written (34 = 17 mappings x 2 directions)",
+        rows.append([f"Converters vs hand-written ({s['converters']} = {s['converters'] // 2} mappings x 2 "
+                     "directions)",
                      f"geomean {s['geomean_vs_handwritten']:.2f}x, min {s['min_vs_handwritten']:.2f}x",
                      "doc-style hand-written",
                      f"{s['meet_hand_target']}/{s['converters']} at >= {t['vs_handwritten']}x",
@@ -96,17 +91,13 @@ def summary_rows(res: dict[str, Any]) -> list[list[str]]:
                      f"geomean {s['geomean_vs_generic']:.2f}x, min {s['min_vs_generic']:.2f}x", "generic copier",
                      f"{s['meet_generic_target']}/{s['converters']} at >= {t['vs_generic']}x",
                      f">= {t['vs_generic']}x", _ok(s["meet_generic_target"] == s["converters"])])
+    rows += codec_rows(res.get("codec"))
     br = res.get("bridge") or {}
     for kind in ("udp", "can"):
         b = br.get(kind)
         if not b or "throughput" not in b:
             continue
-        tp = b["throughput"]
-        for d, label in (("u2r", "UAVCAN->ROS"), ("r2u", "ROS->UAVCAN")):
-            rows.append([f"Bridge {label}, {b['transport']}", f"{_f(tp[f'{d}_bridge']['msg_per_s'])} msg/s",
-                         f"raw pycyphal {_f(tp[f'{d}_raw']['msg_per_s'])} msg/s", f"{tp[f'{d}_ratio']:.2f}x"
-                         + _spread(tp.get(f"{d}_ratio_runs")),
-                         ">= 0.8x", _ok(round(tp[f"{d}_ratio"], 2) >= 0.8)])
+        rows += bridge_rows(b, "raw pycyphal", TARGET_CYPHAL)
         mix = b.get("sensor_mix")
         if mix:
             rows.append([f"SAM sensor mix, zero loss, {b['transport']}",
@@ -115,13 +106,8 @@ def summary_rows(res: dict[str, Any]) -> list[list[str]]:
                          f"{mix['max_sustained_k']:g}x nominal", "-", "-"])
     dc = res.get("dronecan")
     if dc and "throughput" in dc:
-        tp = dc["throughput"]
-        for d, label in (("u2r", "UAVCAN->ROS (RawIMU -> /imu)"), ("r2u", "ROS->UAVCAN (/thruster_angles -> "
-                                                                         "ArrayCommand)")):
-            rows.append([f"Bridge {label}, {dc['transport']}", f"{_f(tp[f'{d}_bridge']['msg_per_s'])} msg/s",
-                         f"raw dronecan {_f(tp[f'{d}_raw']['msg_per_s'])} msg/s", f"{tp[f'{d}_ratio']:.2f}x"
-                         + _spread(tp.get(f"{d}_ratio_runs")),
-                         ">= 0.8x", _ok(round(tp[f"{d}_ratio"], 2) >= 0.8)])
+        rows += bridge_rows(dc, "raw dronecan", TARGET_DRONECAN, (" (RawIMU -> /imu)",
+                                                                  " (/thruster_angles -> ArrayCommand)"))
         lat = dc.get("latency")
         if lat:
             def pp(x: dict[str, Any]) -> str:
@@ -141,12 +127,6 @@ def summary_rows(res: dict[str, Any]) -> list[list[str]]:
                          f"{z['share_of_bus_nominal']:.2f}x a saturated bus ({z['share_of_bus_worst_case']:.2f}x)",
                          "-", "-"])
     return rows
-
-
-def table(header: list[str], rows: list[list[str]]) -> str:
-    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    out += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(out)
 
 
 def markdown(res: dict[str, Any], command: str) -> str:
@@ -232,10 +212,13 @@ def markdown(res: dict[str, Any], command: str) -> str:
                               f"{v['min_vs_handwritten']:.2f}", f"{v['geomean_vs_generic']:.2f}",
                               f"{v['min_vs_generic']:.2f}"]
                              for d, v in s.items()])]
+    codec = res.get("codec")
+    if codec:
+        lines += codec_markdown(codec, "3")
     br = res.get("bridge") or {}
     if br:
         meth = br["method"]
-        lines += ["", "## 3. Bridge", "",
+        lines += ["", "## 4. Bridge", "",
                   "The bridge (runtime/bridge.py, public API, default settings) and the pycyphal device and receiver "
                   "nodes share one process and asyncio loop (python-can's virtual bus exists only inside one process); "
                   "the ROS side (subscribers of the bridged topics, the command publisher) is a separate process, as "
@@ -246,34 +229,19 @@ def markdown(res: dict[str, Any], command: str) -> str:
                   "msg/s are medians, the ratio is the median of the repetitions' ratios (their range in brackets). "
                   "UAVCAN->ROS: sam.sensor.RawIMU (120 bytes, one "
                   "UDP datagram, 2 CAN FD frames) -> /imu; ROS->UAVCAN: sam_msgs/ThrusterAngles on /thruster_angles -> "
-                  f"subject 1202. Latency at {meth['latency_hz']:g} msg/s for {meth['latency_s']} s: "
+                  f"subject 1202. Latency at {meth['latency_hz']:g} msg/s for {meth['latency_s']} s "
+                  f"({meth.get('latency_reps', meth['reps'] - 1)} repetitions): "
                   "UAVCAN publish -> ROS callback and ROS publish -> UAVCAN receive. CPU: this process (all its "
                   "threads) per 1000 messages; the ROS process beside it.", ""]
         for kind in ("udp", "can"):
             b = br.get(kind)
             if not b or "throughput" not in b:
                 continue
-            tp, lat = b["throughput"], b["latency"]
-            lines += [f"### {b['transport']}", ""]
-            rows = []
-            for d, label in (("u2r", "UAVCAN->ROS"), ("r2u", "ROS->UAVCAN")):
-                br_, raw = tp[f"{d}_bridge"], tp[f"{d}_raw"]
-                lb, lr = lat[f"{d}_bridge"], lat[f"{d}_raw"]
-                rows.append([label, _f(br_["msg_per_s"]), _f(raw["msg_per_s"]),
-                             f"{tp[f'{d}_ratio']:.2f}" + _spread(tp.get(f"{d}_ratio_runs")),
-                             f"{lb['p50_us'] / 1e3:.2f} / {lb['p99_us'] / 1e3:.2f} / {lb['max_us'] / 1e3:.2f}",
-                             f"{lr['p50_us'] / 1e3:.2f} / {lr['p99_us'] / 1e3:.2f} / {lr['max_us'] / 1e3:.2f}",
-                             _f(br_["cpu_ms_per_1000"].get("process"), 0), _f(raw["cpu_ms_per_1000"].get("process"), 0),
-                             _f(br_["cpu_ms_per_1000"].get("ROS process"), 0), str(br_["lost"] + lb["lost"])])
-            lines.append(table(["direction", "bridge msg/s", "raw msg/s", "ratio", "bridge latency p50/p99/max ms",
-                                "raw latency p50/p99/max ms", "CPU ms/1000, bridge run", "CPU ms/1000, raw run",
-                                "ROS process CPU ms/1000", "lost"], rows))
-            split = [[f"{d} {w}"] + [_f(tp[f"{d}_{w}"]["cpu_ms_per_1000"].get(k), 0) for k in
-                                      ("main (asyncio loop)", "bridge rclpy thread", "other threads", "ROS process")]
-                     for d in ("u2r", "r2u") for w in ("bridge", "raw")]
-            lines += ["", "CPU ms per 1000 messages by thread:", "",
+            lines += [f"### {b['transport']}", "", block_method(b, meth), "",
+                      table(TRANSPORT_HEADER, transport_rows(b))]
+            lines += ["", "CPU ms per 1000 messages by thread (throughput runs):", "",
                       table(["run", "main (asyncio loop)", "bridge rclpy thread", "other threads (DDS, transport I/O)",
-                             "ROS process"], split)]
+                             "ROS process"], cpu_split_rows(b))]
             rss = b["rss"]
             lines += ["", f"Resident memory: {rss['before_bridge_kib'] / 1024:.0f} MiB before the bridge starts "
                       f"(pycyphal, rclpy, nodes imported), {rss['after_bridge_start_kib'] / 1024:.0f} MiB after "
@@ -310,9 +278,9 @@ def markdown(res: dict[str, Any], command: str) -> str:
 
 def dronecan_markdown(dc: dict[str, Any]) -> list[str]:
     """Section 4: the bridge on DroneCAN (bench/bridge_dronecan.py)."""
-    meth, tp, lat, z = dc["method"], dc["throughput"], dc["latency"], dc.get("zero_loss")
+    meth, lat, z = dc["method"], dc["latency"], dc.get("zero_loss")
     fr = dc["frames"]
-    lines = ["", "## 4. Bridge on DroneCAN", "",
+    lines = ["", "## 5. Bridge on DroneCAN", "",
              f"The bridge with the spec's `dronecan` layout (`Bridge(gen, layout=\"dronecan\", "
              f"dronecan_iface=...)`: node {dc.get('bridge_node_id', 100)}, FrameGate and NodeLoop on the asyncio "
              "loop) and plain `dronecan` nodes (`dronecan.node.Node` on sam_runtime's LoopbackMulticastDriver, "
@@ -333,30 +301,17 @@ def dronecan_markdown(dc: dict[str, Any]) -> list[str]:
              "order): msg/s are medians, the ratio the median of the repetitions' ratios (range in brackets). "
              f"Latency: paced at {lat['rate_hz']:g} msg/s for {lat['seconds']} s "
              f"({meth['latency_reps']} repetition(s)), with the CPU of both processes over it.", ""]
-    rows = []
-    for d, label in (("u2r", "UAVCAN->ROS"), ("r2u", "ROS->UAVCAN")):
-        b, r = tp[f"{d}_bridge"], tp[f"{d}_raw"]
-        lb, lr = lat[f"{d}_bridge"], lat[f"{d}_raw"]
-        rows.append([label, _f(b["msg_per_s"]), _f(r["msg_per_s"]),
-                     f"{tp[f'{d}_ratio']:.2f}" + _spread(tp.get(f"{d}_ratio_runs")),
-                     f"{lb['p50_us'] / 1e3:.2f} / {lb['p99_us'] / 1e3:.2f} / {lb['max_us'] / 1e3:.2f}",
-                     f"{lr['p50_us'] / 1e3:.2f} / {lr['p99_us'] / 1e3:.2f} / {lr['max_us'] / 1e3:.2f}",
-                     _f(b["cpu_ms_per_1000"].get("process"), 0), _f(r["cpu_ms_per_1000"].get("process"), 0),
-                     _f(b["cpu_ms_per_1000"].get("ROS process"), 0), f"{b['lost']} / {lb['lost']}"])
-    lines.append(table(["direction", "bridge msg/s", "raw msg/s", "ratio", "bridge latency p50/p99/max ms",
-                        "raw latency p50/p99/max ms", "CPU ms/1000, bridge run", "CPU ms/1000, raw run",
-                        "ROS process CPU ms/1000", "lost (throughput / latency runs)"], rows))
-    split = [[f"{d} {w}"] + [_f(tp[f"{d}_{w}"]["cpu_ms_per_1000"].get(k), 0) for k in
-                              ("main (asyncio loop)", "bridge rclpy thread", "other threads", "ROS process")]
-             for d in ("u2r", "r2u") for w in ("bridge", "raw")]
+    lines += [block_method(dc, meth), "", table(TRANSPORT_HEADER, transport_rows(dc))]
     lines += ["", "CPU ms per 1000 messages by thread (throughput runs):", "",
               table(["run", "main (asyncio loop)", "bridge rclpy thread", "other threads (DDS, I/O)", "ROS process"],
-                    split)]
-    paced = [[f"{d} {w}", _f(lat[f"{d}_{w}"]["cpu_percent"]["process"], 1),
-              _f(lat[f"{d}_{w}"]["cpu_percent"]["ROS process"], 1),
-              _f(lat[f"{d}_{w}"]["cpu_ms_per_1000"]["process"], 0),
-              _f(lat[f"{d}_{w}"]["cpu_ms_per_1000"]["ROS process"], 0)]
-             for d in ("u2r", "r2u") for w in ("bridge", "raw")]
+                    cpu_split_rows(dc))]
+    paced = [[f"{d} {w}" + (f" ({'codec' if name.startswith('wire') else name.split()[0]})" if w == "bridge" else ""),
+              _f(bl["latency"][f"{d}_{w}"]["cpu_percent"]["process"], 1),
+              _f(bl["latency"][f"{d}_{w}"]["cpu_percent"]["ROS process"], 1),
+              _f(bl["latency"][f"{d}_{w}"]["cpu_ms_per_1000"]["process"], 0),
+              _f(bl["latency"][f"{d}_{w}"]["cpu_ms_per_1000"]["ROS process"], 0)]
+             for name, bl in blocks(dc) for d in ("u2r", "r2u") for w in ("bridge", "raw")
+             if "cpu_percent" in bl["latency"][f"{d}_{w}"]]
     lines += ["", f"CPU at {lat['rate_hz']:g} msg/s (paced runs; the process's idle work, its timers and the "
               "nodes' NodeStatus, included):", "",
               table(["run", "this process % of a core", "ROS process % of a core", "this process ms/1000",
@@ -395,193 +350,6 @@ def dronecan_markdown(dc: dict[str, Any]) -> list[str]:
     return lines
 
 
-def notes(res: dict[str, Any]) -> list[str]:
-    """The closing note: what limits each figure, from this run's numbers and the profiles (bench/profile_bridge.py)."""
-    out: list[str] = []
-    gen = res.get("generator")
-    if gen and gen.get("stages_at_largest", {}).get("seconds"):
-        st = gen["stages_at_largest"]["seconds"]
-        top = sorted(st.items(), key=lambda kv: -kv[1])[:3]
-        growth = gen["growth"]["sam-codegen build"]
-        out.append(
-            f"- **Generator.** Fitted exponent {growth['fitted_exponent']} (local "
-            f"{', '.join(f'{k}: {_f(e)}' for k, e in growth['local_exponents'].items())}); pycyphal's own compile "
-            f"{gen['growth']['pycyphal compile']['fitted_exponent']}. At {gen['stages_at_largest']['types']} types "
-            f"the largest stages are {', '.join(f'{k.strip()} ({v:.2f} s)' for k, v in top)}. pydsdl's namespace "
-            "checks are quadratic (pairwise fixed-port-id check, a scan of every definition per type read), so the "
-            "generator has pydsdl read the emitted DSDL in batches of bounded size (codegen/build.py DSDL_BATCH); "
-            "pycyphal's compile has pydsdl read the whole namespace in one call.")
-    conv = res.get("converters")
-    if conv:
-        s = conv["summary"]
-        imu = next((r for r in conv["rows"] if r["mapping"] == "imu" and r["direction"] == "to_ros"), None)
-        imu_txt = (f"`sensor_msgs/Imu()` alone takes {imu['ctor_ns'] / 1e3:.1f} us, convert.py's constructor "
-                   f"{_f(imu.get('generated_ctor_ns'), 0)} ns, the whole generated imu_to_ros "
-                   f"{imu['ns_per_call']['generated'] / 1e3:.1f} us" if imu else "see the ctor columns")
-        out.append(
-            f"- **Converters.** Generated vs hand-written: geomean {s['all']['geomean_vs_handwritten']:.2f}x (min "
-            f"{s['all']['min_vs_handwritten']:.2f}x); vs the generic copier: geomean "
-            f"{s['all']['geomean_vs_generic']:.2f}x (min {s['all']['min_vs_generic']:.2f}x; to ROS "
-            f"{s['to_ros']['geomean_vs_generic']:.2f}x, to UAVCAN {s['to_uavcan']['geomean_vs_generic']:.2f}x). "
-            "The destination's class constructor used to be most of every converter's time: a rosidl class's "
-            "`__init__` builds every default sub-message even when one is passed, and a pycyphal class's checks "
-            "and copies every array again. The generated converters now compute every value first (every check "
-            "and drop before anything is built), then call convert.py's own constructors, which set the classes' "
-            f"attributes directly ({imu_txt}). convert.py proves at import that each of its constructors builds "
-            "what the class builds (`FAST_CONSTRUCTORS`; with ROS_PYTHON_CHECK_FIELDS=1 or another "
-            "rosidl/nunavut layout it uses the classes), and tests/test_converters.py checks both paths give the "
-            "same messages. What is left is reading numpy arrays (`.tolist()`) and building numpy arrays for the "
-            "fixed-size fields.")
-    br = res.get("bridge") or {}
-    udp = br.get("udp") or {}
-    if udp.get("throughput"):
-        tp = udp["throughput"]
-        steps = udp.get("per_message_us") or {}
-
-        def cpu(run: str, key: str) -> float:
-            return float(tp[run]["cpu_ms_per_1000"].get(key, math.nan))
-
-        def split(direction: str) -> str:
-            b, r = f"{direction}_bridge", f"{direction}_raw"
-            return (f"per message, this process {cpu(b, 'process'):.0f} us against {cpu(r, 'process'):.0f} us raw "
-                    f"(asyncio loop {cpu(b, 'main (asyncio loop)'):.0f} vs {cpu(r, 'main (asyncio loop)'):.0f}, "
-                    f"the bridge's rclpy thread {cpu(b, 'bridge rclpy thread'):.0f}, DDS and I/O threads "
-                    f"{cpu(b, 'other threads'):.0f} vs {cpu(r, 'other threads'):.0f}) plus "
-                    f"{cpu(b, 'ROS process'):.0f} us in the ROS process, which raw does not have")
-
-        publish = steps.get("rclpy publish of the Imu (1 subscriber)", math.nan)
-        convert = steps.get("generated imu_to_ros", math.nan)
-        out.append(
-            f"- **Bridge throughput** (UDP: {tp['u2r_ratio']:.2f}x raw UAVCAN->ROS, {tp['r2u_ratio']:.2f}x "
-            "ROS->UAVCAN). The runs are CPU-bound on the 2 cores, and the ratio follows the CPU each message costs "
-            f"across both processes. UAVCAN->ROS: {split('u2r')}. ROS->UAVCAN: {split('r2u')}. The bridge's own "
-            f"Python per message is small: the converter {convert:.1f} us, the receive stamp "
-            f"{steps.get('bridge: receive stamp per message (system clock unless use_sim_time)', math.nan):.1f} us, "
-            f"its bookkeeping a few us; rclpy's publish alone is {publish:.1f} us, and under load it and Fast DDS's "
-            "threads take several times that (GIL hand-overs between the asyncio loop, the rclpy thread and DDS "
-            "callbacks). What the profiles (`python -m bench.profile_bridge`, `... ab udp` for A/B of the bridge's "
-            "own options) showed and was fixed: the Python executor (now rclpy's EventsExecutor, spinning in 0.1 s "
-            "slices), one loop wake-up per ROS message (now one per batch), the ROS clock read per message (now "
-            "`time.time_ns()` unless use_sim_time), the message constructors (now convert.py's own). What is left "
-            "is the cost of a DDS publication and its delivery to another process, which the raw reference does "
-            "not pay; reaching 0.8x would need the bridge path to cost at most 1.25x the raw pycyphal path, "
-            "i.e. a ROS publish plus delivery in ~25% of what one pycyphal transfer costs in Python. Tried and "
-            "not kept: rclpy without its QoS-event handlers (no gain with the EventsExecutor), Fast DDS "
-            "asynchronous publication mode (slower).")
-    can = br.get("can") or {}
-    mixes = [b["sensor_mix"] for b in (udp, can) if b.get("sensor_mix")]
-    if mixes:
-        trials = [t for m in mixes for t in m["trials"]]
-        failed = [t for t in trials if not t["sustained"]]
-        why = sorted({("publishers behind schedule" if not t["on_schedule"] else "")
-                      + (", messages lost" if t["lost"] else "") + (", bridge drops" if t["bridge_dropped"] else "")
-                      for t in failed} - {""})
-        can_nodes = (can.get("sensor_mix") or {}).get("nodes_on_bus")
-        out.append(
-            f"- **Sensor mix.** The simulated devices ({mixes[0]['device_nodes']} nodes) publish from the bridge's "
-            "own process and asyncio loop, so the rate at which that loop falls 0.25 s behind its schedule bounds the "
-            f"figure; the failing trials failed by: {'; '.join(why) or 'nothing'} "
-            f"({sum(t['lost'] for t in trials)} messages lost and {sum(t['bridge_dropped'] for t in trials)} bridge "
-            "drops over all trials). On python-can's virtual bus every frame is handed, in Python, to every other "
-            f"node on the bus ({can_nodes} there): that fan-out, not the bridge, bounds the CAN figure; a real CAN "
-            "bus filters in hardware. Both figures are lower bounds for the bridge alone.")
-    dc = res.get("dronecan") or {}
-    if dc.get("throughput"):
-        out += dronecan_notes(dc)
-    out.append(
-        "- **Method limits.** 2 cores shared by the publisher, the bridge, DDS threads and the ROS process, and by "
-        "whatever else runs on the machine (see the load average); raw and bridge runs alternate so drifts hit both. "
-        "py-spy cannot attach here (ptrace is refused), so profiles are cProfile of every thread "
-        "(`python -m bench.profile_bridge`).")
-    return out
-
-
-def dronecan_notes(dc: dict[str, Any]) -> list[str]:
-    """What limits the DroneCAN figures, from this run's numbers."""
-    tp, pm, meth = dc["throughput"], dc.get("per_message_us") or {}, dc["method"]
-
-    def cpu(run: str, key: str = "process") -> float:
-        return float(tp[run]["cpu_ms_per_1000"].get(key, math.nan))
-
-    def step(prefix: str) -> float:
-        return next((v for k, v in pm.items() if k.strip().startswith(prefix)), math.nan)
-
-    reads = step("of which: reading the fields")
-    out = [
-        f"- **Bridge on DroneCAN, throughput** ({tp['u2r_ratio']:.2f}x raw UAVCAN->ROS, {tp['r2u_ratio']:.2f}x "
-        "ROS->UAVCAN). Both runs are bound by this process's one Python thread at a time (the GIL): the device or "
-        "sender, the receiver and the bridge's dronecan node all run dronecan's pure-Python code on the asyncio "
-        "loop, so msg/s follows 1 / (CPU per message in this process) and the ratio follows raw CPU / bridge CPU "
-        f"per message. UAVCAN->ROS: {cpu('u2r_bridge'):.0f} us per message in this process against "
-        f"{cpu('u2r_raw'):.0f} us raw (plus {cpu('u2r_bridge', 'ROS process'):.0f} us in the ROS process, on the "
-        "other core). Common to both: the device's encode of a RawIMU "
-        f"({step('dronecan encode RawIMU'):.0f} us), the receiver's decode ({step('dronecan decode RawIMU'):.0f} "
-        f"us: a bit string per field, the transfer CRC in Python) and its field reads ({reads:.0f} us: dronecan "
-        "converts a field from its bits when it is read), 7 datagrams each way. The bridge's own: the converter "
-        f"beyond those reads ({step('generated imu_to_ros') - reads:.0f} us), the rclpy publish "
-        f"({step('rclpy publish'):.0f} us alone, more under load with DDS's threads), the FrameGate "
-        f"({step('sam_runtime FrameGate'):.0f} us a RawIMU: whole-transfer reassembly and counting), NodeLoop "
-        "wake-ups and the inbound bookkeeping (source check, transfer-id gaps, stamps, counters); the inbound "
-        f"handler in place (converter, publish, checks) costs {step('the bridge'):.0f} us "
-        f"a RawIMU against the raw receiver's {reads:.0f} us of reads. What remains of the difference is "
-        "the ROS process and DDS threads competing for the 2 cores (measured apart: a busy loop on the other "
-        "core costs a raw run ~5 % more CPU per message and ~10 % of its msg/s) and the GIL hand-offs to the "
-        "bridge's threads. "
-        "ROS->UAVCAN: "
-        f"this process {cpu('r2u_bridge'):.0f} us against {cpu('r2u_raw'):.0f} us raw, "
-        f"{cpu('r2u_bridge', 'bridge rclpy thread'):.0f} us of it in the bridge's rclpy thread: rclpy's take of "
-        "the ThrusterAngles and the converter, which builds a dronecan ArrayCommand "
-        f"({step('generated thrust_vector_to_uavcan'):.0f} us, all of it dronecan's constructors; the raw sender "
-        "sets two values of one message), then the hand-off to the loop and the outbound queue; the encode "
-        f"({step('dronecan encode ArrayCommand'):.0f} us) and the receiver's decode "
-        f"({step('dronecan decode ArrayCommand'):.0f} us) raw has too. Reaching 0.8x needs the bridge's "
-        "per-message cost in this process at most 1.25x raw's. ROS->UAVCAN costs "
-        f"{cpu('r2u_bridge') / cpu('r2u_raw'):.2f}x here: out of reach while the converter builds dronecan "
-        f"objects (its constructors alone are {step('generated thrust_vector_to_uavcan') / cpu('r2u_raw') * 100:.0f}"
-        " % of raw's whole path) and rclpy's take comes on top. UAVCAN->ROS is nearer "
-        f"({cpu('u2r_bridge') / cpu('u2r_raw'):.2f}x here), the bridge's own share being the FrameGate, the "
-        "inbound handler beyond the reads and the publish. Generated v0 (de)serializers for the spec's types "
-        "(struct packing of the payload, as pycyphal's generated code; dronecan's object model bypassed on the "
-        "bridge's side) would cut the bridge's decode, field conversion and construction to a few us."]
-    lost = tp["r2u_bridge"]["lost"]
-    if lost:
-        per = lost / max(1, meth["reps"])
-        paced_lost = (dc.get("latency") or {}).get("r2u_bridge", {}).get("lost", 0)
-        out.append(
-            f"- **DroneCAN ROS->UAVCAN losses** ({lost} commands over {meth['reps']} throughput runs, "
-            f"{per:g} a run; {paced_lost or 'none'} in the paced runs). Each run starts with a burst of "
-            f"{meth['window_in_flight']} "
-            "commands (the flow-control window); /thruster_angles is `reliable`, keep last 10 (the spec's "
-            "profile), and while the bridge's rclpy thread converts the first ones (dronecan's constructors, "
-            "see above), the rest of the burst overflows the subscription's history in the DDS reader: "
-            f"{meth['window_in_flight']} - 10 = {meth['window_in_flight'] - 10} a run, before the bridge sees "
-            "them, so the bridge's counters cannot show them (measured once apart: 22 of 32 a run, the bridge's "
-            "`received` equal to what arrived; with a window of 8, <= the depth, nothing lost at the same msg/s). "
-            "On Cyphal the converter is fast enough that the history never fills. The same would happen to a "
-            "controller's burst of more than 10 commands.")
-    z = dc.get("zero_loss")
-    if z:
-        failed = [t for t in z["trials"] if not t["sustained"]]
-        why = sorted({("device behind schedule" if not t["on_schedule"] else "")
-                      + (", messages lost" if t["lost"] else "") + (", bridge drops" if t["bridge_dropped"] else "")
-                      + (", not drained in time" if t["drained_in_s"] >= meth["drain_s"] else "")
-                      for t in failed} - {""})
-        out.append(
-            f"- **DroneCAN zero loss.** {_f(z['max_sustained_msg_per_s'], 0)} RawIMU/s = "
-            f"{_f(z['max_sustained_frames_per_s'])} frames/s, {z['share_of_bus_nominal']:.2f}x what a saturated "
-            f"1 Mbit/s classic CAN bus carries ({z['share_of_bus_worst_case']:.2f}x with worst-case stuffing): on "
-            "a real bus the bus, not the bridge, is the limit for RawIMU. The failing trials failed by: "
-            f"{'; '.join(why) or 'nothing'} ({sum(t['lost'] for t in z['trials'])} messages lost and "
-            f"{sum(t['bridge_dropped'] for t in z['trials'])} bridge drops over all trials): this process's one "
-            "Python thread (the bridge's receive, convert and publish, and the device's pre-encoded sends) falls "
-            "behind first"
-            + (f", at {_range([t['cpu_percent']['process'] for t in failed])} % of a core in the failing "
-               "trials" if failed else "")
-            + ". The bisection's last step bounds the figure from below; it moves by a few hundred msg/s between "
-            "runs on this shared machine.")
-    return out
-
-
 # ----------------------------------------------------------------------------------------------- main
 def write_plot(res: dict[str, Any], out: Path) -> None:
     """scaling.png, where the results have what it shows (the generator's growth, the sensor mix)."""
@@ -598,7 +366,7 @@ def write_plot(res: dict[str, Any], out: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.run", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quick", action="store_true", help="fewer repetitions and shorter windows (~3 min)")
+    ap.add_argument("--quick", action="store_true", help="fewer repetitions and shorter windows (~5 min)")
     ap.add_argument("--parts", default=DEFAULT_PARTS, help=f"comma-separated, of {DEFAULT_PARTS}")
     ap.add_argument("--transports", default="udp,can")
     ap.add_argument("--out", type=Path, default=RESULTS)
@@ -627,23 +395,29 @@ def main(argv: list[str] | None = None) -> int:
     unknown = set(parts) - set(DEFAULT_PARTS.split(","))
     if unknown:
         ap.error(f"unknown part(s) {', '.join(sorted(unknown))}; parts: {DEFAULT_PARTS}")
-    gen = generated_package() if {"converters", "bridge", "dronecan"} & set(parts) else None
+    gen = generated_package() if {"converters", "codec", "bridge", "dronecan"} & set(parts) else None
     if "converters" in parts:
         from bench import converters
 
         log("part 2: converters")
         res["converters"] = converters.run(gen, rounds=5 if args.quick else 15, batch_s=0.005)
+    if "codec" in parts:
+        from bench import codec
+
+        log("part 3: wire codecs")
+        res["codec"] = codec.run(gen, rounds=5 if args.quick else 15, batch_s=0.005)
     if "bridge" in parts:
         from bench import bridge
 
-        log("part 3: bridge")
+        log("part 4: bridge")
         kinds = tuple(k.strip() for k in args.transports.split(",") if k.strip())
         res["bridge"] = bridge.run(gen, kinds, reps=2 if args.quick else 5, window_s=1.5 if args.quick else 2.0,
-                                   latency_s=1.5 if args.quick else 2.5, mix_s=2.0 if args.quick else 3.0)
+                                   latency_s=1.5 if args.quick else 2.5, mix_s=2.0 if args.quick else 3.0,
+                                   object_reps=2 if args.quick else 3)
     if "dronecan" in parts:
         from bench import bridge_dronecan
 
-        log("part 4: bridge on DroneCAN")
+        log("part 5: bridge on DroneCAN")
         res["dronecan"] = bridge_dronecan.run(gen, **(bridge_dronecan.QUICK if args.quick else {}))
     res["loadavg_after"] = loadavg()
     res["wall_s"] = time.monotonic() - t0
