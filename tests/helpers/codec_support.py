@@ -8,6 +8,8 @@ Nothing here imports ROS or pycyphal at import time; the class lookups are passe
 from __future__ import annotations
 
 import math
+import struct
+import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -81,6 +83,18 @@ def dsdl_plain(obj: Any, struct: DsdlStruct, lookup: DsdlLookup) -> dict[str, An
 
 # ---- strategies ----------------------------------------------------------------------------------------------
 
+_FLOAT_FORMS = {16: ("<e", 65504.0), 32: ("<f", 3.4028234663852886e38), 64: ("<d", sys.float_info.max)}
+
+
+def any_float(bits: int) -> st.SearchStrategy[float]:
+    """Every float of a width: finite ones, and every bit pattern (infinities, NaNs with payloads, subnormals).
+    Not st.floats(width=16): it rejects each draw that overflows the width, and with a few dozen float16 fields
+    in one message Hypothesis gives up on the filtering (FailedHealthCheck)."""
+    form, biggest = _FLOAT_FORMS[bits]
+    patterns = st.integers(0, (1 << bits) - 1).map(
+        lambda n: float(struct.unpack(form, n.to_bytes(bits // 8, "little"))[0]))
+    return st.one_of(st.floats(-biggest, biggest, width=bits), patterns)  # type: ignore[arg-type]
+
 
 def _dsdl_scalar(t: DsdlType) -> st.SearchStrategy[Any]:
     if t.kind == "bool":
@@ -89,7 +103,7 @@ def _dsdl_scalar(t: DsdlType) -> st.SearchStrategy[Any]:
         lo, hi = (0, 255) if t.kind in ("byte", "utf8") else t.range
         return st.integers(lo, hi)
     assert t.kind == "float", t
-    return st.floats(width=t.bits)  # NaN and infinities included
+    return any_float(t.bits)
 
 
 def dsdl_strategy(struct: DsdlStruct, lookup: DsdlLookup, cls_of: Callable[[DsdlStruct], type],
@@ -135,9 +149,9 @@ def _ros_scalar(base: str, string_bound: int | None) -> st.SearchStrategy[Any]:
     if base in ROS_INT_RANGES:
         return st.integers(*ROS_INT_RANGES[base])
     if base == "float32":
-        return st.floats(width=32)
+        return any_float(32)
     if base == "float64":
-        return st.floats()
+        return any_float(64)
     assert base == "string", base
     if string_bound is not None:
         return st.text(st.characters(max_codepoint=127), max_size=string_bound)
