@@ -35,7 +35,7 @@ HEADER = "std_msgs/Header"
 PAYLOAD, CDR = "payload", "cdr"
 # Module-level names of codec.py that no local may take.
 MODULE_NAMES = frozenset({"WireError", "CODECS", "Any", "Callable", "ConversionStats", "_NAN", "_INF", "_ZEROS",
-                          "_struct", "_array", "_extend", PAYLOAD, CDR})
+                          "_struct", "_array", "_extend", "_support", PAYLOAD, CDR})
 _TOKEN = "_STAMP_"  # stands for a ROS Time read by a to_uavcan step (replaced by its sec / nanosec locals)
 
 

@@ -340,7 +340,7 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
         | {f"_wire_matches_{rm.mapping.name}" for rm in mappings}
         | {"CODECS", "WIRE_MATCHES", "WireError", "ConversionStats", "Callable", "Any", "payload", "cdr",
-           "_NAN", "_INF", "_item", "_struct", "_array", "_ZEROS"}
+           "_NAN", "_INF", "_item", "_struct", "_array", "_ZEROS", "_support"}
     )
     functions, matches = [], []
     for rm in mappings:

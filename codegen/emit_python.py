@@ -572,7 +572,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {py_attr(r) for r in roots}
         | {f"{rm.mapping.name}_to_ros" for rm in resolved.mappings}
         | {f"{rm.mapping.name}_to_uavcan" for rm in resolved.mappings}
-        | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF", "FAST_CONSTRUCTORS", "_np"}
+        | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF", "FAST_CONSTRUCTORS", "_np", "_support"}
     )
     functions = []
     for rm in resolved.mappings:
@@ -615,6 +615,7 @@ def emit(resolved: Resolved) -> dict[str, str]:
         f"{root}/__init__.py": render("python/__init__.py.j2", **common),
         f"{root}/tables.py": render("python/tables.py.j2", **common, **_tables_context(resolved),
                                     **emit_nodes.tables_context(resolved), **emit_python_v0.tables_context(resolved)),
+        f"{root}/conversion_support.py": render("python/conversion_support.py.j2", **common),
         f"{root}/convert.py": render("python/convert.py.j2", **common, **_convert_context(resolved)),
     }
 

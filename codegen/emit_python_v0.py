@@ -208,7 +208,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {f"{rm.mapping.name}_to_uavcan" for rm in resolved.dronecan_mappings}
         | {f"_matches_{rm.mapping.name}" for rm in resolved.dronecan_mappings}
         | {"CONVERTERS", "MATCHES", "TYPES", "CUSTOM_DSDL_DIRS", "ConversionStats", "Callable", "Any", "Path",
-           "_NAN", "_INF", TYPENAMES, "dronecan", "_item", "_always", "check_types", "load_types"}
+           "_NAN", "_INF", TYPENAMES, "dronecan", "_item", "_always", "check_types", "load_types", "_support"}
     )
     functions, matches = [], []
     for rm in resolved.dronecan_mappings:

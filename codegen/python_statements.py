@@ -2,7 +2,7 @@
 renders (for convert.py, convert_v0.py and the wire codecs alike).
 
 The plan (conversion_plan) has decided what happens to each value; this module only says it in Python: which
-condition, which literal, which helper of conversion_helpers.j2.
+condition, which literal, which helper of conversion_support.py.j2.
 """
 
 from __future__ import annotations
@@ -130,24 +130,24 @@ def _clamp_statement(var: str, op: Clamp, policy: Policy) -> dict[str, Any]:
 
 
 def array_check_helper(var: str, link: LinkPlan, elem: DsdlType) -> dict[str, Any] | None:
-    """The conversion_helpers.j2 call that does a ROS -> UAVCAN array link's element checks, if it has any."""
+    """The conversion_support.py.j2 call that does a ROS -> UAVCAN array link's element checks, if it has any."""
     checks = [op for op in link.ops if isinstance(op, (RejectNaN, Round, Limits, Clamp))]
     if not checks:
         return None
     key, reject = repr(link.key), str(link.reject)
     if is_int_dsdl(elem):
         lo, hi = elem.range
-        helper = "_round_ints" if any(isinstance(op, RejectNaN) for op in checks) else "_clamp_ints"
+        helper = "_support.round_ints" if any(isinstance(op, RejectNaN) for op in checks) else "_support.clamp_ints"
         args = [var, str(lo), str(hi), "stats", key, reject]
     else:  # float16 saturates infinities too, float32 keeps them (as for scalars)
-        helper = "_clamp_floats" if elem.bits == 16 else "_clamp_finite_floats"
+        helper = "_support.clamp_floats" if elem.bits == 16 else "_support.clamp_finite_floats"
         args = [var, _num(dsdl_range(elem)[1]), "stats", key, reject]  # type: ignore[index]
     return st("helper", var=var, helper=helper, args=args)
 
 
 def float32_helper(var: str, link: LinkPlan) -> dict[str, Any]:
     """A UAVCAN -> ROS float32 array whose scaled values may pass FLOAT32_MAX."""
-    return st("helper", var=var, helper="_clamp_finite_floats",
+    return st("helper", var=var, helper="_support.clamp_finite_floats",
               args=[var, _num(FLOAT32_MAX), "stats", repr(link.key), str(link.reject)])
 
 

@@ -36,7 +36,7 @@ from typing import Any
 import pytest
 import test_converters as tc
 
-from sam_codegen import emit_codec
+from sam_codegen import emit_codec, emit_python
 from sam_codegen.spec_loader import load_spec_file
 from sam_codegen.validate import validate
 
@@ -82,13 +82,18 @@ if not WORKER:
     @pytest.mark.parametrize("spec", sorted(SPECS))
     def test_ruff_clean_and_standard_library_only(spec: str, tmp_path: Path) -> None:
         text = _codec(SPECS[spec])
-        imported = set()
-        for node in ast.walk(ast.parse(text)):
-            if isinstance(node, ast.Import):
-                imported |= {alias.name.split(".")[0] for alias in node.names}
-            elif isinstance(node, ast.ImportFrom):
-                imported.add((node.module or "").split(".")[0])
-        assert imported <= set(sys.stdlib_module_names) | {"__future__"}, imported
+        support = emit_python.emit(validate(load_spec_file(SPECS[spec])))
+        (support_text,) = (t for path, t in support.items() if path.endswith("/conversion_support.py"))
+        for module in (text, support_text):
+            imported = set()
+            for node in ast.walk(ast.parse(module)):
+                if isinstance(node, ast.Import):
+                    imported |= {alias.name.split(".")[0] for alias in node.names}
+                elif isinstance(node, ast.ImportFrom) and node.level:  # this package's own
+                    imported |= {"." + (node.module or alias.name) for alias in node.names}
+                elif isinstance(node, ast.ImportFrom):
+                    imported.add((node.module or "").split(".")[0])
+            assert imported <= set(sys.stdlib_module_names) | {"__future__", ".conversion_support"}, imported
         ruff = shutil.which("ruff") or str(Path(sys.executable).with_name("ruff"))
         if not Path(ruff).exists():
             pytest.skip("ruff is not installed (pip extra 'test')")

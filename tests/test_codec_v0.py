@@ -254,7 +254,7 @@ if not WORKER:
     @pytest.mark.parametrize("spec", sorted(SPECS))
     def test_codec_is_lint_clean_deterministic_and_standard_library_only(
             spec: str, modules: dict[str, dict[str, str]], tmp_path: Path) -> None:
-        from sam_codegen import emit_codec_v0
+        from sam_codegen import emit_codec_v0, emit_python
 
         files = modules[spec]
         assert files == emit_codec_v0.emit(validate(load_spec_file(SPECS[spec])))
@@ -264,6 +264,9 @@ if not WORKER:
         target.parent.mkdir(parents=True)
         target.write_text(text, encoding="utf-8")
         (target.parent / "__init__.py").write_text("", encoding="utf-8")
+        support = emit_python.emit(validate(load_spec_file(SPECS[spec])))  # codec_v0 imports conversion_support
+        (target.parent / "conversion_support.py").write_text(
+            support[path.replace("codec_v0.py", "conversion_support.py")], encoding="utf-8")
         ruff = shutil.which("ruff") or str(Path(sys.executable).with_name("ruff"))
         if Path(ruff).exists():
             proc = subprocess.run(

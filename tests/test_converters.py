@@ -479,7 +479,8 @@ if WORKER:
 
     def with_class_constructors() -> Any:
         """A second copy of convert.py whose converters build messages with the message classes."""
-        spec = importlib.util.spec_from_file_location(f"_classes_{SPEC_NAME}_convert", convert.__file__)
+        # In the same package, for its relative import of conversion_support.
+        spec = importlib.util.spec_from_file_location(f"{convert.__package__}._classes_convert", convert.__file__)
         assert spec is not None and spec.loader is not None
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)

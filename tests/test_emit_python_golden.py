@@ -87,8 +87,8 @@ def test_golden(sam_files: dict[str, str]) -> None:
 
 
 def test_layout_and_determinism(sam: Resolved, sam_files: dict[str, str], rover: Resolved) -> None:
-    assert sorted(sam_files) == ["python/sam_bridge/__init__.py", "python/sam_bridge/convert.py",
-                                 "python/sam_bridge/tables.py"]
+    assert sorted(sam_files) == ["python/sam_bridge/__init__.py", "python/sam_bridge/conversion_support.py",
+                                 "python/sam_bridge/convert.py", "python/sam_bridge/tables.py"]
     assert emit_python.emit(sam) == sam_files
     assert emit_python.emit(validate(load_spec_file(SAM_SPEC))) == sam_files  # a fresh model too
     assert emit_python.emit(rover) == emit_python.emit(validate(load_spec_file(ROVER_SPEC)))
@@ -119,17 +119,21 @@ def test_imports(which: str, request: pytest.FixtureRequest) -> None:
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, ast.Import):
                 found |= {alias.name for alias in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.level:  # this package's own: ".module"
+                found |= {"." + (node.module or alias.name) for alias in node.names}
             elif isinstance(node, ast.ImportFrom):
                 found.add(node.module or "")
         return found
 
     assert imports(files[f"{package}/__init__.py"]) == set()
     assert imports(files[f"{package}/tables.py"]) <= set(sys.stdlib_module_names) | {"__future__"}
+    assert imports(files[f"{package}/conversion_support.py"]) <= {"__future__"}
     mapped = {f"{rm.ros_message.package}.msg" for rm in resolved.mappings}
     nested = {f"{full.split('/')[0]}.msg" for full in emit_python._ros_closure(resolved)}
     dsdl = {s.namespace for s in resolved.dsdl_types} | {"uavcan.time"}
     convert = imports(files[f"{package}/convert.py"])
-    assert convert - {"__future__", "collections.abc", "copy", "numpy", "typing"} <= nested | dsdl
+    own = {".conversion_support"}
+    assert convert - {"__future__", "collections.abc", "copy", "numpy", "typing"} - own <= nested | dsdl
     assert mapped <= convert
 
 

@@ -28,13 +28,11 @@ import struct as _struct
 from collections.abc import Callable
 from typing import Any
 
+from . import conversion_support as _support
+
 __all__ = ["CODECS", "WireError"]
 
-
-class WireError(ValueError):
-    """A malformed UAVCAN payload or CDR message."""
-
-
+WireError = _support.WireError
 _NAN = float("nan")
 _INF = float("inf")
 _ZEROS = bytes(64)
@@ -59,92 +57,6 @@ _BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_ROS: dict[int, int] = {
 # battery_state: power_supply_health -> state_of_health_pct (first key per value)
 _BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_UAVCAN: dict[int, int] = {0: 127, 3: 0}
 
-
-class ConversionStats:
-    """Counts, per "<mapping>.<field>", the values that were saturated and the messages that were rejected."""
-
-    __slots__ = ("rejected", "saturated")
-
-    def __init__(self) -> None:
-        self.saturated: dict[str, int] = {}
-        self.rejected: dict[str, int] = {}
-
-    def saturate(self, key: str) -> None:
-        self.saturated[key] = self.saturated.get(key, 0) + 1
-
-    def reject(self, key: str) -> None:
-        self.rejected[key] = self.rejected.get(key, 0) + 1
-
-
-def _clamp_floats(
-    values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
-) -> list[float] | None:
-    """Saturate the elements beyond +-bound (infinities too) into it, or reject; NaN passes."""
-    for x in values:
-        if x > bound or x < -bound:
-            break
-    else:
-        return values
-    if reject:
-        stats.reject(key)
-        return None
-    stats.saturate(key)
-    return [bound if x > bound else -bound if x < -bound else x for x in values]
-
-
-def _clamp_finite_floats(
-    values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
-) -> list[float] | None:
-    """Saturate the finite elements beyond +-bound into it, or reject; infinities and NaN pass."""
-    for x in values:
-        if bound < x < _INF or -_INF < x < -bound:
-            break
-    else:
-        return values
-    if reject:
-        stats.reject(key)
-        return None
-    stats.saturate(key)
-    return [bound if bound < x < _INF else -bound if -_INF < x < -bound else x for x in values]
-
-
-def _clamp_ints(
-    values: list[int], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
-) -> list[int] | None:
-    """Saturate integer elements into [lo, hi], or reject."""
-    if values and (max(values) > hi or min(values) < lo):
-        if reject:
-            stats.reject(key)
-            return None
-        stats.saturate(key)
-        return [hi if x > hi else lo if x < lo else x for x in values]
-    return values
-
-
-def _round_ints(
-    values: list[float], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
-) -> list[int] | None:
-    """Round float elements half to even into [lo, hi], saturating (or rejecting) beyond; NaN rejects."""
-    out = []
-    saturated = False
-    for x in values:
-        if x != x:
-            stats.reject(key)
-            return None
-        if x >= hi + 0.5:
-            out.append(hi)
-            saturated = True
-        elif x <= lo - 0.5:
-            out.append(lo)
-            saturated = True
-        else:
-            out.append(round(x))
-    if saturated:
-        if reject:
-            stats.reject(key)
-            return None
-        stats.saturate(key)
-    return out
 
 
 # ---- the structs and constant bytes the codecs pack and unpack ---------------------------------------------
@@ -410,7 +322,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         stats.saturate('magnetic_field.magnetic_field_ga[2]')
         magnetic_field_ga_2 = -65504.0
     magnetic_field_covariance_9 = [x / 1e-08 for x in magnetic_field_covariance]
-    magnetic_field_covariance_9 = _clamp_floats(
+    magnetic_field_covariance_9 = _support.clamp_floats(
         magnetic_field_covariance_9, 65504.0, stats, 'magnetic_field.magnetic_field_covariance', False
     )
     if magnetic_field_covariance_9 is None:
@@ -552,7 +464,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         stats.reject('gps_fix.status')
         return None
     position_covariance_9 = position_covariance
-    position_covariance_9 = _clamp_floats(
+    position_covariance_9 = _support.clamp_floats(
         position_covariance_9, 65504.0, stats, 'gps_fix.position_covariance', False
     )
     if position_covariance_9 is None:

@@ -29,8 +29,12 @@ import struct as _struct
 from collections.abc import Callable
 from typing import Any
 
+from . import conversion_support as _support
+
 __all__ = ["CODECS", "WIRE_MATCHES", "ConversionStats", "WireError"]
 
+ConversionStats = _support.ConversionStats
+WireError = _support.WireError
 _NAN = float("nan")
 _INF = float("inf")
 _ZEROS = bytes(64)
@@ -116,96 +120,6 @@ _GPS_FIX_STATUS_STATUS_TO_ROS: dict[int, int] = {0: -1, 1: -1, 2: 0, 3: 0}
 # gps_fix: status.status -> status (first key per value)
 _GPS_FIX_STATUS_STATUS_TO_UAVCAN: dict[int, int] = {-1: 0, 0: 2}
 
-
-class WireError(ValueError):
-    """A payload dronecan does not decode, or CDR that does not hold the message."""
-
-
-class ConversionStats:
-    """Counts, per "<mapping>.<field>", the values that were saturated and the messages that were rejected."""
-
-    __slots__ = ("rejected", "saturated")
-
-    def __init__(self) -> None:
-        self.saturated: dict[str, int] = {}
-        self.rejected: dict[str, int] = {}
-
-    def saturate(self, key: str) -> None:
-        self.saturated[key] = self.saturated.get(key, 0) + 1
-
-    def reject(self, key: str) -> None:
-        self.rejected[key] = self.rejected.get(key, 0) + 1
-
-
-def _clamp_floats(
-    values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
-) -> list[float] | None:
-    """Saturate the elements beyond +-bound (infinities too) into it, or reject; NaN passes."""
-    for x in values:
-        if x > bound or x < -bound:
-            break
-    else:
-        return values
-    if reject:
-        stats.reject(key)
-        return None
-    stats.saturate(key)
-    return [bound if x > bound else -bound if x < -bound else x for x in values]
-
-
-def _clamp_finite_floats(
-    values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
-) -> list[float] | None:
-    """Saturate the finite elements beyond +-bound into it, or reject; infinities and NaN pass."""
-    for x in values:
-        if bound < x < _INF or -_INF < x < -bound:
-            break
-    else:
-        return values
-    if reject:
-        stats.reject(key)
-        return None
-    stats.saturate(key)
-    return [bound if bound < x < _INF else -bound if -_INF < x < -bound else x for x in values]
-
-
-def _clamp_ints(
-    values: list[int], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
-) -> list[int] | None:
-    """Saturate integer elements into [lo, hi], or reject."""
-    if values and (max(values) > hi or min(values) < lo):
-        if reject:
-            stats.reject(key)
-            return None
-        stats.saturate(key)
-        return [hi if x > hi else lo if x < lo else x for x in values]
-    return values
-
-
-def _round_ints(
-    values: list[float], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
-) -> list[int] | None:
-    """Round float elements half to even into [lo, hi], saturating (or rejecting) beyond; NaN rejects."""
-    out = []
-    saturated = False
-    for x in values:
-        if x != x:
-            stats.reject(key)
-            return None
-        if x >= hi + 0.5:
-            out.append(hi)
-            saturated = True
-        elif x <= lo - 0.5:
-            out.append(lo)
-            saturated = True
-        else:
-            out.append(round(x))
-    if saturated:
-        if reject:
-            stats.reject(key)
-            return None
-        stats.saturate(key)
-    return out
 
 _F32 = _struct.Struct("<f")
 _U32 = _struct.Struct("<I")
@@ -459,7 +373,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         stats.saturate('magnetic_field.magnetic_field_ga[2]')
         magnetic_field_ga_2 = -65504.0
     magnetic_field_covariance_9 = [x / 1e-08 for x in list(magnetic_field_covariance)]
-    magnetic_field_covariance_9 = _clamp_floats(
+    magnetic_field_covariance_9 = _support.clamp_floats(
         magnetic_field_covariance_9, 65504.0, stats, 'magnetic_field.magnetic_field_covariance', False
     )
     if magnetic_field_covariance_9 is None:

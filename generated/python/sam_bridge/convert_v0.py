@@ -41,10 +41,13 @@ from sam_msgs.msg import (
 from sensor_msgs.msg import BatteryState, FluidPressure, Imu, MagneticField, NavSatFix, NavSatStatus, Range
 from std_msgs.msg import Header
 
+from . import conversion_support as _support
+
 __all__ = [
     "CONVERTERS", "CUSTOM_DSDL_DIRS", "MATCHES", "TYPES", "ConversionStats", "check_types", "load_types",
 ]
 
+ConversionStats = _support.ConversionStats
 _NAN = float("nan")
 _INF = float("inf")
 # full name -> the data type loaded now; dronecan.load_dsdl() refills this same dict with new type objects.
@@ -100,92 +103,6 @@ def load_types(generated: str | Path) -> None:
     if problems:
         raise RuntimeError("the DroneCAN types differ from the generated converters': " + "; ".join(problems))
 
-
-class ConversionStats:
-    """Counts, per "<mapping>.<field>", the values that were saturated and the messages that were rejected."""
-
-    __slots__ = ("rejected", "saturated")
-
-    def __init__(self) -> None:
-        self.saturated: dict[str, int] = {}
-        self.rejected: dict[str, int] = {}
-
-    def saturate(self, key: str) -> None:
-        self.saturated[key] = self.saturated.get(key, 0) + 1
-
-    def reject(self, key: str) -> None:
-        self.rejected[key] = self.rejected.get(key, 0) + 1
-
-
-def _clamp_floats(
-    values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
-) -> list[float] | None:
-    """Saturate the elements beyond +-bound (infinities too) into it, or reject; NaN passes."""
-    for x in values:
-        if x > bound or x < -bound:
-            break
-    else:
-        return values
-    if reject:
-        stats.reject(key)
-        return None
-    stats.saturate(key)
-    return [bound if x > bound else -bound if x < -bound else x for x in values]
-
-
-def _clamp_finite_floats(
-    values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
-) -> list[float] | None:
-    """Saturate the finite elements beyond +-bound into it, or reject; infinities and NaN pass."""
-    for x in values:
-        if bound < x < _INF or -_INF < x < -bound:
-            break
-    else:
-        return values
-    if reject:
-        stats.reject(key)
-        return None
-    stats.saturate(key)
-    return [bound if bound < x < _INF else -bound if -_INF < x < -bound else x for x in values]
-
-
-def _clamp_ints(
-    values: list[int], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
-) -> list[int] | None:
-    """Saturate integer elements into [lo, hi], or reject."""
-    if values and (max(values) > hi or min(values) < lo):
-        if reject:
-            stats.reject(key)
-            return None
-        stats.saturate(key)
-        return [hi if x > hi else lo if x < lo else x for x in values]
-    return values
-
-
-def _round_ints(
-    values: list[float], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
-) -> list[int] | None:
-    """Round float elements half to even into [lo, hi], saturating (or rejecting) beyond; NaN rejects."""
-    out = []
-    saturated = False
-    for x in values:
-        if x != x:
-            stats.reject(key)
-            return None
-        if x >= hi + 0.5:
-            out.append(hi)
-            saturated = True
-        elif x <= lo - 0.5:
-            out.append(lo)
-            saturated = True
-        else:
-            out.append(round(x))
-    if saturated:
-        if reject:
-            stats.reject(key)
-            return None
-        stats.saturate(key)
-    return out
 
 
 def _item(items: Any, field: str, value: int) -> Any:
@@ -341,7 +258,7 @@ def magnetic_field_to_uavcan(src: MagneticField, stats: ConversionStats) -> Any 
         stats.saturate('magnetic_field.magnetic_field_ga[2]')
         magnetic_field_ga_2 = -65504.0
     magnetic_field_covariance = [x / 1e-08 for x in src.magnetic_field_covariance.tolist()]
-    magnetic_field_covariance = _clamp_floats(
+    magnetic_field_covariance = _support.clamp_floats(
         magnetic_field_covariance, 65504.0, stats, 'magnetic_field.magnetic_field_covariance', False
     )
     if magnetic_field_covariance is None:

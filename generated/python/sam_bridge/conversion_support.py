@@ -1,4 +1,18 @@
-{#- ConversionStats and the array helpers of the generated converters (convert.py, convert_v0.py). -#}
+# Generated from interfaces.yaml by sam-codegen; do not edit.
+"""What the sam bridge's converters (convert.py, convert_v0.py) and wire codecs (codec.py, codec_v0.py)
+share: the counts of saturated values and rejected messages, the error of malformed wire data, and the element
+checks of arrays. One class of each, whichever module a bridge takes them from.
+
+Standard library only.
+"""
+
+from __future__ import annotations
+
+__all__ = ["ConversionStats", "WireError", "clamp_finite_floats", "clamp_floats", "clamp_ints", "round_ints"]
+
+_INF = float("inf")
+
+
 class ConversionStats:
     """Counts, per "<mapping>.<field>", the values that were saturated and the messages that were rejected."""
 
@@ -15,7 +29,12 @@ class ConversionStats:
         self.rejected[key] = self.rejected.get(key, 0) + 1
 
 
-def _clamp_floats(
+class WireError(ValueError):
+    """A malformed UAVCAN payload (one pycyphal or dronecan would not decode) or CDR that does not hold the
+    message (truncated, a string without its NUL, a bound exceeded, not little-endian plain CDR)."""
+
+
+def clamp_floats(
     values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
 ) -> list[float] | None:
     """Saturate the elements beyond +-bound (infinities too) into it, or reject; NaN passes."""
@@ -31,7 +50,7 @@ def _clamp_floats(
     return [bound if x > bound else -bound if x < -bound else x for x in values]
 
 
-def _clamp_finite_floats(
+def clamp_finite_floats(
     values: list[float], bound: float, stats: ConversionStats, key: str, reject: bool
 ) -> list[float] | None:
     """Saturate the finite elements beyond +-bound into it, or reject; infinities and NaN pass."""
@@ -47,7 +66,7 @@ def _clamp_finite_floats(
     return [bound if bound < x < _INF else -bound if -_INF < x < -bound else x for x in values]
 
 
-def _clamp_ints(
+def clamp_ints(
     values: list[int], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
 ) -> list[int] | None:
     """Saturate integer elements into [lo, hi], or reject."""
@@ -60,7 +79,7 @@ def _clamp_ints(
     return values
 
 
-def _round_ints(
+def round_ints(
     values: list[float], lo: int, hi: int, stats: ConversionStats, key: str, reject: bool
 ) -> list[int] | None:
     """Round float elements half to even into [lo, hi], saturating (or rejecting) beyond; NaN rejects."""
