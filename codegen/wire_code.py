@@ -11,7 +11,7 @@ import re
 from collections.abc import Iterable
 from typing import Any, Protocol
 
-__all__ = ["LINE_LIMIT", "NO_VALUE", "Constants", "Names", "Path", "literal_value", "prune", "wrap_line"]
+__all__ = ["LINE_LIMIT", "NO_VALUE", "Constants", "Names", "Path", "literal_value", "prune", "runs_of", "wrap_line"]
 
 # A path into a message: (field name, index or None) per level, as mapping_rules gives them.
 Path = tuple[tuple[str, Any], ...]
@@ -60,6 +60,26 @@ class Constants:
 
 _SPECIAL = {"_NAN": math.nan, "_INF": math.inf, "-_INF": -math.inf}
 NO_VALUE = object()
+
+
+def runs_of(items: Iterable[Any], atom: type) -> Iterable[Any]:
+    """The items in order, each run of consecutive `atom` instances gathered into one list (code for a run of
+    fixed-size fields is one struct call).
+
+    >>> list(runs_of([1, 2, "x", 3, "y", "z"], int))
+    [[1, 2], 'x', [3], 'y', 'z']
+    """
+    run: list[Any] = []
+    for item in items:
+        if isinstance(item, atom):
+            run.append(item)
+            continue
+        if run:
+            yield run
+            run = []
+        yield item
+    if run:
+        yield run
 
 
 def literal_value(expr: str) -> Any:

@@ -51,7 +51,7 @@ from typing import Any
 
 from .model import V0Struct
 from .typesys import DsdlType
-from .wire_code import Constants, prune
+from .wire_code import Constants, prune, runs_of
 from .wire_v0_layout import V0Layout, code_is_bytes, length_bits, merge_pads, record_index, struct_code, tag_bits
 
 __all__ = ["V0Layout", "WirePath", "record_index", "v0_reader"]
@@ -257,15 +257,10 @@ class _Reader(_Code):
         return inner
 
     def items(self, items: list[Item]) -> None:
-        run: list[_Atom] = []
-        for item in [*items, None]:
-            if isinstance(item, _Atom):
-                run.append(item)
-                continue
-            if run:
-                self.run(run)
-                run = []
-            if isinstance(item, _Dyn):
+        for item in runs_of(items, _Atom):
+            if isinstance(item, list):
+                self.run(item)
+            elif isinstance(item, _Dyn):
                 self.dyn_array(item)
             elif isinstance(item, _Union):
                 self.union(item)

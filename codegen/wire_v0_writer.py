@@ -30,7 +30,7 @@ from typing import Any
 from .model import V0Struct
 from .typesys import DsdlType
 from .wire_code import NO_VALUE as _NO
-from .wire_code import Constants, literal_value
+from .wire_code import Constants, literal_value, runs_of
 from .wire_v0_layout import V0Layout, length_bits, merge_pads, struct_code, tag_bits
 
 __all__ = ["HELPERS", "V0Items", "V0Node", "f16_bits", "v0_writer"]
@@ -484,14 +484,9 @@ def v0_writer(struct_: V0Struct, node: V0Node | None, layout: V0Layout, consts: 
         _flatten(layout, f.type, given.get(f.name) if f.name else None, i == len(fields) - 1,  # type: ignore[arg-type]
                  items)
     w = _Writer(consts)
-    run: list[_Atom] = []
-    for item in [*items, None]:
-        if isinstance(item, _Atom):
-            run.append(item)
-            continue
-        if run:
-            w.run(run)
-            run = []
-        if isinstance(item, _List):
+    for item in runs_of(items, _Atom):
+        if isinstance(item, list):
+            w.run(item)
+        elif isinstance(item, _List):
             w.dyn_list(item)
     return w.lines, w.finish()
