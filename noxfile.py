@@ -28,7 +28,7 @@ def _ros_install(session: nox.Session) -> None:
 def tests(session: nox.Session) -> None:
     """Everything: generated/ is current, sam_msgs builds, then unit, golden, conformance and end-to-end tests."""
     _install(session, "runtime,rosbuild,test")
-    session.run("ruff", "check", "codegen", "runtime", "tests", "noxfile.py")
+    session.run("ruff", "check", "codegen", "runtime", "tests", "bench", "noxfile.py")
     session.run("sam-codegen", "build", "--check")
     _ros_install(session)
     session.run("pytest", *(session.posargs or ["-q"]), env=LOOPBACK)
@@ -37,7 +37,7 @@ def tests(session: nox.Session) -> None:
 @nox.session(python="3.11")
 def lint(session: nox.Session) -> None:
     session.install("ruff>=0.6")
-    session.run("ruff", "check", "codegen", "runtime", "tests", "noxfile.py")
+    session.run("ruff", "check", "codegen", "runtime", "tests", "bench", "noxfile.py")
 
 
 @nox.session(python="3.11")

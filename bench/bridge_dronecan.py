@@ -1,6 +1,6 @@
 """Part 4: the bridge on DroneCAN (UAVCAN v0, layout ``dronecan``) against raw dronecan (issue 10's benchmark).
 
-Same process layout as the Cyphal part (bench/bridge.py, whose ROS process, flow control, latency and CPU helpers
+Same process layout as the Cyphal part (bench/bridge_rig.py, whose ROS process, flow control, latency and CPU helpers
 this module reuses): the Bridge (``Bridge(gen, layout="dronecan", dronecan_iface=...)``) on the asyncio loop of this
 process with plain ``dronecan`` nodes beside it on the same loop, the ROS side (the /imu subscriber, the
 /thruster_angles publisher) in a separate process. Transport: this repo's ``mcast-lo:<bus>:<port>`` loopback
@@ -52,24 +52,20 @@ import time
 from pathlib import Path
 from typing import Any
 
-from bench.bridge import (
+from bench.bridge import wire_steps
+from bench.bridge_blocks import codec_vs_object, object_block, run_block, summarize_latency, summarize_throughput
+from bench.bridge_rig import (
     CMD_TOPIC,
     IMU_TOPIC,
     QOS_DEPTH,
     WINDOW,
     Rig,
     RosSide,
-    _summarize_lat,
-    _summarize_tp,
-    codec_vs_object,
     imu_payload,
     now_us,
-    object_block,
     process_cpu,
     rss_kib,
-    run_block,
     thread_cpu,
-    wire_steps,
 )
 from bench.common import log
 
@@ -171,7 +167,7 @@ class PlainNode:
 
 
 class DroneCanReceiver:
-    """A dronecan handler with CyphalReceiver's interface (bench/bridge.py): counts, records latencies or receive
+    """A dronecan handler with CyphalReceiver's interface (bench/bridge_rig.py): counts, records latencies or receive
     times by sequence number while recording, grants flow-control credits."""
 
     def __init__(self, node: PlainNode, type_name: str, kind: str, source: int | None = None) -> None:
@@ -260,7 +256,7 @@ def array_command_sample() -> Any:
 
 # ----------------------------------------------------------------------------------------------- rig
 class DroneCanRig(Rig):
-    """bench.bridge.Rig's measurement (windowed, paced, CPU) on the DroneCAN bridge and plain dronecan nodes."""
+    """bench.bridge_rig.Rig's measurement (windowed, paced, CPU) on the DroneCAN bridge and plain dronecan nodes."""
 
     def __init__(self, gen: Any, iface_bridge: str, iface_raw: str, wire: str = "codec") -> None:
         super().__init__(gen, "dronecan", iface_bridge, iface_raw, None, wire)
@@ -607,8 +603,8 @@ async def measure(gen: Any, *, reps: int, window_s: float, latency_hz: float, la
                                            latency_hz=latency_hz, latency_s=latency_s)
         rss["after_bridged_kib"] = rss_kib()
         out["bridged_messages"] = bridged
-        out["throughput"] = _summarize_tp(tp)
-        out["latency"] = _summarize_lat(lat, latency_hz, latency_s)  # with the CPU at the paced rate
+        out["throughput"] = summarize_throughput(tp)
+        out["latency"] = summarize_latency(lat, latency_hz, latency_s)  # with the CPU at the paced rate
         out["rss"] = dict(rss)
         out["rss"]["bridge_footprint_mib"] = round((rss["after_bridge_start_kib"] - rss["before_bridge_kib"]) / 1024, 1)
         out["rss"]["growth_kib_per_1000_bridged"] = round(

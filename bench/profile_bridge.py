@@ -131,7 +131,8 @@ def _set_variant(bridge: Any, variant: str) -> None:
 
 
 async def ab(kind: str, seconds: float, reps: int, variants: list[str]) -> None:
-    from bench.bridge import PATHS, Rig
+    from bench.bridge_blocks import PATHS
+    from bench.bridge_rig import Rig
     from bench.common import generated_package, median
     from sam_runtime.bridge import quiet_late_media_completions
     from sam_runtime.bridge.ros_side import RosSide
@@ -193,7 +194,7 @@ def _thread_hook(frame: Any, event: str, arg: Any) -> None:
 
 
 async def main(path_name: str, kind: str, seconds: float) -> None:
-    from bench.bridge import Rig
+    from bench.bridge_rig import Rig
     from bench.common import generated_package
 
     gen = generated_package()
@@ -248,7 +249,7 @@ if __name__ == "__main__":
     if args and args[0] == "ab":
         import logging
 
-        from bench.bridge import cyphal_udp_lock
+        from bench.bridge_rig import cyphal_udp_lock
 
         logging.getLogger("sam_runtime").setLevel(logging.ERROR)
         kind = args[1] if len(args) > 1 else "udp"
