@@ -38,7 +38,8 @@ if WORKER:
     from sam_codegen.model import DsdlStruct
     from sam_codegen.spec_loader import load_spec_file
     from sam_codegen.validate import validate
-    from sam_codegen.wire_cdr import Constants, _flatten, cdr_reader, cdr_writer
+    from sam_codegen.wire_cdr import Constants, cdr_reader, cdr_writer
+    from sam_codegen.wire_cdr_layout import flatten
 
     CONFIG = json.loads(WORKER)
     RESOLVED = validate(load_spec_file(Path(CONFIG["spec"])))
@@ -203,7 +204,7 @@ if WORKER:
         rclpy decodes its writer's bytes, to the message's values (sequences of messages: written empty)."""
         message, lookup = RESOLVED.ros.get(full_name), RESOLVED.ros.get
         assert message is not None
-        leaves = [leaf for leaf in _flatten(message, lookup) if leaf.kind != "msgseq"]
+        leaves = [leaf for leaf in flatten(message, lookup) if leaf.kind != "msgseq"]
         consts = Constants()
         read_lines, found = cdr_reader(message, [leaf.path for leaf in leaves], lookup, _Names(set()), consts, "p")
         write_lines, expr = cdr_writer(message, {leaf.path: f"v[{i}]" for i, leaf in enumerate(leaves)}, lookup,
@@ -215,7 +216,7 @@ if WORKER:
         space: dict[str, Any] = {"WireError": ValueError}
         exec(compile(source, full_name, "exec"), space)  # the generated code under test
         msg = data.draw(ros_strategy(message, lookup, ros_class), label="ros")
-        for leaf in _flatten(message, lookup):
+        for leaf in flatten(message, lookup):
             if leaf.kind == "msgseq":
                 setattr(_parent(msg, leaf.path), leaf.path[-1][0], [])
         msg = ros_wire(msg)
