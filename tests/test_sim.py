@@ -26,6 +26,7 @@ pytest.importorskip("pycyphal")
 pytest.importorskip("can")
 
 from helpers.runtime_support import generated_or_skip
+from helpers.settling import until_stable
 
 from sam_runtime.sim import PHYSICS, DeviceState, SimConfig, Simulator, VehicleState, generic_fill, physics_key
 from sam_runtime.vehicle import SeaFloor, SimulatedVehicle
@@ -203,12 +204,7 @@ async def _quiet_point(sim: Simulator, counts: Counter[int], stable_s: float = 0
     """Pause the devices, wait (deadline) until what they sent has all arrived, and return per subject what they
     sent, the ticks they skipped and what was received."""
     await sim.pause()
-    last, since = dict(counts), time.monotonic()
-    deadline = since + timeout
-    while time.monotonic() < deadline and time.monotonic() - since < stable_s:
-        await asyncio.sleep(0.02)
-        if dict(counts) != last:
-            last, since = dict(counts), time.monotonic()
+    await until_stable(lambda: dict(counts), stable_s, timeout)
     out: dict[int, dict[str, int]] = {}
     for d in sim.devices:
         for pp in d.pubs:

@@ -35,6 +35,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ros_probe import ThreadedProbe
+from settling import until_stable
 
 HERE = Path(__file__).resolve().parent
 BRIDGE = "uavcan_ros_bridge"
@@ -386,15 +387,7 @@ async def settle(bridge: Any, probe: Probe | None, stable_s: float = 0.3, timeou
         return (tuple((m["received"], m["published"], m["dropped_total"]) for m in st.values()),
                 tuple(sorted(probe.counts.items())) if probe is not None else ())
 
-    last, since = snap(), time.monotonic()
-    deadline = since + timeout
-    while time.monotonic() < deadline:
-        await asyncio.sleep(0.02)
-        now = snap()
-        if now != last:
-            last, since = now, time.monotonic()
-        elif time.monotonic() - since >= stable_s:
-            return
+    await until_stable(snap, stable_s, timeout)
 
 
 async def sensor_window(bridge: Any, sim: Any, probe: Probe | None, body: Callable[[], Any]) -> dict[str, Any]:
