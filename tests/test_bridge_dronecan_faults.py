@@ -88,7 +88,8 @@ async def _scenario(gen: Any, iface: str) -> dict[str, Any]:
         # Up long enough that a reboot shows (NodeStatus carries whole seconds of uptime).
         await until(lambda: bridge.stats()["devices"]["imu"].get("uptime_s", 0) >= 2, 10, "the IMU up 2 s")
         imu.close()
-        stopped = time.monotonic()
+        stopped = time.monotonic()  # then the age: the last NodeStatus came at `stopped - age` or later
+        out["age_at_stop_s"] = bridge.stats()["devices"]["imu"]["age_s"]
         await until(lambda: not bridge.stats()["devices"]["imu"].get("alive"), 10, "the IMU lost")
         out["lost_after_s"] = time.monotonic() - stopped
         out["device_lost"] = dict(bridge.stats()["devices"]["imu"])
@@ -132,8 +133,11 @@ def test_a_burst_is_published_or_counted(run: dict[str, Any]) -> None:
 
 
 def test_a_stopped_device_is_lost_after_the_offline_timeout(run: dict[str, Any]) -> None:
-    print(f"\nFIGURES IMU node stopped: lost after {run['lost_after_s']:.2f} s, diagnostics {run['diag_imu']}")
-    assert 2.0 <= run["lost_after_s"] <= 6.0  # the last NodeStatus was 0-1 s old; the timeout is 3 s
+    print(f"\nFIGURES IMU node stopped: lost after {run['lost_after_s']:.2f} s (last NodeStatus then "
+          f"{run['age_at_stop_s']:.3f} s old), diagnostics {run['diag_imu']}")
+    # Not before the 3 s timeout after the last NodeStatus. (That the report is not late is judged, against the
+    # measured loop stalls, by test_faults' heartbeat test: the same HealthMonitor; here the wait is bounded at 10 s.)
+    assert run["lost_after_s"] >= 3.0 - run["age_at_stop_s"] - 0.002
     assert run["device_lost"]["age_s"] >= 3.0
     level, message = run["diag_imu"]
     assert level == b"\x02" and "heartbeat lost" in message

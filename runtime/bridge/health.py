@@ -102,7 +102,10 @@ class DeviceHealth:
         if restarted:
             rec.restarts += 1
             rec.alive_since = now  # a device that just booted gets its grace before it must publish
-        rec.last_seen, rec.status, rec.count = now, st, rec.count + 1
+        # last_seen last: /diagnostics is also built on rclpy's timer thread, and a record that reads alive must
+        # already carry this heartbeat's status and count.
+        rec.status, rec.count = st, rec.count + 1
+        rec.last_seen = now
         self._arm(rec)
         if restarted:
             if nid in self.devices:

@@ -28,7 +28,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections import Counter
+from collections import Counter, defaultdict
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -79,7 +79,8 @@ class Probe(ThreadedProbe):
         self.records: list[dict[str, Any]] = []
         self.latency_ms: list[float] | None = None
         self.diag_latest: dict[str, dict[str, Any]] = {}
-        self.diag_events: list[dict[str, Any]] = []  # level changes: {"t": monotonic, "name", "level", "message"}
+        # level changes: {"t": monotonic, "name", "level", "message", "values"}
+        self.diag_events: list[dict[str, Any]] = []
         self.diag_messages = 0
         self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 50)
 
@@ -103,11 +104,12 @@ class Probe(ThreadedProbe):
         now = time.monotonic()
         for st in arr.status:
             level = _level(st)
+            values = {kv.key: kv.value for kv in st.values}
             prev = self.diag_latest.get(st.name)
             if prev is None or prev["level"] != level:
-                self.diag_events.append({"t": now, "name": st.name, "level": level, "message": st.message})
-            self.diag_latest[st.name] = {"level": level, "message": st.message, "t": now,
-                                         "values": {kv.key: kv.value for kv in st.values}}
+                self.diag_events.append({"t": now, "name": st.name, "level": level, "message": st.message,
+                                         "values": values})
+            self.diag_latest[st.name] = {"level": level, "message": st.message, "t": now, "values": values}
 
     def level(self, name: str) -> int | None:
         d = self.diag_latest.get(name)
@@ -259,11 +261,18 @@ class FaultPlan:
     def __init__(self) -> None:
         self.mode: str | None = None
         self.counts: Counter[str] = Counter()
+        self.times: defaultdict[str, list[float]] = defaultdict(list)  # when each was injected (monotonic)
         self.lock = threading.Lock()
 
     def _count(self, key: str) -> None:
         with self.lock:
             self.counts[key] += 1
+            self.times[key].append(time.monotonic())
+
+    def first(self, keys: tuple[str, ...], since: float) -> float | None:
+        """When the first of ``keys`` happened at or after ``since``."""
+        with self.lock:
+            return min((t for k in keys for t in self.times[k] if t >= since), default=None)
 
     def send_error(self) -> BaseException | None:
         if self.mode == "transient":
@@ -321,6 +330,7 @@ def faulty_can_factory(iface: str, mtu: int, plan: FaultPlan) -> Callable[[int],
         from pycyphal.transport.can import CANTransport
         from pycyphal.transport.can.media.pythoncan import PythonCANMedia
 
+        plan._count("open_attempt")
         err = plan.open_error()
         if err is not None:
             raise err
@@ -637,7 +647,10 @@ async def can_down(bridge: Any, sim: Any, probe: Probe, plan: FaultPlan) -> dict
         plan.mode = "down"
         t0 = time.monotonic()
         await wait_for(lambda: not bridge.stats()["bridge"]["link"]["up"], 5, "the bridge noticing the link down")
-        info["detected_after_s"] = round(time.monotonic() - t0, 3)
+        t_seen = time.monotonic()
+        info["detected_after_s"] = round(t_seen - t0, 3)
+        first = plan.first(("recv_ENETDOWN", "send_ENETDOWN"), t0)  # when pycyphal's media met the fault
+        info["detected_after_media_died_s"] = None if first is None else round(t_seen - first, 3)
         await try_wait_for(lambda: probe.level(BRIDGE) == 2, 3, "the bridge at ERROR on /diagnostics")
         info["diag_bridge_level_while_down"] = probe.level(BRIDGE)
         info["diag_bridge_message_while_down"] = (probe.diag_latest.get(BRIDGE) or {}).get("message")
@@ -649,6 +662,10 @@ async def can_down(bridge: Any, sim: Any, probe: Probe, plan: FaultPlan) -> dict
         t_up = time.monotonic()
         await wait_for(lambda: bridge.stats()["bridge"]["link"]["up"], 15, "the bridge reopening its transport")
         info["reopened_after_up_s"] = round(time.monotonic() - t_up, 3)
+        with plan.lock:
+            after_up = [t for t in plan.times["open_attempt"] if t >= t_up]
+        info["open_attempts_after_up"] = len(after_up)
+        info["first_attempt_after_up_s"] = round(after_up[0] - t_up, 3) if after_up else None
         pub0 = bridge.stats()["mappings"]["imu"]["published"]
         await wait_for(lambda: bridge.stats()["mappings"]["imu"]["published"] > pub0 + 10, 10, "IMU data again")
         info["data_again_after_up_s"] = round(time.monotonic() - t_up, 3)
@@ -676,27 +693,32 @@ async def can_down(bridge: Any, sim: Any, probe: Probe, plan: FaultPlan) -> dict
 async def can_heartbeat(bridge: Any, sim: Any, probe: Probe) -> dict[str, Any]:
     """The GPS stops (power off): its heartbeat times out; then it comes back (a reboot)."""
     name = f"{BRIDGE}/device/gps"
+    t_off = time.monotonic()  # before the age is read: the last heartbeat came at t_off - age or later
     st0 = bridge.stats()
     last_hb_age = st0["devices"]["gps"]["age_s"]
-    t_off = time.monotonic()
     await sim.power_off("gps")
+    n_events = len(probe.diag_events)
     await wait_for(lambda: probe.level(name) == 2, 8, "the GPS at ERROR on /diagnostics")
     t_err = time.monotonic()
-    msg_err = probe.diag_latest[name]["message"]
-    bridge_age_at_err = bridge.stats()["devices"]["gps"]["age_s"]
+    err = next(e for e in probe.diag_events[n_events:] if e["name"] == name and e["level"] == 2)
     pub_off = bridge.stats()["mappings"]["gps_fix"]["published"]
     t_on = time.monotonic()
+    n_events = len(probe.diag_events)
     await sim.power_on("gps")
     await wait_for(lambda: probe.level(name) == 0, 8, "the GPS OK again on /diagnostics")
     t_ok = time.monotonic()
+    ok = next(e for e in probe.diag_events[n_events:] if e["name"] == name and e["level"] == 0)
     await wait_for(lambda: bridge.stats()["mappings"]["gps_fix"]["published"] > pub_off, 5, "GPS fixes again")
     st1 = bridge.stats()
     return {
         "heartbeat_age_at_power_off_s": last_hb_age,
         "error_after_power_off_s": round(t_err - t_off, 3),
-        "heartbeat_age_when_reported_s": bridge_age_at_err,
-        "message_when_lost": msg_err,
+        # What the bridge's own report said (the report's values, not a later reading).
+        "heartbeat_age_when_reported_s": float(err["values"]["age_s"]),
+        "heartbeats_when_lost": int(err["values"]["heartbeats"]),
+        "message_when_lost": err["message"],
         "ok_after_power_on_s": round(t_ok - t_on, 3),
+        "when_ok": {k: int(ok["values"][k]) for k in ("heartbeats", "restarts", "uptime_s")},
         "device": st1["devices"]["gps"],
         "gps_fix": delta(st0["mappings"]["gps_fix"], st1["mappings"]["gps_fix"]),
         "events": [e for e in probe.diag_events if e["name"] == name],
