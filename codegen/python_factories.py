@@ -11,7 +11,7 @@ from .python_statements import typed_literal
 from .typesys import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 
 if TYPE_CHECKING:
-    from .emit_python import _Module
+    from .python_module import _Module
 
 
 def ros_factory_name(alias: str) -> str:
