@@ -17,7 +17,6 @@ from typing import Any
 from . import emit_dsdl_v0
 from .conversion_plan import Constant, RequireItem
 from .emit_python import (
-    _Arr,
     _Ctor,
     _Function,
     _isort_key,
@@ -88,43 +87,23 @@ class _V0Module(_Module):
             return f"{self.ros_aliases[t.base]}()"
         return _typed_literal(0, t.base)
 
-    def insert(self, root: _Ctor, path: tuple, value: str) -> None:
-        """As _Module.insert, and on the DroneCAN side: bounded arrays built with the elements named (positions),
-        items chosen by key (the key field set to its value)."""
-        node: Any = root
-        prefix: tuple = ()
-        for i, (name, index) in enumerate(path):
-            last = i == len(path) - 1
-            t = node.types.get(name)
-            assert t is not None, (path, name)
-            array_path = (*prefix, (name, None))
-            if isinstance(index, Key):
-                items = node.kwargs.setdefault(name, _Items())
-                if index not in items.items:
-                    item = self.child(t.element)
-                    item.kwargs[index.field] = py_literal(index.value)
-                    items.items[index] = item
-                assert not last, path
-                node = items.items[index]
-            elif index is None:
-                if last:
-                    node.kwargs[name] = value
-                else:
-                    if name not in node.kwargs:
-                        node.kwargs[name] = self.child(t)
-                    node = node.kwargs[name]
-            else:
-                if name not in node.kwargs:
-                    size = t.capacity if t.array == "fixed" or isinstance(t, RosType) else self.lengths[array_path]
-                    node.kwargs[name] = _Arr(size or 0, self.element_default(t.element))
-                arr = node.kwargs[name]
-                if last:
-                    arr.items[index] = value
-                else:
-                    if index not in arr.items:
-                        arr.items[index] = self.child(t.element)
-                    node = arr.items[index]
-            prefix = (*prefix, (name, index))
+    def insert_step(self, node: Any, name: str, index: Any, value: str | None, prefix: tuple) -> Any:
+        """As _Module.insert_step, and on the DroneCAN side: items chosen by key (the key field set to its value)."""
+        if not isinstance(index, Key):
+            return super().insert_step(node, name, index, value, prefix)
+        t = node.types.get(name)
+        assert t is not None and value is None, (prefix, name)
+        items = node.kwargs.setdefault(name, _Items())
+        if index not in items.items:
+            item = self.child(t.element)
+            item.kwargs[index.field] = py_literal(index.value)
+            items.items[index] = item
+        return items.items[index]
+
+    def array_size(self, t: Any, array_path: tuple) -> int:
+        """Bounded DroneCAN arrays are built with the elements the mapping names (their positions)."""
+        size = t.capacity if t.array == "fixed" or isinstance(t, RosType) else self.lengths[array_path]
+        return size or 0
 
     def format_node(self, node: Any, indent: int) -> list[str]:
         if isinstance(node, _Items):

@@ -102,27 +102,35 @@ class _Module:
     def insert(self, root: _Ctor, path: tuple, value: str) -> None:
         """Set the field at `path` (segments (name, index or None)) of the tree under root to `value`."""
         node: Any = root
+        prefix: tuple = ()
         for i, (name, index) in enumerate(path):
-            last = i == len(path) - 1
-            t = node.types.get(name)
-            assert t is not None, (path, name)
-            if index is None:
-                if last:
-                    node.kwargs[name] = value
-                else:
-                    if name not in node.kwargs:
-                        node.kwargs[name] = self.child(t)
-                    node = node.kwargs[name]
-            else:
-                if name not in node.kwargs:
-                    node.kwargs[name] = _Arr(t.capacity or 0, self.element_default(t.element))
-                arr = node.kwargs[name]
-                if last:
-                    arr.items[index] = value
-                else:
-                    if index not in arr.items:
-                        arr.items[index] = self.child(t.element)
-                    node = arr.items[index]
+            node = self.insert_step(node, name, index, value if i == len(path) - 1 else None, prefix)
+            prefix = (*prefix, (name, index))
+
+    def insert_step(self, node: Any, name: str, index: Any, value: str | None, prefix: tuple) -> Any:
+        """One segment of `insert`: set `value` there (the last segment), else the child to go on from."""
+        t = node.types.get(name)
+        assert t is not None, (prefix, name)
+        if index is None:
+            if value is not None:
+                node.kwargs[name] = value
+                return None
+            if name not in node.kwargs:
+                node.kwargs[name] = self.child(t)
+            return node.kwargs[name]
+        if name not in node.kwargs:
+            node.kwargs[name] = _Arr(self.array_size(t, (*prefix, (name, None))), self.element_default(t.element))
+        arr = node.kwargs[name]
+        if value is not None:
+            arr.items[index] = value
+            return None
+        if index not in arr.items:
+            arr.items[index] = self.child(t.element)
+        return arr.items[index]
+
+    def array_size(self, t: Any, array_path: tuple) -> int:
+        """How many elements the array at `array_path` is built with."""
+        return t.capacity or 0
 
     def format_node(self, node: Any, indent: int) -> list[str]:
         """Lines of an expression; the first line is not indented, the rest are (absolute indent)."""
