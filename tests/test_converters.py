@@ -19,8 +19,6 @@ padding, int3/int5/int7 arrays, per-element links into fixed arrays of composite
 
 from __future__ import annotations
 
-import contextlib
-import hashlib
 import importlib
 import importlib.util
 import json
@@ -29,11 +27,11 @@ import os
 import shutil
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
+from helpers.ros_packages import built_prefix
 
 from sam_codegen import emit_dsdl, emit_python, emit_ros
 from sam_codegen.spec_loader import load_spec_file
@@ -70,41 +68,6 @@ def _write(files: dict[str, str], out: Path) -> None:
         target.write_text(text, encoding="utf-8")
 
 
-def _tree_hash(folder: Path) -> str:
-    h = hashlib.sha256(f"{sys.version_info[:2]}".encode())
-    for p in sorted(folder.rglob("*")):
-        if p.is_file():
-            h.update(p.relative_to(folder).as_posix().encode() + b"\0" + p.read_bytes() + b"\0")
-    return h.hexdigest()[:20]
-
-
-@contextlib.contextmanager
-def _locked(path: Path) -> Iterator[None]:
-    import fcntl
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "a+b") as fh:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
-
-
-def _ros_prefix(package_dir: Path, build_dir: Path) -> Path:
-    """Install `package_dir` into a prefix cached by the package's content; concurrent runs wait for one build."""
-    from sam_codegen.ros_build import build_ros_package
-
-    cache = ROOT / ".cache" / "ros-prefix"
-    prefix = cache / f"{package_dir.name}-{_tree_hash(package_dir)}"
-    with _locked(cache / f".lock-{prefix.name}"):
-        if not (prefix / ".complete").is_file():
-            shutil.rmtree(prefix, ignore_errors=True)
-            build_ros_package(package_dir, build_dir, prefix)
-            (prefix / ".complete").write_text("built by tests/test_converters.py\n")
-    return prefix
-
-
 def _build(spec: Path, out: Path) -> dict[str, str]:
     """Generate, compile and build one spec; returns the worker's configuration."""
     from sam_runtime.dsdl import ensure_compiled
@@ -117,7 +80,7 @@ def _build(spec: Path, out: Path) -> dict[str, str]:
         dsdl = ensure_compiled([out / "generated" / "dsdl" / resolved.spec.dsdl_root], ROOT / ".cache" / "dsdl")
     finally:
         sys.path[:] = saved
-    prefix = _ros_prefix(out / "generated" / "ros" / resolved.spec.ros.name, out / "ros-build")
+    prefix = built_prefix([out / "generated" / "ros" / resolved.spec.ros.name])
     return {"spec": str(spec), "python": str(out / "generated" / "python"), "dsdl": str(dsdl),
             "prefix": str(prefix), "package": f"{resolved.spec.vehicle}_bridge"}
 

@@ -43,7 +43,8 @@ def _tree_hash(folders: Sequence[Path]) -> str:
 
 
 @contextlib.contextmanager
-def _locked(path: Path) -> Iterator[None]:
+def locked(path: Path) -> Iterator[None]:
+    """Held by one process at a time (concurrent test runs wait for one build)."""
     import fcntl
 
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -61,7 +62,7 @@ def built_prefix(package_dirs: Sequence[Path]) -> Path:
 
     dirs = [Path(d) for d in package_dirs]
     prefix = CACHE / f"{'+'.join(d.name for d in dirs)}-{_tree_hash(dirs)}"
-    with _locked(CACHE / f".lock-{prefix.name}"):
+    with locked(CACHE / f".lock-{prefix.name}"):
         if not (prefix / ".complete").is_file():
             shutil.rmtree(prefix, ignore_errors=True)
             for d in dirs:

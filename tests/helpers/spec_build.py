@@ -9,17 +9,15 @@ A ROS package outside the venv is usable only by a process started with its envi
 
 from __future__ import annotations
 
-import contextlib
-import fcntl
 import hashlib
 import shutil
 import sys
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
+from helpers.ros_packages import built_prefix, locked
 from helpers.runtime_support import REPO
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
@@ -32,25 +30,6 @@ class BuiltSpec:
     prefix: Path  # where its ROS package is installed
 
 
-@contextlib.contextmanager
-def _locked(path: Path) -> Iterator[None]:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "a+b") as fh:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
-
-
-def _tree_hash(folder: Path) -> str:
-    h = hashlib.sha256(f"{sys.version_info[:2]}".encode())
-    for p in sorted(folder.rglob("*")):
-        if p.is_file():
-            h.update(p.relative_to(folder).as_posix().encode() + b"\0" + p.read_bytes() + b"\0")
-    return h.hexdigest()[:20]
-
-
 def generated_spec(name: str) -> Path:
     """The generated/ folder of ``tests/specs/<name>.yaml`` (what needs only the DSDL and Python needs no ROS
     build)."""
@@ -60,7 +39,7 @@ def generated_spec(name: str) -> Path:
     digest = hashlib.sha256(spec.read_bytes()).hexdigest()[:16]
     cache = REPO / ".cache" / "test-specs"
     gen_dir = cache / f"{name}-{digest}" / "generated"
-    with _locked(cache / f".lock-{name}"):
+    with locked(cache / f".lock-{name}"):
         build(spec, gen_dir)  # rewrites only when the generator's output changed
     return gen_dir
 
@@ -71,16 +50,8 @@ def built_spec(name: str) -> BuiltSpec:
         pytest.skip("cmake is not installed")
     if not (Path(sys.prefix) / "share" / "rosidl_default_generators" / "package.xml").is_file():
         pytest.skip("rosidl_default_generators is not installed (pip extra 'rosbuild')")
-    from sam_codegen.ros_build import build_ros_package
     from sam_runtime.genpkg import GeneratedPackage
 
     gen_dir = generated_spec(name)
-    pkg_dir = GeneratedPackage(gen_dir).ros_package_dir()
-    prefixes = REPO / ".cache" / "ros-prefix"
-    prefix = prefixes / f"{pkg_dir.name}-{_tree_hash(pkg_dir)}"
-    with _locked(prefixes / f".lock-{prefix.name}"):
-        if not (prefix / ".complete").is_file():
-            shutil.rmtree(prefix, ignore_errors=True)
-            build_ros_package(pkg_dir, gen_dir.parent / "ros-build", prefix)
-            (prefix / ".complete").write_text("built by tests/helpers/spec_build.py\n")
+    prefix = built_prefix([GeneratedPackage(gen_dir).ros_package_dir()])
     return BuiltSpec(SPECS / f"{name}.yaml", gen_dir, prefix)
