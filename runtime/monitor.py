@@ -42,6 +42,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sam_runtime.diag_view import bridge_lines, status_key
+
 __all__ = ["RunOptions", "TopicMonitor", "run", "summarize_message"]
 
 CHILD_STOP_TIMEOUT_S = 8.0
@@ -215,12 +217,7 @@ class TopicMonitor:
     def _on_diag(self, arr: Any) -> None:
         bridge = str(self.tables.BRIDGE_NAME)
         for s in arr.status:
-            head, sep, rest = s.name.partition("/")
-            if head in (f"{bridge}_cyphal", f"{bridge}_dronecan"):  # the two bridges of a mixed layout
-                if not sep and head in self.diagnostics:
-                    continue  # one status line for the bridges: keep the first one's
-                s.name = bridge + sep + rest
-            self.diagnostics[s.name] = {
+            self.diagnostics[status_key(s.name, bridge)] = {
                 "level": int(s.level[0]) if isinstance(s.level, bytes | bytearray) else int(s.level),
                 "message": s.message, "hardware_id": s.hardware_id,
                 "values": {kv.key: kv.value for kv in s.values}, "at": time.monotonic(),
@@ -290,14 +287,13 @@ class TopicMonitor:
             status = "ok" if diag["level"] == 0 else diag["message"]
             lines.append(f"{d.name:22} {d.node_id:4d} {age_txt:>10} {v.get('health', '-'):9} "
                          f"{v.get('mode', '-'):12} {status}")
-        total = self.diagnostics.get(bridge)
         warnings = []  # mappings not OK: recent drops, or silent while their device is alive
         for n, d in sorted(self.diagnostics.items()):
             if n.startswith(f"{bridge}/mapping/") and d["level"] != 0:
                 why = ", ".join(f"{k}={x}" for k, x in d["values"].items() if k.startswith("dropped."))
                 warnings.append(f"{n.split('/')[-1]}: {d['message']}" + (f" ({why})" if why else ""))
         lines.append("")
-        lines.append(f"bridge: {total['message'] if total else 'no /diagnostics yet'}")
+        lines.extend(bridge_lines(self.diagnostics, bridge))
         lines.extend("  warn " + x for x in warnings)
         return lines
 
