@@ -315,7 +315,8 @@ def test_can_interface_down_and_back_the_bridge_reopens(can_run: dict[str, Any])
     # reopen is retried every REOPEN_BACKOFF_S[1] at most, and the first attempt after the interface came up works.
     lag_s = ph["loop_lag_max_ms"] / 1000
     assert ph["detected_after_media_died_s"] is not None
-    assert ph["detected_after_media_died_s"] <= CHECK_PERIOD_S + lag_s + 0.2, (ph["detected_after_media_died_s"], lag_s)
+    # (+0.3 s: the injector's recv sleeps 0.05 s before it raises, and pycyphal's media thread closes the media.)
+    assert ph["detected_after_media_died_s"] <= CHECK_PERIOD_S + lag_s + 0.3, (ph["detected_after_media_died_s"], lag_s)
     assert ph["diag_bridge_level_while_down"] == 2  # ERROR while down
     assert ph["diag_bridge_level_after"] == 0 and ph["link"]["up"] and ph["link"]["outages"] == 1
     assert ph["open_attempts_after_up"] == 1 and ph["bridge_errors"]["transport_reopened"] == 1
