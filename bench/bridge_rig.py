@@ -303,7 +303,7 @@ class Rig:
         self.ros: RosSide | None = None
 
     def node(self, name: str, node_id: int, raw: bool = False) -> Any:
-        from sam_runtime.transport import make_node
+        from sam_runtime.cyphal_io.transport import make_node
 
         n = make_node(f"org.sam.bench.{name}", node_id, self.kind, iface=self.iface_r if raw else self.iface_b,
                       mtu=self.mtu)
@@ -391,7 +391,7 @@ class Rig:
 
     async def drop_nodes(self, keep: int) -> None:
         """Close the nodes made after the first ``keep``."""
-        from sam_runtime.transport import aclose
+        from sam_runtime.cyphal_io.transport import aclose
 
         extra, self.nodes[keep:] = self.nodes[keep:], []
         with contextlib.suppress(Exception):
@@ -399,7 +399,7 @@ class Rig:
         await asyncio.sleep(0.2)
 
     async def close(self) -> None:
-        from sam_runtime.transport import aclose
+        from sam_runtime.cyphal_io.transport import aclose
 
         try:
             if self.bridge is not None:

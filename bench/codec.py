@@ -131,8 +131,8 @@ class DroneCanSide:
         self.mappings = list(gen.tables().DRONECAN_MAPPINGS)
 
     def sample(self, m: Any, seed: int = 0, t: float = 12.5) -> Any:
-        from sam_runtime.device_models import DeviceState, VehicleState
-        from sam_runtime.device_models_v0 import ensure_element, generic_fill_v0, parse_element, physics_v0
+        from sam_runtime.sim.devices import DeviceState, VehicleState
+        from sam_runtime.sim.devices_dronecan import ensure_element, generic_fill_v0, parse_element, physics_v0
 
         dt = m.data_type
         veh = VehicleState(rng=random.Random(seed))
@@ -168,7 +168,7 @@ class DroneCanSide:
         return encode
 
     def builtin(self, obj: Any) -> Any:
-        from sam_runtime.device_models_v0 import to_builtin_v0
+        from sam_runtime.sim.devices_dronecan import to_builtin_v0
 
         return None if obj is None else to_builtin_v0(obj)
 

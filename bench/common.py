@@ -112,7 +112,7 @@ def machine() -> dict[str, Any]:
 # ----------------------------------------------------------------------------------------------- samples
 def sample_uavcan(gen: Any, port: Any, seed: int = 0, t: float = 12.5) -> Any:
     """A realistic pycyphal object of a port's type: the simulator's generic values, then its SAM physics."""
-    from sam_runtime.sim import PHYSICS, DeviceState, VehicleState, generic_fill, physics_key
+    from sam_runtime.sim.simulator import PHYSICS, DeviceState, VehicleState, generic_fill, physics_key
 
     dtype = gen.dsdl_class(port)
     veh = VehicleState(rng=random.Random(seed))

@@ -52,7 +52,7 @@ COMPILE = (
 
 
 def _uavcan_root() -> Path:
-    from sam_codegen.cyphal_path import dsdl_lookup_roots
+    from sam_codegen.project.cyphal_path import dsdl_lookup_roots
 
     return next(r for r in dsdl_lookup_roots() if r.name == "uavcan")
 
@@ -146,10 +146,11 @@ def stages(spec_path: Path) -> dict[str, float]:
     import yaml
 
     from sam_codegen import build
-    from sam_codegen.build import emitters, verify_dsdl, write_atomically
-    from sam_codegen.spec_loader import parse_spec
-    from sam_codegen.validate import validate
-    from sam_codegen.yaml_source import _LOADER, _Converter
+    from sam_codegen.build import verify_dsdl, write_atomically
+    from sam_codegen.frontend.loader import parse_spec
+    from sam_codegen.frontend.yaml_source import _LOADER, _Converter
+    from sam_codegen.targets.registry import EMITTERS
+    from sam_codegen.validate.resolve import validate
 
     text = spec_path.read_text(encoding="utf-8")
     out: dict[str, float] = {}
@@ -167,7 +168,7 @@ def stages(spec_path: Path) -> dict[str, float]:
         resolved = validate(spec)
         out["validate (cross-references, mapping rules)"] = time.perf_counter() - t
         files: dict[str, str] = {}
-        for emit in emitters():
+        for emit in EMITTERS:
             t = time.perf_counter()
             files.update(emit(resolved))
             out[f"emit {emit.__module__.rsplit('.', 1)[-1]}"] = time.perf_counter() - t

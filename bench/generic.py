@@ -180,8 +180,8 @@ def _set_array(obj: Any, path: tuple[PathSeg, ...], values: list[Any]) -> None:
 
 def build(gen: Any, spec_path: Path) -> dict[str, GenericMapping]:
     """A GenericMapping per mapping of the spec (resolved by sam_codegen, as the generator sees it)."""
-    from sam_codegen.spec_loader import load_spec_file
-    from sam_codegen.validate import validate
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.validate.resolve import validate
 
     resolved = validate(load_spec_file(Path(spec_path)))
     by_name = {m.name: m for m in gen.tables().MAPPINGS}

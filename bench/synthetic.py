@@ -167,8 +167,8 @@ def write_spec(n: int, path: Path) -> Path:
 
 def validate_spec(path: Path) -> Any:
     """Parse and validate with sam_codegen (raises SpecError with every problem)."""
-    from sam_codegen.spec_loader import load_spec_file
-    from sam_codegen.validate import validate
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.validate.resolve import validate
 
     return validate(load_spec_file(Path(path)))
 

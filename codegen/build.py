@@ -7,42 +7,24 @@ import gc
 import os
 import shutil
 import tempfile
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import pydsdl
 
-from .diagnostics import Diagnostic, Pos, SpecError
-from .model import DsdlStruct
-from .spec_loader import load_spec_file
-from .typesys import DsdlType, split_composite_name
-from .validate import Resolved, validate
-from .workspace import GENERATED_MARKER, OutDirError, check_out_dir
+from sam_codegen.frontend.loader import load_spec_file
+from sam_codegen.model.diagnostics import Diagnostic, Pos, SpecError
+from sam_codegen.model.spec import DsdlStruct
+from sam_codegen.model.types import DsdlType, split_composite_name
+from sam_codegen.project.workspace import GENERATED_MARKER, OutDirError, check_out_dir
+from sam_codegen.targets.registry import EMITTERS
+from sam_codegen.validate.resolve import Resolved, validate
 
-Emitter = Callable[[Resolved], dict[str, str]]
 MARKER = GENERATED_MARKER  # marks a directory as ours, so that a rebuild never replaces someone else's folder
 
 
 class OutputError(OutDirError):
     """The output folder cannot be written (not ours, or a file system error); the spec may well be valid."""
-
-
-def emitters() -> list[Emitter]:
-    from . import (
-        emit_codec,
-        emit_codec_v0,
-        emit_docs,
-        emit_dsdl,
-        emit_dsdl_v0,
-        emit_nodes,
-        emit_python,
-        emit_python_v0,
-        emit_ros,
-    )
-
-    return [emit_ros.emit, emit_dsdl.emit, emit_dsdl_v0.emit, emit_python.emit, emit_python_v0.emit, emit_nodes.emit,
-            emit_docs.emit, emit_codec.emit, emit_codec_v0.emit]
 
 
 # pydsdl reads about this many of the spec's types per call. Its namespace-wide passes are O(N^2) in the
@@ -67,7 +49,7 @@ def verify_dsdl(resolved: Resolved, files: dict[str, str], *, batch: int | None 
     collisions, cannot fail here: batches are used only when every emitted file is a spec type's
     `Name.MAJOR.MINOR.dsdl`, which carries no fixed port id; any other emitted tree is read in one call.
     """
-    from .emit_dsdl import dsdl_path
+    from sam_codegen.targets.dsdl import dsdl_path
 
     dsdl_files = {path: text for path, text in files.items() if path.startswith("dsdl/")}
     if not dsdl_files:
@@ -163,7 +145,7 @@ def generate(spec_path: Path) -> dict[str, str]:
 def _generate(spec_path: Path) -> dict[str, str]:
     resolved = validate(load_spec_file(spec_path))
     files: dict[str, str] = {}
-    for emit in emitters():
+    for emit in EMITTERS:
         for path, text in emit(resolved).items():
             if path in files:
                 raise AssertionError(f"two emitters write {path}")

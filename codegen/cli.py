@@ -12,9 +12,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from .cyphal_path import CyphalPathError
-from .diagnostics import SpecError
-from .workspace import Workspace, WorkspaceError, ensure_state_dir, workspace_for
+from sam_codegen.model.diagnostics import SpecError
+from sam_codegen.project.cyphal_path import CyphalPathError
+from sam_codegen.project.workspace import Workspace, WorkspaceError, ensure_state_dir, workspace_for
 
 SPEC_HELP = "the interface spec (default: spec/interfaces.yaml in the working directory or its nearest parent)"
 OUT_HELP = ("the generated folder (default: generated/ in the spec's project: beside spec/, or beside a spec file "
@@ -35,7 +35,7 @@ def _shown(path: Path, cwd: Path) -> str:
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    from .build import build
+    from sam_codegen.build import build
 
     ws = _workspace(args)
     assert ws.spec is not None
@@ -66,8 +66,8 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from .spec_loader import load_spec_file
-    from .validate import validate
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.validate.resolve import validate
 
     ws = _workspace(args)
     assert ws.spec is not None
@@ -82,7 +82,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _cmd_ros_install(args: argparse.Namespace) -> int:
-    from .ros_build import RosBuildError, build_ros_packages, ros_packages_in_order
+    from sam_codegen.project.ros_install import RosBuildError, build_ros_packages, ros_packages_in_order
 
     ws = _workspace(args, need_spec=False)
     ros_dir = ws.generated / "ros"

@@ -17,9 +17,9 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
-from .mapping_rules import Key, PathSeg, ResolvedMapping, Step
-from .model import Scalar
-from .typesys import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from sam_codegen.model.spec import Scalar
+from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from sam_codegen.validate.mapping_rules import Key, PathSeg, ResolvedMapping, Step
 
 TO_ROS = "to_ros"
 TO_UAVCAN = "to_uavcan"

@@ -5,7 +5,7 @@ Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_
 :func:`main`. Also ``python -m sam_runtime.cli {bridge,sim,nodes,run} ...``.
 
 Where: ``--generated``, else ``$SAM_GENERATED_DIR``, else the generated folder of the project the working directory
-is in (see sam_codegen.workspace); ``run`` also finds the spec the way ``sam-codegen build`` does.
+is in (see sam_codegen.project.workspace); ``run`` also finds the spec the way ``sam-codegen build`` does.
 
 Transport selection (bridge and sim): ``--transport udp|can|loopback|env``; without it, the standard
 Cyphal register environment variables are used when one of UAVCAN__UDP__IFACE, UAVCAN__CAN__IFACE,
@@ -106,8 +106,8 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
     _stay_with_parent()
     _setup_logging(args.log_level)
     from sam_runtime.bridge import Bridge, BridgeConfigError, TransportConfig
+    from sam_runtime.cyphal_io.transport import TransportConfigError
     from sam_runtime.genpkg import GeneratedPackageError
-    from sam_runtime.transport import TransportConfigError
 
     async def run(stop: asyncio.Event) -> int:
         bridge = Bridge(
@@ -215,7 +215,7 @@ def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
 
 def _vehicle_options(args: argparse.Namespace) -> dict[str, Any]:
     """SimConfig's vehicle options from the sim's command line (ValueError: one clear line)."""
-    from sam_runtime.vehicle import SeaFloor
+    from sam_runtime.physics.vehicle import SeaFloor
 
     lat, lon = _floats(args.gps_origin, 2, "--gps-origin")
     return {
@@ -232,9 +232,9 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
     _require_runtime("sim")
     _stay_with_parent()
     _setup_logging(args.log_level)
+    from sam_runtime.cyphal_io.transport import TransportConfigError
     from sam_runtime.genpkg import GeneratedPackageError
-    from sam_runtime.sim import SimConfig, Simulator
-    from sam_runtime.transport import TransportConfigError
+    from sam_runtime.sim.simulator import SimConfig, Simulator
 
     async def run(stop: asyncio.Event) -> int:
         kind = _transport_kind(args)
@@ -283,12 +283,12 @@ def _add_mission_args(p: argparse.ArgumentParser) -> None:
                         "altitude above the sea floor, 0 the surface) instead of the demo mission")
     m.add_argument("--mission", type=Path, default=None, metavar="FILE",
                    help="a mission file (YAML: a list of pose/heading goals with arrival tolerances, see "
-                        "sam_runtime.nodes.mission_plan) instead of the demo mission")
+                        "sam_runtime.nav.mission) instead of the demo mission")
 
 
 def _mission_goals(args: argparse.Namespace) -> Any:
     """The mission's goals from --goal/--mission (None: the demo mission); MissionError for a bad file or goal."""
-    from sam_runtime.nodes.mission_plan import load_mission, single_goal
+    from sam_runtime.nav.mission import load_mission, single_goal
 
     if args.goal is not None:
         return single_goal(*args.goal)
@@ -318,8 +318,8 @@ def nodes_main(argv: Sequence[str] | None = None) -> int:
     _stay_with_parent()
     _setup_logging(args.log_level)
     from sam_runtime.genpkg import GeneratedPackageError
+    from sam_runtime.nav.mission import MissionError
     from sam_runtime.nodes.host import HostConfigError, NodeHost, plan_host
-    from sam_runtime.nodes.mission_plan import MissionError
 
     try:
         goals = _mission_goals(args)
@@ -400,8 +400,8 @@ def run_main(argv: Sequence[str] | None = None) -> int:
     args = _run_parser().parse_args(argv)
     _require_runtime("run")
     _setup_logging(args.log_level)
-    from sam_runtime.monitor import RunOptions, run
-    from sam_runtime.nodes.mission_plan import MissionError
+    from sam_runtime.main_job.job import RunOptions, run
+    from sam_runtime.nav.mission import MissionError
 
     try:
         _mission_goals(args)  # a bad mission file stops here, before anything starts

@@ -157,7 +157,7 @@ async def _wait(stop: asyncio.Event, seconds: float | None) -> None:
 
 async def _drain_tasks(timeout: float) -> list[str]:
     """Cancel every task still running, repeatedly (a cancellation that lands inside ``wait_for`` can be lost
-    on Python 3.11, see sam_runtime.transport.aclose), until all are done or the deadline passes. Returns the
+    on Python 3.11, see sam_runtime.cyphal_io.transport.aclose), until all are done or the deadline passes. Returns the
     names of the tasks that refused to end."""
     me = asyncio.current_task()
     loop = asyncio.get_running_loop()

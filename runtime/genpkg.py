@@ -24,7 +24,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from sam_codegen.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
+from sam_codegen.project.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
 
 __all__ = [
     "GENERATED_ENV_VAR",
@@ -44,7 +44,7 @@ class GeneratedPackageError(Exception):
 
 def default_generated_dir() -> Path:
     """``$SAM_GENERATED_DIR``, else the generated folder of the project the working directory is in (the folder
-    itself when the working directory is inside it; see sam_codegen.workspace)."""
+    itself when the working directory is inside it; see sam_codegen.project.workspace)."""
     try:
         return find_generated()
     except WorkspaceError as ex:
@@ -126,7 +126,7 @@ class GeneratedPackage:
     def compile_dsdl(self) -> Path:
         """Compile the generated DSDL + ``uavcan`` (cached) and put it on sys.path. Call before importing
         ``uavcan`` or ``pycyphal.application`` anywhere in the process."""
-        from sam_runtime.dsdl import ensure_compiled
+        from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
 
         dirs = self.dsdl_dirs
         if not dirs:
@@ -230,7 +230,7 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
     directory); an install is stamped with its sources' hash, so a changed spec triggers a rebuild and an unchanged
     one costs a few ms.
     """
-    from sam_codegen.ros_build import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
+    from sam_codegen.project.ros_install import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
 
     prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
     own = gen.ros_package_dir()

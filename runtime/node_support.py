@@ -31,7 +31,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from .tf_buffer import TfBuffer, TfError
+from sam_runtime.tf_buffer import TfBuffer, TfError
 
 __all__ = [
     "DIAGNOSTICS_TOPIC",

@@ -1,5 +1,5 @@
 # ruff: noqa: E501  (a table of exact diagnostics, one per line, as tests/broken_cases.py)
-"""Broken specs for the node, QoS, TF and external-package checks (codegen/validate_nodes.py).
+"""Broken specs for the node, QoS, TF and external-package checks (codegen/validate/nodes.py).
 
 Each case edits tests/specs/minimal.yaml (every `old` is replaced by its `new` once, in order; the case fails
 loudly if an `old` is not there) and names the exact diagnostics, with the file shown as its base name, all at

@@ -28,7 +28,7 @@ module                 job
 ``handoff``            the rclpy thread -> asyncio loop hand-off, one wake-up per batch
 ``loss``               transfer-loss accounting from the gaps in transfer ids
 ``health``             device health from heartbeats: offline timers, restarts
-``silence``            mappings silent while their device is alive (rules: sam_runtime.liveness)
+``silence``            mappings silent while their device is alive (rules: sam_runtime.bridge.liveness)
 ``link``               the backend's link opened, watched, reopened with back-off
 ``counters``           per-mapping counters and drop reasons, the bounded-rate log
 ``reporting``          the stats snapshot and /diagnostics publishing; ``diagnostics`` builds the message
@@ -105,11 +105,11 @@ message is still published), rejected ones under ``rejected.<...>``.
   yakut) are tracked in the stats; their first appearance is logged at INFO, their comings and goings at DEBUG.
 - Silence: a UAVCAN -> ROS mapping that gets nothing from its device while the device's heartbeat is alive -
   never, or no more - for longer than max(3 s, 5 nominal periods) is WARN in /diagnostics ("no message for N s
-  while device X is alive; nominal R Hz"), logged once when it starts and when it ends (sam_runtime.liveness).
+  while device X is alive; nominal R Hz"), logged once when it starts and when it ends (sam_runtime.bridge.liveness).
 - Cyphal ports and registers: the bridge's ports are named after its mappings, with the standard registers
   ``uavcan.sub.<mapping>.id``/``.type`` and ``uavcan.pub.<mapping>.id``/``.type`` (a subject of several mappings:
   the first one's name) whose defaults are the spec's subject ids, overridable as usual (e.g.
-  ``UAVCAN__SUB__IMU__ID``), and ``uavcan.node.id`` (sam_runtime.cyphal_ports).
+  ``UAVCAN__SUB__IMU__ID``), and ``uavcan.node.id`` (sam_runtime.cyphal_io.ports).
 - A Cyphal transport that dies (pycyphal's CAN media close themselves for good on unrecoverable OS errors,
   e.g. ENETDOWN when a SocketCAN interface goes down) is detected within 0.2 s and reopened with back-off
   (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
@@ -131,14 +131,13 @@ import os
 # Must precede any rclpy import in the process (loopback-only discovery on these machines).
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
+from sam_runtime.bridge.backend import BridgeConfigError
+from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportConfig, quiet_late_media_completions
+from sam_runtime.bridge.composition import Bridge
+from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, DROP_REASONS, MappingStats, RateLimitedLog
+from sam_runtime.bridge.lifetime import cancel_and_wait
+from sam_runtime.bridge.outbound import DEFAULT_QUEUE_SIZE
 from sam_runtime.node_support import ros_parameter_name
-
-from .backend import BridgeConfigError
-from .composition import Bridge
-from .counters import DEFAULT_LOG_INTERVAL_S, DROP_REASONS, MappingStats, RateLimitedLog
-from .cyphal_backend import DEFAULT_RX_QUEUE_SIZE, TransportConfig, quiet_late_media_completions
-from .lifetime import cancel_and_wait
-from .outbound import DEFAULT_QUEUE_SIZE
 
 __all__ = [
     "DEFAULT_LOG_INTERVAL_S",

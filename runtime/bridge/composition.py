@@ -9,22 +9,26 @@ import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from sam_runtime.bridge.backend import Backend, BridgeConfigError
+from sam_runtime.bridge.backends.cyphal import (
+    DEFAULT_RX_QUEUE_SIZE,
+    CyphalBackend,
+    TransportConfig,
+    quiet_late_media_completions,
+)
+from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, RateLimitedLog, log
+from sam_runtime.bridge.health import DeviceHealth
+from sam_runtime.bridge.inbound import Inbound
+from sam_runtime.bridge.layout import select
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.bridge.link import LinkSupervisor
+from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.outbound import DEFAULT_QUEUE_SIZE, Outbound
+from sam_runtime.bridge.reporting import Reporter
+from sam_runtime.bridge.ros_side import RosSide
+from sam_runtime.bridge.silence import SilenceWatch
+from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 from sam_runtime.genpkg import GeneratedPackage
-
-from .backend import Backend, BridgeConfigError
-from .counters import DEFAULT_LOG_INTERVAL_S, MappingStats, RateLimitedLog, log
-from .cyphal_backend import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig, quiet_late_media_completions
-from .health import DeviceHealth
-from .inbound import Inbound
-from .layout import select
-from .lifetime import Lifetime
-from .link import LinkSupervisor
-from .loss import TransferLoss
-from .outbound import DEFAULT_QUEUE_SIZE, Outbound
-from .reporting import Reporter
-from .ros_side import RosSide
-from .silence import SilenceWatch
-from .wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 
 __all__ = ["Bridge"]
 
@@ -97,7 +101,7 @@ class Bridge:
         self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in sel.mappings}
         self.backend: Backend
         if sel.protocol == "dronecan":
-            from .dronecan_backend import DroneCanBackend
+            from sam_runtime.bridge.backends.dronecan import DroneCanBackend
 
             self.backend = DroneCanBackend(dronecan_iface, self.node_id, rlog=self.log, errors=self.lifetime.errors,
                                            name=f"org.{tables.VEHICLE}.{self.name}")
@@ -116,7 +120,7 @@ class Bridge:
         self.inbound: Inbound | None = None
         self.outbound: Outbound | None = None
         self.reporter: Reporter | None = None
-        self.duties: Any = None  # DroneCAN: sam_runtime.bridge.dronecan_duties
+        self.duties: Any = None  # DroneCAN: sam_runtime.bridge.backends.dronecan_duties
 
     @property
     def name(self) -> str:
@@ -196,7 +200,7 @@ class Bridge:
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
         if sel.protocol == "dronecan":
-            from .dronecan_duties import DroneCanDuties
+            from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
 
             self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **self._dronecan_options)
             self.duties.attach()

@@ -1,7 +1,7 @@
 """The bridge's stats snapshot as diagnostic_msgs/DiagnosticArray: one status for the bridge (ERROR while its link
 is down), one per mapping (received, published, dropped and dropped.<reason>, saturated and saturated.<field>,
 rejected.<field>, out_of_order, the protocol stack's counters; WARN while it dropped within the last 10 s, or while
-it gets nothing from a device whose heartbeat is alive for longer than its grace: sam_runtime.liveness), one per
+it gets nothing from a device whose heartbeat is alive for longer than its grace: sam_runtime.bridge.liveness), one per
 device (OK while its heartbeat is alive and its health means OK, WARN or ERROR as its health says, ERROR when the
 heartbeat is lost, STALE when never seen)."""
 
@@ -89,7 +89,7 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
         live = m.get("liveness")
         if live is not None:
             values["liveness"] = live["state"]
-            if live["state"] != "ok":  # silent while its device is alive (sam_runtime.liveness)
+            if live["state"] != "ok":  # silent while its device is alive (sam_runtime.bridge.liveness)
                 level = warn
                 msg = live["message"] + ("" if msg == "ok" else f"; {msg}")
                 values.update(silent_s=live["silent_s"], grace_s=live["grace_s"],

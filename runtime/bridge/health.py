@@ -25,8 +25,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from .backend import DeviceStatus
-from .counters import log
+from sam_runtime.bridge.backend import DeviceStatus
+from sam_runtime.bridge.counters import log
 
 __all__ = ["OFFLINE_TIMEOUT_S", "DeviceHealth", "NodeRecord"]
 

@@ -29,10 +29,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from .backend import Backend, Inlet
-from .counters import MappingStats, count_handler_error
-from .lifetime import Lifetime
-from .loss import TransferLoss
+from sam_runtime.bridge.backend import Backend, Inlet
+from sam_runtime.bridge.counters import MappingStats, count_handler_error
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.bridge.loss import TransferLoss
 
 __all__ = ["InMapping", "Inbound", "PortGroup"]
 

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from .backend import BridgeConfigError
+from sam_runtime.bridge.backend import BridgeConfigError
 
 __all__ = ["PROTOCOLS", "Selection", "destinations_of", "port_id_of", "select"]
 

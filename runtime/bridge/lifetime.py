@@ -21,7 +21,7 @@ import time
 from collections.abc import Awaitable, Callable, Sequence
 from typing import Any
 
-from .counters import RateLimitedLog, log
+from sam_runtime.bridge.counters import RateLimitedLog, log
 
 __all__ = ["Hook", "Lifetime", "cancel_and_wait"]
 

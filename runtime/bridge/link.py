@@ -17,9 +17,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from .backend import Backend
-from .counters import log
-from .lifetime import Lifetime
+from sam_runtime.bridge.backend import Backend
+from sam_runtime.bridge.counters import log
+from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["CHECK_PERIOD_S", "REOPEN_BACKOFF_S", "LinkSupervisor"]
 
@@ -63,7 +63,7 @@ class LinkSupervisor:
 
     async def _close(self) -> None:
         if self._reopen_task is not None:
-            from .lifetime import cancel_and_wait
+            from sam_runtime.bridge.lifetime import cancel_and_wait
 
             await cancel_and_wait([self._reopen_task])
         await self.backend.close()

@@ -18,11 +18,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from .backend import Backend, LinkDownError, Outlet
-from .counters import MappingStats, count_handler_error, log
-from .handoff import Handoff
-from .layout import port_id_of
-from .lifetime import Lifetime, cancel_and_wait
+from sam_runtime.bridge.backend import Backend, LinkDownError, Outlet
+from sam_runtime.bridge.counters import MappingStats, count_handler_error, log
+from sam_runtime.bridge.handoff import Handoff
+from sam_runtime.bridge.layout import port_id_of
+from sam_runtime.bridge.lifetime import Lifetime, cancel_and_wait
 
 __all__ = ["DEFAULT_QUEUE_SIZE", "OutMapping", "Outbound"]
 

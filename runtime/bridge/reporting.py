@@ -10,16 +10,16 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from .backend import Backend
-from .counters import MappingStats, RateLimitedLog
-from .diagnostics import Naming, diagnostic_array
-from .health import DeviceHealth
-from .inbound import Inbound
-from .layout import destinations_of, port_id_of
-from .lifetime import Lifetime
-from .link import LinkSupervisor
-from .outbound import Outbound
-from .silence import SilenceWatch
+from sam_runtime.bridge.backend import Backend
+from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+from sam_runtime.bridge.diagnostics import Naming, diagnostic_array
+from sam_runtime.bridge.health import DeviceHealth
+from sam_runtime.bridge.inbound import Inbound
+from sam_runtime.bridge.layout import destinations_of, port_id_of
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.bridge.link import LinkSupervisor
+from sam_runtime.bridge.outbound import Outbound
+from sam_runtime.bridge.silence import SilenceWatch
 
 __all__ = ["DIAGNOSTICS_TOPIC", "Reporter"]
 

@@ -25,8 +25,8 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from .backend import BridgeConfigError
-from .lifetime import Lifetime
+from sam_runtime.bridge.backend import BridgeConfigError
+from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["RosSide"]
 

@@ -1,4 +1,4 @@
-"""UAVCAN -> ROS mappings that get nothing from a device whose heartbeat is alive (the rules: sam_runtime.liveness),
+"""UAVCAN -> ROS mappings that get nothing from a device whose heartbeat is alive (rules: bridge.liveness),
 checked every 0.2 s; a mapping going silent, and the end of it, is logged once and handed to the handlers (the
 bridge publishes /diagnostics at once)."""
 
@@ -8,10 +8,9 @@ import time
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
-from sam_runtime.liveness import LivenessMonitor, Silence
-
-from .counters import log
-from .lifetime import Lifetime
+from sam_runtime.bridge.counters import log
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.bridge.liveness import LivenessMonitor, Silence
 
 __all__ = ["CHECK_PERIOD_S", "SilenceWatch"]
 

@@ -1,6 +1,6 @@
 """From the generated tables and converters to the bridge's run-time mappings: each mapping's converter, its ROS
 message class and DSDL class; the UAVCAN -> ROS mappings grouped by port (one subscription per port, named after
-its first mapping: sam_runtime.cyphal_ports.subscription_names); the ROS -> UAVCAN destinations checked against the
+its first mapping: sam_runtime.cyphal_io.ports.subscription_names); the ROS -> UAVCAN destinations checked against the
 devices."""
 
 from __future__ import annotations
@@ -8,14 +8,13 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from sam_runtime.cyphal_ports import subscription_names
-
-from .backend import BridgeConfigError
-from .counters import MappingStats, log
-from .inbound import InMapping, PortGroup
-from .layout import destinations_of, port_id_of
-from .loss import TransferLoss
-from .outbound import OutMapping
+from sam_runtime.bridge.backend import BridgeConfigError
+from sam_runtime.bridge.counters import MappingStats, log
+from sam_runtime.bridge.inbound import InMapping, PortGroup
+from sam_runtime.bridge.layout import destinations_of, port_id_of
+from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.outbound import OutMapping
+from sam_runtime.cyphal_io.ports import subscription_names
 
 __all__ = ["check_destinations", "find_converter", "in_groups", "missing_codecs", "nominal_rates", "out_mappings"]
 

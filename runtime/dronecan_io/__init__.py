@@ -12,13 +12,13 @@
 The ``dronecan`` package is imported by these modules: install the ``runtime`` extra.
 """
 
-from .bus_load import BusLoadMeter, TransferCost, frame_bits, payload_length, transfer_cost
-from .drops import DropCounter, DropKey, DropReason, RateLimitedLog
-from .frame_gate import FrameGate
-from .iface import Iface, IfaceError, make_driver, make_node, parse_iface
-from .loopback import Acceptance, LoopbackMulticastDriver
-from .mcast_packet import MCAST_PORT, group_for_bus
-from .node_loop import HandlerError, NodeLoop, classify_spin_error, close_node
+from sam_runtime.dronecan_io.bus_load import BusLoadMeter, TransferCost, frame_bits, payload_length, transfer_cost
+from sam_runtime.dronecan_io.drops import DropCounter, DropKey, DropReason, RateLimitedLog
+from sam_runtime.dronecan_io.frame_gate import FrameGate
+from sam_runtime.dronecan_io.iface import Iface, IfaceError, make_driver, make_node, parse_iface
+from sam_runtime.dronecan_io.loopback import Acceptance, LoopbackMulticastDriver
+from sam_runtime.dronecan_io.mcast_packet import MCAST_PORT, group_for_bus
+from sam_runtime.dronecan_io.node_loop import HandlerError, NodeLoop, classify_spin_error, close_node
 
 __all__ = [
     "MCAST_PORT",

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 from dronecan.driver.common import AbstractDriver, CANFrame
 
-from .can_id import Tail, V0Id
-from .drops import DropCounter, DropReason
-from .wire import TransferTaps
+from sam_runtime.dronecan_io.can_id import Tail, V0Id
+from sam_runtime.dronecan_io.drops import DropCounter, DropReason
+from sam_runtime.dronecan_io.wire import TransferTaps
 
 __all__ = ["FrameGate"]
 

@@ -18,10 +18,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .drops import DropCounter
-from .frame_gate import FrameGate
-from .loopback import LoopbackMulticastDriver
-from .mcast_packet import MCAST_PORT
+from sam_runtime.dronecan_io.drops import DropCounter
+from sam_runtime.dronecan_io.frame_gate import FrameGate
+from sam_runtime.dronecan_io.loopback import LoopbackMulticastDriver
+from sam_runtime.dronecan_io.mcast_packet import MCAST_PORT
 
 __all__ = ["DEFAULT_BITRATE", "Iface", "IfaceError", "make_driver", "make_node", "parse_iface"]
 

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 from dronecan.driver.common import AbstractDriver, CANFrame, DriverError, TxQueueFullError
 
-from .drops import DropCounter, DropReason
-from .mcast_packet import MCAST_PORT, PacketError, decode_packet, encode_packet, group_for_bus
+from sam_runtime.dronecan_io.drops import DropCounter, DropReason
+from sam_runtime.dronecan_io.mcast_packet import MCAST_PORT, PacketError, decode_packet, encode_packet, group_for_bus
 
 __all__ = ["LOOPBACK_ADDRESS", "Acceptance", "LoopbackMulticastDriver"]
 

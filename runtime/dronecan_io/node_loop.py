@@ -27,9 +27,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from .can_id import V0Id
-from .drops import DropCounter, DropKey, DropReason, RateLimitedLog
-from .frame_gate import FrameGate
+from sam_runtime.dronecan_io.can_id import V0Id
+from sam_runtime.dronecan_io.drops import DropCounter, DropKey, DropReason, RateLimitedLog
+from sam_runtime.dronecan_io.frame_gate import FrameGate
 
 __all__ = ["HandlerError", "LoopStats", "NodeLoop", "classify_spin_error", "watchable_fd"]
 

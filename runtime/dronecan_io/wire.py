@@ -18,8 +18,8 @@ from typing import Any
 
 from dronecan.driver.common import CANFrame
 
-from .can_id import TAIL_TOGGLE
-from .drops import DropCounter, DropReason
+from sam_runtime.dronecan_io.can_id import TAIL_TOGGLE
+from sam_runtime.dronecan_io.drops import DropCounter, DropReason
 
 __all__ = ["TransferTaps", "broadcast_payload", "crc16"]
 

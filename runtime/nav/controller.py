@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from sam_runtime.nav.geo import euler_from_quaternion, wrap_angle
+from sam_runtime.physics.geo import euler_from_quaternion, wrap_angle
 
 __all__ = ["Commands", "Controller", "ControllerConfig", "ControllerPose"]
 

@@ -6,11 +6,11 @@ and the thrusters' feedback.
   from the estimated surge and the measured rates, so turns and speed changes do not tilt the estimate; readings
   whose norm is far from g are not trusted at all.
 - Heading: the magnetometer levelled with the estimated roll and pitch gives the world ENU yaw (the Earth field's
-  horizontal part points north, :data:`sam_runtime.vehicle.EARTH_FIELD_ENU_GA`); the gyro-integrated yaw is pulled
-  toward it.
+  horizontal part points north, :data:`~sam_runtime.physics.vehicle.EARTH_FIELD_ENU_GA`); the gyro-integrated
+  yaw is pulled toward it.
 - Depth: from the pressure, d = (p - p_atm) / (rho g) with sea water; odom z = -d.
 - Speed: the surge ODE of the vehicle's nominal parameters driven by the feedback RPMs (at steady state the same
-  rpm -> speed relation as :func:`sam_runtime.vehicle.steady_surge_speed`).
+  rpm -> speed relation as :func:`sam_runtime.physics.vehicle.steady_surge_speed`).
 - Position: the surge along the estimated attitude, integrated in odom (ENU, origin where the estimator started).
 
 Times are seconds from any clock, passed in; readings older than the last processed time are used with a zero
@@ -23,7 +23,7 @@ import math
 from collections import Counter
 from dataclasses import dataclass, field
 
-from sam_runtime.nav.geo import (
+from sam_runtime.physics.geo import (
     P_ATM,
     RHO_SEAWATER,
     G,
@@ -33,7 +33,7 @@ from sam_runtime.nav.geo import (
     rotate_body_to_world,
     wrap_angle,
 )
-from sam_runtime.vehicle import VehicleParams, surge_acceleration
+from sam_runtime.physics.vehicle import VehicleParams, surge_acceleration
 
 __all__ = ["DeadReckoning", "DeadReckoningConfig", "DrPose"]
 

@@ -18,7 +18,7 @@ import math
 from collections import Counter
 from dataclasses import dataclass
 
-from sam_runtime.nav.geo import Vec3, local_from_latlon
+from sam_runtime.physics.geo import Vec3, local_from_latlon
 
 __all__ = ["SlamConfig", "SlamCorrector"]
 

@@ -17,7 +17,7 @@ from sam_nodes.controller import ControllerBase
 
 from sam_runtime.nav.controller import Commands, ControllerConfig, ControllerPose
 from sam_runtime.nav.controller import Controller as Law
-from sam_runtime.nav.planner import GOAL_FRAME
+from sam_runtime.nav.motion_planner import GOAL_FRAME
 from sam_runtime.nodes.common import Level, StatusReporter, guarded_timer, now_s, stamp_s
 from sam_runtime.tf_buffer import TfError
 

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sam_runtime.nav.mission import MissionGoal
 from sam_runtime.nodes import ImplementationError, implemented, load_implementation, unimplemented
-from sam_runtime.nodes.mission_plan import MissionGoal
 
 __all__ = ["HostConfigError", "HostPlan", "NodeHost", "plan_host"]
 

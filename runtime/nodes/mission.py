@@ -1,5 +1,5 @@
 """Mission (an addition to the document: where the planner's goals come from): publishes a sequence of goals
-(:mod:`sam_runtime.nodes.mission_plan`) on /nav_goal or /nav_heading and advances on arrival, judged from
+(:mod:`sam_runtime.nav.mission`) on /nav_goal or /nav_heading and advances on arrival, judged from
 world -> base_link.
 
 It starts once the planner subscribes and world -> base_link exists (a goal sent into nothing would be lost:
@@ -14,8 +14,8 @@ from typing import Any
 
 from sam_nodes.mission import MissionBase
 
+from sam_runtime.nav.mission import DEMO_MISSION, MissionGoal, arrived
 from sam_runtime.nodes.common import Level, StatusReporter, guarded_timer, now_s
-from sam_runtime.nodes.mission_plan import DEMO_MISSION, MissionGoal, arrived
 from sam_runtime.tf_buffer import TfError
 
 __all__ = ["REPUBLISH_S", "Mission"]

@@ -1,6 +1,6 @@
 """Motion planner (IV.F): /nav_goal or /nav_heading -> nav_msgs/Path on /global_plan.
 
-The geometry, the z convention and the safety clamps are :class:`sam_runtime.nav.planner.Planner`'s. This node
+The geometry, the z convention and the safety clamps are :class:`sam_runtime.nav.motion_planner.Planner`'s. This node
 replans every REPLAN_PERIOD_S from world -> base_link, at once on a new goal and on a change of safe_depth or
 safe_altitude. A goal in another frame than world or with a non-finite number is refused: logged with its reason,
 counted (``refused.<kind>`` on /diagnostics) and the current goal is kept. A plan whose target was limited by
@@ -17,7 +17,7 @@ from typing import Any
 from sam_nodes.motion_planner import MotionPlannerBase
 
 from sam_runtime.nav.controller import ControllerPose
-from sam_runtime.nav.planner import Goal, Plan, Planner, PlannerConfig
+from sam_runtime.nav.motion_planner import Goal, Plan, Planner, PlannerConfig
 from sam_runtime.nodes.common import Level, StatusReporter, guarded_timer, now_s
 from sam_runtime.tf_buffer import TfError, TfStale
 

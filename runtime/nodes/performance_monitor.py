@@ -1,4 +1,5 @@
-"""Performance monitor (IV.H): :class:`sam_runtime.nav.monitor.PerformanceMonitor` on /pressure, /altitude and
+"""Performance monitor (IV.H): :class:`~sam_runtime.nav.performance_monitor.PerformanceMonitor`
+on /pressure, /altitude and
 /battery_state, evaluated at EVALUATE_HZ and at once when one of its parameters changes (through the node's
 ~/set_parameters service: the new limits apply from that moment).
 
@@ -15,8 +16,8 @@ from typing import Any
 
 from sam_nodes.performance_monitor import PerformanceMonitorBase
 
-from sam_runtime.nav.monitor import EMERGENCY, MonitorLimits, MonitorOutput
-from sam_runtime.nav.monitor import PerformanceMonitor as StateMachine
+from sam_runtime.nav.performance_monitor import EMERGENCY, MonitorLimits, MonitorOutput
+from sam_runtime.nav.performance_monitor import PerformanceMonitor as StateMachine
 from sam_runtime.nodes.common import Level, StatusReporter, guarded_timer, now_s
 
 __all__ = ["EVALUATE_HZ", "PerformanceMonitor"]

@@ -84,9 +84,9 @@ def check_parameters(bridge: Any) -> dict[str, Any]:
 
 async def main(args: argparse.Namespace) -> dict[str, Any]:
     from sam_runtime.bridge import Bridge, TransportConfig
+    from sam_runtime.cyphal_io.transport import aclose, make_node
     from sam_runtime.genpkg import GeneratedPackage
-    from sam_runtime.sim import SimConfig, Simulator, generic_fill
-    from sam_runtime.transport import aclose, make_node
+    from sam_runtime.sim.simulator import SimConfig, Simulator, generic_fill
 
     gen = GeneratedPackage()
     gen.compile_dsdl()

@@ -29,11 +29,11 @@ if WORKER:
     from hypothesis import strategies as st
     from rclpy.serialization import deserialize_message, serialize_message
 
-    from sam_codegen.mapping_rules import Key, ResolvedMapping
-    from sam_codegen.model import RosMessage
-    from sam_codegen.spec_loader import load_spec_file
-    from sam_codegen.typesys import ROS_INT_RANGES, RosType
-    from sam_codegen.validate import Resolved, validate
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.model.spec import RosMessage
+    from sam_codegen.model.types import ROS_INT_RANGES, RosType
+    from sam_codegen.validate.mapping_rules import Key, ResolvedMapping
+    from sam_codegen.validate.resolve import Resolved, validate
     from sam_runtime.genpkg import GeneratedPackage
 
     CONFIG = json.loads(WORKER)

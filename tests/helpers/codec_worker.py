@@ -32,14 +32,14 @@ if WORKER:
         ros_strategy,
         same,
     )
-    from sam_codegen.emit_python import _Names, py_class_name, py_module
-    from sam_codegen.emit_python import _ros_closure as ros_closure
-    from sam_codegen.mapping_rules import ResolvedMapping
-    from sam_codegen.model import DsdlStruct
-    from sam_codegen.spec_loader import load_spec_file
-    from sam_codegen.validate import validate
-    from sam_codegen.wire_cdr import Constants, cdr_reader, cdr_writer
-    from sam_codegen.wire_cdr_layout import flatten
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.model.spec import DsdlStruct
+    from sam_codegen.targets.python.convert import _Names, py_class_name, py_module
+    from sam_codegen.targets.python.convert import _ros_closure as ros_closure
+    from sam_codegen.targets.wire.cdr_layout import flatten
+    from sam_codegen.targets.wire.cdr_write import Constants, cdr_reader, cdr_writer
+    from sam_codegen.validate.mapping_rules import ResolvedMapping
+    from sam_codegen.validate.resolve import validate
 
     CONFIG = json.loads(WORKER)
     RESOLVED = validate(load_spec_file(Path(CONFIG["spec"])))

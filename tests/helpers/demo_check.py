@@ -49,7 +49,7 @@ def check_classes(gen: Any) -> dict[str, Any]:
     from rclpy.serialization import deserialize_message, serialize_message
     from rosidl_parser import definition as d
 
-    from sam_runtime.ros_demo import demo_message, field_problems
+    from sam_runtime.main_job.demo import demo_message, field_problems
 
     tables = gen.tables()
     classes = {m.topic.ros_type: gen.ros_class(m.topic) for m in tables.MAPPINGS}
@@ -102,8 +102,8 @@ def run_monitor(gen: Any, want: int, timeout: float) -> dict[str, Any]:
     from rclpy.node import Node
     from rclpy.signals import SignalHandlerOptions
 
-    from sam_runtime.monitor import TopicMonitor
-    from sam_runtime.ros_demo import field_problems
+    from sam_runtime.main_job.demo import field_problems
+    from sam_runtime.main_job.job import TopicMonitor
 
     tables = gen.tables()
     commands = sorted({m.topic.name: m.topic for m in tables.MAPPINGS if m.direction == "ros_to_uavcan"}.items())

@@ -438,7 +438,7 @@ async def sensor_window(bridge: Any, sim: Any, probe: Probe | None, body: Callab
 async def main_can(args: argparse.Namespace) -> dict[str, Any]:
     from sam_runtime.bridge import Bridge, TransportConfig
     from sam_runtime.genpkg import GeneratedPackage
-    from sam_runtime.sim import SimConfig, Simulator
+    from sam_runtime.sim.simulator import SimConfig, Simulator
 
     gen = GeneratedPackage()
     gen.compile_dsdl()

@@ -71,7 +71,7 @@ class ScriptedDevice:
         return 1 + int((time.monotonic() - self.booted) * 1e6)
 
     async def boot(self, heartbeat: bool = True) -> None:
-        from sam_runtime.transport import make_node
+        from sam_runtime.cyphal_io.transport import make_node
 
         self.node = make_node(f"org.test.{self.info.name}", self.info.node_id, start=heartbeat, **self.transport)
         self.pub = self.node.make_publisher(self.gen.dsdl_class(self.port), self.subject)
@@ -82,7 +82,7 @@ class ScriptedDevice:
         self.node.start()
 
     async def send(self, stamp_us: int | None = None) -> None:
-        from sam_runtime.sim import generic_fill
+        from sam_runtime.sim.simulator import generic_fill
 
         stamp = self.clock_us() if stamp_us is None else stamp_us
         msg = generic_fill(self.gen.dsdl_class(self.port)(), time.monotonic() - self.booted, stamp)
@@ -110,7 +110,7 @@ class ScriptedDevice:
             self._task = None
 
     async def power_off(self) -> None:
-        from sam_runtime.transport import aclose
+        from sam_runtime.cyphal_io.transport import aclose
 
         await self.stop_publishing()
         await aclose(self.pub)
@@ -163,7 +163,7 @@ def warn_events(probe: Probe, mapping: str) -> list[dict[str, Any]]:
 
 async def tools_come_and_go(transport: dict[str, Any], bridge: Any) -> dict[str, Any]:
     """Node 126 (a tool such as yakut) appears, leaves, appears, leaves: the bridge must not warn about it."""
-    from sam_runtime.transport import aclose, make_node
+    from sam_runtime.cyphal_io.transport import aclose, make_node
 
     seen = []
     for _ in range(2):
@@ -280,9 +280,9 @@ async def phase_restart(bridge: Any, ctd: ScriptedDevice, *, heartbeat_first: bo
 
 async def main_can(args: argparse.Namespace, log: LogRecords) -> dict[str, Any]:
     from sam_runtime.bridge import Bridge, TransportConfig
+    from sam_runtime.cyphal_io.transport import aclose, make_node
     from sam_runtime.genpkg import GeneratedPackage
-    from sam_runtime.sim import SimConfig, Simulator
-    from sam_runtime.transport import aclose, make_node
+    from sam_runtime.sim.simulator import SimConfig, Simulator
 
     gen = GeneratedPackage(args.generated)
     gen.compile_dsdl()

@@ -59,9 +59,9 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
     from rclpy.parameter import Parameter
 
     from sam_runtime.bridge import Bridge, TransportConfig
+    from sam_runtime.cyphal_io.transport import aclose, make_node
     from sam_runtime.genpkg import GeneratedPackage
-    from sam_runtime.sim import generic_fill
-    from sam_runtime.transport import aclose, make_node
+    from sam_runtime.sim.simulator import generic_fill
 
     gen = GeneratedPackage()
     gen.compile_dsdl()

@@ -15,9 +15,9 @@ from pathlib import Path
 
 
 async def run(args: argparse.Namespace) -> dict[str, int]:
+    from sam_runtime.cyphal_io.transport import aclose, make_node
     from sam_runtime.genpkg import GeneratedPackage
-    from sam_runtime.sim import generic_fill
-    from sam_runtime.transport import aclose, make_node
+    from sam_runtime.sim.simulator import generic_fill
 
     gen = GeneratedPackage(args.generated)
     gen.compile_dsdl()

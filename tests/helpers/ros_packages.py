@@ -58,7 +58,7 @@ def locked(path: Path) -> Iterator[None]:
 
 def built_prefix(package_dirs: Sequence[Path]) -> Path:
     """One prefix with every package of `package_dirs` installed, in order (a later one may use an earlier)."""
-    from sam_codegen.ros_build import build_ros_package
+    from sam_codegen.project.ros_install import build_ros_package
 
     dirs = [Path(d) for d in package_dirs]
     prefix = CACHE / f"{'+'.join(d.name for d in dirs)}-{_tree_hash(dirs)}"
@@ -72,7 +72,7 @@ def built_prefix(package_dirs: Sequence[Path]) -> Path:
 
 
 def child_env(prefix: Path, domain: str, extra: Mapping[str, str] | None = None) -> dict[str, str]:
-    from sam_codegen.ros_build import ros_runtime_env
+    from sam_codegen.project.ros_install import ros_runtime_env
 
     env = ros_runtime_env(prefix)
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"

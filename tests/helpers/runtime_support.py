@@ -85,7 +85,7 @@ def domain_id(offset: int) -> str:
 
 
 def child_env(prefix: Path, domain: str, extra: Mapping[str, str] | None = None) -> dict[str, str]:
-    from sam_codegen.ros_build import ros_runtime_env
+    from sam_codegen.project.ros_install import ros_runtime_env
 
     base = dict(os.environ)
     # Never inherit a Cyphal transport from the caller's shell: the tests choose it explicitly.

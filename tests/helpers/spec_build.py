@@ -4,7 +4,8 @@
 (``.cache/test-specs/<name>-<hash>``) and builds its ROS package with CMake into a prefix cached the same way
 (``.cache/ros-prefix/<package>-<hash>``, ~20 s once). Concurrent test runs wait for one build (file locks).
 A ROS package outside the venv is usable only by a process started with its environment
-(:func:`sam_codegen.ros_build.ros_runtime_env`): run the runtime in a child process (``child_env(prefix, ...)``).
+(:func:`sam_codegen.project.ros_install.ros_runtime_env`):
+run the runtime in a child process (``child_env(prefix, ...)``).
 """
 
 from __future__ import annotations

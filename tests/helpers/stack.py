@@ -165,8 +165,8 @@ class Probe:
 
     # ---------------------------------------------------------------------------------- callbacks
     def _on_tf(self, msg: Any, static: bool) -> None:
-        from sam_runtime.nav.geo import euler_from_quaternion
         from sam_runtime.node_support import stamp_to_ns
+        from sam_runtime.physics.geo import euler_from_quaternion
 
         for ts in msg.transforms:
             t, r = ts.transform.translation, ts.transform.rotation
@@ -209,7 +209,7 @@ class Probe:
 
     def world_origin_in_sim(self, gps_origin: Sequence[float]) -> tuple[float, float]:
         """Where world's origin (SLAM's first fix, from its status) lies in the simulator's frame."""
-        from sam_runtime.nav.geo import local_from_latlon
+        from sam_runtime.physics.geo import local_from_latlon
 
         slam = wait_for(lambda: (s := self.status("slam")) and "origin_lat" in s.values and s, 30, "SLAM's origin")
         return local_from_latlon(float(slam.values["origin_lat"]), float(slam.values["origin_lon"]), *gps_origin)

@@ -33,13 +33,13 @@ def check_standard_types(tmp: Path, names: list[str], trials: int = 12) -> None:
 
 def _main(tmp: Path, trials: int, names: list[str]) -> None:
     from helpers.codec_support import corruptions, same
-    from sam_codegen import emit_dsdl
-    from sam_codegen.emit_python import _Names, py_attr, py_class_name, py_module
-    from sam_codegen.spec_loader import load_spec_file
-    from sam_codegen.validate import validate
-    from sam_codegen.wire_cdr import Constants
-    from sam_codegen.wire_cyphal import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
-    from sam_runtime.dsdl import ensure_compiled
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.targets import dsdl as emit_dsdl
+    from sam_codegen.targets.python.convert import _Names, py_attr, py_class_name, py_module
+    from sam_codegen.targets.wire.cdr_write import Constants
+    from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
+    from sam_codegen.validate.resolve import validate
+    from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
 
     # The barge spec's DSDL refers to reg: compiling it brings uavcan and reg.
     resolved = validate(load_spec_file(HERE.parent / "specs" / "barge.yaml"))

@@ -1,0 +1,99 @@
+"""ROS message definitions: the spec's own, the spec's external ones and the installed packages' .msg files."""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+from pathlib import Path
+
+from sam_codegen.model.diagnostics import Pos
+from sam_codegen.model.spec import Constant, Field, RosMessage, Scalar, Spec
+from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, parse_ros_type
+
+_CONSTANT = re.compile(r"^(?P<type>\S+)\s+(?P<name>[A-Za-z][A-Za-z0-9_]*)\s*=\s*(?P<value>.*)$")
+_FIELD = re.compile(r"^(?P<type>\S+)\s+(?P<name>[A-Za-z][A-Za-z0-9_]*)(?:\s+(?P<default>.+))?$")
+
+
+def _literal(type_name: str, text: str) -> Scalar:
+    text = text.strip()
+    if type_name in ROS_INT_RANGES:
+        return int(text, 0)
+    if type_name in ROS_FLOAT_BITS:
+        return float(text)
+    if type_name == "bool":
+        return text.lower() in ("true", "1")
+    return text.strip("'\"")
+
+
+def parse_msg(text: str, package: str, name: str, file: str = "") -> RosMessage:
+    """Parse a .msg file (comments kept per field, defaults and constants read).
+
+    >>> m = parse_msg("int8 A=1  # first\\nfloat64[9] cov # row major\\nint8 s -2", "p", "M")
+    >>> [(f.name, str(f.type), f.default, f.comment) for f in m.fields], m.constants[0].value
+    ([('cov', 'float64[9]', None, 'row major'), ('s', 'int8', -2, '')], 1)
+    """
+    fields: list[Field] = []
+    constants: list[Constant] = []
+    for number, raw in enumerate(text.splitlines(), 1):
+        line, _, comment = raw.partition("#")
+        line = line.strip()
+        if not line:
+            continue
+        pos = Pos(file, number, 1)
+        constant = _CONSTANT.match(line)
+        if constant:
+            type_ = parse_ros_type(constant["type"], package)
+            constants.append(
+                Constant(constant["name"], type_, _literal(type_.base, constant["value"]), comment.strip(), pos)
+            )
+            continue
+        match = _FIELD.match(line)
+        if not match:
+            raise ValueError(f"{file}:{number}: cannot parse {line!r}")
+        type_ = parse_ros_type(match["type"], package)
+        default = None
+        if match["default"] and not type_.array:
+            default = _literal(type_.base, match["default"])
+        fields.append(Field(match["name"], type_, comment.strip(), pos, default))
+    return RosMessage(package, name, fields, constants, pos=Pos(file))
+
+
+def ros_share_dirs() -> list[Path]:
+    """Where installed ROS packages keep share/<pkg>/msg: AMENT_PREFIX_PATH, then this interpreter's prefix."""
+    prefixes = [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+    prefixes.append(Path(sys.prefix))
+    seen: list[Path] = []
+    for prefix in prefixes:
+        share = prefix / "share"
+        if share.is_dir() and share not in seen:
+            seen.append(share)
+    return seen
+
+
+class RosCatalog:
+    """Looks ROS message definitions up by `pkg/Name`, caching what it reads."""
+
+    def __init__(self, spec: Spec, share_dirs: list[Path] | None = None) -> None:
+        self._spec = spec
+        self._share_dirs = ros_share_dirs() if share_dirs is None else share_dirs
+        self._cache: dict[str, RosMessage | None] = {}
+
+    def get(self, full_name: str) -> RosMessage | None:
+        if full_name in self._spec.messages:
+            return self._spec.messages[full_name]
+        if full_name in self._spec.external_messages:
+            return self._spec.external_messages[full_name]
+        if full_name not in self._cache:
+            self._cache[full_name] = self._read(full_name)
+        return self._cache[full_name]
+
+    def _read(self, full_name: str) -> RosMessage | None:
+        package, _, name = full_name.partition("/")
+        for share in self._share_dirs:
+            path = share / package / "msg" / f"{name}.msg"
+            if path.is_file():
+                message = parse_msg(path.read_text(encoding="utf-8"), package, name, str(path))
+                message.external = True
+                return message
+        return None

@@ -1,0 +1,104 @@
+"""The spec's type sections: ROS messages (own and external), Cyphal DSDL types and DroneCAN (v0) types."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from sam_codegen.frontend.reading import Reader, parse_type, seq_items, text_of
+from sam_codegen.frontend.yaml_source import YNode
+from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.spec import Constant, DsdlStruct, Field, RosMessage, V0Struct
+from sam_codegen.model.types import DsdlType, parse_dsdl_type, parse_ros_type, parse_v0_type
+
+__all__ = ["parse_dronecan_type", "parse_dsdl_struct", "parse_ros_message"]
+
+
+_FIELD_KEYS = ("name", "type", "comment", "default")
+_CONST_KEYS = ("name", "type", "value", "comment")
+
+
+def _fields(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics) -> list[Field]:
+    """The fields of a message or DSDL type; DSDL void padding comes as a Field without a name."""
+    result = []
+    for item in seq_items(node, f"the fields of {what}", diag):
+        r = Reader(item, f"a field of {what}", diag, _FIELD_KEYS)
+        type_text = r.get("type", str)
+        type_ = parse_type(type_text, r.key_pos("type"), parse, diag)
+        if type_ is None and parse in (parse_dsdl_type, parse_v0_type) and str(type_text).strip().startswith("void"):
+            continue  # padding with a bad type (reported): it has no name to miss
+        if isinstance(type_, DsdlType) and type_.kind == "void":
+            # DSDL padding has no name (`void3`); it is kept for the layout and mapped by no one.
+            if r.node("name") is not None:
+                diag.error(r.key_pos("name"), f"void padding in {what} has no name in DSDL",
+                           f"{{type: {type_}}} without a name")
+            if r.node("default") is not None:
+                diag.error(r.key_pos("default"), f"void padding in {what} has no value")
+            result.append(Field("", type_, text_of(r, "comment"), item.pos))
+            continue
+        name = r.get("name", str)
+        default = r.get("default", (bool, int, float, str), None)
+        if name is not None and type_ is not None:
+            result.append(Field(name, type_, text_of(r, "comment"), item.pos, default))
+    return result
+
+
+def _constants(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics) -> list[Constant]:
+    result = []
+    for item in seq_items(node, f"the constants of {what}", diag):
+        r = Reader(item, f"a constant of {what}", diag, _CONST_KEYS)
+        name, type_text = r.get("name", str), r.get("type", str)
+        value = r.get("value", (bool, int, float, str))
+        type_ = parse_type(type_text, r.key_pos("type"), parse, diag)
+        if name is not None and type_ is not None and value is not None:
+            result.append(Constant(name, type_, value, text_of(r, "comment"), item.pos))
+    return result
+
+
+def parse_ros_message(key: str, pos: Pos, node: YNode, package: str, external: bool, diag: Diagnostics) -> RosMessage:
+    what = f"message {key!r}"
+    r = Reader(node, what, diag, ("description", "fields", "constants", "derive_from"))
+    pkg, _, name = key.rpartition("/")
+    pkg = pkg.replace("/msg", "") or package
+
+    def parse(text: str) -> Any:
+        return parse_ros_type(text, pkg)
+
+    derive = r.get("derive_from", str, None)
+    if derive is not None and r.node("fields") is not None:
+        diag.error(r.key_pos("fields"), f"{what} is derived from {derive}: it cannot also list fields")
+    fields = _fields(r.node("fields"), what, parse, diag)
+    if derive is None and not fields and r.ok and not external:
+        diag.error(pos, f"{what} has no fields", "a `fields` list or `derive_from`")
+    return RosMessage(
+        pkg, name, fields, _constants(r.node("constants"), what, parse, diag),
+        text_of(r, "description"), derive, external, pos,
+    )
+
+
+def parse_dsdl_struct(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> DsdlStruct:
+    what = f"DSDL type {key!r}"
+    r = Reader(node, what, diag, ("description", "fields", "constants", "sealed", "extent"))
+    sealed = r.get("sealed", bool, False)
+    extent = r.get("extent", int, None)
+    if r.ok and not sealed and extent is None:
+        diag.error(pos, f"{what} needs `sealed: true` or `extent: <bytes>`", "sealed or extent (DSDL requires one)")
+    if sealed and extent is not None:
+        diag.error(r.key_pos("extent"), f"{what} cannot be both sealed and have an extent")
+    layout = _fields(r.node("fields"), what, parse_dsdl_type, diag)
+    fields = [f for f in layout if f.name]
+    return DsdlStruct(
+        key, fields, _constants(r.node("constants"), what, parse_dsdl_type, diag),
+        text_of(r, "description"), bool(sealed), extent, pos=pos, layout=layout if len(fields) < len(layout) else [],
+    )
+
+
+def parse_dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V0Struct:
+    what = f"DroneCAN type {key!r}"
+    r = Reader(node, what, diag, ("id", "description", "fields", "constants"))
+    layout = _fields(r.node("fields"), what, parse_v0_type, diag)
+    fields = [f for f in layout if f.name]
+    return V0Struct(
+        key, fields, _constants(r.node("constants"), what, parse_v0_type, diag), text_of(r, "description"),
+        pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int, None),
+    )

@@ -1,0 +1,411 @@
+"""The validated spec: what every emitter and the runtime tables read.
+
+Built by spec_loader from YAML, checked by validate; positions point back into the YAML for errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from sam_codegen.model.diagnostics import NOWHERE, Pos
+from sam_codegen.model.types import DsdlType, RosType, split_composite_name
+
+Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
+Reliability = Literal["reliable", "best_effort"]
+Durability = Literal["volatile", "transient_local"]
+OutOfRange = Literal["saturate", "reject"]
+Scalar = bool | int | float | str
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    type: RosType | DsdlType
+    comment: str = ""
+    pos: Pos = NOWHERE
+    default: Scalar | None = None
+
+
+@dataclass(frozen=True)
+class Constant:
+    name: str
+    type: RosType | DsdlType
+    value: Scalar
+    comment: str = ""
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class RosMessage:
+    package: str
+    name: str
+    fields: list[Field]
+    constants: list[Constant] = field(default_factory=list)
+    description: str = ""
+    derived_from: str | None = None
+    external: bool = False
+    pos: Pos = NOWHERE
+
+    @property
+    def full_name(self) -> str:
+        return f"{self.package}/{self.name}"
+
+    def field(self, name: str) -> Field | None:
+        return next((f for f in self.fields if f.name == name), None)
+
+
+@dataclass
+class DsdlStruct:
+    """A DSDL composite type: one of the spec's own, or a standard one read from CYPHAL_PATH."""
+
+    name: str  # full name with version: sam.sensor.RawIMU.0.1
+    fields: list[Field]  # the data fields: void padding left out, as pydsdl's fields_except_padding
+    constants: list[Constant] = field(default_factory=list)
+    description: str = ""
+    sealed: bool = True
+    extent: int | None = None
+    standard: bool = False
+    union: bool = False
+    pos: Pos = NOWHERE
+    # Every field as declared, void padding (no name) included; empty when the type has no padding.
+    layout: list[Field] = field(default_factory=list)
+
+    @property
+    def declared_fields(self) -> list[Field]:
+        """The fields in declaration order with the padding between them: what the DSDL definition lists."""
+        return self.layout or self.fields
+
+    @property
+    def full_name(self) -> str:
+        return split_composite_name(self.name)[0]
+
+    @property
+    def version(self) -> tuple[int, int]:
+        _, major, minor = split_composite_name(self.name)
+        return major, minor
+
+    @property
+    def namespace(self) -> str:
+        return self.full_name.rsplit(".", 1)[0]
+
+    @property
+    def short_name(self) -> str:
+        return self.full_name.rsplit(".", 1)[1]
+
+    def field(self, name: str) -> Field | None:
+        return next((f for f in self.fields if f.name == name), None)
+
+
+@dataclass
+class V0Struct(DsdlStruct):
+    """A UAVCAN v0 (DroneCAN) composite type: one of the spec's `dronecan_types` or a standard one of dronecan's
+    definitions. Its name has no version (`uavcan.equipment.ahrs.RawIMU`); fields hold v0 types (composites by
+    full name)."""
+
+    data_type_id: int | None = None  # None: only nested in other types (e.g. uavcan.Timestamp)
+    signature: int = 0  # the data type signature (CRC-64-WE), which seeds a transfer's CRC
+    service: bool = False
+    source: str = ""  # the definition file of a standard type
+
+    @property
+    def full_name(self) -> str:
+        return self.name
+
+    @property
+    def version(self) -> tuple[int, int]:
+        return 0, 0
+
+    @property
+    def file_name(self) -> str:
+        """`<data type id>.<Name>.uavcan`, or `<Name>.uavcan` for a type without id."""
+        prefix = f"{self.data_type_id}." if self.data_type_id is not None else ""
+        return f"{prefix}{self.short_name}.uavcan"
+
+
+@dataclass(frozen=True)
+class Qos:
+    """The QoS of a topic's endpoints: reliability, durability and keep-last history depth."""
+
+    reliability: Reliability
+    durability: Durability
+    depth: int
+    profile: str = ""  # the named profile it came from; "" for a spelled-out mapping
+
+    def describe(self) -> str:
+        """
+        >>> QOS_PROFILES["latched"].describe()
+        'latched (reliable, transient_local, keep last 1)'
+        >>> Qos("best_effort", "volatile", 3).describe()
+        'best_effort, volatile, keep last 3'
+        """
+        text = f"{self.reliability}, {self.durability}, keep last {self.depth}"
+        return f"{self.profile} ({text})" if self.profile else text
+
+
+# The named profiles a spec may give as `qos: <name>`. sensor_data is rclpy's qos_profile_sensor_data.
+QOS_PROFILES: dict[str, Qos] = {
+    "sensor_data": Qos("best_effort", "volatile", 5, "sensor_data"),
+    "reliable": Qos("reliable", "volatile", 10, "reliable"),
+    "latched": Qos("reliable", "transient_local", 1, "latched"),
+    "tf": Qos("reliable", "volatile", 100, "tf"),
+}
+RELIABILITIES: tuple[Reliability, ...] = ("reliable", "best_effort")
+DURABILITIES: tuple[Durability, ...] = ("volatile", "transient_local")
+
+
+@dataclass
+class Topic:
+    name: str
+    type: str  # pkg/Name
+    description: str = ""
+    section: str = ""
+    pos: Pos = NOWHERE
+    declared_qos: Qos | None = None  # the spec's `qos:`, if any
+    qos_pos: Pos = NOWHERE
+    # Set by validation: the declared QoS or the default for the topic (validate_nodes.default_qos).
+    qos: Qos | None = None
+    qos_origin: str = ""  # why: "declared", or the default rule that chose it
+
+
+@dataclass
+class Parameter:
+    name: str
+    type: str
+    default: Scalar
+    unit: str = ""
+    minimum: float | None = None
+    maximum: float | None = None
+    description: str = ""
+    section: str = ""
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class ParameterRule:
+    left: str
+    op: str
+    right: str
+    description: str = ""
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class Frame:
+    name: str
+    parent: str | None = None
+    description: str = ""
+    pos: Pos = NOWHERE
+    # A static child frame's mounting offset in its parent (URDF's origin): metres, and roll, pitch, yaw in
+    # radians (fixed axes x, y, z).
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass
+class Transform:
+    parent: str
+    child: str
+    publisher: str
+    description: str = ""
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class Port:
+    subject_id: int
+    type: str  # DSDL full name with version
+    rate_hz: float
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class V0Port:
+    """A UAVCAN v0 (DroneCAN) message a device broadcasts or receives: no subject id, the data type says it all."""
+
+    type: str  # full name, e.g. uavcan.equipment.ahrs.RawIMU
+    rate_hz: float
+    pos: Pos = NOWHERE
+
+
+PROTOCOLS = ("cyphal", "dronecan")
+
+
+@dataclass
+class Device:
+    name: str
+    node_id: int
+    description: str = ""
+    publishes: list[Port] = field(default_factory=list)  # its Cyphal ports
+    subscribes: list[Port] = field(default_factory=list)
+    pos: Pos = NOWHERE
+    protocol: str = "cyphal"  # what it speaks in the default layout
+    protocols: tuple[str, ...] = ("cyphal",)  # every protocol it has ports for (firmware it can run)
+    dronecan_publishes: list[V0Port] = field(default_factory=list)  # its DroneCAN ports
+    dronecan_subscribes: list[V0Port] = field(default_factory=list)
+    protocol_pos: dict[str, Pos] = field(default_factory=dict)  # where each protocol's ports are declared
+
+
+@dataclass
+class Layout:
+    """Which protocol each device speaks: the vehicle as one firmware set (a bus may carry both protocols)."""
+
+    name: str
+    description: str = ""
+    protocol: str | None = None  # every device that has ports for it; None: each device's own `protocol`
+    devices: dict[str, str] = field(default_factory=dict)  # per-device overrides
+    device_pos: dict[str, Pos] = field(default_factory=dict)
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class FieldLink:
+    """One `ros_path: uavcan_source` line of a mapping."""
+
+    ros_path: str
+    uavcan_path: str | None = None
+    scale: float | None = None
+    offset: float | None = None
+    table: dict[int, int] | None = None
+    table_default: int | None = None  # the ROS value of every UAVCAN value the table does not list
+    value: Scalar | None = None
+    limits: tuple[float, float] | None = None
+    pos: Pos = NOWHERE
+    round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
+
+
+@dataclass
+class Mapping:
+    name: str
+    direction: Direction
+    topic: str
+    subject_id: int
+    source_node_ids: list[int] = field(default_factory=list)
+    destination_node_id: int | None = None
+    frame_id: str | None = None
+    links: list[FieldLink] = field(default_factory=list)
+    ignore: list[str] = field(default_factory=list)
+    uavcan_values: dict[str, Scalar] = field(default_factory=dict)
+    auto: bool = False
+    on_out_of_range: OutOfRange = "saturate"
+    pos: Pos = NOWHERE
+    protocol: str = "cyphal"
+    # DroneCAN only: messages carry no subject id (the data type is the key) and no destination (they are
+    # broadcast); `select` keeps the messages whose fields have these values (UAVCAN->ROS) and sets them (ROS->UAVCAN).
+    data_type: str = ""
+    destination_node_ids: list[int] = field(default_factory=list)
+    select: dict[str, Scalar] = field(default_factory=dict)
+    select_pos: Pos = NOWHERE
+
+
+@dataclass
+class Bridge:
+    name: str
+    node_id: int
+    mappings: list[Mapping] = field(default_factory=list)  # Cyphal
+    pos: Pos = NOWHERE
+    dronecan_mappings: list[Mapping] = field(default_factory=list)
+
+    @property
+    def all_mappings(self) -> list[Mapping]:
+        return [*self.mappings, *self.dronecan_mappings]
+
+
+@dataclass(frozen=True)
+class NodeTopic:
+    """One entry of a node's `publishes` or `subscribes`."""
+
+    topic: str
+    qos: Qos | None = None  # a subscription's own QoS; None: the topic's
+    pos: Pos = NOWHERE
+    type: str | None = None  # the type the node expects, checked against the topic's
+
+
+@dataclass(frozen=True)
+class NodeTransform:
+    """One `parent->child` entry of a node's `transforms` (it publishes) or `reads_transforms` (it looks up)."""
+
+    parent: str
+    child: str
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
+class NodeParameter:
+    name: str
+    pos: Pos = NOWHERE
+
+
+@dataclass
+class Node:
+    name: str
+    description: str = ""
+    publish_items: list[NodeTopic] = field(default_factory=list)
+    subscribe_items: list[NodeTopic] = field(default_factory=list)
+    parameter_items: list[NodeParameter] = field(default_factory=list)
+    transform_items: list[NodeTransform] = field(default_factory=list)  # published on /tf
+    read_transform_items: list[NodeTransform] = field(default_factory=list)  # looked up from /tf, /tf_static
+    pos: Pos = NOWHERE
+
+    @property
+    def publishes(self) -> list[str]:
+        return [item.topic for item in self.publish_items]
+
+    @property
+    def subscribes(self) -> list[str]:
+        return [item.topic for item in self.subscribe_items]
+
+    @property
+    def parameters(self) -> list[str]:
+        return [item.name for item in self.parameter_items]
+
+    @property
+    def transforms(self) -> list[tuple[str, str]]:
+        return [(item.parent, item.child) for item in self.transform_items]
+
+    @property
+    def reads_transforms(self) -> list[tuple[str, str]]:
+        return [(item.parent, item.child) for item in self.read_transform_items]
+
+
+@dataclass
+class RosPackageInfo:
+    name: str
+    version: str = "0.1.0"
+    description: str = ""
+    maintainer: str = "maintainer"
+    maintainer_email: str = "maintainer@example.org"
+    license: str = "MIT"
+
+
+@dataclass
+class Spec:
+    file: str
+    vehicle: str
+    description: str
+    ros: RosPackageInfo
+    dsdl_root: str
+    external_messages: dict[str, RosMessage] = field(default_factory=dict)
+    messages: dict[str, RosMessage] = field(default_factory=dict)  # by full name pkg/Name
+    dsdl_types: dict[str, DsdlStruct] = field(default_factory=dict)  # by full name with version
+    frames: dict[str, Frame] = field(default_factory=dict)
+    transforms: list[Transform] = field(default_factory=list)
+    topics: dict[str, Topic] = field(default_factory=dict)
+    parameters: dict[str, Parameter] = field(default_factory=dict)
+    parameter_rules: list[ParameterRule] = field(default_factory=list)
+    devices: dict[str, Device] = field(default_factory=dict)
+    bridge: Bridge | None = None
+    nodes: dict[str, Node] = field(default_factory=dict)
+    dronecan_types: dict[str, V0Struct] = field(default_factory=dict)  # the spec's own v0 types, by full name
+    layouts: dict[str, Layout] = field(default_factory=dict)  # the named layouts beside the implicit default
+
+    def devices_by_node_id(self) -> dict[int, Device]:
+        return {d.node_id: d for d in self.devices.values()}
+
+    def subject_types(self) -> dict[int, str]:
+        """Subject id -> DSDL type, from every device port."""
+        result: dict[int, str] = {}
+        for device in self.devices.values():
+            for port in device.publishes + device.subscribes:
+                result.setdefault(port.subject_id, port.type)
+        return result

@@ -1,0 +1,2 @@
+"""The docs target: generated/docs/interfaces.md and dataflow.svg.
+"""

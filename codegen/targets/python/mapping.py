@@ -1,0 +1,326 @@
+"""One mapping's conversion plan said in Python: its to_ros and to_uavcan functions of convert.py."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from sam_codegen.conversion_plan import (
+    CHECK_OPS,
+    TO_ROS,
+    TO_UAVCAN,
+    Clamp,
+    Constant,
+    DecodeUtf8,
+    EncodeUtf8,
+    FixedLength,
+    LinkPlan,
+    MaxLength,
+    Offset,
+    Pad,
+    ReceiveTime,
+    Scale,
+    StaticFrameId,
+    Table,
+    TimestampFromRos,
+    TimestampToRos,
+    Utf8Length,
+    lower_link,
+    lower_mapping,
+)
+from sam_codegen.model.types import DsdlType, RosType
+from sam_codegen.targets.python import statements as pys
+from sam_codegen.targets.python.module import _Function, _Module
+from sam_codegen.targets.python.names import _access, _identifier, _Names, dict_literal, py_attr
+from sam_codegen.targets.python.statements import dsdl_literal, py_literal
+from sam_codegen.targets.python.statements import typed_literal as _typed_literal
+from sam_codegen.validate.mapping_rules import ResolvedMapping, Step, format_path
+
+_st = pys.st  # one statement for templates/python/statements.j2
+_Policy = pys.Policy
+
+
+class _MappingEmitter:
+    def __init__(self, module: _Module, rm: ResolvedMapping) -> None:
+        self.module, self.rm = module, rm
+        self.mapping = rm.mapping
+        self.name = rm.mapping.name
+        self.reject = rm.mapping.on_out_of_range == "reject"
+        self.ros_class = module.ros_aliases[rm.ros_message.full_name]
+        self.dsdl_ref = module.dsdl_ref(rm.dsdl_struct)
+        self.plan = lower_mapping(rm)  # what both converters do; the methods below only say it in Python
+        self._links = {(id(link.step), link.direction): link for link in (*self.plan.to_ros, *self.plan.to_uavcan)}
+
+    def policy(self, path: str) -> _Policy:
+        return _Policy(repr(f"{self.name}.{path}"), self.reject)
+
+    def link(self, s: Step, direction: str) -> LinkPlan:
+        """The plan of one link (lowered here for a step that is not the mapping's own)."""
+        found = self._links.get((id(s), direction))
+        if found is not None and found.step == s:
+            return found
+        return lower_link(s, direction, self.name, self.reject)  # type: ignore[arg-type]
+
+    # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
+    def to_ros(self) -> _Function:
+        """Values first (every check and drop before anything is built), then one nested constructor call."""
+        rm = self.rm
+        names = _Names(self.module.module_names)
+        fn = _Function(
+            f"{self.name}_to_ros",
+            [f"src: {self.dsdl_ref}", "receive_ns: int", "stats: ConversionStats"],
+            f"{self.ros_class} | None",
+            [f"Mapping {self.name!r}, UAVCAN -> ROS.", "", f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"],
+        )
+        steps = list(rm.steps)
+        listed = self.bind_uavcan_arrays(fn, names, steps)
+
+        def uav_read(path: tuple) -> str:
+            if path[-1][1] is not None:
+                array_path = (*path[:-1], (path[-1][0], None))
+                if array_path in listed:
+                    return f"{listed[array_path]}[{path[-1][1]}]"
+            return self.uav_access("src", path)
+
+        root = self.module.ros_ctor(rm.ros_message)
+        for fs in self.plan.ros_fields:
+            if isinstance(fs.op, StaticFrameId):
+                self.module.insert(root, fs.path, py_literal(fs.op.value))
+            elif isinstance(fs.op, ReceiveTime):
+                self.module.insert(root, (*fs.path, ("sec", None)), "receive_ns // 1_000_000_000")
+                self.module.insert(root, (*fs.path, ("nanosec", None)), "receive_ns % 1_000_000_000")
+        for s in steps:
+            for path, value in self.step_to_ros(s, names, uav_read, fn.statements):
+                self.module.insert(root, path, value)
+        fn.result = self.module.format_return(root)
+        return fn
+
+    def bind_uavcan_arrays(self, fn: _Function, names: _Names, steps: list[Step],
+                           listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
+        """Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one list each (beside those
+        in `listed` already)."""
+        listed = {} if listed is None else listed
+        for s in steps:
+            if s.kind in ("number", "table") and s.uavcan_path and s.uavcan_path[-1][1] is not None:
+                array_path = (*s.uavcan_path[:-1], (s.uavcan_path[-1][0], None))
+                if array_path not in listed:
+                    listed[array_path] = names.new(format_path(list(array_path)))
+                    fn.binds.append(_st("assign", target=listed[array_path],
+                                        expr=self.uav_list(self.uav_access("src", array_path))))
+        return listed
+
+    def uav_access(self, base: str, path: tuple) -> str:
+        """The expression reading a field of a received UAVCAN object."""
+        return _access(base, path, py_attr)
+
+    def uav_list(self, expr: str) -> str:
+        """A UAVCAN array as a list of plain Python values (pycyphal keeps them in numpy arrays)."""
+        return f"{expr}.tolist()"
+
+    def step_to_ros(self, s: Step, names: _Names, uav_read, statements: list[dict[str, Any]]
+                    ) -> list[tuple[tuple, str]]:
+        """Append the statements of one link (its planned operations); return the (ROS path, expression) pairs
+        it sets."""
+        link = self.link(s, TO_ROS)
+        ops = link.ops
+        key = repr(link.key)
+        first = ops[0] if ops else None
+        if isinstance(first, Constant):
+            return [(s.ros_path, _typed_literal(first.value, s.ros_type.base))]
+        assert s.uavcan_type is not None
+        read = uav_read(s.uavcan_path)
+        if isinstance(first, TimestampToRos):
+            us, sec, nanosec = names.new("us"), names.new("sec"), names.new("nanosec")
+            statements.append(pys.timestamp_to_ros(first, us, read, sec, nanosec, key))
+            return [((*s.ros_path, ("sec", None)), sec), ((*s.ros_path, ("nanosec", None)), nanosec)]
+        if isinstance(first, Table):
+            var = names.new(s.ros)
+            table = self.module_table(s, TO_ROS)
+            default = None if first.default is None else py_literal(first.default)
+            statements.append(_st("table", var=var, table=table, read=read, key=key, default=default))
+            return [(s.ros_path, var)]
+        if isinstance(first, DecodeUtf8):
+            return [(s.ros_path, f"{read}.tobytes().decode(errors='replace')")]
+        ros_base = s.ros_type.base
+        if s.kind == "number":
+            expr = pys.to_ros_expr(read, ops, ros_base)
+            if not link.has(*CHECK_OPS):
+                return [(s.ros_path, expr)]
+            var = names.new(s.ros)
+            statements.append(_st("assign", target=var, expr=expr))
+            statements.extend(pys.check_statements(var, ops, key))
+            return [(s.ros_path, var)]
+        # array: the elements, their float32 range, then the padding
+        elem = pys.to_ros_expr("x", ops, ros_base)
+        base_list = self.uav_list(read)
+        expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
+        pad = link.first(Pad)
+        overflow = link.has(Clamp)
+        if pad is None and not overflow:
+            return [(s.ros_path, expr)]
+        var = names.new(s.ros)
+        statements.append(_st("assign", target=var, expr=expr))
+        if overflow:
+            statements.append(pys.float32_helper(var, link))
+        if isinstance(pad, Pad):
+            statements.append(_st("pad", var=var, size=pad.size, zero=_typed_literal(0, ros_base)))
+        return [(s.ros_path, var)]
+
+    def module_table(self, s: Step, direction: str) -> str:
+        """The module constant holding a link's table in `direction` (one per link and direction)."""
+        const = f"_{self.name}_{_identifier(s.ros)}".upper() + ("_TO_ROS" if direction == TO_ROS else "_TO_UAVCAN")
+        if not any(t["name"] == const for t in self.module.tables):
+            pairs = [(py_literal(k), py_literal(v))
+                     for k, v in Table(s.table, s.table_default, direction != TO_ROS).lookup()]
+            self.module.tables.append({
+                "name": const,
+                "items": pairs,
+                "literal": dict_literal(f"{const}: dict[int, int] = ", pairs),
+                "what": f"{self.name}: {s.uavcan} -> {s.ros}" if direction == TO_ROS
+                else f"{self.name}: {s.ros} -> {s.uavcan} (first key per value)",
+            })
+        return const
+
+    # -- ROS -> UAVCAN ---------------------------------------------------------------------------------------
+    def to_uavcan(self) -> _Function:
+        rm = self.rm
+        names = _Names(self.module.module_names)
+        fn = _Function(
+            f"{self.name}_to_uavcan",
+            [f"src: {self.ros_class}", "stats: ConversionStats"],
+            f"{self.dsdl_ref} | None",
+            [f"Mapping {self.name!r}, ROS -> UAVCAN.", "", f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"],
+        )
+        steps = [s for s in rm.steps if s.uavcan_path]
+        ros_read = self.ros_reader(fn, names, steps)
+        root = self.module.dsdl_ctor(rm.dsdl_struct)
+        for s in steps:
+            value = self.step_to_uavcan(s, names, ros_read, fn.statements)
+            self.module.insert(root, s.uavcan_path, value)
+        for fs in self.plan.uavcan_fields:  # uavcan_values, then DroneCAN's select
+            assert isinstance(fs.op, Constant) and isinstance(fs.type, DsdlType)
+            self.module.insert(root, fs.path, dsdl_literal(fs.op.value, fs.type))
+        fn.result = self.module.format_return(root)
+        return fn
+
+    def ros_reader(self, fn: _Function, names: _Names, steps: list[Step]) -> Callable[[tuple], str]:
+        """The to_uavcan read helper: binds what the steps read (appended to fn.binds) and returns the function
+        from a ROS path to the expression reading it (a Time path: an expression with .sec and .nanosec).
+        Overridden by the wire codecs (emit_codec), which read from CDR bytes."""
+        # Locals for ROS parents read more than once, and one .tolist() per ROS array read by index.
+        reads: dict[tuple, int] = {}
+        for s in steps:
+            if s.kind == "time":
+                reads[s.ros_path] = reads.get(s.ros_path, 0) + 2
+            elif len(s.ros_path) > 1:
+                reads[s.ros_path[:-1]] = reads.get(s.ros_path[:-1], 0) + 1
+        parent_local: dict[tuple, str] = {}
+        for parent, count in reads.items():
+            if count >= 2 and all(index is None for _, index in parent):
+                parent_local[parent] = names.new(parent[-1][0])
+                fn.binds.append(_st("assign", target=parent_local[parent], expr=_access("src", parent)))
+        listed: dict[tuple, str] = {}
+        for s in steps:
+            if s.kind in ("number", "table") and s.ros_path[-1][1] is not None:
+                array_path = (*s.ros_path[:-1], (s.ros_path[-1][0], None))
+                if array_path not in listed:
+                    listed[array_path] = names.new(format_path(list(array_path)))
+                    fn.binds.append(_st("assign", target=listed[array_path],
+                                        expr=self.ros_array_read(_access("src", array_path), s.ros_type)))
+
+        def ros_read(path: tuple) -> str:
+            if path in parent_local:
+                return parent_local[path]
+            if path[-1][1] is not None:
+                array_path = (*path[:-1], (path[-1][0], None))
+                if array_path in listed:
+                    return f"{listed[array_path]}[{path[-1][1]}]"
+            parent = path[:-1]
+            if parent in parent_local:
+                return _access(parent_local[parent], path[-1:])
+            return _access("src", path)
+
+        return ros_read
+
+    def ros_array_read(self, expr: str, ros_type: RosType) -> str:
+        """A ROS array field as a list of plain Python values."""
+        base = ros_type.base
+        if base == "byte":
+            return f"[b[0] for b in {expr}]"
+        if base == "bool":
+            return f"list({expr})"
+        return f"{expr}.tolist()"
+
+    def step_to_uavcan(self, s: Step, names: _Names, ros_read, statements: list[dict[str, Any]]) -> str:
+        """Append the statements of one link (its planned operations); return the expression of the UAVCAN
+        value."""
+        assert s.uavcan_type is not None
+        link = self.link(s, TO_UAVCAN)
+        ops = link.ops
+        key = repr(link.key)
+        uav = s.uavcan_type
+        first = ops[0] if ops else None
+        if isinstance(first, TimestampFromRos):
+            stamp = ros_read(s.ros_path)
+            var = names.new("us")
+            statements.extend(pys.timestamp_from_ros(first, var, self.ros_time_us(stamp), key))
+            return var
+        read = ros_read(s.ros_path)
+        if isinstance(first, Table):
+            var = names.new(s.uavcan)
+            table = self.module_table(s, TO_UAVCAN)
+            statements.append(_st("table", var=var, table=table, read=read, key=key, default=None))
+            return var
+        if isinstance(first, EncodeUtf8):
+            var = names.new(s.uavcan)
+            cut = ops[1]
+            assert isinstance(cut, Utf8Length)
+            statements.append(_st("assign", target=var, expr=f"{read}.encode(errors='replace')"))
+            statements.append(_st("utf8_length", var=var, cap=cut.capacity, key=key, reject=cut.reject))
+            return var
+        if s.kind == "number":
+            return self.scalar_to_uavcan(link, names, read, statements)
+        # array: the elements' arithmetic, the length, then the elements' range
+        elem_uav = uav.element
+        var = names.new(s.uavcan)
+        elem = pys.to_uavcan_expr("x", ops)
+        base_list = self.ros_array_read(read, s.ros_type)
+        expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
+        statements.append(_st("assign", target=var, expr=expr))
+        for op in ops:
+            if isinstance(op, FixedLength):
+                statements.append(_st("fixed_length", var=var, cap=op.size, zero=dsdl_literal(0, elem_uav), key=key,
+                                      reject=op.reject))
+            elif isinstance(op, MaxLength):  # a longer fixed ROS array: only non-zero elements count
+                statements.append(_st("max_length", var=var, cap=op.capacity, key=key, reject=op.reject,
+                                      padded=op.padded))
+        helper = pys.array_check_helper(var, link, elem_uav)
+        if helper is not None:
+            statements.append(helper)
+        return var
+
+    def ros_time_us(self, stamp: str) -> str:
+        """Microseconds of a builtin_interfaces/Time read as `stamp` (the expression ros_read gave)."""
+        return f"{stamp}.sec * 1_000_000 + {stamp}.nanosec // 1000"
+
+    def scalar_to_uavcan(self, link: LinkPlan, names: _Names, read: str, statements: list[dict[str, Any]]) -> str:
+        """A number link's operations in order: its arithmetic builds an expression, the first check binds it to a
+        local (limits come before the inverse scale/offset: they are in ROS units)."""
+        s = link.step
+        expr = f"{read}[0]" if s.ros_type.base == "byte" else read
+        var: str | None = None
+        pending: list = []  # arithmetic not yet applied to var
+        for op in link.ops:
+            if isinstance(op, (Offset, Scale)):
+                pending.append(op)
+            elif isinstance(op, CHECK_OPS):
+                if var is None or pending:
+                    target = var if var is not None else names.new(s.uavcan)
+                    statements.append(_st("assign", target=target, expr=pys.to_uavcan_expr(var or expr, pending)))
+                    var, pending = target, []
+                statements.extend(pys.check_statements(var, [op], repr(link.key)))
+        if var is None:
+            return pys.to_uavcan_expr(expr, pending)
+        if pending:
+            statements.append(_st("assign", target=var, expr=pys.to_uavcan_expr(var, pending)))
+        return var

@@ -1,0 +1,423 @@
+"""Bridge mappings: each `ros_field: uavcan_field` line resolved against both types and the conversion rules,
+and the check that every UAVCAN field of a mapping is mapped, ignored or given a value."""
+
+from __future__ import annotations
+
+import re
+from typing import Any, TypeVar
+
+from sam_codegen.catalogs.cyphal import DsdlCatalog
+from sam_codegen.catalogs.ros import RosCatalog
+from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.spec import Device, DsdlStruct, FieldLink, Mapping, Port, RosMessage, Spec, Topic, V0Struct
+from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from sam_codegen.validate.mapping_rules import (
+    HEADER,
+    TIME,
+    TIMESTAMPS,
+    Key,
+    ResolvedMapping,
+    RuleError,
+    Step,
+    auto_links,
+    check_arrays,
+    check_scalar,
+    check_string,
+    format_path,
+    missing_table_keys,
+    parse_path,
+)
+from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
+
+T = TypeVar("T", RosType, DsdlType)
+
+
+class _Reported(RuleError):
+    """The path runs into a type that is reported broken already: the link adds no error of its own."""
+
+
+def _indexed(leaf: T, name: str, index: int | Key | None, v0: bool = False) -> T:
+    """The element type for `name[index]`, which only a fixed-size array allows; in a DroneCAN message also a
+    bounded one (the element of a broadcast array, e.g. rpm[1] of esc.RPMCommand), and `name[key=value]` (checked
+    by the caller) an array of composites."""
+    if index is None:
+        return leaf
+    if isinstance(index, Key):
+        if not v0 or isinstance(leaf, RosType):
+            raise RuleError(f"{name}[{index}]: an item is chosen by key only in the arrays of a DroneCAN message")
+        if not leaf.array or leaf.kind != "composite":
+            raise RuleError(f"{name}[{index}]: an item is chosen by key in an array of composites, {name} is {leaf}")
+        return leaf.element
+    if leaf.array != "fixed" and not (v0 and leaf.array == "bounded" and isinstance(leaf, DsdlType)):
+        allowed = "fixed-size and DroneCAN arrays" if v0 else "fixed-size arrays"
+        raise RuleError(f"{name}[{index}]: only {allowed} take an index, {name} is {leaf}")
+    if index >= (leaf.capacity or 0):
+        raise RuleError(f"{name}[{index}]: index out of range, {name} has {leaf.capacity} elements"
+                        if leaf.array == "fixed" else f"{name}[{index}]: index out of range, {name} holds at most "
+                        f"{leaf.capacity} elements")
+    return leaf.element
+
+
+class MappingValidator:
+    """Resolves the bridge's mappings; reports into the run's Diagnostics."""
+
+    def __init__(self, spec: Spec, ros: RosCatalog, dsdl: DsdlCatalog, diag: Diagnostics,
+                 publishers: dict[int, str], bad_dsdl_fields: set[tuple[str, str]] | None = None,
+                 failed_messages: set[str] | None = None, v0_types: Any = None) -> None:
+        self.spec, self.ros, self.dsdl, self.diag = spec, ros, dsdl, diag
+        self.v0_types = v0_types  # the DroneCAN catalog (dronecan_catalog.V0Catalog), for DroneCAN mappings
+        self.v0 = False  # the mapping being resolved is a DroneCAN one
+        self.types: Any = dsdl  # where its composite types are looked up
+        self.elements: dict[tuple, dict[str, dict]] = {}
+        self.publishers = publishers  # subject id -> who publishes it (devices; mappings are added)
+        # Reported already (with their declarations): no follow-on errors about them.
+        self.bad_dsdl_fields = bad_dsdl_fields or set()  # (DSDL type, field)
+        self.failed_messages = failed_messages or set()  # ROS messages whose derive_from failed
+
+    def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
+        self.diag.error(pos, message, expected)
+
+    def resolve_mappings(self) -> list[ResolvedMapping]:
+        s = self.spec
+        if s.bridge is None:
+            return []
+        devices_by_id = s.devices_by_node_id()
+        self.ports_by_subject: dict[int, list[tuple[Device, Port, bool]]] = {}
+        for d in s.devices.values():
+            for p, publishing in [(p, True) for p in d.publishes] + [(p, False) for p in d.subscribes]:
+                self.ports_by_subject.setdefault(p.subject_id, []).append((d, p, publishing))
+        result = []
+        for mapping in s.bridge.mappings:
+            resolved = self.resolve_mapping(mapping, devices_by_id)
+            if resolved is not None:
+                result.append(resolved)
+        return result
+
+    def resolve_mapping(self, mapping: Mapping, devices_by_id: dict) -> ResolvedMapping | None:
+        s, what = self.spec, f"mapping {mapping.name!r}"
+        if not re.fullmatch(r"[a-z][a-z0-9_]*", mapping.name) or not python_safe(mapping.name):
+            self.error(mapping.pos, f"mapping name {mapping.name!r} is not valid", "lower_case identifier")
+        topic = s.topics.get(mapping.topic)
+        if topic is None:
+            self.error(mapping.pos, f"{what} uses undeclared topic {mapping.topic!r}", "a topic of `topics`")
+        if mapping.subject_id not in SUBJECT_IDS:
+            self.error(mapping.pos, f"subject id {mapping.subject_id} of {what} is out of range", "0..8191")
+        ports = self.ports_by_subject.get(mapping.subject_id, [])
+        if not ports:
+            self.error(mapping.pos, f"subject id {mapping.subject_id} of {what} is used by no device",
+                       "a subject a device publishes or subscribes")
+            return None
+        port = ports[0][1]
+        if mapping.direction == "uavcan_to_ros":
+            publishers = {d.node_id for d, _, pub in ports if pub}
+            for node_id in mapping.source_node_ids:
+                if node_id not in CAN_NODE_IDS:
+                    self.error(mapping.pos, f"source node id {node_id} of {what} is out of range", "0..127")
+                elif node_id not in publishers:
+                    owner = devices_by_id.get(node_id)
+                    self.error(mapping.pos, f"source node id {node_id} of {what} does not publish subject "
+                               f"{mapping.subject_id}" + (f" (it is device {owner.name})" if owner else ""),
+                               "the node id of a device that publishes it: " + ", ".join(map(str, sorted(publishers)))
+                               if publishers else "a publishing device")
+        else:
+            dest = mapping.destination_node_id
+            subscribers = {d.node_id for d, _, pub in ports if not pub}
+            if dest is not None and dest not in CAN_NODE_IDS:
+                self.error(mapping.pos, f"destination node id {dest} of {what} is out of range", "0..127")
+            elif dest is not None and dest not in subscribers:
+                self.error(mapping.pos, f"destination node id {dest} of {what} does not subscribe to subject "
+                           f"{mapping.subject_id}", "the node id of a device that subscribes to it")
+            owner = self.publishers.get(mapping.subject_id)
+            if owner is not None:
+                self.error(mapping.pos, f"duplicate subject id {mapping.subject_id}: {what} publishes it but "
+                           f"{owner} does too", "one publisher per subject")
+            self.publishers[mapping.subject_id] = what
+        return self.resolve_body(mapping, what, topic, self.dsdl.get(port.type), port.rate_hz)
+
+    def resolve_body(self, mapping: Mapping, what: str, topic: Topic | None, struct: DsdlStruct | None,
+                     rate_hz: float) -> ResolvedMapping | None:
+        """The protocol-independent part: the links, values and ignores against both types, and coverage."""
+        s = self.spec
+        self.v0 = isinstance(struct, V0Struct)
+        self.types = self.v0_types if self.v0 else self.dsdl
+        # DroneCAN arrays whose elements the mapping names: array path -> {"index": {i: None}, "key": {Key: None}}
+        self.elements = {}
+        ros_message = self.ros.get(topic.type) if topic is not None else None
+        if struct is None or ros_message is None:
+            return None
+        if ros_message.full_name in self.failed_messages:
+            return None  # its fields are unknown: every line would be a follow-on error
+        if struct.union:
+            self.error(mapping.pos, f"{what}: union types ({struct.name}) cannot be mapped")
+            return None
+        has_header = any(f.name == "header" and isinstance(f.type, RosType) and f.type.base == HEADER
+                         for f in ros_message.fields)
+        if mapping.frame_id is not None and mapping.frame_id not in s.frames:
+            self.error(mapping.pos, f"frame_id {mapping.frame_id!r} of {what} is not a declared frame",
+                       "one of " + ", ".join(s.frames))
+        if mapping.direction == "uavcan_to_ros" and has_header and mapping.frame_id is None:
+            self.error(mapping.pos, f"{what} publishes {ros_message.full_name}, which has a header: it needs "
+                       "a frame_id")
+        links = auto_links(struct, mapping.pos) if mapping.auto else mapping.links
+        if mapping.auto and not self.v0 and ros_message.derived_from != struct.name:
+            self.error(mapping.pos, f"{what} uses `fields: auto`, which needs a ROS message derived from "
+                       f"{struct.name} (topic type is {ros_message.full_name})")
+            return None
+        if mapping.auto and self.v0:  # by name: every field of the DroneCAN type into the ROS field of its name
+            missing = [link.ros_path for link in links if link.ros_path != "header.stamp"
+                       and ros_message.field(link.ros_path) is None]
+            if missing:
+                self.error(mapping.pos, f"{what} uses `fields: auto`, but {ros_message.full_name} has no field "
+                           + ", ".join(repr(m) for m in missing), f"a ROS message with the fields of {struct.name}")
+                return None
+        resolved = ResolvedMapping(mapping, ros_message, struct, has_header=has_header, rate_hz=rate_hz)
+        ros_targets: dict[str, Pos] = {}
+        self.failed_paths: set[str] = set()
+        for link in links:
+            step = self.resolve_link(link, ros_message, struct, mapping, what)
+            if step is None:
+                # Its UAVCAN side is reported already; do not report it again as unmapped.
+                if link.uavcan_path:
+                    self.failed_paths.add(link.uavcan_path.split("[")[0].split(".")[0])
+                continue
+            if step.ros in ros_targets:
+                self.error(link.pos, f"ROS field {step.ros!r} is set twice in {what}")
+            ros_targets[step.ros] = link.pos
+            resolved.steps.append(step)
+        for path_text, value in mapping.select.items():
+            try:
+                path = parse_path(path_text)
+                if any(index is not None for _, index in path):
+                    raise RuleError(f"{path_text} names an array element; a selection compares a field")
+                leaf = self.dsdl_leaf(struct, path)
+                if leaf.array or leaf.kind not in ("bool", "int", "uint"):
+                    raise RuleError(f"{path_text} is {leaf}; a selection compares an integer or bool field")
+            except _Reported:
+                continue
+            except RuleError as exc:
+                self.error(mapping.select_pos, f"select of {what}: {exc}")
+                continue
+            check_dsdl_value(self.diag, leaf, value, mapping.select_pos, f"select value {path_text!r} of {what}")
+            resolved.select.append((tuple(path), leaf, value))
+        for path_text, value in mapping.uavcan_values.items():
+            try:
+                path = parse_path(path_text)
+                leaf = self.dsdl_leaf(struct, path)
+            except _Reported:
+                self.failed_paths.add(path_text.split("[")[0].split(".")[0])
+                continue
+            except RuleError as exc:
+                self.error(mapping.pos, f"uavcan_values of {what}: {exc}")
+                continue
+            check_dsdl_value(self.diag, leaf, value, mapping.pos, f"uavcan value {path_text!r} of {what}")
+            resolved.uavcan_values.append((tuple(path), leaf, value))
+        self.ignored: set[str] = set()
+        for ignored in mapping.ignore:
+            try:
+                path = parse_path(ignored)
+                self.dsdl_leaf(struct, path, allow_composite=True, record=False)
+            except _Reported:
+                self.ignored.add(ignored.split("[")[0].split(".")[0])
+            except RuleError as exc:
+                self.error(mapping.pos, f"ignore of {what}: {exc}")
+            else:
+                self.ignored.add(format_path(path))
+        if self.check_elements(resolved, what):  # (else coverage would only repeat the confusion)
+            self.check_coverage(resolved, what)
+        return resolved
+
+    def ros_leaf(self, message: RosMessage, path: list) -> RosType:
+        current: RosMessage | None = message
+        leaf: RosType | None = None
+        for i, (name, index) in enumerate(path):
+            if current is None:
+                raise RuleError(f"{format_path(path[:i])} is a {leaf}, it has no field {name!r}")
+            f = current.field(name)
+            if f is None:
+                raise RuleError(f"{current.full_name} has no field {name!r}")
+            assert isinstance(f.type, RosType)
+            leaf = f.type
+            leaf = _indexed(leaf, name, index)
+            nested = not (leaf.is_primitive or leaf.array or leaf.base == TIME)
+            current = self.ros.get(leaf.base) if nested else None
+            if nested and (current is None or current.full_name in self.failed_messages):
+                raise _Reported(f"{leaf.base} is unknown or could not be derived")  # reported with the type
+        assert leaf is not None
+        return leaf
+
+    def dsdl_leaf(self, struct: DsdlStruct, path: list, allow_composite: bool = False, record: bool = True
+                  ) -> DsdlType:
+        """The type at `path`; with `record`, the DroneCAN array elements it names are noted (self.elements)."""
+        current: DsdlStruct | None = struct
+        leaf: DsdlType | None = None
+        for i, (name, index) in enumerate(path):
+            if current is None:
+                raise RuleError(f"{format_path(path[:i])} is a {leaf}, it has no field {name!r}")
+            f = current.field(name)
+            if f is None:
+                raise RuleError(f"{current.name} has no field {name!r}")
+            assert isinstance(f.type, DsdlType)
+            leaf = f.type
+            array = leaf
+            leaf = _indexed(leaf, name, index, self.v0)
+            current = self.types.get(leaf.composite) if leaf.kind == "composite" and not leaf.array else None
+            if current is None and leaf.kind == "composite" and not leaf.array:
+                raise _Reported(f"unknown DSDL type {leaf.composite}")  # reported with the field's declaration
+            if current is not None and current.union:
+                raise RuleError(f"{name} is a union ({current.name}); unions cannot be mapped")
+            if isinstance(index, Key) and current is not None:
+                self.check_key(current, name, index)
+            if record and ((index is not None and self.v0 and array.array == "bounded") or isinstance(index, Key)):
+                uses = self.elements.setdefault((*path[:i], (name, None)), {"index": {}, "key": {}})
+                uses["key" if isinstance(index, Key) else "index"][index] = None
+        assert leaf is not None
+        if leaf.kind == "composite" and not leaf.array and not allow_composite and leaf.composite not in TIMESTAMPS:
+            raise RuleError(f"{format_path(path)} is a composite ({leaf.composite}); map its fields one by one")
+        return leaf
+
+    def check_key(self, item: DsdlStruct, name: str, key: Key) -> None:
+        """`name[field=value]`: `field` an integer of the item type, `value` one of its values."""
+        f = item.field(key.field)
+        t = f.type if f is not None else None
+        if not isinstance(t, DsdlType) or t.array or t.kind not in ("int", "uint"):
+            raise RuleError(f"{name}[{key}]: the key must be an integer field of {item.name}"
+                            + (f", {key.field} is {t}" if t is not None else f", which has no field {key.field!r}"))
+        lo, hi = t.range
+        if not lo <= key.value <= hi:
+            raise RuleError(f"{name}[{key}]: {key.value} is outside the range of {key.field} ({t}) [{lo}, {hi}]")
+
+    def resolve_link(self, link: FieldLink, ros_message: RosMessage, struct: DsdlStruct, mapping: Mapping,
+                     what: str) -> Step | None:
+        try:
+            ros_path = parse_path(link.ros_path)
+            ros_type = self.ros_leaf(ros_message, ros_path)
+            if link.value is not None:
+                if mapping.direction == "ros_to_uavcan":
+                    raise RuleError("a `value` sets a ROS field; a ROS->UAVCAN mapping sets UAVCAN fields with "
+                                    "uavcan_values")
+                if ros_type.array or not ros_type.is_primitive:
+                    raise RuleError(f"a `value` sets a primitive field, {link.ros_path} is {ros_type}")
+                check_ros_value(self.diag, ros_type, link.value, link.pos, f"value of {link.ros_path!r}")
+                return Step("value", tuple(ros_path), ros_type, value=link.value, pos=link.pos)
+            assert link.uavcan_path is not None
+            uav_path = parse_path(link.uavcan_path)
+            uav_type = self.dsdl_leaf(struct, uav_path)
+            if uav_type.kind == "composite" and uav_type.composite in TIMESTAMPS:
+                uav_path.append((TIMESTAMPS[uav_type.composite], None))
+                uav_type = DsdlType("uint", 56, truncated=True)
+            if not ros_type.is_primitive and ros_type.base == TIME and not ros_type.array:
+                if uav_type.kind not in ("uint", "int") or uav_type.array or link.scale or link.table:
+                    raise RuleError(f"builtin_interfaces/Time receives a microsecond integer, not {uav_type}")
+                return Step("time", tuple(ros_path), ros_type, tuple(uav_path), uav_type, pos=link.pos)
+            if not ros_type.is_primitive:
+                raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one")
+            if link.limits is not None and (ros_type.array or ros_type.base not in {*ROS_INT_RANGES, *ROS_FLOAT_BITS}):
+                raise RuleError("limits apply to numeric scalar fields")
+            if link.limits is not None and mapping.direction == "uavcan_to_ros":  # the converters apply none there
+                raise RuleError("limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping "
+                                "passes on what the device measured")
+            if uav_type.kind == "utf8" or ros_type.base == "string":
+                exact = check_string(ros_type, uav_type, link)
+                kind = "string"
+            elif uav_type.array or ros_type.array:
+                exact = check_arrays(ros_type, uav_type, link)
+                kind = "array"
+            else:
+                kind, exact = check_scalar(ros_type, uav_type, link)
+            if kind == "table" and mapping.direction == "uavcan_to_ros" and link.table_default is None:
+                self.check_table_covers(uav_type, link, what)
+            return Step(kind, tuple(ros_path), ros_type, tuple(uav_path), uav_type, link.scale, link.offset,
+                        tuple(sorted((link.table or {}).items())), link.table_default, None, link.limits, exact,
+                        link.pos)
+        except _Reported:
+            return None
+        except RuleError as exc:
+            self.error(link.pos, f"{what}, field {link.ros_path!r}: {exc}")
+            return None
+
+    def check_table_covers(self, uav: DsdlType, link: FieldLink, what: str) -> None:
+        """A UAVCAN -> ROS table must say what every value the device may send becomes; a value it misses
+        would drop the whole message at run time."""
+        count, first = missing_table_keys(uav, set(link.table or {}))
+        if count:
+            listed = ", ".join(map(str, first)) + (", ..." if count > len(first) else "")
+            total = uav.range[1] - uav.range[0] + 1
+            self.error(link.pos, f"{what}, field {link.ros_path!r}: the table has no entry for {count} of the "
+                       f"{total} values of {uav} ({listed}); a message carrying one would be dropped",
+                       "an entry for each value, or `default: <ROS value>` for the values it does not list")
+
+    def uncovered(self, struct: DsdlStruct, prefix: str, pool: set[str], skip: str | None = None
+                  ) -> list[tuple[str, DsdlType]]:
+        """The fields of `struct` (paths under `prefix`) that `pool` leaves without a value, each as large as
+        possible: a field or array element under which the pool has no path is one entry, whole."""
+        result: list[tuple[str, DsdlType]] = []
+        for f in struct.fields:
+            assert isinstance(f.type, DsdlType)
+            if (struct.name, f.name) not in self.bad_dsdl_fields and f.name != skip:  # reported with its declaration
+                result.extend(self.uncovered_at(prefix + f.name, f.type, pool))
+        return result
+
+    def uncovered_at(self, path: str, t: DsdlType, pool: set[str]) -> list[tuple[str, DsdlType]]:
+        if path in pool:
+            return []
+        uses = self.element_uses.get(path)
+        if uses is not None:  # a DroneCAN array of which the mapping names elements
+            if self.direction == "uavcan_to_ros":
+                return []  # it reads its elements; the others are other mappings' (or nobody's)
+            if uses["index"]:  # the message is built with exactly the elements up to the last one named
+                return [u for i in range(max(uses["index"]) + 1)
+                        for u in self.uncovered_at(f"{path}[{i}]", t.element, pool)]
+            item = self.types.get(t.composite) if t.composite else None
+            return [u for key in uses["key"] for u in self.uncovered(item, f"{path}[{key}].", pool, key.field)
+                    ] if item is not None else []
+        if not any(p.startswith((path + ".", path + "[")) for p in pool):
+            return [(path, t)]
+        if t.array == "fixed":  # some elements (or their fields) are covered: look at each
+            return [u for i in range(t.capacity or 0) for u in self.uncovered_at(f"{path}[{i}]", t.element, pool)]
+        nested = self.types.get(t.composite) if t.kind == "composite" and not t.array and t.composite else None
+        if nested is not None:
+            return self.uncovered(nested, path + ".", pool)
+        return [(path, t)]
+
+    def check_elements(self, resolved: ResolvedMapping, what: str) -> bool:
+        """A DroneCAN array's elements are named by position or by one key field, not both."""
+        ok = True
+        for path, uses in self.elements.items():
+            text = format_path(list(path))
+            fields = {key.field for key in uses["key"]}
+            if uses["index"] and uses["key"]:
+                self.error(resolved.mapping.pos, f"{what} names elements of {text} both by position and by key",
+                           "one way for one array")
+                ok = False
+            elif len(fields) > 1:
+                self.error(resolved.mapping.pos, f"{what} chooses items of {text} by more than one key field ("
+                           + ", ".join(sorted(fields)) + ")", "one key field per array")
+                ok = False
+            else:
+                resolved.elements[path] = list(uses["index"] or uses["key"])
+        self.element_uses = {format_path(list(path)): uses for path, uses in self.elements.items()}
+        return ok
+
+    def check_coverage(self, resolved: ResolvedMapping, what: str) -> None:
+        mapping = resolved.mapping
+        self.direction = mapping.direction
+        linked = {s.uavcan for s in resolved.steps if s.uavcan_path} | self.failed_paths
+        valued = {format_path(list(p)) for p, _, _ in resolved.uavcan_values}
+        selected = {format_path(list(p)) for p, _, _ in resolved.select}
+        for path in sorted(selected & (linked | valued)):
+            self.error(mapping.pos, f"UAVCAN field {path!r} is set by `select` in {what}; it cannot also be mapped",
+                       "the field in select only")
+        linked |= selected
+        struct = resolved.dsdl_struct
+        if mapping.direction == "uavcan_to_ros":
+            for path, t in self.uncovered(struct, "", linked | self.ignored):
+                self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
+                           f"{struct.name} is neither mapped nor ignored in {what}",
+                           f"a `ros_field: {path}` line or `{path}` in ignore")
+        else:
+            for path, t in self.uncovered(struct, "", linked | valued):
+                self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
+                           f"{struct.name} gets no value in {what}",
+                           f"a `ros_field: {path}` line or an entry in uavcan_values")
+            for path in sorted(linked & valued):
+                self.error(mapping.pos, f"UAVCAN field {path!r} is both mapped and in uavcan_values in {what}")

@@ -1,0 +1,416 @@
+"""The Cyphal v1 backend: a pycyphal.application node (heartbeat, GetInfo, registers) on a pycyphal transport, the
+bridge's ports as named ports with the standard registers (sam_runtime.cyphal_io.ports), the devices' heartbeats as
+device status events, pycyphal's per-subject counters, and the signs of a dead transport.
+
+- Transports: :class:`TransportConfig` (UDP on 127.0.0.1 by default, CAN through pycyphal's media, loopback, the
+  standard UAVCAN__* register variables, or a custom factory).
+- Ports: ``uavcan.sub.<name>.id/.type`` and ``uavcan.pub.<name>.id/.type`` registers whose defaults are the spec's
+  subject ids (overridable as usual, e.g. ``UAVCAN__SUB__IMU__ID``), and ``uavcan.node.id``.
+- Cyphal v1 messages carry no destination: a command reaches its device because each actuator has its own subject.
+- Below the bridge: pycyphal's counters of each subscription (``errors`` with their kinds per source node on UDP,
+  ``deserialization_failures``, ``overruns`` of the bounded receive queue, ``drops``), accumulated across
+  reopenings; increments are logged at a bounded rate.
+- A dead transport: the CAN media close themselves for good on unrecoverable OS errors (the transport then only
+  raises ResourceClosedError); a publish that finds its port closed says so too.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import collections
+import logging
+import os
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from sam_runtime.bridge.backend import (
+    Backend,
+    BelowBridge,
+    BridgeConfigError,
+    DeviceStatus,
+    Inlet,
+    LinkDownError,
+    Outlet,
+)
+from sam_runtime.bridge.backends.cyphal_wire import RawReceiver, RawSender
+from sam_runtime.bridge.counters import RateLimitedLog, log
+from sam_runtime.cyphal_io.ports import PortConfigError, register_environment, register_node_id, resolve_subject
+
+__all__ = ["DEFAULT_RX_QUEUE_SIZE", "CyphalBackend", "TransportConfig", "quiet_late_media_completions"]
+
+DEFAULT_RX_QUEUE_SIZE = 1000
+SEND_TIMEOUT_S = 1.0
+_HEALTH = {0: "NOMINAL", 1: "ADVISORY", 2: "CAUTION", 3: "WARNING"}
+_HEALTH_LEVEL = {0: 0, 1: 0, 2: 1}  # /diagnostics: NOMINAL, ADVISORY OK; CAUTION WARN; WARNING (or unknown) ERROR
+_MODE = {0: "OPERATIONAL", 1: "INITIALIZATION", 2: "MAINTENANCE", 3: "SOFTWARE_UPDATE"}
+_PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
+
+
+@dataclass
+class TransportConfig:
+    """How the bridge reaches the Cyphal network.
+
+    ``kind``: ``udp`` (default, ``iface`` default 127.0.0.1), ``can`` (``iface`` like ``virtual:bus0`` or
+    ``socketcan:can0``, ``mtu`` 8 = Classic CAN, 64 = CAN FD), ``loopback``, or ``env``: the standard
+    register environment variables (UAVCAN__UDP__IFACE, UAVCAN__CAN__IFACE, UAVCAN__CAN__MTU, ...) in
+    ``environ`` (default ``os.environ``), or ``custom``: ``factory(node_id)`` returns a new pycyphal transport
+    (called again whenever the bridge reopens a failed transport; e.g. special CAN media, fault injection).
+    """
+
+    kind: str = "udp"
+    iface: str | None = None
+    mtu: int | None = None
+    environ: Mapping[str, str] | None = None
+    factory: Callable[[int], Any] | None = None
+
+    def describe(self) -> str:
+        if self.kind == "custom":
+            return f"custom({getattr(self.factory, '__name__', self.factory)!s})"
+        if self.kind == "env":
+            env = self.env()
+            keys = sorted(k for k in env if k.startswith("UAVCAN__") and k != "UAVCAN__NODE__ID")
+            return "env(" + ", ".join(f"{k}={env[k]}" for k in keys) + ")"
+        if self.kind == "udp":
+            return f"udp:{self.iface or '127.0.0.1'}"
+        if self.kind == "can":
+            return f"can:{self.iface} mtu={self.mtu or 64}"
+        return self.kind
+
+    def env(self) -> Mapping[str, str]:
+        return os.environ if self.environ is None else self.environ
+
+    def node_id(self, default: int) -> int:
+        """``UAVCAN__NODE__ID`` for an ``env`` transport, else ``default``."""
+        if self.kind == "env":
+            raw = str(self.env().get("UAVCAN__NODE__ID", "")).strip()
+            if raw:
+                try:
+                    return int(raw)
+                except ValueError:
+                    raise BridgeConfigError(f"UAVCAN__NODE__ID={raw!r} is not an integer") from None
+        return int(default)
+
+
+def quiet_late_media_completions(loop: asyncio.AbstractEventLoop) -> None:
+    """pycyphal's python-can media completes a frame's future from its TX thread with call_soon_threadsafe;
+    when the awaiting task was cancelled meanwhile (a node closing, a send deadline), ``set_result`` on the
+    cancelled future raises InvalidStateError inside the loop, which asyncio prints as a traceback. Those are
+    harmless: log them at DEBUG level. Installed only when the loop has no exception handler of its own."""
+    if loop.get_exception_handler() is not None:
+        return
+
+    def handler(lp: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
+        exc = context.get("exception")
+        if isinstance(exc, asyncio.InvalidStateError) and "set_" in repr(context.get("handle", "")):
+            log.debug("late completion of a cancelled Cyphal media future: %s", context.get("handle"))
+            return
+        lp.default_exception_handler(context)
+
+    loop.set_exception_handler(handler)
+
+
+def _error_kinds(session_stats: Any) -> dict[str, int]:
+    """pycyphal's breakdown of a session's errors, where the transport gives one (UDP: reassembly errors per
+    source node; CAN: reception error counters)."""
+    out: collections.Counter[str] = collections.Counter()
+    per_src = getattr(session_stats, "reassembly_errors_per_source_node_id", None)
+    if isinstance(per_src, dict):
+        for src, errs in per_src.items():
+            for err, n in errs.items():
+                if n:
+                    out[f"{getattr(err, 'name', err)}.node{src}"] += int(n)
+    for attr in ("reassembly_errors", "reception_error_counters"):
+        errs = getattr(session_stats, attr, None)
+        if isinstance(errs, dict):
+            for err, n in errs.items():
+                if n:
+                    out[str(getattr(err, "name", err))] += int(n)
+    return dict(out)
+
+
+def _transport_dead(transport: Any) -> bool:
+    """Best effort: pycyphal's CAN media close themselves for good on unrecoverable OS errors (the python-can
+    media on any OSError of its receive thread, SocketCAN on ENETDOWN & co.); the transport then only raises
+    ResourceClosedError. A redundant transport is dead when all its inferiors are."""
+    inferiors = getattr(transport, "inferiors", None)
+    if isinstance(inferiors, list | tuple) and inferiors:
+        return all(_transport_dead(t) for t in inferiors)
+    if not hasattr(transport, "_maybe_media"):
+        return False
+    media = transport._maybe_media
+    return media is None or bool(getattr(media, "_closed", False))
+
+
+def _monotonic(transfer: Any) -> float:
+    try:
+        return transfer.timestamp.monotonic_ns * 1e-9  # .monotonic builds a Decimal
+    except Exception:
+        return time.monotonic()
+
+
+class _Subscription(Inlet):
+    def __init__(self, name: str, spec_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
+                 raw: bool = False) -> None:
+        self.name, self.spec_id, self.dtype, self.handler, self.raw = name, spec_id, dtype, handler, raw
+        self.port_name = f"uavcan.sub.{name}"
+        self.port_id: int | None = None
+        self.below = BelowBridge()
+        self.subscriber: Any = None  # a pycyphal Subscriber, or on the wire path a RawReceiver
+        self.seen: dict[str, int] = {}  # pycyphal's counters of the current subscriber already accumulated
+        self.refused = 0  # the wire path: payloads the codec refused since the port opened
+
+    def malformed(self, src: int | None, detail: str) -> None:
+        # Reported like pycyphal's deserialization_failures of a presentation-layer port (poll_statistics).
+        self.refused += 1
+
+    def statistics(self) -> tuple[dict[str, int], Any]:
+        """pycyphal's counters of the current port (cumulative since it opened) and its transport session's
+        statistics."""
+        if self.raw:
+            ts = self.subscriber.statistics()
+            return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
+                    "deserialization_failures": self.refused, "overruns": 0}, ts
+        s = self.subscriber.sample_statistics()
+        ts = s.transport_session
+        return {"transfers": ts.transfers, "frames": ts.frames, "errors": ts.errors, "drops": ts.drops,
+                "deserialization_failures": s.deserialization_failures, "overruns": s.overruns}, ts
+
+    def on_transfer(self, msg: Any, transfer: Any) -> None:
+        self.handler(msg, transfer.source_node_id, transfer.transfer_id, _monotonic(transfer))
+
+
+class _Publication(Outlet):
+    def __init__(self, backend: CyphalBackend, name: str, spec_id: int, dtype: Any, raw: bool = False) -> None:
+        self._backend = backend
+        self.name, self.spec_id, self.dtype = name, spec_id, dtype
+        self.port_name = f"uavcan.pub.{name}"
+        self.port_id: int | None = None
+        self.send_timeout = SEND_TIMEOUT_S
+        self.publisher: Any = None  # a pycyphal Publisher, or on the wire path a RawSender with its session open
+        self.raw_sender = RawSender() if raw else None
+
+    @property
+    def ready(self) -> bool:
+        return self.publisher is not None
+
+    async def publish(self, obj: Any) -> bool:
+        import pycyphal.transport
+
+        pub = self.publisher
+        if pub is None:
+            raise LinkDownError(self.port_name)
+        try:
+            if pub is self.raw_sender:
+                return await pub.send(obj, self.send_timeout)
+            return bool(await pub.publish(obj))
+        except pycyphal.transport.ResourceClosedError as ex:
+            if self.publisher is pub:  # not replaced by a reopened one meanwhile: the transport is gone
+                self._backend.suspect(f"publish on {self.port_id}: {type(ex).__name__}: {ex}")
+            raise
+
+
+class CyphalBackend(Backend):
+    """:param name: the node's GetInfo name (``org.<vehicle>.<bridge>``).
+    :param rx_queue_size: bound of each subject's pycyphal receive queue (beyond: ``overruns``); 0 = unbounded.
+    :param rlog: the bridge's bounded-rate log (transport errors, what pycyphal discarded);
+        ``errors``: the bridge's error counters (``cyphal.<kind>`` per transport error)."""
+
+    protocol, label, stack = "cyphal", "Cyphal", "pycyphal"
+
+    def __init__(self, name: str, node_id: int, transport: TransportConfig, *, rlog: RateLimitedLog,
+                 errors: collections.Counter[str], rx_queue_size: int = DEFAULT_RX_QUEUE_SIZE) -> None:
+        self.name = name[:50]
+        self.node_id = node_id
+        self.transport_config = transport
+        self.rx_queue_size = int(rx_queue_size)
+        self._rlog, self._errors = rlog, errors
+        self._subs: list[_Subscription] = []
+        self._pubs: list[_Publication] = []
+        self._status_handlers: list[Callable[[DeviceStatus], None]] = []
+        self._node: Any = None
+        self._hb_sub: Any = None
+        self._suspect: str | None = None
+        self._modulo = 2**64
+        self._poll_lock = threading.Lock()
+
+    def describe(self) -> str:
+        return self.transport_config.describe()
+
+    # -------------------------------------------------------------------------------------------- declarations
+    def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
+                  *, raw: bool = False) -> Inlet:
+        sub = _Subscription(name, port_id, dtype, handler, raw)
+        self._subs.append(sub)
+        return sub
+
+    def advertise(self, name: str, port_id: int, dtype: Any, *, raw: bool = False) -> Outlet:
+        pub = _Publication(self, name, port_id, dtype, raw)
+        self._pubs.append(pub)
+        return pub
+
+    def on_device_status(self, handler: Callable[[DeviceStatus], None]) -> None:
+        self._status_handlers.append(handler)
+
+    # -------------------------------------------------------------------------------------------- the link
+    @property
+    def transfer_id_modulo(self) -> int:
+        return self._modulo
+
+    def suspect(self, reason: str) -> None:
+        self._suspect = reason
+
+    def link_problem(self) -> str | None:
+        if self._node is None:
+            return "no Cyphal node"
+        if self._suspect:
+            return self._suspect
+        try:
+            if _transport_dead(self._node.presentation.transport):
+                return "the transport's media closed itself"
+        except Exception as ex:
+            return f"{type(ex).__name__}: {ex}"
+        return None
+
+    def _make_transport(self) -> Any:
+        from sam_runtime.cyphal_io.transport import make_transport, transport_from_env
+
+        tc = self.transport_config
+        if tc.kind == "env":
+            env = dict(tc.env())
+            env["UAVCAN__NODE__ID"] = str(self.node_id)
+            return transport_from_env(env)
+        if tc.kind == "custom":
+            if tc.factory is None:
+                raise BridgeConfigError("a custom transport needs a factory")
+            return tc.factory(self.node_id)
+        return make_transport(tc.kind, node_id=self.node_id, iface=tc.iface, mtu=tc.mtu)
+
+    async def open(self) -> None:
+        """The Cyphal node and every port (at start and whenever the transport is reopened)."""
+        try:
+            self._open()  # (in the loop: the wire path's receive tasks start there)
+        except PortConfigError as ex:
+            raise BridgeConfigError(str(ex)) from None
+
+    def _open(self) -> None:
+        import uavcan.node
+
+        from sam_runtime.cyphal_io.transport import make_node
+
+        tc = self.transport_config
+        env = tc.environ if tc.kind == "env" and tc.environ is not None else os.environ
+        # The registers (uavcan.node.id, uavcan.pub/sub.<port>.id/.type) and their UAVCAN__* overrides.
+        node = make_node(self.name, self.node_id, transport=self._make_transport(),
+                         environ=register_environment(env))
+        try:
+            register_node_id(node.registry, self.node_id)
+            node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+            transport = node.presentation.transport
+            self._modulo = int(transport.protocol_parameters.transfer_id_modulo)
+            if hasattr(transport, "add_error_hook"):  # CAN: media errors (bus off, error passive, ...) counted
+                transport.add_error_hook(self._on_transport_error)
+            rxq = self.rx_queue_size if self.rx_queue_size > 0 else None
+            for pub in self._pubs:
+                pub.port_id = resolve_subject(node.registry, "pub", pub.name, pub.dtype, pub.spec_id)
+                if pub.raw_sender is not None:
+                    pub.raw_sender.reopen(transport, pub.port_id, pub.dtype)
+                    pub.publisher = pub.raw_sender
+                    continue
+                p = node.presentation.make_publisher(pub.dtype, pub.port_id)
+                p.send_timeout = pub.send_timeout
+                pub.publisher = p
+            for sub in self._subs:
+                sub.port_id = resolve_subject(node.registry, "sub", sub.name, sub.dtype, sub.spec_id)
+                sub.seen, sub.refused = {}, 0
+                if sub.raw:
+                    sub.subscriber = RawReceiver(transport, sub.port_id, sub.dtype, sub.handler)
+                    continue
+                sub.subscriber = node.presentation.make_subscriber(sub.dtype, sub.port_id, rxq)
+                sub.subscriber.receive_in_background(sub.on_transfer)
+            self._hb_sub = node.make_subscriber(uavcan.node.Heartbeat_1_0)
+            self._hb_sub.receive_in_background(self._on_heartbeat)
+        except BaseException:
+            for sub in self._subs:
+                if isinstance(sub.subscriber, RawReceiver):
+                    sub.subscriber.task.cancel()
+                    sub.subscriber = None
+            node.close()
+            raise
+        self._node = node
+        self._suspect = None
+
+    async def close(self) -> None:
+        """Close every port and the node (what their subscribers counted is kept)."""
+        from sam_runtime.cyphal_io.transport import aclose
+
+        self.poll_statistics()
+        receivers = [s.subscriber for s in self._subs if isinstance(s.subscriber, RawReceiver)]
+        ports: list[Any] = [s.subscriber for s in self._subs if not isinstance(s.subscriber, RawReceiver)]
+        ports += [p.publisher for p in self._pubs if not isinstance(p.publisher, RawSender)] + [self._hb_sub]
+        for s in self._subs:
+            s.subscriber = None
+        for p in self._pubs:
+            if p.raw_sender is not None:
+                p.raw_sender.close()
+            p.publisher = None
+        self._hb_sub = None
+        node, self._node = self._node, None
+        try:
+            for receiver in receivers:
+                await receiver.close()
+            await aclose(*[p for p in ports if p is not None])
+            if node is not None:
+                await aclose(node)
+        except Exception as ex:  # a dead transport may refuse to close cleanly
+            log.warning("closing the Cyphal node: %s: %s", type(ex).__name__, ex)
+
+    def _on_transport_error(self, timestamp: Any, error: Any) -> None:
+        kind = getattr(error, "name", str(error))
+        self._errors[f"cyphal.{kind}"] += 1
+        self._rlog.note(("cyphal", kind), logging.WARNING, "transport error %s", kind)
+
+    def _on_heartbeat(self, msg: Any, transfer: Any) -> None:
+        nid = transfer.source_node_id
+        if nid is None:
+            return
+        health, mode = int(msg.health.value), int(msg.mode.value)
+        st = DeviceStatus(nid, _HEALTH.get(health, str(health)), _HEALTH_LEVEL.get(health, 2),
+                          _MODE.get(mode, str(mode)), int(msg.uptime), int(msg.vendor_specific_status_code))
+        for handler in self._status_handlers:
+            handler(st)
+
+    # -------------------------------------------------------------------------------------------- counters
+    def poll_statistics(self) -> None:
+        """Accumulate pycyphal's per-subject counters (they restart with each new subscriber) and log their
+        increments at a bounded rate (thread-safe)."""
+        with self._poll_lock:
+            for sub in self._subs:
+                subscriber = sub.subscriber
+                if subscriber is None:
+                    continue
+                try:
+                    now, ts = sub.statistics()
+                except Exception:  # closed meanwhile
+                    continue
+                kinds = _error_kinds(ts)
+                below = sub.below
+                for key, value in now.items():
+                    delta = int(value) - sub.seen.get(key, 0)
+                    if delta <= 0:
+                        continue
+                    sub.seen[key] = int(value)
+                    below.count(key, delta, key in _PROBLEMS)
+                    if key in _PROBLEMS:
+                        detail = ""
+                        if key == "errors" and kinds:
+                            detail = f" ({', '.join(f'{k} {v}' for k, v in sorted(kinds.items()))} in all)"
+                        self._rlog.note((f"subject {sub.spec_id}", f"cyphal.{key}"), logging.WARNING,
+                                        "%d discarded by pycyphal below the bridge%s", delta, detail, count=delta)
+                for k, v in kinds.items():
+                    base = sub.seen.get(f"kind.{k}", 0)
+                    if v > base:
+                        below.count_kind(k, v - base)
+                        sub.seen[f"kind.{k}"] = v

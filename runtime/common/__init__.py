@@ -1,0 +1,1 @@
+"""Utilities every part of the runtime shares; imports nothing else of sam_runtime."""

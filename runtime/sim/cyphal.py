@@ -1,0 +1,105 @@
+"""The simulator's Cyphal adapter: a pycyphal node per device (heartbeats from the start), a publisher per published
+port, a subscriber per command subject; generic values from sam_runtime.sim.devices, records as transmitted.
+(The DroneCAN one is sam_runtime.sim.dronecan; the schedule, physics and counters are sam_runtime.sim.simulator's.)"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from typing import TYPE_CHECKING, Any
+
+from sam_runtime.sim.devices import PHYSICS, SAM_ACTUATORS, generic_fill, physics_key
+
+if TYPE_CHECKING:
+    from sam_runtime.sim.simulator import Simulator, _PubPort, _SimDevice, _SubPort
+
+__all__ = ["CyphalDevices"]
+
+_log = logging.getLogger("sam_runtime.sim.simulator")
+
+
+class CyphalDevices:
+    """The Cyphal adapter: a pycyphal node per device, a publisher per port, a subscriber per command subject."""
+
+    protocol = "cyphal"
+
+    def __init__(self, sim: Simulator) -> None:
+        self.sim = sim
+
+    def prepare(self) -> None:
+        from sam_runtime.bridge import quiet_late_media_completions
+
+        self.sim.gen.compile_dsdl()
+        quiet_late_media_completions(asyncio.get_running_loop())
+
+    def ports(self, dev: _SimDevice) -> None:
+        from sam_runtime.sim.simulator import _PubPort, _SubPort
+
+        gen = self.sim.gen
+        dev.subs += [_SubPort(port, gen.dsdl_class(port)) for port in dev.info.subscribes]
+        dev.pubs += [_PubPort(port, gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type)))
+                     for port in dev.info.publishes]
+
+    def open(self, dev: _SimDevice) -> None:
+        """The device's node (heartbeats start at once) and its ports."""
+        import uavcan.node
+
+        from sam_runtime.cyphal_io.transport import make_node, transport_from_env
+
+        cfg = self.sim.config
+        name = f"org.{self.sim.tables.VEHICLE}.sim.{dev.info.name}"[:50]
+        if cfg.kind == "env":
+            env = dict(cfg.environ or {})
+            env["UAVCAN__NODE__ID"] = str(dev.info.node_id)
+            dev.node = make_node(name, dev.info.node_id, transport=transport_from_env(env))
+        else:
+            dev.node = make_node(name, dev.info.node_id, cfg.kind, iface=cfg.iface, mtu=cfg.mtu)
+        dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+        for sp in dev.subs:
+            sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
+            sp.subscriber.receive_in_background(
+                lambda msg, tr, dev=dev, sp=sp: self.sim._on_command(dev, sp, msg, tr))
+        for pp in dev.pubs:
+            pp.publisher = dev.node.make_publisher(pp.dtype, pp.port.subject_id)
+            pp.publisher.send_timeout = 1.0
+
+    async def close(self, devices: list[_SimDevice]) -> None:
+        """Close the devices' ports, then their nodes (never raises)."""
+        from sam_runtime.cyphal_io.transport import aclose
+
+        ports = [p.publisher for d in devices for p in d.pubs] + [s.subscriber for d in devices for s in d.subs]
+        nodes = [d.node for d in devices]
+        for d in devices:
+            d.node = None
+            for pp in d.pubs:
+                pp.publisher = None
+            for sp in d.subs:
+                sp.subscriber = None
+        try:
+            await aclose(*[p for p in ports if p is not None])
+            await aclose(*[n for n in nodes if n is not None])
+        except Exception as ex:
+            _log.warning("closing the simulated Cyphal nodes: %s: %s", type(ex).__name__, ex)
+
+    def blank(self, pp: _PubPort, t: float, now_us: int) -> Any:
+        return generic_fill(pp.dtype(), t, now_us, seed=pp.ident)
+
+    def finish(self, dev: _SimDevice, pp: _PubPort, obj: Any, t: float, now_us: int) -> None:
+        pass
+
+    def command_values(self, dev: _SimDevice, sp: _SubPort, msg: Any) -> dict[str, Any] | None:
+        import pycyphal.dsdl
+
+        return pycyphal.dsdl.to_builtin(msg)  # type: ignore[no-any-return]
+
+    def apply(self, dev: _SimDevice, values: dict[str, Any]) -> dict[str, float]:
+        dev.state.command.update(values)
+        inputs = SAM_ACTUATORS.get(dev.info.name, {})
+        return {inputs[k]: float(v) for k, v in values.items() if k in inputs}
+
+    def record(self, port: Any, obj: Any, transmitted: bool) -> dict[str, Any]:
+        import pycyphal.dsdl
+
+        if transmitted:  # the values as transmitted (float16 rounding etc.)
+            obj = pycyphal.dsdl.deserialize(type(obj), list(pycyphal.dsdl.serialize(obj)))
+        return {"subject": port.port.subject_id, "value": pycyphal.dsdl.to_builtin(obj)}

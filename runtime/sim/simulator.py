@@ -1,0 +1,543 @@
+"""Simulated devices: one node per device of the spec, with the spec's node id, in one asyncio loop.
+
+- Protocols: the layout (``SimConfig.layout``, one of the spec's ``layouts``; :func:`layout_protocols`) says which
+  firmware each device runs: a pycyphal node on ``kind``/``iface`` (:mod:`sam_runtime.sim.cyphal`), or a dronecan
+  (UAVCAN v0) node on ``dronecan_iface`` (:mod:`sam_runtime.sim.dronecan`). The node, its ports, the messages'
+  generic values and closing are one small adapter per protocol; the schedule, physics, command policy, counters
+  and faults are shared.
+- Every published port runs at its nominal rate (``rate_hz`` of the spec, optionally scaled), on an
+  absolute schedule (no drift; a late tick is published late, never twice).
+- Values (:mod:`sam_runtime.sim.devices`): generic in-range values for any DSDL type; where the type is
+  known, measurements of one shared simulated vehicle (:mod:`sam_runtime.physics.vehicle`): IMU, magnetometer,
+  pressure, altimeter, GNSS (a fix only at the surface), battery, and the actuators' feedback.
+- One vehicle: the SAM actuator devices (:data:`SAM_ACTUATORS`, by device name) drive the model's inputs; the
+  model moves toward them at finite rates and integrates in fixed 10 ms steps up to the time a device reads it,
+  so a seed and a command sequence give one trajectory. Devices of other specs keep their own simple feedback
+  model (moving toward the last command at a finite rate).
+- Actuators accept commands only from the bridge's node id; commands from any other node are counted and
+  ignored.
+- Timestamps: microseconds on a monotonic clock whose epoch is the wall-clock time at start (realistic
+  ROS stamps, never jumping); with ``time_scale`` the vehicle's clock (and the stamps) run that many times
+  faster than the wall clock, and so do the publication rates.
+- Ground truth: ``Simulator.truth()`` in process, and ``truth_file`` (JSON lines when it ends in ``.jsonl``,
+  else one JSON object replaced atomically) at ``truth_rate_hz`` of vehicle time.
+
+``Simulator.report()`` gives counts per device and port (published, commands accepted/rejected, the last command):
+a Cyphal port is keyed by its subject id (``"1100"``), a DroneCAN one by ``"dronecan:<data type name>"``
+(``"dronecan:uavcan.equipment.ahrs.RawIMU"``); a DroneCAN command port also counts ``not_addressed`` (broadcasts
+without this device's element). ``record`` writes every transmitted and received message (as transmitted) as JSON
+lines (``subject`` for Cyphal, ``protocol``/``data_type``/``data_type_id`` for DroneCAN).
+For fault tests: ``power_off(name)``/``power_on(name)`` (a device that stops - its heartbeat too - and
+reboots; ``restart(name)``: both, as DroneCAN's RestartNode) and ``pause()``/``resume()`` (hold every publication,
+heartbeats go on, nothing left in flight).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import math
+import os
+import time
+from collections import Counter
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.physics.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, VehicleParams
+from sam_runtime.sim.devices import (
+    PHYSICS,
+    SAM_ACTUATORS,
+    DeviceState,
+    PhysicsFn,
+    VehicleState,
+    generic_fill,
+    physics_key,
+)
+
+# The device models live in sam_runtime.sim.devices; re-exported here, where the tests and benchmarks import them.
+__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState", "generic_fill",
+           "layout_protocols", "physics_key"]
+
+_log = logging.getLogger("sam_runtime.sim.simulator")
+
+
+# ============================================================================================ simulator
+@dataclass
+class SimConfig:
+    """``kind``/``iface``/``mtu`` as in :func:`~sam_runtime.cyphal_io.transport.make_transport`
+    (``env``: UAVCAN__UDP__IFACE
+    / UAVCAN__CAN__IFACE / UAVCAN__CAN__MTU from ``environ``; node ids always come from the spec)."""
+
+    kind: str = "udp"
+    iface: str | None = None
+    mtu: int | None = None
+    environ: Mapping[str, str] | None = None
+    layout: str = "default"  # one of the spec's layouts: which devices run Cyphal, which DroneCAN
+    dronecan_iface: str = "mcast-lo:"  # the DroneCAN devices' bus (a sam_runtime.dronecan_io interface URI)
+    bridge_node_id: int | None = None  # commands accepted only from it; default: the spec's bridge
+    devices: Iterable[str] | None = None  # subset of device names; default all
+    rate_scale: float = 1.0
+    record: Path | None = None  # JSON lines of every transmitted/received message
+    # The simulated vehicle (physics.vehicle): noise seed, sea floor, start pose in the sim's world frame
+    # (ENU metres around gps_origin; yaw counter-clockwise from east), battery, time.
+    seed: int = 0
+    sea_floor: SeaFloor = field(default_factory=SeaFloor)
+    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw
+    battery_percent: float = 95.0
+    battery_drain_factor: float = 1.0  # multiplies the power drawn (a scenario can drain the battery quickly)
+    battery_health_pct: int = 98
+    gps_origin: tuple[float, float] = (59.35, 18.07)  # lat, lon of the sim's world origin (KTH, Stockholm)
+    vehicle_params: VehicleParams = field(default_factory=VehicleParams)
+    noise: SensorNoise = field(default_factory=SensorNoise)
+    time_scale: float = 1.0  # vehicle seconds per wall second (rates and stamps follow)
+    truth_file: Path | None = None  # the true state: JSON lines if it ends in .jsonl, else an atomic JSON file
+    truth_rate_hz: float = 5.0  # of vehicle time
+
+    def make_vehicle(self) -> SimulatedVehicle:
+        """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""
+        return SimulatedVehicle(seed=self.seed, sea_floor=self.sea_floor, start=self.start,
+                                battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
+                                battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
+                                params=self.vehicle_params, noise=self.noise)
+    log_interval: float = 10.0  # failed publications: the first logged at once, then a count per interval
+
+
+def layout_protocols(tables: Any, layout: str = "default") -> dict[str, str]:
+    """Device name -> ``"cyphal"`` | ``"dronecan"`` under a layout of the spec (the generated ``LAYOUTS``, in spec
+    order; ``default``: every device on its own ``protocol``, or on Cyphal for tables without layouts). ValueError
+    names the spec's layouts."""
+    layouts = {lay.name: lay for lay in getattr(tables, "LAYOUTS", ())}
+    lay = layouts.get(layout)
+    if lay is not None:
+        return dict(lay.protocols)
+    if layout == "default" and not layouts:
+        return {d.name: "cyphal" for d in tables.DEVICES}
+    raise ValueError(f"the spec has no layout {layout!r}; its layouts: {', '.join(sorted(layouts) or ['default'])}")
+
+
+@dataclass
+class _PubPort:
+    port: Any  # PortInfo (Cyphal) or DroneCanPortInfo
+    dtype: Any  # the pycyphal class, or the v0 type's full name
+    physics: PhysicsFn | None
+    key: str = ""  # in report(): the subject id (Cyphal), "dronecan:<data type name>"
+    ident: int = 0  # the subject id or data type id: the schedule's offset, the generic values' seed
+    publisher: Any = None
+    task: asyncio.Task[None] | None = None
+    sent: int = 0
+    late: int = 0
+    failed: int = 0
+    busy: bool = False  # a publish in flight
+    extra: Any = None  # the protocol adapter's
+
+    def __post_init__(self) -> None:
+        if not self.key:
+            self.key, self.ident = str(self.port.subject_id), int(self.port.subject_id)
+
+
+@dataclass
+class _SubPort:
+    port: Any
+    dtype: Any
+    subscriber: Any = None
+    accepted: int = 0
+    rejected: int = 0
+    rejected_sources: Counter[int] = field(default_factory=Counter)
+    last: dict[str, Any] | None = None
+    key: str = ""
+    ident: int = 0
+    not_addressed: int = 0  # DroneCAN: broadcasts without this device's element
+    extra: Any = None
+
+    def __post_init__(self) -> None:
+        if not self.key:
+            self.key, self.ident = str(self.port.subject_id), int(self.port.subject_id)
+
+
+@dataclass
+class _SimDevice:
+    info: Any  # DeviceInfo (Cyphal) or DroneCanDeviceInfo
+    state: DeviceState
+    node: Any = None
+    pubs: list[_PubPort] = field(default_factory=list)
+    subs: list[_SubPort] = field(default_factory=list)
+    powered: bool = False
+    power_cycles: int = 0
+    protocol: str = "cyphal"
+    extra: Any = None  # the protocol adapter's (DroneCAN: the NodeLoop)
+
+
+class Simulator:
+    """All simulated devices of a spec. In a running loop: ``await start()``, ``start_publishing()`` (or pass
+    ``publish_now=True``), ..., ``await close()``."""
+
+    def __init__(self, gen: GeneratedPackage, config: SimConfig | None = None) -> None:
+        self.gen = gen
+        self.tables = gen.tables()
+        self.config = config or SimConfig()
+        if not (math.isfinite(self.config.time_scale) and self.config.time_scale > 0):
+            raise ValueError(f"time_scale must be > 0, got {self.config.time_scale}")
+        if not (math.isfinite(self.config.truth_rate_hz) and self.config.truth_rate_hz > 0):
+            raise ValueError(f"truth_rate_hz must be > 0, got {self.config.truth_rate_hz}")
+        self.vehicle = VehicleState(time_scale=self.config.time_scale, model=self.config.make_vehicle())
+        self._truth_task: asyncio.Task[None] | None = None
+        self.truth_written = 0
+        self.bridge_node_id = int(self.config.bridge_node_id if self.config.bridge_node_id is not None
+                                  else self.tables.BRIDGE_NODE_ID)
+        protocols = layout_protocols(self.tables, self.config.layout)
+        wanted = None if self.config.devices is None else set(self.config.devices)
+        if wanted is not None and wanted - set(protocols):
+            raise ValueError(f"unknown device(s) {sorted(wanted - set(protocols))}; the spec has {sorted(protocols)}")
+        firmware = {"cyphal": {d.name: d for d in self.tables.DEVICES},
+                    "dronecan": {d.name: d for d in getattr(self.tables, "DRONECAN_DEVICES", ())}}
+        self.devices = []
+        for name, protocol in protocols.items():
+            info = firmware.get(protocol, {}).get(name)
+            if info is None:
+                raise ValueError(f"layout {self.config.layout!r} puts {name} on {protocol}, but the spec gives it no "
+                                 f"{protocol} firmware")
+            if wanted is None or name in wanted:
+                self.devices.append(_SimDevice(info, DeviceState(name, info.node_id), protocol=protocol))
+        self._adapters: dict[str, Any] = {}
+        for protocol in {d.protocol for d in self.devices}:
+            if protocol == "dronecan":
+                from sam_runtime.sim.dronecan import DroneCanDevices
+
+                self._adapters[protocol] = DroneCanDevices(self)
+            else:
+                from sam_runtime.sim.cyphal import CyphalDevices
+
+                self._adapters[protocol] = CyphalDevices(self)
+        self._go: asyncio.Event | None = None  # created in start() (inside the loop)
+        self._running: asyncio.Event | None = None  # cleared by pause()
+        self._record: TextIO | None = None
+        self._publishing_since: float | None = None
+        self._publishing_until: float | None = None
+        self._closed = False
+        from sam_runtime.bridge import RateLimitedLog
+
+        self.log = RateLimitedLog(_log, self.config.log_interval)  # bounded, like the bridge's
+
+    # ---------------------------------------------------------------------------------- lifecycle
+    async def start(self, *, publish_now: bool = False) -> None:
+        """Create every device's node (heartbeats start at once) and its ports; sensors wait for
+        :meth:`start_publishing` unless ``publish_now``."""
+        for adapter in self._adapters.values():
+            adapter.prepare()
+        self._go = asyncio.Event()
+        self._running = asyncio.Event()
+        self._running.set()
+        if self.config.record is not None:
+            self._record = open(self.config.record, "w", buffering=1)
+        try:
+            for dev in self.devices:
+                self._adapter(dev).ports(dev)
+                self._open_device(dev)
+            for dev in self.devices:
+                self._start_device_tasks(dev)
+            if self.config.truth_file is not None:
+                self._truth_task = asyncio.create_task(self._truth_loop(), name="sim-truth")
+        except BaseException:
+            await self.close()
+            raise
+        if publish_now:
+            self.start_publishing()
+
+    def _adapter(self, dev: _SimDevice) -> Any:
+        return self._adapters[dev.protocol]
+
+    def _open_device(self, dev: _SimDevice) -> None:
+        """The device's node (heartbeats start at once) and its ports."""
+        self._adapter(dev).open(dev)
+        dev.powered = True
+
+    def _start_device_tasks(self, dev: _SimDevice, restart: bool = False) -> None:
+        for pp in dev.pubs:
+            pp.task = asyncio.create_task(self._publish_loop(dev, pp, restart), name=f"sim-{dev.info.name}-{pp.key}")
+
+    def device(self, name: str) -> _SimDevice:
+        for dev in self.devices:
+            if dev.info.name == name:
+                return dev
+        raise KeyError(f"no simulated device {name!r}")
+
+    async def power_off(self, name: str) -> None:
+        """Cut the device's power: its node closes, so its heartbeats and publications stop (a device that stops
+        sending, for heartbeat-timeout tests). Its counters are kept."""
+        from sam_runtime.bridge import cancel_and_wait
+
+        dev = self.device(name)
+        if not dev.powered:
+            return
+        dev.powered = False
+        if "rpm" in SAM_ACTUATORS.get(name, {}):  # a motor without power stops; servos hold their position
+            self.vehicle.sync(self.vehicle.t())
+            self.vehicle.vehicle.command(**{SAM_ACTUATORS[name]["rpm"]: 0.0})
+        await cancel_and_wait([pp.task for pp in dev.pubs if pp.task is not None])
+        for pp in dev.pubs:
+            pp.task = None
+        await self._adapter(dev).close([dev])
+        dev.power_cycles += 1
+
+    async def power_on(self, name: str) -> None:
+        """Power a device back on: a new node (uptime and transfer ids from 0, like a reboot) that publishes on
+        its schedule again (if publishing was started)."""
+        dev = self.device(name)
+        if dev.powered or self._closed:
+            return
+        self._open_device(dev)
+        self._start_device_tasks(dev, restart=True)
+
+    async def restart(self, name: str) -> None:
+        """A reboot (DroneCAN's RestartNode): power off, then on again (uptime and transfer ids from 0)."""
+        if self._closed:
+            return
+        await self.power_off(name)
+        await self.power_on(name)
+
+    def start_publishing(self, duration: float | None = None) -> None:
+        """Open the gate: every publisher starts its schedule now; with ``duration``, stops after it."""
+        assert self._go is not None, "start() first"
+        now = time.monotonic()
+        self._publishing_since = now
+        self._publishing_until = None if duration is None else now + duration
+        self._go.set()
+
+    async def pause(self, timeout: float = 2.0) -> None:
+        """Hold every publication (heartbeats go on) and wait until none is in flight: afterwards the counts of
+        sent messages do not move (for exact before/after accounting in tests)."""
+        assert self._running is not None, "start() first"
+        self._running.clear()
+        deadline = time.monotonic() + timeout
+        while any(pp.busy for d in self.devices for pp in d.pubs) and time.monotonic() < deadline:
+            await asyncio.sleep(0.005)
+
+    def resume(self) -> None:
+        """Publish again, each port on a new schedule from now (no burst to catch up, no late ticks)."""
+        assert self._running is not None, "start() first"
+        self._running.set()
+
+    @property
+    def publishing_done(self) -> bool:
+        return self._publishing_until is not None and time.monotonic() >= self._publishing_until and all(
+            pp.task is None or pp.task.done() for d in self.devices for pp in d.pubs)
+
+    async def wait_publishing_done(self) -> None:
+        tasks = [pp.task for d in self.devices for pp in d.pubs if pp.task is not None]
+        if tasks:
+            await asyncio.gather(*tasks, return_exceptions=True)
+
+    async def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        from sam_runtime.bridge import cancel_and_wait
+
+        stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None]
+                                      + ([self._truth_task] if self._truth_task is not None else []))
+        if self.config.truth_file is not None:
+            self._write_truth()
+        if stuck:
+            _log.warning("%d publish tasks did not stop", len(stuck))
+        for protocol, adapter in self._adapters.items():
+            try:
+                await adapter.close([d for d in self.devices if d.protocol == protocol and d.node is not None])
+            except Exception as ex:  # the adapters log their own; never raise out of close()
+                _log.warning("closing the simulated %s nodes: %s: %s", protocol, type(ex).__name__, ex)
+        if self._record is not None:
+            self._record.close()
+            self._record = None
+        self.log.flush(force=True)  # no count stays unlogged
+
+    # ---------------------------------------------------------------------------------- publishing
+    def make_sample(self, dev: _SimDevice, pp: _PubPort, dt: float) -> Any:
+        """One message of the port: generic values, then the device's physics (if known)."""
+        t, now_us = self.vehicle.t(), self.vehicle.now_us()
+        adapter = self._adapter(dev)
+        obj = adapter.blank(pp, t, now_us)
+        if pp.physics is not None:
+            pp.physics(obj, dev.state, self.vehicle, t, dt * self.vehicle.time_scale, self.vehicle.rng)
+        adapter.finish(dev, pp, obj, t, now_us)
+        dev.state.last_update = t
+        return obj
+
+    async def _publish_loop(self, dev: _SimDevice, pp: _PubPort, restart: bool = False) -> None:
+        assert self._go is not None
+        await self._go.wait()
+        rate = float(pp.port.rate_hz) * float(self.config.rate_scale) * self.vehicle.time_scale  # per wall second
+        if rate <= 0:
+            return
+        period = 1.0 / rate
+        # Align every port to the gate, offset a little per subject so that not all fire at once.
+        offset = (pp.ident % 17) * period / 17.0
+        started = self._publishing_since if self._publishing_since is not None else time.monotonic()
+        if restart:  # powered on again: a new schedule from now
+            started = time.monotonic() - offset
+        k = 0
+        while not self._closed:
+            if self._running is not None and not self._running.is_set():
+                await self._running.wait()
+                started, k = time.monotonic() - offset, 0
+                continue
+            due = started + offset + k * period
+            until = self._publishing_until
+            if until is not None and due >= until:
+                return
+            delay = due - time.monotonic()
+            if delay > 0:
+                await asyncio.sleep(delay)
+            elif delay < -period:
+                # Too late for this tick: skip the missed ones (counted), never burst.
+                missed = int(-delay // period)
+                pp.late += missed
+                k += missed
+                continue
+            if self._running is not None and not self._running.is_set():
+                continue  # paused while sleeping
+            obj = self.make_sample(dev, pp, period)
+            if pp.publisher is None:  # powered off meanwhile
+                return
+            pp.busy = True
+            pub = pp.publisher
+            try:
+                ok = await pub.publish(obj)
+            except asyncio.CancelledError:
+                raise
+            except Exception as ex:
+                pp.failed += 1
+                self.log.note((dev.info.name, f"publish on {pp.key}"), logging.WARNING, "failed: %s: %s",
+                              type(ex).__name__, ex)
+                ok = None
+            finally:
+                pp.busy = False
+            if ok:
+                pp.sent += 1
+                if self._record is not None:
+                    self._write_record("tx", dev, pp, obj, seq=pp.sent)
+            elif ok is False:
+                pp.failed += 1
+                self.log.note((dev.info.name, f"publish on {pp.key}"), logging.WARNING,
+                              "not every frame sent within %.1f s", pub.send_timeout)
+            if pp.failed:
+                self.log.flush()  # a count whose interval has passed, also when the failures have stopped
+            k += 1
+
+    # ---------------------------------------------------------------------------------- commands
+    def _on_command(self, dev: _SimDevice, sp: _SubPort, msg: Any, transfer: Any) -> None:
+        adapter = self._adapter(dev)
+        values = adapter.command_values(dev, sp, msg)
+        if values is None:  # a broadcast without this device's element: not a command for it
+            sp.not_addressed += 1
+            return
+        src = transfer.source_node_id
+        accepted = src == self.bridge_node_id
+        if accepted:
+            sp.accepted += 1
+            sp.last = values
+            inputs = adapter.apply(dev, values)
+            if inputs:  # from now on (the model first catches up with the time of arrival)
+                self.vehicle.sync(self.vehicle.t())
+                self.vehicle.vehicle.command(**inputs)
+        else:
+            sp.rejected += 1
+            sp.rejected_sources[-1 if src is None else int(src)] += 1
+        if self._record is not None:
+            self._write_record("rx", dev, sp, msg, source=src, accepted=accepted,
+                               seq=sp.accepted if accepted else sp.rejected)
+
+    # ---------------------------------------------------------------------------------- truth
+    def truth(self) -> dict[str, Any]:
+        """The vehicle's true state now (see :meth:`sam_runtime.physics.vehicle.Vehicle.truth`), with the sim's stamp
+        clock (``stamp_us``, as in the devices' timestamps), the wall clock and the GPS origin."""
+        veh = self.vehicle.sync(self.vehicle.t())
+        return {**veh.truth(), "stamp_us": self.vehicle.epoch_us + round(veh.t * 1e6), "wall_ns": time.time_ns(),
+                "gps_origin": list(self.config.gps_origin), "time_scale": self.vehicle.time_scale}
+
+    def _write_truth(self) -> None:
+        path = self.config.truth_file
+        assert path is not None
+        line = json.dumps(self.truth(), default=_json_default)
+        try:
+            if path.suffix == ".jsonl":
+                with open(path, "a") as f:
+                    f.write(line + "\n")
+            else:
+                tmp = path.with_name(f"{path.name}.tmp{os.getpid()}")
+                tmp.write_text(line + "\n")
+                os.replace(tmp, path)
+            self.truth_written += 1
+        except OSError as ex:
+            _log.warning("truth file %s: %s", path, ex)
+
+    async def _truth_loop(self) -> None:
+        if self.config.truth_file is not None and self.config.truth_file.suffix == ".jsonl":
+            self.config.truth_file.write_text("")  # a new run
+        period = 1.0 / (self.config.truth_rate_hz * self.vehicle.time_scale)  # wall seconds
+        start = time.monotonic()
+        k = 0
+        while not self._closed:
+            self._write_truth()
+            k += 1
+            await asyncio.sleep(max(0.0, start + k * period - time.monotonic()))
+
+    # ---------------------------------------------------------------------------------- reporting
+    def _write_record(self, direction: str, dev: _SimDevice, port: _PubPort | _SubPort, obj: Any,
+                      **extra: Any) -> None:
+        fields = self._adapter(dev).record(port, obj, direction == "tx")
+        value = fields.pop("value")
+        assert self._record is not None
+        line = {"dir": direction, "device": dev.info.name, "node_id": dev.info.node_id, **fields,
+                "wall_ns": time.time_ns(), **extra, "value": value}
+        self._record.write(json.dumps(line, default=_json_default) + "\n")
+
+    def report(self) -> dict[str, Any]:
+        devices: dict[str, Any] = {}
+        for d in self.devices:
+            devices[d.info.name] = {
+                "protocol": d.protocol,
+                "node_id": d.info.node_id,
+                "powered": d.powered,
+                "power_cycles": d.power_cycles,
+                "published": {p.key: p.sent for p in d.pubs},
+                "late": {p.key: p.late for p in d.pubs if p.late},
+                "failed": {p.key: p.failed for p in d.pubs if p.failed},
+                "commands": {
+                    s.key: {
+                        "accepted": s.accepted, "rejected": s.rejected,
+                        "rejected_sources": {str(k): v for k, v in s.rejected_sources.items()},
+                        "last": s.last,
+                        **({"not_addressed": s.not_addressed} if d.protocol == "dronecan" else {}),
+                    } for s in d.subs
+                },
+                "position": dict(d.state.position),
+            }
+        truth = self.truth()
+        since = self._publishing_since
+        return {
+            "layout": self.config.layout,
+            "bridge_node_id": self.bridge_node_id,
+            "publishing_s": None if since is None else round(
+                (min(time.monotonic(), self._publishing_until or math.inf)) - since, 3),
+            "devices": devices,
+            "vehicle": truth,
+            "rejected_vehicle_commands": self.vehicle.vehicle.rejected_commands,
+        }
+
+
+def _json_default(o: Any) -> Any:
+    try:
+        import numpy
+
+        if isinstance(o, numpy.ndarray):
+            return o.tolist()
+        if isinstance(o, numpy.generic):
+            return o.item()
+    except ImportError:  # pragma: no cover
+        pass
+    if isinstance(o, bytes | bytearray):
+        return o.decode(errors="replace")
+    return str(o)
