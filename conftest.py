@@ -16,13 +16,14 @@ import importlib.abc
 import importlib.util
 import sys
 from types import ModuleType
+from typing import ClassVar
 
 collect_ignore = [f"runtime/nodes/{name}.py" for name in
                   ("controller", "dead_reckoning", "mission", "motion_planner", "performance_monitor", "slam")]
 
 
 class _SourceFolderAlias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    PACKAGES = {"codegen": "sam_codegen", "runtime": "sam_runtime"}
+    PACKAGES: ClassVar[dict[str, str]] = {"codegen": "sam_codegen", "runtime": "sam_runtime"}
 
     def find_spec(self, name: str, path: object = None, target: object = None) -> importlib.machinery.ModuleSpec | None:
         return importlib.util.spec_from_loader(name, self) if name.partition(".")[0] in self.PACKAGES else None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import nox
 
@@ -12,6 +13,25 @@ nox.options.reuse_existing_virtualenvs = True
 
 # Every process that starts rclpy keeps DDS discovery on loopback (these machines may only talk to 127/8).
 LOOPBACK = {"ROS_AUTOMATIC_DISCOVERY_RANGE": os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "LOCALHOST"}
+
+
+REPO = Path(__file__).resolve().parent
+# The import names of the source folders (pyproject's package-dir): mypy needs folders named after the packages.
+PACKAGE_DIRS = {"sam_codegen": "codegen", "sam_runtime": "runtime"}
+RUFF_PATHS = ("codegen", "runtime", "tests", "bench", "noxfile.py", "conftest.py")
+
+
+def _static_checks(session: nox.Session) -> None:
+    """ruff, mypy over both packages, and the import layers (tests/test_layers.py)."""
+    session.run("ruff", "check", *RUFF_PATHS)
+    links = Path(session.create_tmp()) / "mypy-path"
+    links.mkdir(exist_ok=True)
+    for package, folder in PACKAGE_DIRS.items():
+        link = links / package
+        if not link.is_symlink():
+            link.symlink_to(REPO / folder, target_is_directory=True)
+    session.run("mypy", "-p", "sam_codegen", "-p", "sam_runtime", env={"MYPYPATH": str(links)})
+    session.run("pytest", "-q", "-p", "no:cacheprovider", "--noconftest", "tests/test_layers.py")
 
 
 def _install(session: nox.Session, extras: str) -> None:
@@ -26,9 +46,10 @@ def _ros_install(session: nox.Session) -> None:
 
 @nox.session(python="3.11")
 def tests(session: nox.Session) -> None:
-    """Everything: generated/ is current, sam_msgs builds, then unit, golden, conformance and end-to-end tests."""
+    """Everything: ruff, mypy and the import layers, generated/ is current, sam_msgs builds, then unit, golden,
+    conformance and end-to-end tests."""
     _install(session, "runtime,rosbuild,test")
-    session.run("ruff", "check", "codegen", "runtime", "tests", "bench", "noxfile.py")
+    _static_checks(session)
     session.run("sam-codegen", "build", "--check")
     _ros_install(session)
     session.run("pytest", *(session.posargs or ["-q"]), env=LOOPBACK)
@@ -36,8 +57,9 @@ def tests(session: nox.Session) -> None:
 
 @nox.session(python="3.11")
 def lint(session: nox.Session) -> None:
-    session.install("ruff>=0.6")
-    session.run("ruff", "check", "codegen", "runtime", "tests", "bench", "noxfile.py")
+    """The static checks alone: ruff, mypy, the import layers."""
+    session.install("ruff>=0.6", "mypy>=1.11", "pytest>=8")
+    _static_checks(session)
 
 
 @nox.session(python="3.11")
