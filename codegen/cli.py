@@ -101,8 +101,7 @@ def _cmd_ros_install(args: argparse.Namespace) -> int:
     build_root = Path(args.build_dir).absolute() if args.build_dir else ensure_state_dir(ws) / "ros-build"
     names = ", ".join(p.name for p in packages)
     try:
-        build_ros_packages(packages, build_root, prefix, log=lambda name: print(f"sam-codegen: building {name}...",
-                                                                                 flush=True))
+        build_ros_packages(packages, build_root, prefix, log=lambda line: print(f"sam-codegen: {line}", flush=True))
     except RosBuildError as exc:
         print(f"sam-codegen: building {exc.package or names} failed: {exc}", file=sys.stderr)
         return 1
