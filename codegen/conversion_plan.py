@@ -23,7 +23,7 @@ from sam_codegen.validate.mapping_rules import Key, PathSeg, ResolvedMapping, St
 
 TO_ROS = "to_ros"
 TO_UAVCAN = "to_uavcan"
-Direction = Literal["to_ros", "to_uavcan"]
+PlanDirection = Literal["to_ros", "to_uavcan"]
 
 FLOAT16_MAX = 65504.0
 FLOAT32_MAX = 3.4028234663852886e38
@@ -260,11 +260,16 @@ class MaxLength:
 
 
 @dataclass(frozen=True)
-class Constant:
+class SetConstant:
     """A field set to a value from the spec (`value` links; uavcan_values; DroneCAN's `select`)."""
 
     value: Scalar
     select: bool = False
+
+
+# The old name, for targets/docs until it imports SetConstant (it is another engineer's): remove then. It collides with
+# model.spec.Constant, a declared constant of a type, which is why SetConstant is the name.
+Constant = SetConstant
 
 
 @dataclass(frozen=True)
@@ -297,7 +302,7 @@ class RequireLength:
 
 
 Op = (Convert | Scale | Offset | RejectNaN | Limits | Clamp | Round | Table | TimestampToRos | TimestampFromRos
-      | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | Constant)
+      | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | SetConstant)
 EXPRESSION_OPS = (Convert, Scale, Offset)  # pure arithmetic on the value; everything else may drop or fix it
 CHECK_OPS = (RejectNaN, Limits, Clamp, Round)
 
@@ -307,7 +312,7 @@ class LinkPlan:
     """One link in one direction: its operations in the order they apply."""
 
     step: Step
-    direction: Direction
+    direction: PlanDirection
     key: str  # the stats key: "<mapping>.<ROS field>" to ROS, "<mapping>.<UAVCAN field>" to UAVCAN
     ops: tuple[Op, ...]
     reject: bool  # the mapping's on_out_of_range is "reject"
@@ -329,7 +334,7 @@ class FieldSet:
 
     path: tuple[PathSeg, ...]
     type: DsdlType | RosType | None
-    op: Constant | StaticFrameId | ReceiveTime
+    op: SetConstant | StaticFrameId | ReceiveTime
 
 
 @dataclass(frozen=True)
@@ -343,7 +348,7 @@ class MappingPlan:
     uavcan_fields: tuple[FieldSet, ...]  # ROS -> UAVCAN: uavcan_values, then DroneCAN's select
     required: tuple[RequireItem | RequireLength, ...]  # DroneCAN: elements a received message must have
 
-    def links(self, direction: Direction) -> tuple[LinkPlan, ...]:
+    def links(self, direction: PlanDirection) -> tuple[LinkPlan, ...]:
         return self.to_ros if direction == TO_ROS else self.to_uavcan
 
 
@@ -433,7 +438,7 @@ def _convert(src: str, dst: str) -> list[Op]:
 
 def _lower_to_ros(s: Step, reject: bool) -> list[Op]:
     if s.kind == "value":
-        return [Constant(s.value)]  # type: ignore[arg-type]
+        return [SetConstant(s.value)]  # type: ignore[arg-type]
     uav = s.uavcan_type
     assert uav is not None
     if s.kind == "time":
@@ -504,7 +509,7 @@ def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
     return [*ops, *range_ops(value_is_float, value_range, elem, None, reject)]
 
 
-def lower_link(step: Step, direction: Direction, mapping: str, reject: bool) -> LinkPlan:
+def lower_link(step: Step, direction: PlanDirection, mapping: str, reject: bool) -> LinkPlan:
     """The operations of one link in one direction (`mapping`: the mapping's name, for the stats key)."""
     if direction == TO_ROS:
         return LinkPlan(step, TO_ROS, f"{mapping}.{step.ros}", tuple(_lower_to_ros(step, reject)), reject)
@@ -532,7 +537,7 @@ def lower_mapping(rm: ResolvedMapping) -> MappingPlan:
         name=m.name, direction=m.direction, reject=reject, ros_fields=tuple(ros_fields),
         to_ros=tuple(lower_link(s, TO_ROS, m.name, reject) for s in rm.steps),
         to_uavcan=tuple(lower_link(s, TO_UAVCAN, m.name, reject) for s in rm.steps if s.uavcan_path),
-        uavcan_fields=tuple([*(FieldSet(p, t, Constant(v)) for p, t, v in rm.uavcan_values),
-                             *(FieldSet(p, t, Constant(v, select=True)) for p, t, v in rm.select)]),
+        uavcan_fields=tuple([*(FieldSet(p, t, SetConstant(v)) for p, t, v in rm.uavcan_values),
+                             *(FieldSet(p, t, SetConstant(v, select=True)) for p, t, v in rm.select)]),
         required=tuple(required),
     )

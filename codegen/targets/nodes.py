@@ -10,7 +10,8 @@ Output, under generated/:
 - ``params/<vehicle>.params.yaml``: every spec parameter's default in ROS 2's ``--params-file`` format for all
   nodes (``/**``): ROS 2 has no global parameters, this file gives them one value across the nodes.
 
-Also the node and QoS parts of the bridge's tables (``tables_context``, rendered by templates/python/tables.py.j2).
+The node and QoS parts of the bridge's tables.py are built by targets/python/tables.py from this module's names
+(``nodes_package``, ``params_file``, ``static_transforms``): this module imports no other target.
 Every text from the spec reaches a docstring through ``doc``/``doc_wrap`` (inert) and code through ``py_str`` (repr).
 """
 
@@ -26,8 +27,8 @@ from typing import Any
 
 from sam_codegen.model.spec import Parameter, Qos, Spec
 from sam_codegen.render.filters import natural_key, one_line, py_str
+from sam_codegen.render.pysource import float_literal, text_literal
 from sam_codegen.render.templating import environment, render
-from sam_codegen.targets.ros import build_order
 from sam_codegen.validate.nodes import (
     TF_STATIC_TOPIC,
     TF_TOPIC,
@@ -41,7 +42,7 @@ from sam_codegen.validate.nodes import (
 )
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["emit", "nodes_package", "params_file", "quat_from_rpy", "tables_context"]
+__all__ = ["emit", "nodes_package", "params_file", "quat_from_rpy"]
 
 PY_TYPES = {"double": "float", "integer": "int", "bool": "bool", "string": "str"}
 # Names the generated modules define or import themselves; a message class of the same name gets an alias.
@@ -99,11 +100,6 @@ def quat_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, 
             cr * cp * cy + sr * sp * sy)
 
 
-def _num(value: float) -> str:
-    """A float literal; -0.0 written as 0.0 (a rotation of 0 rad gives it)."""
-    return repr(float(value) + 0.0)
-
-
 def qos_args(qos: Qos) -> str:
     """
     >>> qos_args(Qos("reliable", "transient_local", 1))
@@ -113,7 +109,9 @@ def qos_args(qos: Qos) -> str:
 
 
 def _value_literal(p: Parameter) -> str:
-    return _num(p.default) if p.type == "double" else py_str(p.default) if p.type == "string" else repr(p.default)
+    if p.type == "double":
+        return float_literal(p.default)
+    return py_str(p.default) if p.type == "string" else repr(p.default)
 
 
 def _range_text(p: Parameter) -> str:
@@ -159,13 +157,11 @@ class _Imports:
 
 
 def _parameter_spec(spec: Spec, p: Parameter) -> dict[str, Any]:
-    from sam_codegen.targets.python.convert import _text  # long text as chunked literals
-
     readers = [n.name for n in spec.nodes.values() if p.name in n.parameters]
     args = [f"name={py_str(p.name)}", f"type={py_str(p.type)}", f"default={_value_literal(p)}",
-            f"minimum={'None' if p.minimum is None else _num(p.minimum)}",
-            f"maximum={'None' if p.maximum is None else _num(p.maximum)}", f"unit={py_str(p.unit)}",
-            f"description={_text(p.description, 8 + len('description='))}",
+            f"minimum={'None' if p.minimum is None else float_literal(p.minimum)}",
+            f"maximum={'None' if p.maximum is None else float_literal(p.maximum)}", f"unit={py_str(p.unit)}",
+            f"description={text_literal(p.description, 8 + len('description='))}",
             "readers=(" + "".join(f"{py_str(r)}, " for r in readers).rstrip(" ") + ")"]
     return {"args": args, "name": p.name, "ros_name": ros_parameter_name(p.name),
             "attr": parameter_identifier(p.name), "py_type": PY_TYPES[p.type], "unit": p.unit,
@@ -207,10 +203,8 @@ def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
     partners = [spec.parameters[p] for p in rule_partners(spec, node)]
     involved = set(node.parameters)
     rules = [r for r in spec.parameter_rules if r.left in involved or r.right in involved]
-    from sam_codegen.targets.python.convert import _text
-
     rule_items = [{"args": [f"left={py_str(r.left)}", f"op={py_str(r.op)}", f"right={py_str(r.right)}",
-                            f"description={_text(r.description, 8 + len('description='))}"],
+                            f"description={text_literal(r.description, 8 + len('description='))}"],
                    "text": f"{ros_parameter_name(r.left)} {r.op} {ros_parameter_name(r.right)}",
                    "description": one_line(r.description)} for r in rules]
     return {
@@ -236,8 +230,8 @@ def static_transforms(spec: Spec) -> list[tuple[str, str, tuple[float, float, fl
 def _package_context(resolved: Resolved) -> dict[str, Any]:
     spec = resolved.spec
     package = nodes_package(spec)
-    static = [{"parent": p, "child": c, "xyz": ", ".join(_num(v) for v in xyz),
-               "rotation": ", ".join(_num(v) for v in q)} for p, c, xyz, q in static_transforms(spec)]
+    static = [{"parent": p, "child": c, "xyz": ", ".join(float_literal(v) for v in xyz),
+               "rotation": ", ".join(float_literal(v) for v in q)} for p, c, xyz, q in static_transforms(spec)]
     static_qos = spec.topics[TF_STATIC_TOPIC].qos if TF_STATIC_TOPIC in spec.topics else None
     return {
         "package": package, "vehicle": spec.vehicle, "params_file": params_file(spec),
@@ -264,42 +258,6 @@ def _yaml_scalar(p: Parameter) -> str:
     if p.type == "integer":
         return str(int(value))
     return json.dumps(str(value), ensure_ascii=False)  # a double-quoted YAML scalar
-
-
-def tables_context(resolved: Resolved) -> dict[str, Any]:
-    """What templates/python/tables.py.j2 adds for QoS, transforms and nodes (as literals)."""
-    from sam_codegen.targets.python.convert import (
-        _text,  # long text as chunked literals (emit_python renders the tables)
-    )
-
-    spec = resolved.spec
-    package = nodes_package(spec)
-
-    def qos_info(qos: Qos) -> str:
-        return f"QosInfo({py_str(qos.reliability)}, {py_str(qos.durability)}, {qos.depth}, {py_str(qos.profile)})"
-
-    def endpoints(node_items: list) -> list[str]:
-        return [f"EndpointInfo({py_str(i.topic)}, {qos_info(node_topic_qos(spec, i))})" for i in node_items]
-
-    nodes = []
-    for n in spec.nodes.values():
-        nodes.append({
-            "name": py_str(n.name), "description": _text(n.description, 8),
-            "module": py_str(f"{package}.{n.name}"), "base_class": py_str(class_name(n.name)),
-            "publishes": endpoints(n.publish_items), "subscribes": endpoints(n.subscribe_items),
-            "parameters": [py_str(p) for p in n.parameters],
-            "transforms": [f"({py_str(p)}, {py_str(c)})" for p, c in n.transforms],
-            "reads_transforms": [f"({py_str(p)}, {py_str(c)})" for p, c in n.reads_transforms],
-        })
-    return {
-        "topic_qos": {py_str(t.name): qos_info(t.qos) for t in spec.topics.values() if t.qos is not None},
-        "static_transforms": [{"parent": py_str(p), "child": py_str(c), "xyz": ", ".join(_num(v) for v in xyz),
-                               "rotation": ", ".join(_num(v) for v in q)} for p, c, xyz, q in static_transforms(spec)],
-        "transforms": [f"TransformInfo({py_str(t.parent)}, {py_str(t.child)}, {py_str(t.publisher)})"
-                       for t in spec.transforms],
-        "nodes": nodes, "nodes_package": py_str(package), "params_file": py_str(params_file(spec)),
-        "ros_packages": [py_str(name) for name in build_order(resolved)],
-    }
 
 
 def emit(resolved: Resolved) -> dict[str, str]:

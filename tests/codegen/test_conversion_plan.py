@@ -25,7 +25,10 @@ from sam_codegen.conversion_plan import (
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.targets.docs.graph import describe_link
-from sam_codegen.targets.python.convert import _MappingEmitter, _Module, _Names, _ros_aliases
+from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
+from sam_codegen.targets.python.module import ConvertModule
+from sam_codegen.targets.python.names import LocalNames, ros_aliases
+from sam_codegen.targets.python.statements import Assign, Statement
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved, validate
 
@@ -66,16 +69,17 @@ def test_docs_word_the_planned_operations(path: Path) -> None:
 def test_converters_render_the_planned_operations(path: Path) -> None:
     """A ROS -> UAVCAN number link gets a check statement exactly when its plan has a check operation."""
     resolved = _resolved(path)
-    module = _Module(resolved)
-    module.ros_aliases = _ros_aliases(resolved)
+    module = ConvertModule(resolved)
+    module.ros_aliases = ros_aliases(resolved)
     for rm in resolved.mappings:
-        emitter = _MappingEmitter(module, rm)
+        emitter = MappingEmitter(module, rm)
         for link in emitter.plan.to_uavcan:
             if link.step.kind != "number":
                 continue
-            statements: list[dict] = []
-            emitter.step_to_uavcan(link.step, _Names(set()), lambda p: "v", statements)
-            checks = [s["kind"] for s in statements if s["kind"] != "assign" or "round(" in s["expr"]]
+            statements: list[Statement] = []
+            reads = RosReads(lambda p: "v", lambda p: ("v.sec", "v.nanosec"))
+            emitter.step_to_uavcan(link.step, LocalNames(set()), reads, statements)
+            checks = [s for s in statements if not isinstance(s, Assign) or "round(" in s.expr]
             assert len(checks) == sum(isinstance(op, (RejectNaN, Limits, Clamp, Round)) for op in link.ops), link
 
 

@@ -139,16 +139,10 @@ if WORKER:
     from hypothesis import strategies as st
     from rclpy.serialization import deserialize_message, serialize_message
 
+    from sam_codegen.conversion_plan import FLOAT16_MAX, FLOAT32_MAX, TIME_US_MAX_TO_ROS
     from sam_codegen.model.spec import DsdlStruct
     from sam_codegen.model.types import ROS_INT_RANGES, DsdlType
-    from sam_codegen.targets.python.convert import (
-        FLOAT16_MAX,
-        FLOAT32_MAX,
-        TIME_US_MAX_TO_ROS,
-        py_attr,
-        py_class_name,
-        py_module,
-    )
+    from sam_codegen.targets.python.names import py_attr, py_class_name, py_module
     from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
 
     CONFIG = json.loads(WORKER)

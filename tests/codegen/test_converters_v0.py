@@ -69,10 +69,10 @@ if WORKER:
     from hypothesis import strategies as st
     from rclpy.serialization import deserialize_message, serialize_message
 
+    from sam_codegen.conversion_plan import FLOAT16_MAX, FLOAT32_MAX, TIME_US_MAX_TO_ROS
     from sam_codegen.frontend.loader import load_spec_file
     from sam_codegen.model.spec import DsdlStruct
     from sam_codegen.model.types import ROS_INT_RANGES, DsdlType
-    from sam_codegen.targets.python.convert import FLOAT16_MAX, FLOAT32_MAX, TIME_US_MAX_TO_ROS
     from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, Step
     from sam_codegen.validate.resolve import Resolved, validate
 

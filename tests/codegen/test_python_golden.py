@@ -24,6 +24,7 @@ import pytest
 
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.targets.python import convert as emit_python
+from sam_codegen.targets.python.names import py_attr, ros_closure
 from sam_codegen.validate.resolve import Resolved, validate
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -129,7 +130,7 @@ def test_imports(which: str, request: pytest.FixtureRequest) -> None:
     assert imports(files[f"{package}/tables.py"]) <= set(sys.stdlib_module_names) | {"__future__"}
     assert imports(files[f"{package}/conversion_support.py"]) <= {"__future__"}
     mapped = {f"{rm.ros_message.package}.msg" for rm in resolved.mappings}
-    nested = {f"{full.split('/')[0]}.msg" for full in emit_python._ros_closure(resolved)}
+    nested = {f"{full.split('/')[0]}.msg" for full in ros_closure(resolved)}
     dsdl = {s.namespace for s in resolved.dsdl_types} | {"uavcan.time"}
     convert = imports(files[f"{package}/convert.py"])
     own = {".conversion_support"}
@@ -218,7 +219,7 @@ def test_python_names_follow_pycyphal() -> None:
     language = nunavut.LanguageContextBuilder().set_target_language("py").create().get_target_language()
     for name in names:
         if name.isidentifier():
-            assert emit_python.py_attr(name) == language.filter_id(name), name
+            assert py_attr(name) == language.filter_id(name), name
 
 
 @pytest.mark.parametrize("which", ["sam", "rover"])

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import ROS_INT_RANGES, DsdlType, RosType
-from sam_codegen.targets.python.convert import py_attr
+from sam_codegen.targets.python.names import py_attr
 
 DsdlLookup = Callable[[str], DsdlStruct | None]
 RosLookup = Callable[[str], RosMessage | None]

@@ -34,8 +34,7 @@ if WORKER:
     )
     from sam_codegen.frontend.loader import load_spec_file
     from sam_codegen.model.spec import DsdlStruct
-    from sam_codegen.targets.python.convert import _Names, py_class_name, py_module
-    from sam_codegen.targets.python.convert import _ros_closure as ros_closure
+    from sam_codegen.targets.python.names import LocalNames, py_class_name, py_module, ros_closure
     from sam_codegen.targets.wire.cdr_layout import flatten
     from sam_codegen.targets.wire.cdr_write import Constants, cdr_reader, cdr_writer
     from sam_codegen.validate.mapping_rules import ResolvedMapping
@@ -206,9 +205,9 @@ if WORKER:
         assert message is not None
         leaves = [leaf for leaf in flatten(message, lookup) if leaf.kind != "msgseq"]
         consts = Constants()
-        read_lines, found = cdr_reader(message, [leaf.path for leaf in leaves], lookup, _Names(set()), consts, "p")
+        read_lines, found = cdr_reader(message, [leaf.path for leaf in leaves], lookup, LocalNames(set()), consts, "p")
         write_lines, expr = cdr_writer(message, {leaf.path: f"v[{i}]" for i, leaf in enumerate(leaves)}, lookup,
-                                       _Names(set()), consts)
+                                       LocalNames(set()), consts)
         source = "\n".join(["import struct as _struct", "from array import array as _array", "_ZEROS = bytes(64)",
                             *consts.lines(), "def read(p):", *("    " + line for line in read_lines),
                             f"    return [{', '.join(found[leaf.path] for leaf in leaves)}]",

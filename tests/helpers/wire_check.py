@@ -35,7 +35,7 @@ def _main(tmp: Path, trials: int, names: list[str]) -> None:
     from helpers.codec_support import corruptions, same
     from sam_codegen.frontend.loader import load_spec_file
     from sam_codegen.targets import dsdl as emit_dsdl
-    from sam_codegen.targets.python.convert import _Names, py_attr, py_class_name, py_module
+    from sam_codegen.targets.python.names import LocalNames, py_attr, py_class_name, py_module
     from sam_codegen.targets.wire.cdr_write import Constants
     from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
     from sam_codegen.validate.resolve import validate
@@ -120,9 +120,9 @@ def _main(tmp: Path, trials: int, names: list[str]) -> None:
         assert struct is not None, name
         cls, ls = cls_of(struct), leaves(struct)
         consts = Constants()
-        read_lines, found = cyphal_reader(struct, [p for p, _ in ls], lookup, _Names(set()), consts, "payload")
+        read_lines, found = cyphal_reader(struct, [p for p, _ in ls], lookup, LocalNames(set()), consts, "payload")
         write_lines, expr = cyphal_writer(struct, {p: f"v[{i}]" for i, (p, _) in enumerate(ls)}, lookup,
-                                          _Names(set()), consts)
+                                          LocalNames(set()), consts)
         source = "\n".join(["import struct as _struct", "from typing import Any", *CYPHAL_PRELUDE, *consts.lines(),
                             "def read(payload):", *("    " + line for line in read_lines),
                             f"    return [{', '.join(found[p] for p, _ in ls)}]",

@@ -1,46 +1,60 @@
 """The fast constructors of convert.py: one per ROS message class and pycyphal class the converters build, writing
-the slots their setters would write (the converters have checked ranges and lengths already)."""
+the slots their setters would write (the converters have checked ranges and lengths already).
+
+Invariant: a Factory says what its code needs (numpy, copy): convert.py's imports come from these flags, never from
+searching the generated text.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
 
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
-from sam_codegen.targets.python.names import LINE_LIMIT, py_attr, py_class_name, py_module
-from sam_codegen.targets.python.statements import typed_literal
-
-if TYPE_CHECKING:
-    from sam_codegen.targets.python.module import _Module
-
-
-def ros_factory_name(alias: str) -> str:
-    """The generated constructor of a ROS message class.
-
-    >>> ros_factory_name("Imu")
-    '_new_Imu'
-    """
-    return f"_new_{alias}"
-
+from sam_codegen.render.pysource import LINE_LIMIT, typed_literal
+from sam_codegen.targets.python.module import ConvertModule
+from sam_codegen.targets.python.names import dsdl_factory_name, py_attr, ros_factory_name
 
 # rosidl_generator_py keeps fixed-size arrays of these in numpy arrays (`char` is uint8 in ROS 2 IDL).
 _NUMPY_BASES = frozenset(base for base in [*ROS_INT_RANGES, *ROS_FLOAT_BITS] if base != "byte")
 _PY_TYPES = {"bool": "bool", "byte": "bytes", "string": "str", "wstring": "str"}
 
 
+@dataclass(frozen=True)
+class FactoryField:
+    """How a constructor sets one slot: one `line`, or if/elif/else `branches` ((condition or None, statement))."""
+
+    line: str | None = None
+    branches: tuple[tuple[str | None, str], ...] = ()
+
+
+@dataclass(frozen=True)
+class Factory:
+    """One fast constructor of convert.py, as templates/python/convert.py.j2 writes it."""
+
+    name: str
+    cls: str  # the class it stands in for
+    ros: bool
+    params: tuple[str, ...]
+    fields: tuple[FactoryField, ...]
+    prototype: str | None  # a default instance whose arrays the defaults copy
+    uses_numpy: bool = False
+    uses_copy: bool = False
+
+
 def _factory_field(slot: str, param: str, default: str, given: list[tuple[str | None, str]] | None = None
-                   ) -> dict[str, Any]:
+                   ) -> FactoryField:
     """One field of a generated constructor: `default` when the argument is None, else `given` (if/elif/else
     branches: (condition or None, statement)); by default the argument goes into the slot as it is."""
     if given is None:
         line = f"_m.{slot} = {default} if {param} is None else {param}"
         if len(line) + 4 <= LINE_LIMIT - 30:
-            return {"line": line}
+            return FactoryField(line=line)
         given = [(None, f"_m.{slot} = {param}")]
-    return {"branches": [(f"{param} is None", f"_m.{slot} = {default}"), *given]}
+    return FactoryField(branches=((f"{param} is None", f"_m.{slot} = {default}"), *given))
 
 
-def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
+def ros_factory(module: ConvertModule, full: str) -> Factory:
     """What templates/python/convert.py.j2 needs to write the fast constructor of one ROS message class.
 
     Scalars, strings and nested messages go straight into their slots, as rosidl_generator_py's setters put them
@@ -51,8 +65,8 @@ def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
     alias = module.ros_aliases[full]
     prototype = f"_DEFAULT_{alias}"
     params: list[str] = []
-    fields: list[dict[str, Any]] = []
-    uses_prototype = False
+    fields: list[FactoryField] = []
+    uses_prototype = uses_copy = False
     for f in message.fields:
         t = f.type
         assert isinstance(t, RosType)
@@ -64,7 +78,7 @@ def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
             elif t.array == "fixed" and t.base in _NUMPY_BASES:
                 default, uses_prototype = f"{prototype}._{f.name}.copy()", True
             else:
-                default, uses_prototype = f"_copy({prototype}._{f.name})", True
+                default, uses_prototype, uses_copy = f"_copy({prototype}._{f.name})", True, True
             # the setter converts a given sequence to the class's array type
             fields.append(_factory_field(f"_{f.name}", f.name, default, [(None, f"_m.{f.name} = {f.name}")]))
         elif not t.is_primitive:
@@ -76,26 +90,9 @@ def _ros_factory(module: _Module, full: str) -> dict[str, Any]:
             if t.base in ("string", "wstring") and f.default is None:
                 default = "''"
             params.append(f"{f.name}: {py_type} = {default}")
-            fields.append({"line": f"_m._{f.name} = {f.name}"})
-    return {"name": ros_factory_name(alias), "cls": alias, "ros": True, "params": params, "fields": fields,
-            "prototype": prototype if uses_prototype else None}
-
-
-def dsdl_factory_name(struct: DsdlStruct) -> str:
-    """The generated constructor of a pycyphal class.
-
-    >>> from sam_codegen.model.spec import DsdlStruct
-    >>> dsdl_factory_name(DsdlStruct("uavcan.time.SynchronizedTimestamp.1.0", []))
-    '_new_uavcan_time_SynchronizedTimestamp_1_0'
-    """
-    return "_new_" + py_module(struct.namespace).replace(".", "_") + "_" + py_class_name(struct)
-
-
-def dsdl_factory_supported(struct: DsdlStruct) -> bool:
-    """Structures of primitives, primitive arrays and nested composites get a constructor; unions and arrays of
-    composites (rare in bridged types) are built by their pycyphal class."""
-    return not struct.union and not any(
-        isinstance(f.type, DsdlType) and f.type.array and f.type.kind == "composite" for f in struct.fields)
+            fields.append(FactoryField(line=f"_m._{f.name} = {f.name}"))
+    return Factory(ros_factory_name(alias), alias, True, tuple(params), tuple(fields),
+                   prototype if uses_prototype else None, uses_copy=uses_copy)
 
 
 def _numpy_dtype(t: DsdlType) -> str:
@@ -114,14 +111,15 @@ def _numpy_dtype(t: DsdlType) -> str:
     return f"_np.{t.kind}{bits}"
 
 
-def _dsdl_factory(module: _Module, struct: DsdlStruct) -> dict[str, Any]:
+def dsdl_factory(module: ConvertModule, struct: DsdlStruct) -> Factory:
     """What templates/python/convert.py.j2 needs to write the fast constructor of one pycyphal class.
 
     Values go straight into the attributes pycyphal's properties keep them in (`_<name>`), converted as its
     setters convert them; the converters have already checked ranges and lengths, which the setters check again.
     """
     params: list[str] = []
-    fields: list[dict[str, Any]] = []
+    fields: list[FactoryField] = []
+    uses_numpy = False
     for f in struct.fields:
         t = f.type
         assert isinstance(t, DsdlType)
@@ -133,7 +131,7 @@ def _dsdl_factory(module: _Module, struct: DsdlStruct) -> dict[str, Any]:
             params.append(f"{name}: Any = None")
             fields.append(_factory_field(f"_{name}", name, f"{module.dsdl_new(nested)}()"))
         elif t.array or t.kind == "utf8":
-            dtype = _numpy_dtype(t)
+            dtype, uses_numpy = _numpy_dtype(t), True
             default = f"_np.zeros({t.capacity}, {dtype})" if t.array == "fixed" else f"_np.array([], {dtype})"
             given: list[tuple[str | None, str]] = [(None, f"_m._{name} = _np.array({name}, {dtype})")]
             if dtype == "_np.uint8":  # pycyphal takes bytes for these too (utf8 text, byte strings)
@@ -142,10 +140,9 @@ def _dsdl_factory(module: _Module, struct: DsdlStruct) -> dict[str, Any]:
             fields.append(_factory_field(f"_{name}", name, default, given))
         elif t.kind == "float":
             params.append(f"{name}: float = 0.0")
-            fields.append({"line": f"_m._{name} = float({name})"})
+            fields.append(FactoryField(line=f"_m._{name} = float({name})"))
         else:
             params.append(f"{name}: {'bool' if t.kind == 'bool' else 'int'} = {'False' if t.kind == 'bool' else '0'}")
-            fields.append({"line": f"_m._{name} = {name}"})
-    return {"name": dsdl_factory_name(struct), "cls": module.dsdl_ref(struct), "ros": False, "params": params,
-            "fields": fields,
-            "prototype": None}
+            fields.append(FactoryField(line=f"_m._{name} = {name}"))
+    return Factory(dsdl_factory_name(struct), module.dsdl_ref(struct), False, tuple(params), tuple(fields), None,
+                   uses_numpy=uses_numpy)

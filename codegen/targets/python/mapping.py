@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from dataclasses import dataclass
 
 from sam_codegen.conversion_plan import (
     CHECK_OPS,
     TO_ROS,
     TO_UAVCAN,
     Clamp,
-    Constant,
     DecodeUtf8,
     EncodeUtf8,
     FixedLength,
@@ -20,6 +19,7 @@ from sam_codegen.conversion_plan import (
     Pad,
     ReceiveTime,
     Scale,
+    SetConstant,
     StaticFrameId,
     Table,
     TimestampFromRos,
@@ -29,19 +29,36 @@ from sam_codegen.conversion_plan import (
     lower_mapping,
 )
 from sam_codegen.model.types import DsdlType, RosType
+from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.targets.python import statements as pys
-from sam_codegen.targets.python.module import _Function, _Module
-from sam_codegen.targets.python.names import _access, _identifier, _Names, dict_literal, py_attr
-from sam_codegen.targets.python.statements import dsdl_literal, py_literal
-from sam_codegen.targets.python.statements import typed_literal as _typed_literal
+from sam_codegen.targets.python.module import ConvertModule, FunctionDraft
+from sam_codegen.targets.python.names import LocalNames, access, dict_literal, identifier, py_attr
+from sam_codegen.targets.python.statements import (
+    Assign,
+    CutToMaxLength,
+    CutUtf8,
+    FixLength,
+    PadArray,
+    Policy,
+    Statement,
+    TableLookup,
+    dsdl_literal,
+)
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step, format_path
 
-_st = pys.st  # one statement for templates/python/statements.j2
-_Policy = pys.Policy
+
+@dataclass(frozen=True)
+class RosReads:
+    """How a to_uavcan function reads its ROS side: `value(path)` is the expression of a field, `time(path)` the
+    (sec, nanosec) expressions of a builtin_interfaces/Time field. Values, not text to patch: the object and the
+    wire converters differ here and nowhere in the statements built from these expressions."""
+
+    value: Callable[[tuple], str]
+    time: Callable[[tuple], tuple[str, str]]
 
 
-class _MappingEmitter:
-    def __init__(self, module: _Module, rm: ResolvedMapping) -> None:
+class MappingEmitter:
+    def __init__(self, module: ConvertModule, rm: ResolvedMapping) -> None:
         self.module, self.rm = module, rm
         self.mapping = rm.mapping
         self.name = rm.mapping.name
@@ -51,8 +68,8 @@ class _MappingEmitter:
         self.plan = lower_mapping(rm)  # what both converters do; the methods below only say it in Python
         self._links = {(id(link.step), link.direction): link for link in (*self.plan.to_ros, *self.plan.to_uavcan)}
 
-    def policy(self, path: str) -> _Policy:
-        return _Policy(repr(f"{self.name}.{path}"), self.reject)
+    def policy(self, path: str) -> Policy:
+        return Policy(repr(f"{self.name}.{path}"), self.reject)
 
     def link(self, s: Step, direction: str) -> LinkPlan:
         """The plan of one link (lowered here for a step that is not the mapping's own)."""
@@ -62,11 +79,11 @@ class _MappingEmitter:
         return lower_link(s, direction, self.name, self.reject)  # type: ignore[arg-type]
 
     # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
-    def to_ros(self) -> _Function:
+    def to_ros(self) -> FunctionDraft:
         """Values first (every check and drop before anything is built), then one nested constructor call."""
         rm = self.rm
-        names = _Names(self.module.module_names)
-        fn = _Function(
+        names = LocalNames(self.module.module_names)
+        fn = FunctionDraft(
             f"{self.name}_to_ros",
             [f"src: {self.dsdl_ref}", "receive_ns: int", "stats: ConversionStats"],
             f"{self.ros_class} | None",
@@ -95,7 +112,7 @@ class _MappingEmitter:
         fn.result = self.module.format_return(root)
         return fn
 
-    def bind_uavcan_arrays(self, fn: _Function, names: _Names, steps: list[Step],
+    def bind_uavcan_arrays(self, fn: FunctionDraft, names: LocalNames, steps: list[Step],
                            listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
         """Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one list each (beside those
         in `listed` already)."""
@@ -105,19 +122,19 @@ class _MappingEmitter:
                 array_path = (*s.uavcan_path[:-1], (s.uavcan_path[-1][0], None))
                 if array_path not in listed:
                     listed[array_path] = names.new(format_path(list(array_path)))
-                    fn.binds.append(_st("assign", target=listed[array_path],
-                                        expr=self.uav_list(self.uav_access("src", array_path))))
+                    fn.binds.append(Assign(listed[array_path],
+                                        self.uav_list(self.uav_access("src", array_path))))
         return listed
 
     def uav_access(self, base: str, path: tuple) -> str:
         """The expression reading a field of a received UAVCAN object."""
-        return _access(base, path, py_attr)
+        return access(base, path, py_attr)
 
     def uav_list(self, expr: str) -> str:
         """A UAVCAN array as a list of plain Python values (pycyphal keeps them in numpy arrays)."""
         return f"{expr}.tolist()"
 
-    def step_to_ros(self, s: Step, names: _Names, uav_read, statements: list[dict[str, Any]]
+    def step_to_ros(self, s: Step, names: LocalNames, uav_read, statements: list[Statement]
                     ) -> list[tuple[tuple, str]]:
         """Append the statements of one link (its planned operations); return the (ROS path, expression) pairs
         it sets."""
@@ -125,8 +142,8 @@ class _MappingEmitter:
         ops = link.ops
         key = repr(link.key)
         first = ops[0] if ops else None
-        if isinstance(first, Constant):
-            return [(s.ros_path, _typed_literal(first.value, s.ros_type.base))]
+        if isinstance(first, SetConstant):
+            return [(s.ros_path, typed_literal(first.value, s.ros_type.base))]
         assert s.uavcan_type is not None
         read = uav_read(s.uavcan_path)
         if isinstance(first, TimestampToRos):
@@ -137,7 +154,7 @@ class _MappingEmitter:
             var = names.new(s.ros)
             table = self.module_table(s, TO_ROS)
             default = None if first.default is None else py_literal(first.default)
-            statements.append(_st("table", var=var, table=table, read=read, key=key, default=default))
+            statements.append(TableLookup(var, table, read, key, default))
             return [(s.ros_path, var)]
         if isinstance(first, DecodeUtf8):
             return [(s.ros_path, f"{read}.tobytes().decode(errors='replace')")]
@@ -147,7 +164,7 @@ class _MappingEmitter:
             if not link.has(*CHECK_OPS):
                 return [(s.ros_path, expr)]
             var = names.new(s.ros)
-            statements.append(_st("assign", target=var, expr=expr))
+            statements.append(Assign(var, expr))
             statements.extend(pys.check_statements(var, ops, key))
             return [(s.ros_path, var)]
         # array: the elements, their float32 range, then the padding
@@ -159,16 +176,16 @@ class _MappingEmitter:
         if pad is None and not overflow:
             return [(s.ros_path, expr)]
         var = names.new(s.ros)
-        statements.append(_st("assign", target=var, expr=expr))
+        statements.append(Assign(var, expr))
         if overflow:
             statements.append(pys.float32_helper(var, link))
         if isinstance(pad, Pad):
-            statements.append(_st("pad", var=var, size=pad.size, zero=_typed_literal(0, ros_base)))
+            statements.append(PadArray(var, pad.size, typed_literal(0, ros_base)))
         return [(s.ros_path, var)]
 
     def module_table(self, s: Step, direction: str) -> str:
         """The module constant holding a link's table in `direction` (one per link and direction)."""
-        const = f"_{self.name}_{_identifier(s.ros)}".upper() + ("_TO_ROS" if direction == TO_ROS else "_TO_UAVCAN")
+        const = f"_{self.name}_{identifier(s.ros)}".upper() + ("_TO_ROS" if direction == TO_ROS else "_TO_UAVCAN")
         if not any(t["name"] == const for t in self.module.tables):
             pairs = [(py_literal(k), py_literal(v))
                      for k, v in Table(s.table, s.table_default, direction != TO_ROS).lookup()]
@@ -182,31 +199,30 @@ class _MappingEmitter:
         return const
 
     # -- ROS -> UAVCAN ---------------------------------------------------------------------------------------
-    def to_uavcan(self) -> _Function:
+    def to_uavcan(self) -> FunctionDraft:
         rm = self.rm
-        names = _Names(self.module.module_names)
-        fn = _Function(
+        names = LocalNames(self.module.module_names)
+        fn = FunctionDraft(
             f"{self.name}_to_uavcan",
             [f"src: {self.ros_class}", "stats: ConversionStats"],
             f"{self.dsdl_ref} | None",
             [f"Mapping {self.name!r}, ROS -> UAVCAN.", "", f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"],
         )
         steps = [s for s in rm.steps if s.uavcan_path]
-        ros_read = self.ros_reader(fn, names, steps)
+        reads = self.ros_reader(fn, names, steps)
         root = self.module.dsdl_ctor(rm.dsdl_struct)
         for s in steps:
-            value = self.step_to_uavcan(s, names, ros_read, fn.statements)
+            value = self.step_to_uavcan(s, names, reads, fn.statements)
             self.module.insert(root, s.uavcan_path, value)
         for fs in self.plan.uavcan_fields:  # uavcan_values, then DroneCAN's select
-            assert isinstance(fs.op, Constant) and isinstance(fs.type, DsdlType)
+            assert isinstance(fs.op, SetConstant) and isinstance(fs.type, DsdlType)
             self.module.insert(root, fs.path, dsdl_literal(fs.op.value, fs.type))
         fn.result = self.module.format_return(root)
         return fn
 
-    def ros_reader(self, fn: _Function, names: _Names, steps: list[Step]) -> Callable[[tuple], str]:
-        """The to_uavcan read helper: binds what the steps read (appended to fn.binds) and returns the function
-        from a ROS path to the expression reading it (a Time path: an expression with .sec and .nanosec).
-        Overridden by the wire codecs (emit_codec), which read from CDR bytes."""
+    def ros_reader(self, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
+        """The to_uavcan reads: binds what the steps read (appended to fn.binds) and returns how to read a path.
+        Overridden by the wire codecs, which read from CDR bytes."""
         # Locals for ROS parents read more than once, and one .tolist() per ROS array read by index.
         reads: dict[tuple, int] = {}
         for s in steps:
@@ -218,15 +234,15 @@ class _MappingEmitter:
         for parent, count in reads.items():
             if count >= 2 and all(index is None for _, index in parent):
                 parent_local[parent] = names.new(parent[-1][0])
-                fn.binds.append(_st("assign", target=parent_local[parent], expr=_access("src", parent)))
+                fn.binds.append(Assign(parent_local[parent], access("src", parent)))
         listed: dict[tuple, str] = {}
         for s in steps:
             if s.kind in ("number", "table") and s.ros_path[-1][1] is not None:
                 array_path = (*s.ros_path[:-1], (s.ros_path[-1][0], None))
                 if array_path not in listed:
                     listed[array_path] = names.new(format_path(list(array_path)))
-                    fn.binds.append(_st("assign", target=listed[array_path],
-                                        expr=self.ros_array_read(_access("src", array_path), s.ros_type)))
+                    fn.binds.append(Assign(listed[array_path],
+                                        self.ros_array_read(access("src", array_path), s.ros_type)))
 
         def ros_read(path: tuple) -> str:
             if path in parent_local:
@@ -237,10 +253,14 @@ class _MappingEmitter:
                     return f"{listed[array_path]}[{path[-1][1]}]"
             parent = path[:-1]
             if parent in parent_local:
-                return _access(parent_local[parent], path[-1:])
-            return _access("src", path)
+                return access(parent_local[parent], path[-1:])
+            return access("src", path)
 
-        return ros_read
+        def time_read(path: tuple) -> tuple[str, str]:
+            stamp = ros_read(path)
+            return f"{stamp}.sec", f"{stamp}.nanosec"
+
+        return RosReads(ros_read, time_read)
 
     def ros_array_read(self, expr: str, ros_type: RosType) -> str:
         """A ROS array field as a list of plain Python values."""
@@ -251,7 +271,7 @@ class _MappingEmitter:
             return f"list({expr})"
         return f"{expr}.tolist()"
 
-    def step_to_uavcan(self, s: Step, names: _Names, ros_read, statements: list[dict[str, Any]]) -> str:
+    def step_to_uavcan(self, s: Step, names: LocalNames, reads: RosReads, statements: list[Statement]) -> str:
         """Append the statements of one link (its planned operations); return the expression of the UAVCAN
         value."""
         assert s.uavcan_type is not None
@@ -261,22 +281,22 @@ class _MappingEmitter:
         uav = s.uavcan_type
         first = ops[0] if ops else None
         if isinstance(first, TimestampFromRos):
-            stamp = ros_read(s.ros_path)
+            sec, nanosec = reads.time(s.ros_path)
             var = names.new("us")
-            statements.extend(pys.timestamp_from_ros(first, var, self.ros_time_us(stamp), key))
+            statements.extend(pys.timestamp_from_ros(first, var, f"{sec} * 1_000_000 + {nanosec} // 1000", key))
             return var
-        read = ros_read(s.ros_path)
+        read = reads.value(s.ros_path)
         if isinstance(first, Table):
             var = names.new(s.uavcan)
             table = self.module_table(s, TO_UAVCAN)
-            statements.append(_st("table", var=var, table=table, read=read, key=key, default=None))
+            statements.append(TableLookup(var, table, read, key, None))
             return var
         if isinstance(first, EncodeUtf8):
             var = names.new(s.uavcan)
             cut = ops[1]
             assert isinstance(cut, Utf8Length)
-            statements.append(_st("assign", target=var, expr=f"{read}.encode(errors='replace')"))
-            statements.append(_st("utf8_length", var=var, cap=cut.capacity, key=key, reject=cut.reject))
+            statements.append(Assign(var, f"{read}.encode(errors='replace')"))
+            statements.append(CutUtf8(var, cut.capacity, key, cut.reject))
             return var
         if s.kind == "number":
             return self.scalar_to_uavcan(link, names, read, statements)
@@ -286,24 +306,18 @@ class _MappingEmitter:
         elem = pys.to_uavcan_expr("x", ops)
         base_list = self.ros_array_read(read, s.ros_type)
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
-        statements.append(_st("assign", target=var, expr=expr))
+        statements.append(Assign(var, expr))
         for op in ops:
             if isinstance(op, FixedLength):
-                statements.append(_st("fixed_length", var=var, cap=op.size, zero=dsdl_literal(0, elem_uav), key=key,
-                                      reject=op.reject))
+                statements.append(FixLength(var, op.size, dsdl_literal(0, elem_uav), key, op.reject))
             elif isinstance(op, MaxLength):  # a longer fixed ROS array: only non-zero elements count
-                statements.append(_st("max_length", var=var, cap=op.capacity, key=key, reject=op.reject,
-                                      padded=op.padded))
+                statements.append(CutToMaxLength(var, op.capacity, key, op.reject, op.padded))
         helper = pys.array_check_helper(var, link, elem_uav)
         if helper is not None:
             statements.append(helper)
         return var
 
-    def ros_time_us(self, stamp: str) -> str:
-        """Microseconds of a builtin_interfaces/Time read as `stamp` (the expression ros_read gave)."""
-        return f"{stamp}.sec * 1_000_000 + {stamp}.nanosec // 1000"
-
-    def scalar_to_uavcan(self, link: LinkPlan, names: _Names, read: str, statements: list[dict[str, Any]]) -> str:
+    def scalar_to_uavcan(self, link: LinkPlan, names: LocalNames, read: str, statements: list[Statement]) -> str:
         """A number link's operations in order: its arithmetic builds an expression, the first check binds it to a
         local (limits come before the inverse scale/offset: they are in ROS units)."""
         s = link.step
@@ -316,11 +330,11 @@ class _MappingEmitter:
             elif isinstance(op, CHECK_OPS):
                 if var is None or pending:
                     target = var if var is not None else names.new(s.uavcan)
-                    statements.append(_st("assign", target=target, expr=pys.to_uavcan_expr(var or expr, pending)))
+                    statements.append(Assign(target, pys.to_uavcan_expr(var or expr, pending)))
                     var, pending = target, []
                 statements.extend(pys.check_statements(var, [op], repr(link.key)))
         if var is None:
             return pys.to_uavcan_expr(expr, pending)
         if pending:
-            statements.append(_st("assign", target=var, expr=pys.to_uavcan_expr(var, pending)))
+            statements.append(Assign(var, pys.to_uavcan_expr(var, pending)))
         return var

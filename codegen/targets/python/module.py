@@ -1,4 +1,9 @@
-"""The convert.py being built: its functions, the constructor trees they return, and what the mappings add to it."""
+"""The converter module being built: its functions (FunctionDraft), the constructor trees they return (CtorNode,
+ArrayNode), and what the mappings add to it (ConvertModule: tables, imports, constructors used).
+
+Invariant: the trees hold code (expressions) at their leaves and types at their nodes; how a tree becomes code (a
+nested constructor call here, bytes in the wire codecs) is the module's `format_return`, nothing else.
+"""
 
 from __future__ import annotations
 
@@ -7,24 +12,35 @@ from typing import Any
 
 from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import DsdlType, RosType
-from sam_codegen.targets.python.factories import dsdl_factory_name, dsdl_factory_supported, ros_factory_name
-from sam_codegen.targets.python.names import LINE_LIMIT, py_attr, py_class_ref, py_module
-from sam_codegen.targets.python.statements import typed_literal as _typed_literal
+from sam_codegen.render.pysource import LINE_LIMIT, typed_literal
+from sam_codegen.targets.python.names import (
+    dsdl_factory_name,
+    dsdl_factory_supported,
+    py_attr,
+    py_class_ref,
+    py_module,
+    ros_factory_name,
+)
+from sam_codegen.targets.python.statements import Statement
 from sam_codegen.validate.resolve import Resolved
 
 
 @dataclass
-class _Function:
+class FunctionDraft:
+    """One generated function: signature, then `decode` lines (the wire codecs' reads), `binds`, `statements` and
+    the `result` lines (its return), as the templates' `function` macro lays them out."""
+
     name: str
     params: list[str]
     returns: str
     doc: list[str]  # docstring lines
-    binds: list[dict[str, Any]] = field(default_factory=list)
-    statements: list[dict[str, Any]] = field(default_factory=list)
-    result: list[str] = field(default_factory=list)  # lines of the final return (to_uavcan) or empty
+    binds: list[Statement] = field(default_factory=list)
+    statements: list[Statement] = field(default_factory=list)
+    result: list[str] = field(default_factory=list)
+    decode: list[str] = field(default_factory=list)
 
 
-class _Ctor:
+class CtorNode:
     """A message under construction, a DSDL object or a ROS message: field name -> expression or nested node."""
 
     def __init__(self, ref: str, fields: list[tuple[str, Any]], keyword=lambda name: name) -> None:
@@ -37,7 +53,7 @@ class _Ctor:
         return [(self.keyword(name), self.kwargs[name]) for name in self.types if name in self.kwargs]
 
 
-class _Arr:
+class ArrayNode:
     """A fixed-size array written element by element; the other elements get `default`."""
 
     def __init__(self, capacity: int, default: str) -> None:
@@ -46,7 +62,7 @@ class _Arr:
 
 
 @dataclass
-class _Module:
+class ConvertModule:
     """What convert.py needs beyond the functions."""
 
     resolved: Resolved
@@ -78,13 +94,14 @@ class _Module:
         self.dsdl_factories.setdefault(struct.name, struct)
         return dsdl_factory_name(struct)
 
-    def dsdl_ctor(self, struct: DsdlStruct) -> _Ctor:
-        return _Ctor(self.dsdl_new(struct), [(f.name, f.type) for f in struct.fields], py_attr)
+    def dsdl_ctor(self, struct: DsdlStruct) -> CtorNode:
+        return CtorNode(self.dsdl_new(struct), [(f.name, f.type) for f in struct.fields], py_attr)
 
-    def ros_ctor(self, message: RosMessage) -> _Ctor:
-        return _Ctor(ros_factory_name(self.ros_aliases[message.full_name]), [(f.name, f.type) for f in message.fields])
+    def ros_ctor(self, message: RosMessage) -> CtorNode:
+        fields = [(f.name, f.type) for f in message.fields]
+        return CtorNode(ros_factory_name(self.ros_aliases[message.full_name]), fields)
 
-    def child(self, t: DsdlType | RosType) -> _Ctor:
+    def child(self, t: DsdlType | RosType) -> CtorNode:
         """A node for a composite field (or element) of type t."""
         if isinstance(t, DsdlType):
             return self.dsdl_ctor(self.struct(t.composite))  # type: ignore[arg-type]
@@ -94,12 +111,12 @@ class _Module:
         if isinstance(t, DsdlType):
             if t.kind == "composite":
                 return f"{self.dsdl_new(self.struct(t.composite))}()"  # type: ignore[arg-type]
-            return _typed_literal(0, "float" if t.kind == "float" else t.kind)
+            return typed_literal(0, "float" if t.kind == "float" else t.kind)
         if not t.is_primitive:
             return f"{ros_factory_name(self.ros_aliases[t.base])}()"
-        return _typed_literal(0, t.base)
+        return typed_literal(0, t.base)
 
-    def insert(self, root: _Ctor, path: tuple, value: str) -> None:
+    def insert(self, root: CtorNode, path: tuple, value: str) -> None:
         """Set the field at `path` (segments (name, index or None)) of the tree under root to `value`."""
         node: Any = root
         prefix: tuple = ()
@@ -119,7 +136,7 @@ class _Module:
                 node.kwargs[name] = self.child(t)
             return node.kwargs[name]
         if name not in node.kwargs:
-            node.kwargs[name] = _Arr(self.array_size(t, (*prefix, (name, None))), self.element_default(t.element))
+            node.kwargs[name] = ArrayNode(self.array_size(t, (*prefix, (name, None))), self.element_default(t.element))
         arr = node.kwargs[name]
         if value is not None:
             arr.items[index] = value
@@ -136,7 +153,7 @@ class _Module:
         """Lines of an expression; the first line is not indented, the rest are (absolute indent)."""
         if isinstance(node, str):
             return [node]
-        if isinstance(node, _Arr):
+        if isinstance(node, ArrayNode):
             items = [node.items.get(i, node.default) for i in range(node.capacity)]
             parts = [self.format_node(item, indent + 4) for item in items]
             one = "[" + ", ".join(p[0] for p in parts) + "]"
@@ -161,7 +178,7 @@ class _Module:
         lines.append(" " * indent + ")")
         return lines
 
-    def format_return(self, root: _Ctor) -> list[str]:
+    def format_return(self, root: CtorNode) -> list[str]:
         lines = self.format_node(root, 4)
         lines[0] = "return " + lines[0]
         return [line[4:] if i else line for i, line in enumerate(lines)]

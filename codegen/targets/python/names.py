@@ -1,16 +1,23 @@
-"""Names in the generated Python: pycyphal's attribute, module and class names, locals that never shadow a module
-name or builtin, the ROS classes and DSDL roots convert.py names, and dict literals that fit the line."""
+"""Names in the generated Python: pycyphal's attribute, module and class names, the fast constructors' names, locals
+that never shadow a module name or builtin, the ROS classes and DSDL roots convert.py names, and dict literals that
+fit the line.
+
+Invariant: every name here is a pure function of the spec (no counters shared across modules), so the output does
+not depend on the order the emitters run in.
+"""
 
 from __future__ import annotations
 
 import builtins
 import keyword
 import re
+from collections.abc import Callable
 from typing import Any
 
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.filters import natural_key
+from sam_codegen.render.pysource import LINE_LIMIT
 from sam_codegen.validate.mapping_rules import ResolvedMapping
 from sam_codegen.validate.resolve import Resolved
 
@@ -19,8 +26,6 @@ from sam_codegen.validate.resolve import Resolved
 _NUNAVUT_RESERVED = frozenset([*keyword.kwlist, *dir(builtins)])
 # Names no generated local may take: keywords, builtins (the converters call round, len, float ...), parameters.
 _LOCAL_RESERVED = _NUNAVUT_RESERVED | frozenset(keyword.softkwlist) | {"src", "stats", "receive_ns", "msg"}
-
-LINE_LIMIT = 110
 
 
 # ---- names -------------------------------------------------------------------------------------------------
@@ -55,7 +60,32 @@ def py_class_ref(struct: DsdlStruct) -> str:
     return f"{py_module(struct.namespace)}.{py_class_name(struct)}"
 
 
-def dict_literal(prefix: str, pairs: list[tuple[str, str]], width: int = 110) -> str:
+def ros_factory_name(alias: str) -> str:
+    """The generated constructor of a ROS message class.
+
+    >>> ros_factory_name("Imu")
+    '_new_Imu'
+    """
+    return f"_new_{alias}"
+
+
+def dsdl_factory_name(struct: DsdlStruct) -> str:
+    """The generated constructor of a pycyphal class.
+
+    >>> dsdl_factory_name(DsdlStruct("uavcan.time.SynchronizedTimestamp.1.0", []))
+    '_new_uavcan_time_SynchronizedTimestamp_1_0'
+    """
+    return "_new_" + py_module(struct.namespace).replace(".", "_") + "_" + py_class_name(struct)
+
+
+def dsdl_factory_supported(struct: DsdlStruct) -> bool:
+    """Structures of primitives, primitive arrays and nested composites get a constructor; unions and arrays of
+    composites (rare in bridged types) are built by their pycyphal class."""
+    return not struct.union and not any(
+        isinstance(f.type, DsdlType) and f.type.array and f.type.kind == "composite" for f in struct.fields)
+
+
+def dict_literal(prefix: str, pairs: list[tuple[str, str]], width: int = LINE_LIMIT) -> str:
     """``prefix{k: v, ...}`` on one line when it fits in `width`, else wrapped with four spaces of indent.
 
     >>> dict_literal("T = ", [("0", "1"), ("2", "3")])
@@ -81,21 +111,21 @@ def dict_literal(prefix: str, pairs: list[tuple[str, str]], width: int = 110) ->
     return "\n".join([*lines, "}"])
 
 
-def _identifier(text: str) -> str:
+def identifier(text: str) -> str:
     """A lower-case identifier from a path: `rate_gyro_latest[0]` -> `rate_gyro_latest_0`."""
     ident = re.sub(r"[^0-9A-Za-z_]+", "_", text).strip("_").lower()
     return ident if ident and not ident[0].isdigit() else f"v_{ident}"
 
 
-class _Names:
+class LocalNames:
     """Local variable names of one function: readable, unique, never shadowing a module name or builtin."""
 
     def __init__(self, reserved: set[str]) -> None:
-        self.reserved = reserved  # the module's names: shared, not copied (one _Names per function)
+        self.reserved = reserved  # the module's names: shared, not copied (one LocalNames per function)
         self.taken = set(_LOCAL_RESERVED)
 
     def new(self, hint: str) -> str:
-        base = _identifier(hint)
+        base = identifier(hint)
         name, n = base, 2
         while name in self.taken or name in self.reserved:
             name, n = f"{base}_{n}", n + 1
@@ -103,7 +133,12 @@ class _Names:
         return name
 
 
-def _access(base: str, path: tuple[tuple[str, int | None], ...], attr=lambda n: n) -> str:
+def access(base: str, path: tuple[tuple[str, Any], ...], attr: Callable[[str], str] = str) -> str:
+    """The expression reading the field at `path` of `base`, attribute names through `attr`.
+
+    >>> access("src", (("a", None), ("b", 2)))
+    'src.a.b[2]'
+    """
     text = base
     for name, index in path:
         text += f".{attr(name)}"
@@ -115,7 +150,7 @@ def _access(base: str, path: tuple[tuple[str, int | None], ...], attr=lambda n: 
 # ---- what convert.py imports -----------------------------------------------------------------------------
 
 
-def _ros_closure(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> list[str]:
+def ros_closure(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> list[str]:
     """Every ROS message type the converters build: the mapped ones and, transitively, their nested types."""
     seen: set[str] = set()
     todo = [rm.ros_message.full_name for rm in (resolved.mappings if mappings is None else mappings)]
@@ -130,9 +165,9 @@ def _ros_closure(resolved: Resolved, mappings: list[ResolvedMapping] | None = No
     return sorted(seen)
 
 
-def _ros_aliases(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> dict[str, str]:
+def ros_aliases(resolved: Resolved, mappings: list[ResolvedMapping] | None = None) -> dict[str, str]:
     """A local class name per ROS message type the converters use; package-qualified when names clash."""
-    used = _ros_closure(resolved, mappings)
+    used = ros_closure(resolved, mappings)
     by_name: dict[str, list[str]] = {}
     for full in used:
         by_name.setdefault(full.split("/")[1], []).append(full)
@@ -144,7 +179,7 @@ def _ros_aliases(resolved: Resolved, mappings: list[ResolvedMapping] | None = No
     return aliases
 
 
-def _referenced_roots(resolved: Resolved) -> set[str]:
+def referenced_roots(resolved: Resolved) -> set[str]:
     """Root namespaces of every composite the mapped DSDL types contain (module names locals must not shadow)."""
     roots: set[str] = set()
     seen: set[str] = set()
@@ -163,7 +198,7 @@ def _referenced_roots(resolved: Resolved) -> set[str]:
     return roots
 
 
-def _isort_key(name: str) -> tuple[int, list[Any]]:
+def isort_key(name: str) -> tuple[int, list[Any]]:
     """isort's (and ruff's) order of imported names: CONSTANTS, then Classes, then variables, case-insensitive."""
     kind = 0 if len(name) > 1 and name.isupper() else 1 if name[0].isupper() else 2
     return kind, natural_key(name)

@@ -1,15 +1,18 @@
-"""Conversion-plan operations as Python: literals, expressions and the statement dicts templates/python/statements.j2
-renders (for convert.py, convert_v0.py and the wire codecs alike).
+"""Conversion-plan operations as Python: the typed statements templates/python/statements.j2 renders (for convert.py,
+convert_v0.py and the wire codecs alike), and the expressions and literals inside them.
 
 The plan (conversion_plan) has decided what happens to each value; this module only says it in Python: which
 condition, which literal, which helper of conversion_support.py.j2.
+
+Invariants: a statement is a frozen value (the emitters build lists of them and never change one); its fields are
+pieces of Python code (expressions, names, literals), never spec text that is not a literal yet; each class has a
+`kind`, the name of its branch in statements.j2's `statement` macro, and renders at function-body indentation.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from typing import Any
+from typing import ClassVar
 
 from sam_codegen.conversion_plan import (
     FLOAT32_MAX,
@@ -29,38 +32,13 @@ from sam_codegen.conversion_plan import (
     is_int_dsdl,
 )
 from sam_codegen.model.spec import Scalar
-from sam_codegen.model.types import ROS_FLOAT_BITS, DsdlType
+from sam_codegen.model.types import DsdlType
+from sam_codegen.render.pysource import py_literal, typed_literal
 
-
-def py_literal(value: Scalar) -> str:
-    """A Python literal; non-finite floats refer to the module constants _NAN and _INF of convert.py.
-
-    >>> py_literal(1.0), py_literal(float("nan")), py_literal(-float("inf")), py_literal("a'b"), py_literal(2)
-    ('1.0', '_NAN', '-_INF', '"a\\'b"', '2')
-    """
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "_NAN"
-        if math.isinf(value):
-            return "_INF" if value > 0 else "-_INF"
-    return repr(value)
-
-
-def typed_literal(value: Scalar, base: str) -> str:
-    """A literal of the Python type rclpy / pycyphal keep for a field of primitive type `base`.
-
-    >>> typed_literal(0, "float32"), typed_literal(1, "bool"), typed_literal(7, "byte"), typed_literal(3.0, "int8")
-    ('0.0', 'True', "b'\\\\x07'", '3')
-    """
-    if base in ROS_FLOAT_BITS or base.startswith("float"):
-        return py_literal(float(value))
-    if base == "bool":
-        return py_literal(bool(value))
-    if base == "byte":
-        return repr(bytes((int(value),)))
-    if base in ("string", "wstring"):
-        return py_literal(str(value))
-    return py_literal(int(value))
+__all__ = ["Assign", "Bound", "CutToMaxLength", "CutUtf8", "FindItem", "FixLength", "HelperCall", "NanReject",
+           "PadArray", "Policy", "RequireMinLength", "Statement", "TableLookup", "TimeToRos", "array_check_helper",
+           "bound_statement", "check_statements", "dsdl_literal", "float32_helper", "timestamp_from_ros",
+           "timestamp_to_ros", "to_ros_expr", "to_uavcan_expr"]
 
 
 def dsdl_literal(value: Scalar, t: DsdlType) -> str:
@@ -74,37 +52,167 @@ _num = py_literal  # a numeric literal in generated code (ints stay ints)
 # ---- statements ------------------------------------------------------------------------------------------------
 
 
-def st(kind: str, **kw: Any) -> dict[str, Any]:
-    """One statement for statements.j2's `statement` macro."""
-    return {"kind": kind, **kw}
+@dataclass(frozen=True)
+class Statement:
+    """One statement of a generated function body."""
+
+    kind: ClassVar[str]
 
 
-@dataclass
+@dataclass(frozen=True)
+class Assign(Statement):
+    kind: ClassVar[str] = "assign"
+    target: str
+    expr: str
+
+
+@dataclass(frozen=True)
+class NanReject(Statement):
+    """Drop the message when `var` is NaN (it cannot become an integer)."""
+
+    kind: ClassVar[str] = "nan_reject"
+    var: str
+    key: str
+
+
+@dataclass(frozen=True)
+class Bound(Statement):
+    """if/elif chain: each (condition, saturated value) saturates or rejects; `otherwise` runs when none hit."""
+
+    kind: ClassVar[str] = "bound"
+    var: str
+    checks: tuple[tuple[str, str], ...]
+    key: str
+    reject: bool
+    otherwise: str | None = None
+
+
+@dataclass(frozen=True)
+class TableLookup(Statement):
+    """`var` = the table's value for `read`: `default` when missing, else the message is dropped."""
+
+    kind: ClassVar[str] = "table"
+    var: str
+    table: str
+    read: str
+    key: str
+    default: str | None
+
+
+@dataclass(frozen=True)
+class TimeToRos(Statement):
+    """A UAVCAN microsecond timestamp `read` -> builtin_interfaces/Time locals `sec` and `nanosec` (0: the receive
+    time); `checks` are (condition, saturated sec, saturated nanosec)."""
+
+    kind: ClassVar[str] = "time_to_ros"
+    us: str
+    read: str
+    sec: str
+    nanosec: str
+    checks: tuple[tuple[str, str, str], ...]
+    key: str
+    reject: bool
+
+
+@dataclass(frozen=True)
+class PadArray(Statement):
+    kind: ClassVar[str] = "pad"
+    var: str
+    size: int
+    zero: str
+
+
+@dataclass(frozen=True)
+class HelperCall(Statement):
+    """`var` = a conversion_support helper's result; None drops the message."""
+
+    kind: ClassVar[str] = "helper"
+    var: str
+    helper: str
+    args: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class FixLength(Statement):
+    """A list for a fixed-size array: padded with `zero` or cut to `cap` (counted)."""
+
+    kind: ClassVar[str] = "fixed_length"
+    var: str
+    cap: int
+    zero: str
+    key: str
+    reject: bool
+
+
+@dataclass(frozen=True)
+class CutToMaxLength(Statement):
+    """A list for a bounded array cut to `cap` (counted); `padded`: only zero elements may go."""
+
+    kind: ClassVar[str] = "max_length"
+    var: str
+    cap: int
+    key: str
+    reject: bool
+    padded: bool
+
+
+@dataclass(frozen=True)
+class CutUtf8(Statement):
+    """UTF-8 bytes cut to `cap` at a character boundary (counted)."""
+
+    kind: ClassVar[str] = "utf8_length"
+    var: str
+    cap: int
+    key: str
+    reject: bool
+
+
+@dataclass(frozen=True)
+class RequireMinLength(Statement):
+    """Drop the message when the list `var` has fewer than `size` elements."""
+
+    kind: ClassVar[str] = "min_length"
+    var: str
+    size: int
+    key: str
+
+
+@dataclass(frozen=True)
+class FindItem(Statement):
+    """`var` = the first item of `array` whose `field` (attribute name or record position) is `value`, or drop."""
+
+    kind: ClassVar[str] = "required_item"
+    var: str
+    array: str
+    field: str
+    value: str
+    key: str
+
+
+@dataclass(frozen=True)
 class Policy:
     key: str  # the stats key literal
     reject: bool  # on_out_of_range == "reject"
 
 
-def bound_statement(var: str, checks: list[tuple[str, str]], policy: Policy, otherwise: str | None = None
-                    ) -> dict[str, Any]:
-    """if/elif chain: each (condition, saturated value) saturates or rejects; `otherwise` runs when none hit."""
-    return st("bound", var=var, checks=checks, key=policy.key, reject=policy.reject, otherwise=otherwise)
+def bound_statement(var: str, checks: list[tuple[str, str]], policy: Policy, otherwise: str | None = None) -> Bound:
+    return Bound(var, tuple(checks), policy.key, policy.reject, otherwise)
 
 
-def check_statements(var: str, ops: list[Op] | tuple[Op, ...], key: str) -> list[dict[str, Any]]:
+def check_statements(var: str, ops: list[Op] | tuple[Op, ...], key: str) -> list[Statement]:
     """The statements of the check operations (RejectNaN, Limits, Clamp, Round) among `ops`, on local `var`.
 
-    >>> [s["kind"] for s in check_statements("v", [RejectNaN(), Clamp("round", 0, 255, False)], "'k'")]
-    ['nan_reject', 'bound']
-    >>> check_statements("v", [Clamp("float32", -1.0, 1.0, True)], "'k'")[0]["checks"]
-    [('1.0 < v < _INF', '1.0'), ('-_INF < v < -1.0', '-1.0')]
+    >>> [type(s).__name__ for s in check_statements("v", [RejectNaN(), Clamp("round", 0, 255, False)], "'k'")]
+    ['NanReject', 'Bound']
+    >>> check_statements("v", [Clamp("float32", -1.0, 1.0, True)], "'k'")[0].checks
+    (('1.0 < v < _INF', '1.0'), ('-_INF < v < -1.0', '-1.0'))
     """
-    out: list[dict[str, Any]] = []
+    out: list[Statement] = []
     for op in ops:
         if isinstance(op, RejectNaN):
-            out.append(st("nan_reject", var=var, key=key))
+            out.append(NanReject(var, key))
         elif isinstance(op, Round):
-            out.append(st("assign", target=var, expr=f"round({var})"))
+            out.append(Assign(var, f"round({var})"))
         elif isinstance(op, Limits):
             low, high = _num(op.low), _num(op.high)
             out.append(bound_statement(var, [(f"{var} < {low}", low), (f"{var} > {high}", high)],
@@ -114,7 +222,7 @@ def check_statements(var: str, ops: list[Op] | tuple[Op, ...], key: str) -> list
     return out
 
 
-def _clamp_statement(var: str, op: Clamp, policy: Policy) -> dict[str, Any]:
+def _clamp_statement(var: str, op: Clamp, policy: Policy) -> Bound:
     lo, hi = op.low, op.high
     if op.mode == "round":
         assert lo is not None and hi is not None
@@ -129,7 +237,7 @@ def _clamp_statement(var: str, op: Clamp, policy: Policy) -> dict[str, Any]:
                            policy)
 
 
-def array_check_helper(var: str, link: LinkPlan, elem: DsdlType) -> dict[str, Any] | None:
+def array_check_helper(var: str, link: LinkPlan, elem: DsdlType) -> HelperCall | None:
     """The conversion_support.py.j2 call that does a ROS -> UAVCAN array link's element checks, if it has any."""
     checks = [op for op in link.ops if isinstance(op, (RejectNaN, Round, Limits, Clamp))]
     if not checks:
@@ -142,28 +250,28 @@ def array_check_helper(var: str, link: LinkPlan, elem: DsdlType) -> dict[str, An
     else:  # float16 saturates infinities too, float32 keeps them (as for scalars)
         helper = "_support.clamp_floats" if elem.bits == 16 else "_support.clamp_finite_floats"
         args = [var, _num(dsdl_range(elem)[1]), "stats", key, reject]  # type: ignore[index]
-    return st("helper", var=var, helper=helper, args=args)
+    return HelperCall(var, helper, tuple(args))
 
 
-def float32_helper(var: str, link: LinkPlan) -> dict[str, Any]:
+def float32_helper(var: str, link: LinkPlan) -> HelperCall:
     """A UAVCAN -> ROS float32 array whose scaled values may pass FLOAT32_MAX."""
-    return st("helper", var=var, helper="_support.clamp_finite_floats",
-              args=[var, _num(FLOAT32_MAX), "stats", repr(link.key), str(link.reject)])
+    return HelperCall(var, "_support.clamp_finite_floats",
+                      (var, _num(FLOAT32_MAX), "stats", repr(link.key), str(link.reject)))
 
 
-def timestamp_to_ros(op: TimestampToRos, us: str, read: str, sec: str, nanosec: str, key: str) -> dict[str, Any]:
-    checks = []
+def timestamp_to_ros(op: TimestampToRos, us: str, read: str, sec: str, nanosec: str, key: str) -> TimeToRos:
+    checks: list[tuple[str, str, str]] = []
     if op.high is not None:
         checks.append((f"{us} > {op.high}", str(INT32_MAX), "999_999_999"))
     if op.low is not None:
         checks.append((f"{us} < {op.low}", str(-(2**31)), "0"))
-    return st("time_to_ros", us=us, read=read, sec=sec, nanosec=nanosec, checks=checks, key=key, reject=op.reject)
+    return TimeToRos(us, read, sec, nanosec, tuple(checks), key, op.reject)
 
 
-def timestamp_from_ros(op: TimestampFromRos, var: str, us: str, key: str) -> list[dict[str, Any]]:
+def timestamp_from_ros(op: TimestampFromRos, var: str, us: str, key: str) -> list[Statement]:
     """`var` = the microseconds expression `us`, then the target integer's bounds."""
-    out = [st("assign", target=var, expr=us)]
-    checks = []
+    out: list[Statement] = [Assign(var, us)]
+    checks: list[tuple[str, str]] = []
     if op.high is not None:
         checks.append((f"{var} > {op.high}", str(op.high)))
     if op.low is not None:

@@ -1,48 +1,40 @@
-"""The context of tables.py (devices, topics, mappings, parameters and frames as Python literals) and the literal
-helpers the other tables emitters share."""
+"""The whole context of tables.py: the Cyphal devices, topics, mappings, parameters and frames, the DroneCAN devices,
+types, mappings and layouts, and the nodes' QoS, transforms and endpoints, as Python literals.
+
+This module owns tables.py: the other targets give it names (targets.nodes, targets.ros, targets.dsdl_v0,
+convert_v0.used_types) and import nothing of it. Every spec text reaches the output through py_str (repr: inert).
+"""
 
 from __future__ import annotations
 
-import re
 from typing import Any
 
-from sam_codegen.model.spec import Port
+from sam_codegen.model.spec import Port, Qos, V0Struct
 from sam_codegen.render.filters import py_str
-from sam_codegen.targets.python.names import LINE_LIMIT, py_class_name, py_module
-from sam_codegen.targets.python.statements import py_literal
+from sam_codegen.render.pysource import (
+    LINE_LIMIT,
+    float_literal,
+    frozenset_literal,
+    py_literal,
+    text_literal,
+    tuple_literal,
+)
+from sam_codegen.targets import dsdl_v0
+from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
+from sam_codegen.targets.python.convert_v0 import used_types
+from sam_codegen.targets.python.names import py_class_name, py_module
+from sam_codegen.targets.ros import build_order
+from sam_codegen.validate.mapping_rules import format_path
+from sam_codegen.validate.nodes import class_name, node_topic_qos
 from sam_codegen.validate.resolve import Resolved
+
+__all__ = ["cyphal_context", "dronecan_context", "nodes_context", "tables_context"]
 
 
 def _ros_type_parts(full: str) -> tuple[str, str, str]:
     """`sensor_msgs/Imu` -> ("sensor_msgs/msg/Imu", "sensor_msgs.msg", "Imu")."""
     package, name = full.split("/")
     return f"{package}/msg/{name}", f"{package}.msg", name
-
-
-def _text(text: str, indent: int) -> str:
-    """A string literal (py_str: repr, inert) at `indent`; long text becomes implicitly concatenated chunks."""
-    literal = py_str(text)
-    if indent + len(literal) <= LINE_LIMIT - 10:
-        return literal
-    chunks: list[str] = []
-    for word in re.findall(r"\S*\s*", text):
-        if chunks and len(py_str(chunks[-1] + word)) + indent + 4 <= LINE_LIMIT - 2:
-            chunks[-1] += word
-        elif word:
-            chunks.append(word)
-    pad = " " * (indent + 4)
-    return "(\n" + "".join(f"{pad}{py_str(c)}\n" for c in chunks) + " " * indent + ")"
-
-
-def _tuple(items: list[str], indent: int) -> str:
-    """A tuple literal of rendered items, on one line if it fits."""
-    if not items:
-        return "()"
-    one = "(" + ", ".join(items) + ("," if len(items) == 1 else "") + ")"
-    if indent + len(one) <= LINE_LIMIT - 30:
-        return one
-    pad = " " * (indent + 4)
-    return "(\n" + "".join(f"{pad}{item},\n" for item in items) + " " * indent + ")"
 
 
 def _port_info(resolved: Resolved, port: Port, indent: int, prefix: int = 0) -> str:
@@ -59,10 +51,11 @@ def _port_info(resolved: Resolved, port: Port, indent: int, prefix: int = 0) -> 
     return "PortInfo(\n" + "".join(f"{pad}{k}={v},\n" for k, v in zip(names, args, strict=True)) + " " * indent + ")"
 
 
-def _tables_context(resolved: Resolved) -> dict[str, Any]:
+def cyphal_context(resolved: Resolved) -> dict[str, Any]:
+    """The Cyphal part of tables.py and what every spec has (topics, parameters, frames, the bridge)."""
     spec = resolved.spec
     devices = [{
-        "name": py_str(d.name), "node_id": str(d.node_id), "description": _text(d.description, 8),
+        "name": py_str(d.name), "node_id": str(d.node_id), "description": text_literal(d.description, 8),
         "publishes": [_port_info(resolved, p, 12) for p in d.publishes],
         "subscribes": [_port_info(resolved, p, 12) for p in d.subscribes],
     } for d in spec.devices.values() if "cyphal" in d.protocols]
@@ -70,7 +63,7 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
     for topic in spec.topics.values():
         ros_type, module, cls = _ros_type_parts(topic.type)
         topics.append({"name": py_str(topic.name), "ros_type": py_str(ros_type), "ros_module": py_str(module),
-                       "ros_class": py_str(cls), "description": _text(topic.description, 8)})
+                       "ros_class": py_str(cls), "description": text_literal(topic.description, 8)})
     ports = {}
     for d in spec.devices.values():
         for p in [*d.publishes, *d.subscribes]:
@@ -89,7 +82,7 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
             "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
             "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
-            "exact_uavcan_fields": _tuple(exact, 8), "linked_uavcan_fields": _tuple(linked, 8),
+            "exact_uavcan_fields": tuple_literal(exact, 8), "linked_uavcan_fields": tuple_literal(linked, 8),
         })
     parameters = []
     for p in spec.parameters.values():
@@ -98,13 +91,13 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
             default = float(default)
         parameters.append({
             "name": py_str(p.name), "type": py_str(p.type),
-            "default": _text(default, 8) if isinstance(default, str) else py_literal(default),
+            "default": text_literal(default, 8) if isinstance(default, str) else py_literal(default),
             "minimum": py_literal(None if p.minimum is None else float(p.minimum)),
             "maximum": py_literal(None if p.maximum is None else float(p.maximum)),
-            "unit": py_str(p.unit), "description": _text(p.description, 8),
+            "unit": py_str(p.unit), "description": text_literal(p.description, 8),
         })
     rules = [{"left": py_str(r.left), "op": py_str(r.op), "right": py_str(r.right),
-              "description": _text(r.description, 8)} for r in spec.parameter_rules]
+              "description": text_literal(r.description, 8)} for r in spec.parameter_rules]
     frames = [(py_str(f.name), py_str(f.parent) if f.parent is not None else "None") for f in spec.frames.values()]
     bridge = spec.bridge
     return {
@@ -115,3 +108,104 @@ def _tables_context(resolved: Resolved) -> dict[str, Any]:
         "devices": devices, "topics": topics,
         "mappings": mappings, "parameters": parameters, "rules": rules, "frames": frames,
     }
+
+
+def _type_info(struct: V0Struct) -> str:
+    return (f"DroneCanTypeInfo({py_str(struct.name)}, {struct.data_type_id}, 0x{struct.signature:016X}, "
+            f"{not struct.standard})")
+
+
+def _type_ref(struct: V0Struct) -> str:
+    return f"_DRONECAN_TYPE[{py_str(struct.name)}]"
+
+
+def _dronecan_port_info(struct: V0Struct, rate_hz: float, indent: int) -> str:
+    one = f"DroneCanPortInfo({_type_ref(struct)}, {py_literal(float(rate_hz))})"
+    if indent + len(one) + 1 <= LINE_LIMIT:
+        return one
+    pad = " " * (indent + 4)
+    return f"DroneCanPortInfo(\n{pad}{_type_ref(struct)},\n{pad}{py_literal(float(rate_hz))},\n{' ' * indent})"
+
+
+def dronecan_context(resolved: Resolved) -> dict[str, Any]:
+    """The DroneCAN entries of tables.py (empty for a spec without DroneCAN) and the layouts."""
+    spec = resolved.spec
+    catalog = resolved.dronecan
+    types = {t.name: t for t in used_types(resolved)} if catalog is not None else {}
+    devices = []
+    for d in spec.devices.values():
+        if "dronecan" not in d.protocols:
+            continue
+        devices.append({
+            "name": py_str(d.name), "node_id": str(d.node_id), "description": text_literal(d.description, 8),
+            "publishes": [_dronecan_port_info(types[p.type], p.rate_hz, 12) for p in d.dronecan_publishes],
+            "subscribes": [_dronecan_port_info(types[p.type], p.rate_hz, 12) for p in d.dronecan_subscribes],
+        })
+    mappings = []
+    for rm in resolved.dronecan_mappings:
+        m = rm.mapping
+        struct = types[rm.dsdl_struct.name]
+        select = [f"({py_str(format_path(list(p)))}, {py_literal(v)})" for p, _, v in rm.select]
+        elements = [py_str(f"{format_path(list(path))}[{u}]") for path, uses in rm.elements.items() for u in uses]
+        mappings.append({
+            "name": py_str(m.name), "direction": py_str(m.direction), "topic": py_str(m.topic),
+            "data_type": _type_ref(struct), "select": tuple_literal(select, 8), "elements": tuple_literal(elements, 8),
+            "source_node_ids": frozenset_literal(m.source_node_ids),
+            "destination_node_ids": frozenset_literal(m.destination_node_ids),
+            "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
+            "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
+            "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
+            "exact_uavcan_fields": tuple_literal([py_str(s.uavcan) for s in rm.steps if s.uavcan_path and s.exact], 8),
+            "linked_uavcan_fields": tuple_literal([py_str(s.uavcan) for s in rm.steps if s.uavcan_path], 8),
+        })
+    layouts = [{
+        "name": py_str(layout.name), "description": text_literal(layout.description, 8),
+        "protocols": tuple_literal([f"({py_str(d)}, {py_str(p)})" for d, p in layout.protocols.items()], 8),
+        "cyphal_mappings": tuple_literal([py_str(n) for n in layout.cyphal_mappings], 8),
+        "dronecan_mappings": tuple_literal([py_str(n) for n in layout.dronecan_mappings], 8),
+    } for layout in resolved.layouts]
+    return {
+        "dronecan_dirs": [py_str(d) for d in dsdl_v0.load_dirs(resolved)],
+        "dronecan_types": [_type_info(t) for t in types.values()],
+        "dronecan_devices": devices,
+        "dronecan_mappings": mappings,
+        "layouts": layouts,
+    }
+
+
+def nodes_context(resolved: Resolved) -> dict[str, Any]:
+    """The QoS, transforms and nodes of tables.py (as literals)."""
+    spec = resolved.spec
+    package = nodes_package(spec)
+
+    def qos_info(qos: Qos) -> str:
+        return f"QosInfo({py_str(qos.reliability)}, {py_str(qos.durability)}, {qos.depth}, {py_str(qos.profile)})"
+
+    def endpoints(node_items: list) -> list[str]:
+        return [f"EndpointInfo({py_str(i.topic)}, {qos_info(node_topic_qos(spec, i))})" for i in node_items]
+
+    nodes = []
+    for n in spec.nodes.values():
+        nodes.append({
+            "name": py_str(n.name), "description": text_literal(n.description, 8),
+            "module": py_str(f"{package}.{n.name}"), "base_class": py_str(class_name(n.name)),
+            "publishes": endpoints(n.publish_items), "subscribes": endpoints(n.subscribe_items),
+            "parameters": [py_str(p) for p in n.parameters],
+            "transforms": [f"({py_str(p)}, {py_str(c)})" for p, c in n.transforms],
+            "reads_transforms": [f"({py_str(p)}, {py_str(c)})" for p, c in n.reads_transforms],
+        })
+    return {
+        "topic_qos": {py_str(t.name): qos_info(t.qos) for t in spec.topics.values() if t.qos is not None},
+        "static_transforms": [{"parent": py_str(p), "child": py_str(c), "xyz": ", ".join(map(float_literal, xyz)),
+                               "rotation": ", ".join(map(float_literal, q))}
+                              for p, c, xyz, q in static_transforms(spec)],
+        "transforms": [f"TransformInfo({py_str(t.parent)}, {py_str(t.child)}, {py_str(t.publisher)})"
+                       for t in spec.transforms],
+        "nodes": nodes, "nodes_package": py_str(package), "params_file": py_str(params_file(spec)),
+        "ros_packages": [py_str(name) for name in build_order(resolved)],
+    }
+
+
+def tables_context(resolved: Resolved) -> dict[str, Any]:
+    """Everything templates/python/tables.py.j2 renders."""
+    return {**cyphal_context(resolved), **nodes_context(resolved), **dronecan_context(resolved)}

@@ -11,7 +11,7 @@ from typing import Any
 
 from sam_codegen.model.spec import Field, RosMessage, Scalar
 from sam_codegen.model.types import ROS_FLOAT_BITS, RosType
-from sam_codegen.targets.wire.code import Path
+from sam_codegen.targets.wire.code import FieldPath
 
 __all__ = ["ARRAY_CODE", "HEADER", "MODULE_PRELUDE", "PRIM", "Leaf", "Phase", "elem_path", "flatten", "nested_message",
            "ros_default", "strip_pads", "typed"]
@@ -62,7 +62,7 @@ class Leaf:
     """One item of a message's layout in wire order."""
 
     kind: str  # prim | block (fixed array of primitives) | string | seq | msgseq
-    path: Path
+    path: FieldPath
     base: str = ""
     count: int = 1  # block: elements
     bound: int | None = None  # string / sequence bound
@@ -71,7 +71,7 @@ class Leaf:
     array: str = ""  # block: the ROS array kind, for the element paths
 
 
-def flatten(message: RosMessage, lookup: Callable[[str], RosMessage | None], prefix: Path = ()) -> list[Leaf]:
+def flatten(message: RosMessage, lookup: Callable[[str], RosMessage | None], prefix: FieldPath = ()) -> list[Leaf]:
     if not message.fields:  # rosidl gives an empty message one uint8 member
         return [Leaf("prim", (*prefix, ("structure_needs_at_least_one_member", None)), "uint8", default=0)]
     out: list[Leaf] = []
@@ -114,7 +114,7 @@ def nested_message(lookup: Callable[[str], RosMessage | None], name: str) -> Ros
     return message
 
 
-def elem_path(path: Path, i: int) -> Path:
+def elem_path(path: FieldPath, i: int) -> FieldPath:
     return (*path[:-1], (path[-1][0], i))
 
 

@@ -8,7 +8,7 @@ from collections.abc import Callable, Iterable
 
 from sam_codegen.model.spec import RosMessage
 from sam_codegen.targets.wire.cdr_layout import PRIM, Leaf, Phase, elem_path, flatten, strip_pads
-from sam_codegen.targets.wire.code import Constants, Names, Path, prune
+from sam_codegen.targets.wire.code import Constants, FieldPath, Names, prune
 
 __all__ = ["cdr_reader"]
 
@@ -18,10 +18,10 @@ __all__ = ["cdr_reader"]
 
 class _Reader:
     def __init__(self, lookup: Callable[[str], RosMessage | None], names: Names, consts: Constants, buf: str,
-                 wanted: set[Path], size: str, var: str | None = None) -> None:
+                 wanted: set[FieldPath], size: str, var: str | None = None) -> None:
         self.lookup, self.names, self.consts, self.buf = lookup, names, consts, buf
         self.wanted = wanted
-        self.found: dict[Path, str] = {}
+        self.found: dict[FieldPath, str] = {}
         self.lines: list[str] = []
         self.phase = Phase()
         self.var = var  # the local holding the dynamic part of the offset (None: 0)
@@ -93,7 +93,7 @@ class _Reader:
         self.delta += size
         self.phase.advance(size)
 
-    def want(self, path: Path, hint: str | None = None) -> str | None:
+    def want(self, path: FieldPath, hint: str | None = None) -> str | None:
         if path not in self.wanted:
             return None
         name = self.names.new(hint or "_".join(str(p) for seg in path for p in seg if p is not None))
@@ -206,8 +206,8 @@ class _Reader:
         self.open_segment()
 
 
-def cdr_reader(message: RosMessage, wanted: Iterable[Path], lookup: Callable[[str], RosMessage | None],
-               names: Names, consts: Constants, buf: str) -> tuple[list[str], dict[Path, str]]:
+def cdr_reader(message: RosMessage, wanted: Iterable[FieldPath], lookup: Callable[[str], RosMessage | None],
+               names: Names, consts: Constants, buf: str) -> tuple[list[str], dict[FieldPath, str]]:
     """Statements that check the CDR bytes in `buf` and decode the `wanted` leaves; (lines, path -> local)."""
     wanted = set(wanted)
     r = _Reader(lookup, names, consts, buf, wanted, names.new("size"))

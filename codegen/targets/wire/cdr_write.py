@@ -32,7 +32,7 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
   ints). They raise ``WireError`` (a name the generated module defines) on a wrong header, truncated data, a
   string without its NUL, a length beyond the buffer or a bound exceeded: never another exception.
 - ``lookup(full_name) -> RosMessage`` resolves nested types (``Resolved.ros.get``, external ones included);
-  ``names.new(hint)`` gives a fresh local (emit_python's ``_Names``).
+  ``names.new(hint)`` gives a fresh local (emit_python's ``LocalNames``).
 
 The generated code needs, in its module, ``import struct as _struct``, ``from array import array as _array``, the
 ``WireError`` class and ``_ZEROS`` (zero bytes, at least 8: ``MODULE_PRELUDE``).
@@ -61,12 +61,33 @@ from sam_codegen.targets.wire.cdr_layout import (
     strip_pads,
 )
 from sam_codegen.targets.wire.cdr_read import cdr_reader
-from sam_codegen.targets.wire.code import LINE_LIMIT, NO_VALUE, Constants, Names, Path, literal_value, prune, wrap_line
+from sam_codegen.targets.wire.code import (
+    LINE_LIMIT,
+    NO_VALUE,
+    Constants,
+    FieldPath,
+    Names,
+    literal_value,
+    prune,
+    wrap_line,
+)
 
-# Constants, literal_value, NO_VALUE, Names, Path, wrap_line and prune live in wire_code, ros_default and
+# Constants, literal_value, NO_VALUE, Names, FieldPath, wrap_line and prune live in wire_code, ros_default and
 # MODULE_PRELUDE in wire_cdr_layout, cdr_reader in wire_cdr_read; re-exported here (API).
-__all__ = ["LINE_LIMIT", "MODULE_PRELUDE", "NO_VALUE", "Constants", "Names", "Path", "cdr_reader", "cdr_writer",
-           "literal_value", "prune", "ros_default", "wrap_line"]
+__all__ = [
+    "LINE_LIMIT",
+    "MODULE_PRELUDE",
+    "NO_VALUE",
+    "Constants",
+    "FieldPath",
+    "Names",
+    "cdr_reader",
+    "cdr_writer",
+    "literal_value",
+    "prune",
+    "ros_default",
+    "wrap_line",
+]
 
 
 # ---- writer --------------------------------------------------------------------------------------------------
@@ -119,9 +140,9 @@ class _Run:
 
 class _Writer:
     def __init__(self, lookup: Callable[[str], RosMessage | None], names: Names, consts: Constants,
-                 values: dict[Path, str]) -> None:
+                 values: dict[FieldPath, str]) -> None:
         self.lookup, self.names, self.consts, self.values = lookup, names, consts, values
-        self.used: set[Path] = set()
+        self.used: set[FieldPath] = set()
         self.phase = Phase()
         self.run = _Run()
         self.lines: list[str] = []
@@ -129,7 +150,7 @@ class _Writer:
         self.buf: str | None = None  # the bytearray local, once something needs the length so far
 
     # -- values
-    def value(self, path: Path, default: Any) -> tuple[str, Any]:
+    def value(self, path: FieldPath, default: Any) -> tuple[str, Any]:
         """(expression, literal value or NO_VALUE) of a leaf."""
         expr = self.values.get(path)
         if expr is None:
@@ -241,6 +262,7 @@ class _Writer:
         elif leaf.base in ("bool", "uint8", "char"):
             self.emit(f"bytes({seq})")
         else:
+            self.consts.imports.add("array")
             self.emit(f"_array({ARRAY_CODE[leaf.base]!r}, {seq}).tobytes()")
         self.phase.unknown(min(size, 4))
 
@@ -256,7 +278,7 @@ def _lit(value: float) -> str:
     return "_NAN" if math.isnan(value) else "_INF" if value > 0 else "-_INF"
 
 
-def cdr_writer(message: RosMessage, values: dict[Path, str], lookup: Callable[[str], RosMessage | None],
+def cdr_writer(message: RosMessage, values: dict[FieldPath, str], lookup: Callable[[str], RosMessage | None],
                names: Names, consts: Constants) -> tuple[list[str], str]:
     """Statements and the final expression of the CDR bytes (header included) of `message` with `values`.
 

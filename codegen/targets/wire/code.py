@@ -11,11 +11,13 @@ import re
 from collections.abc import Iterable
 from typing import Any, Protocol
 
-__all__ = ["LINE_LIMIT", "NO_VALUE", "Constants", "Names", "Path", "literal_value", "prune", "runs_of", "wrap_line"]
+from sam_codegen.render.pysource import LINE_LIMIT
+
+__all__ = ["LINE_LIMIT", "NO_VALUE", "Constants", "FieldPath", "Names", "literal_value", "prune", "runs_of",
+           "wrap_line"]
 
 # A path into a message: (field name, index or None) per level, as mapping_rules gives them.
-Path = tuple[tuple[str, Any], ...]
-LINE_LIMIT = 110
+FieldPath = tuple[tuple[str, Any], ...]
 
 
 class Names(Protocol):
@@ -33,6 +35,7 @@ class Constants:
     def __init__(self, prefix: str = "_K") -> None:
         self.prefix = prefix
         self._names: dict[str, str] = {}  # expression -> name
+        self.imports: set[str] = set()  # optional imports the code uses ("array"): the module imports them
 
     def named(self, expr: str) -> str:
         if expr not in self._names:

@@ -6,40 +6,40 @@ Per mapping ``m`` of the spec's Cyphal mappings, both directions:
   message's CDR bytes (encapsulation header included) and its header stamp in ns (-1 without a header);
 - ``m_ros_to_wire(cdr, stats) -> payload | None``: CDR bytes (as a raw subscription gives them) -> the payload.
 
-The value semantics are convert.py's, literally: the emitter is emit_python's ``_MappingEmitter`` with the reads
-and the result replaced. Reads come from the payload / CDR decoded by wire_cyphal / wire_cdr into locals; the
-result tree (emit_python's ``_Ctor``) is written by the wire writers instead of calling constructors; the value
-statements between them (checks, saturation, stats keys, tables, stamps) are the same dicts, rendered by the same
-templates/python/statements.j2 macros. codec.py imports the standard library only.
+The value semantics are convert.py's, literally: the emitter is targets.python's ``MappingEmitter`` with the reads
+and the result replaced. Reads come from the payload / CDR decoded by cyphal_read / cdr_read into locals (the
+function's `decode` lines), and are handed to the emitter as values (``RosReads``, ``uav_access``); the result tree
+(``CtorNode``) is written by the wire writers instead of calling constructors; the statements between them (checks,
+saturation, stats keys, tables, stamps) are the same typed statements, rendered by the same
+templates/python/statements.j2. Nothing is patched in generated text. codec.py imports the standard library only.
 """
 
 from __future__ import annotations
 
-import re
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.templating import render
-from sam_codegen.targets.python.convert import _Arr, _Ctor, _Function, _MappingEmitter, _Module, _Names, _st
+from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
+from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft
+from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["codec_context", "emit"]
+__all__ = ["HEADER", "WireCtorNode", "codec_context", "emit", "stamp_ns", "tree_values", "wrap_body"]
 
 HEADER = "std_msgs/Header"
 PAYLOAD, CDR = "payload", "cdr"
 # Module-level names of codec.py that no local may take.
 MODULE_NAMES = frozenset({"WireError", "CODECS", "Any", "Callable", "ConversionStats", "_NAN", "_INF", "_ZEROS",
                           "_struct", "_array", "_extend", "_support", PAYLOAD, CDR})
-_TOKEN = "_STAMP_"  # stands for a ROS Time read by a to_uavcan step (replaced by its sec / nanosec locals)
 
 
-class _WireCtor(_Ctor):
+class WireCtorNode(CtorNode):
     """A message under construction whose fields are written as wire bytes: knows its type."""
 
     def __init__(self, of: DsdlStruct | RosMessage, fields: list[tuple[str, Any]]) -> None:
@@ -47,48 +47,48 @@ class _WireCtor(_Ctor):
         self.of = of
 
 
-class _CodecModule(_Module):
+class _CodecModule(ConvertModule):
     """codec.py's view of types: nothing imported, nothing constructed; trees become bytes."""
 
     consts: Constants
-    names: _Names  # the locals of the function being emitted (its writers take names from it too)
+    names: LocalNames  # the locals of the function being emitted (its writers take names from it too)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return struct.name
 
-    def dsdl_ctor(self, struct: DsdlStruct) -> _Ctor:
-        return _WireCtor(struct, [(f.name, f.type) for f in struct.fields])
+    def dsdl_ctor(self, struct: DsdlStruct) -> CtorNode:
+        return WireCtorNode(struct, [(f.name, f.type) for f in struct.fields])
 
-    def ros_ctor(self, message: RosMessage) -> _Ctor:
-        return _WireCtor(message, [(f.name, f.type) for f in message.fields])
+    def ros_ctor(self, message: RosMessage) -> CtorNode:
+        return WireCtorNode(message, [(f.name, f.type) for f in message.fields])
 
     def element_default(self, t: DsdlType | RosType) -> str:
         return "None"  # an element nobody sets: the writers give the type's default
 
-    def format_return(self, root: _Ctor) -> list[str]:
-        assert isinstance(root, _WireCtor)
+    def format_return(self, root: CtorNode) -> list[str]:
+        assert isinstance(root, WireCtorNode)
         values = tree_values(root)
         names = self.names
         if isinstance(root.of, RosMessage):
             lines, expr = cdr_writer(root.of, values, self.resolved.ros.get, names, self.consts)
-            return _wrapped([*lines, f"return {expr}, {stamp_ns(root.of, values)}"])
+            return wrap_body([*lines, f"return {expr}, {stamp_ns(root.of, values)}"])
         lines, expr = cyphal_writer(root.of, values, self.resolved.dsdl.get, names, self.consts)
-        return _wrapped([*lines, f"return {expr}"])
+        return wrap_body([*lines, f"return {expr}"])
 
 
-def _wrapped(lines: list[str]) -> list[str]:
+def wrap_body(lines: list[str]) -> list[str]:
     """Statements of a function body (indented by 4 in the module) within the line limit."""
     return [part for line in lines for part in wrap_line(line, LINE_LIMIT - 4)]
 
 
-def tree_values(root: _Ctor, prefix: tuple = ()) -> dict[tuple, str]:
+def tree_values(root: CtorNode, prefix: tuple = ()) -> dict[tuple, str]:
     """The leaf expressions of a result tree by path; an element of a bounded array makes it a whole list."""
     out: dict[tuple, str] = {}
     for name, node in root.kwargs.items():
         path = (*prefix, (name, None))
         if isinstance(node, str):
             out[path] = node
-        elif isinstance(node, _Arr):
+        elif isinstance(node, ArrayNode):
             t = root.types[name]
             if t.array == "bounded":  # built with `capacity` elements, as the object converter does
                 if not all(isinstance(v, str) for v in node.items.values()):
@@ -129,7 +129,7 @@ def stamp_ns(message: RosMessage, values: dict[tuple, str]) -> str:
     return f"{sec} * 1_000_000_000 + {nanosec}"
 
 
-class _CodecEmitter(_MappingEmitter):
+class _CodecEmitter(MappingEmitter):
     module: _CodecModule
 
     def __init__(self, module: _CodecModule, rm: ResolvedMapping) -> None:
@@ -138,13 +138,13 @@ class _CodecEmitter(_MappingEmitter):
         self.stamps: dict[str, tuple[str, str]] = {}  # token -> (sec local, nanosec local)
 
     # -- UAVCAN -> ROS: the reads come out of the payload
-    def bind_uavcan_arrays(self, fn: _Function, names: _Names, steps: list[Step],
+    def bind_uavcan_arrays(self, fn: FunctionDraft, names: LocalNames, steps: list[Step],
                            listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
         wanted = {tuple(s.uavcan_path) for s in steps if s.kind != "value" and s.uavcan_path}
         self.module.names = names
         lines, self.reads = cyphal_reader(self.rm.dsdl_struct, wanted, self.module.resolved.dsdl.get, names,
                                           self.module.consts, PAYLOAD)
-        fn.binds.append(_st("raw", lines=_wrapped(lines)))
+        fn.decode = wrap_body(lines)
         return {}
 
     def uav_access(self, base: str, path: tuple) -> str:
@@ -154,44 +154,25 @@ class _CodecEmitter(_MappingEmitter):
         return expr  # the reader's locals are lists already
 
     # -- ROS -> UAVCAN: the reads come out of the CDR
-    def ros_reader(self, fn: _Function, names: _Names, steps: list[Step]) -> Callable[[tuple], str]:
+    def ros_reader(self, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
         wanted: set[tuple] = set()
-        times: set[tuple] = set()
         for s in steps:
             if s.kind == "time":
-                times.add(tuple(s.ros_path))
                 wanted |= {(*s.ros_path, ("sec", None)), (*s.ros_path, ("nanosec", None))}
             else:
                 wanted.add(tuple(s.ros_path))
         self.module.names = names
         lines, found = cdr_reader(self.rm.ros_message, wanted, self.module.resolved.ros.get, names,
                                   self.module.consts, CDR)
-        fn.binds.append(_st("raw", lines=_wrapped(lines)))
-
-        def read(path: tuple) -> str:
-            path = tuple(path)
-            if path in times:
-                token = f"{_TOKEN}{len(self.stamps)}"
-                self.stamps[token] = (found[(*path, ("sec", None))], found[(*path, ("nanosec", None))])
-                return token
-            return found[path]
-
-        return read
+        fn.decode = wrap_body(lines)
+        return RosReads(lambda path: found[tuple(path)],
+                        lambda path: (found[(*path, ("sec", None))], found[(*path, ("nanosec", None))]))
 
     def ros_array_read(self, expr: str, ros_type: RosType) -> str:
         return expr  # the reader's locals are lists of plain values already (byte arrays as ints)
 
-    def step_to_uavcan(self, s: Step, names: _Names, ros_read, statements: list[dict[str, Any]]) -> str:
-        start = len(statements)
-        value = super().step_to_uavcan(s, names, ros_read, statements)
-        for token, (sec, nanosec) in self.stamps.items():  # a Time read: `.sec` / `.nanosec` are the locals
-            for i in range(start, len(statements)):
-                statements[i] = _replace(statements[i], {f"{token}.sec": sec, f"{token}.nanosec": nanosec})
-            value = value.replace(f"{token}.sec", sec).replace(f"{token}.nanosec", nanosec)
-        return value
-
     # -- the functions, named and typed as codec.py's API says
-    def wire_to_ros(self) -> _Function:
+    def wire_to_ros(self) -> FunctionDraft:
         fn = self.to_ros()
         rm = self.rm
         fn.name = f"{self.name}_wire_to_ros"
@@ -199,9 +180,9 @@ class _CodecEmitter(_MappingEmitter):
         fn.returns = "tuple[bytes, int] | None"
         fn.doc = [f"Mapping {self.name!r}, UAVCAN -> ROS, payload bytes -> CDR bytes and stamp [ns].", "",
                   f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"]
-        return _checked(fn)
+        return fn
 
-    def ros_to_wire(self) -> _Function:
+    def ros_to_wire(self) -> FunctionDraft:
         fn = self.to_uavcan()
         rm = self.rm
         fn.name = f"{self.name}_ros_to_wire"
@@ -209,51 +190,7 @@ class _CodecEmitter(_MappingEmitter):
         fn.returns = "bytes | None"
         fn.doc = [f"Mapping {self.name!r}, ROS -> UAVCAN, CDR bytes -> payload bytes.", "",
                   f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"]
-        return _checked(fn)
-
-
-def _replace(value: Any, mapping: dict[str, str]) -> Any:
-    """`value` (a statement dict, list, tuple or string) with every key of `mapping` replaced in its strings."""
-    if isinstance(value, str):
-        for old, new in mapping.items():
-            value = value.replace(old, new)
-        return value
-    if isinstance(value, dict):
-        return {k: _replace(v, mapping) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return type(value)(_replace(v, mapping) for v in value)
-    return value
-
-
-_OBJECT_READ = re.compile(rf"\bsrc\b|{_TOKEN}")
-_STRING = re.compile(r"'(?:[^'\\]|\\.)*'|\"(?:[^\"\\]|\\.)*\"")
-
-
-def _code_strings(value: Any) -> list[str]:
-    """The strings in statements (dicts, lists, tuples of them): each a piece of generated code."""
-    if isinstance(value, str):
-        return [value]
-    if isinstance(value, dict):
-        value = list(value.values())
-    if isinstance(value, (list, tuple)):
-        return [text for item in value for text in _code_strings(item)]
-    return []
-
-
-def _checked(fn: _Function) -> _Function:
-    """A codec function may read nothing but its bytes: a `src` or a Time token left in its code (outside string
-    literals: a stats key may name a field `src`) is an emitter bug.
-
-    >>> _ = _checked(_Function("f", [], "", [], statements=[{"kind": "assign", "expr": "len('a.src')"}]))
-    >>> _checked(_Function("f", [], "", [], statements=[{"kind": "assign", "expr": "src.x"}]))
-    Traceback (most recent call last):
-    ...
-    AssertionError: f: an object read is left in the codec: src.x
-    """
-    for line in _code_strings([fn.binds, fn.statements, fn.result]):
-        if _OBJECT_READ.search(_STRING.sub("''", line)):
-            raise AssertionError(f"{fn.name}: an object read is left in the codec: {line[:400]}")
-    return fn
+        return fn
 
 
 def codec_context(resolved: Resolved) -> dict[str, Any]:
@@ -268,9 +205,8 @@ def codec_context(resolved: Resolved) -> dict[str, Any]:
     for rm in resolved.mappings:
         emitter = _CodecEmitter(module, rm)
         functions.append((emitter.wire_to_ros(), emitter.ros_to_wire()))
-    code = repr(functions)
     return {
-        "uses_array": "_array(" in code,
+        "uses_array": "array" in module.consts.imports,
         "prelude": [*MODULE_PRELUDE, *CYPHAL_PRELUDE],
         "constants": module.consts.lines(),
         "tables": module.tables,

@@ -18,17 +18,22 @@ fixed array gets the first elements of a longer one, as rclpy serializes it.
 from __future__ import annotations
 
 import ast
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from sam_codegen.model.spec import RosMessage, V0Struct
 from sam_codegen.model.types import DsdlType, RosType
+from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.render.templating import render
-from sam_codegen.targets.python.convert import _Arr, _Ctor, _Function, _Names, _ros_aliases, _typed_literal, py_literal
-from sam_codegen.targets.python.convert_v0 import _Items, _V0MappingEmitter, _V0Module
+from sam_codegen.targets.python.mapping import RosReads
+from sam_codegen.targets.python.mapping_v0 import KeyedItems, V0ConvertModule, V0MappingEmitter
+from sam_codegen.targets.python.module import ArrayNode, CtorNode, FunctionDraft
+from sam_codegen.targets.python.names import LocalNames, ros_aliases
+from sam_codegen.targets.python.statements import FindItem
 from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_writer
 from sam_codegen.targets.wire.code import Constants
-from sam_codegen.targets.wire.codec import _TOKEN, _checked, _replace, _WireCtor, _wrapped, stamp_ns
+from sam_codegen.targets.wire.codec import WireCtorNode, stamp_ns, wrap_body
 from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
 from sam_codegen.targets.wire.v0_read import WirePath, v0_reader
 from sam_codegen.targets.wire.v0_write import HELPERS, V0Items, V0Node, v0_writer
@@ -40,26 +45,26 @@ __all__ = ["emit"]
 _DEFAULT = "<default>"  # an element left at its default (never rendered: the writers know the defaults)
 
 
-class _CodecV0Module(_V0Module):
+class _CodecV0Module(V0ConvertModule):
     """codec_v0.py's view: the same tree of values as convert_v0, written as bytes."""
 
     consts: Constants
     layout: V0Layout
-    names: _Names  # the locals of the function being emitted
+    names: LocalNames  # the locals of the function being emitted
 
-    def dsdl_ctor(self, struct: Any) -> _Ctor:
-        return _WireCtor(struct, [(f.name, f.type) for f in struct.fields])
+    def dsdl_ctor(self, struct: Any) -> CtorNode:
+        return WireCtorNode(struct, [(f.name, f.type) for f in struct.fields])
 
-    def ros_ctor(self, message: RosMessage) -> _Ctor:
-        return _WireCtor(message, [(f.name, f.type) for f in message.fields])
+    def ros_ctor(self, message: RosMessage) -> CtorNode:
+        return WireCtorNode(message, [(f.name, f.type) for f in message.fields])
 
     def element_default(self, t: DsdlType | RosType) -> str:
         if isinstance(t, DsdlType):
-            return _DEFAULT if t.kind == "composite" else _typed_literal(0, "float" if t.kind == "float" else t.kind)
-        return _DEFAULT if not t.is_primitive else _typed_literal(0, t.base)
+            return _DEFAULT if t.kind == "composite" else typed_literal(0, "float" if t.kind == "float" else t.kind)
+        return _DEFAULT if not t.is_primitive else typed_literal(0, t.base)
 
-    def format_return(self, root: _Ctor) -> list[str]:
-        assert isinstance(root, _WireCtor)
+    def format_return(self, root: CtorNode) -> list[str]:
+        assert isinstance(root, WireCtorNode)
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
             return _lines([*lines, f"return {expr}"])
@@ -76,7 +81,7 @@ def _lines(lines: list[str]) -> list[str]:
     as they are, marked (a long bit expression or comprehension)."""
     out: list[str] = []
     for line in lines:
-        wrapped = _wrapped([line])
+        wrapped = wrap_body([line])
         if len(wrapped) == 1 or line.rstrip().endswith(":") or _tree(wrapped) != _tree([line]):
             out.append(line if len(wrapped) == 1 else f"{line}  # noqa: E501")
         else:
@@ -95,27 +100,27 @@ def _tree(lines: list[str]) -> str:
 
 def _v0_node(node: Any) -> Any:
     """The writer's view of a DroneCAN value: V0Node / V0Items / expression / None (default)."""
-    if isinstance(node, _Ctor):
+    if isinstance(node, CtorNode):
         return V0Node({name: _v0_node(value) for name, value in node.kwargs.items()})
-    if isinstance(node, _Items):
+    if isinstance(node, KeyedItems):
         return V0Items([_v0_node(item) for item in node.items.values()])
-    if isinstance(node, _Arr):
+    if isinstance(node, ArrayNode):
         return V0Items([_v0_node(node.items[i]) if i in node.items else None for i in range(node.capacity)])
     return None if node == _DEFAULT else node
 
 
-def _ros_values(node: _Ctor, prefix: tuple, out: dict[tuple, str], checks: list[str]) -> None:
+def _ros_values(node: CtorNode, prefix: tuple, out: dict[tuple, str], checks: list[str]) -> None:
     """The CDR writer's values: leaf path -> expression. A whole array goes into a ROS sequence only within its
     bound (rclpy refuses to serialize more), into a fixed array as its first elements (rclpy keeps those)."""
     for name, value in node.kwargs.items():
         t = node.types[name]
         path = (*prefix, (name, None))
-        if isinstance(value, _Ctor):
+        if isinstance(value, CtorNode):
             _ros_values(value, path, out, checks)
-        elif isinstance(value, _Arr):
+        elif isinstance(value, ArrayNode):
             for i, item in sorted(value.items.items()):
                 element = (*prefix, (name, i))
-                if isinstance(item, _Ctor):
+                if isinstance(item, CtorNode):
                     _ros_values(item, element, out, checks)
                 elif item != _DEFAULT:
                     out[element] = item
@@ -128,13 +133,12 @@ def _ros_values(node: _Ctor, prefix: tuple, out: dict[tuple, str], checks: list[
             out[path] = value
 
 
-class _CodecV0MappingEmitter(_V0MappingEmitter):
+class _CodecV0MappingEmitter(V0MappingEmitter):
     module: _CodecV0Module
 
     def __init__(self, module: _CodecV0Module, rm: ResolvedMapping) -> None:
         super().__init__(module, rm)
         self.wire: dict[WirePath, str] = {}  # wire path -> the local the payload is decoded into
-        self.tokens: dict[str, tuple] = {}  # placeholder -> ROS path of a Time read whole (to_uavcan)
         self.found: dict[tuple, str] = {}  # ROS path -> the local the CDR is decoded into
 
     # -- reading the payload
@@ -161,20 +165,20 @@ class _CodecV0MappingEmitter(_V0MappingEmitter):
             paths += [s.uavcan_path for s in self.rm.steps if s.uavcan_path]
         return {self.wire_path(p) for p in paths}
 
-    def decode(self, names: _Names, wanted: set[WirePath]) -> list[str]:
+    def decode(self, names: LocalNames, wanted: set[WirePath]) -> list[str]:
         lines, self.wire = v0_reader(self.rm.dsdl_struct, wanted, self.module.layout,  # type: ignore[arg-type]
                                      self.module.consts, "payload", names.new)
         return _lines(lines)
 
-    def bind_uavcan_arrays(self, fn: _Function, names: _Names, steps: list[Step],
+    def bind_uavcan_arrays(self, fn: FunctionDraft, names: LocalNames, steps: list[Step],
                            listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
         self.module.names = names
-        fn.decode = self.decode(names, self.wanted())  # type: ignore[attr-defined]
+        fn.decode = self.decode(names, self.wanted())
         result = super().bind_uavcan_arrays(fn, names, steps)
-        for st in fn.binds:
-            if st["kind"] == "required_item":  # records: the key field by position
-                struct = self.item_struct(st["var"])
-                st["field"] = str(record_index(struct, ast.literal_eval(st["field"])))
+        for i, st in enumerate(fn.binds):
+            if isinstance(st, FindItem):  # records: the key field by position
+                struct = self.item_struct(st.var)
+                fn.binds[i] = replace(st, field=str(record_index(struct, ast.literal_eval(st.field))))
         return result
 
     def item_struct(self, local: str) -> V0Struct:
@@ -227,17 +231,17 @@ class _CodecV0MappingEmitter(_V0MappingEmitter):
                 text += f"[{index}]"
         return text
 
-    def to_ros(self) -> _Function:
+    def to_ros(self) -> FunctionDraft:
         fn = super().to_ros()
         fn.name = f"{self.name}_wire_to_ros"
         fn.params = ["payload: bytes | bytearray | memoryview", "receive_ns: int", "stats: Any"]
         fn.returns = "tuple[bytes, int] | None"
         fn.doc = [f"Mapping {self.name!r}, UAVCAN -> ROS: payload -> (CDR, stamp in ns).", "",
                   f"{self.rm.dsdl_struct.name} -> {self.rm.ros_message.full_name}"]
-        return _checked(fn)
+        return fn
 
     # -- reading the CDR
-    def ros_reader(self, fn: _Function, names: _Names, steps: list[Step]):
+    def ros_reader(self, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
         self.module.names = names
         wanted: set[tuple] = set()
         sequences: dict[tuple, int] = {}  # a sequence element read by index -> the index
@@ -257,16 +261,9 @@ class _CodecV0MappingEmitter(_V0MappingEmitter):
             lines += [f"if len({whole}) <= {index}:",
                       f"    raise WireError({f'{path[-1][0]}: no element {index}'!r})"]
             self.found[path] = f"{whole}[{index}]"
-        fn.decode = _lines(lines)  # type: ignore[attr-defined]
-
-        def read(path: tuple) -> str:
-            if path in self.found:
-                return self.found[path]
-            token = f"{_TOKEN}{len(self.tokens)}"
-            self.tokens[token] = path
-            return token
-
-        return read
+        fn.decode = _lines(lines)
+        return RosReads(lambda path: self.found[tuple(path)],
+                        lambda path: (self.found[(*path, ("sec", None))], self.found[(*path, ("nanosec", None))]))
 
     def ros_type(self, path: tuple) -> RosType:
         message = self.rm.ros_message
@@ -279,26 +276,17 @@ class _CodecV0MappingEmitter(_V0MappingEmitter):
                 message = self.module.ros_message(t.base)
         return t
 
-    def step_to_uavcan(self, s: Step, names: _Names, ros_read, statements: list[dict[str, Any]]) -> str:
-        first = len(statements)
-        value = super().step_to_uavcan(s, names, ros_read, statements)
-        # a Time read whole: its .sec / .nanosec are locals
-        fields = {f"{token}.{leaf}": self.found[(*path, (leaf, None))]
-                  for token, path in self.tokens.items() for leaf in ("sec", "nanosec")}
-        statements[first:] = [_replace(st, fields) for st in statements[first:]]
-        return _replace(value, fields)
-
     def ros_array_read(self, expr: str, ros_type: RosType) -> str:
         return f"list({expr})"  # the CDR reader's list (byte arrays as ints), copied: converters may trim it
 
-    def to_uavcan(self) -> _Function:
+    def to_uavcan(self) -> FunctionDraft:
         fn = super().to_uavcan()
         fn.name = f"{self.name}_ros_to_wire"
         fn.params = ["cdr: bytes | memoryview", "stats: Any"]
         fn.returns = "bytes | None"
         fn.doc = [f"Mapping {self.name!r}, ROS -> UAVCAN: CDR -> payload.", "",
                   f"{self.rm.ros_message.full_name} -> {self.rm.dsdl_struct.name}"]
-        return _checked(fn)
+        return fn
 
     # -- WIRE_MATCHES
     def wire_matches(self) -> dict[str, Any] | None:
@@ -306,14 +294,14 @@ class _CodecV0MappingEmitter(_V0MappingEmitter):
         WireError where the payload does not decode."""
         if self.matches() is None:
             return None
-        names = _Names(self.module.module_names)
+        names = LocalNames(self.module.module_names)
         saved_wire, saved_items = self.wire, self.items
         self.items = {}
         decode = self.decode(names, self.wanted(matches=True))
         conditions = []
         for path, leaf, value in self.rm.select:
             conditions.append(f"{self.uav_access('payload', path)} == "
-                              f"{_typed_literal(value, 'float' if leaf.kind == 'float' else leaf.kind)}")
+                              f"{typed_literal(value, 'float' if leaf.kind == 'float' else leaf.kind)}")
         for array_path, uses in self.rm.elements.items():
             if any(i is not None for _, i in array_path):
                 continue  # inside an item: the converter checks it
@@ -334,7 +322,7 @@ def _context(resolved: Resolved) -> dict[str, Any]:
     assert resolved.dronecan is not None
     module.layout = V0Layout(resolved.dronecan.get)
     module.used_ros = set()
-    module.ros_aliases = _ros_aliases(resolved, resolved.dronecan_mappings)
+    module.ros_aliases = ros_aliases(resolved, resolved.dronecan_mappings)
     mappings = resolved.dronecan_mappings
     module.module_names = (
         {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
@@ -347,9 +335,8 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         emitter = _CodecV0MappingEmitter(module, rm)
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
         matches.append((rm.mapping.name, emitter.wire_matches()))
-    text = repr(functions)
     return {
-        "uses_array": "_array(" in text,
+        "uses_array": "array" in module.consts.imports,
         "tables": module.tables,
         "functions": functions,
         "matches": matches,

@@ -39,22 +39,22 @@ from dataclasses import dataclass, field
 
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType
-from sam_codegen.targets.wire.code import Constants, Names, Path, prune
+from sam_codegen.targets.wire.code import Constants, FieldPath, Names, prune
 from sam_codegen.targets.wire.cyphal_layout import (
-    _FLOAT,
-    _STD,
-    _UNSIGNED,
     CYPHAL_PRELUDE,
+    FLOAT_FORMATS,
+    STD_FORMATS,
+    UNSIGNED_FORMATS,
     Lookup,
-    _ceil8,
-    _elem_path,
-    _has_delimited,
-    _piece_sizes,
-    _signed,
-    _struct_of,
-    _tag_bits,
+    ceil8,
+    elem_path,
+    has_delimited,
     max_bits,
+    piece_sizes,
     prefix_bits,
+    signed_expr,
+    struct_of,
+    union_tag_bits,
 )
 from sam_codegen.targets.wire.cyphal_write import cyphal_writer
 
@@ -69,17 +69,17 @@ class _Shared:
     lookup: Lookup
     names: Names
     consts: Constants
-    wanted: set[Path]
-    found: dict[Path, str] = field(default_factory=dict)
+    wanted: set[FieldPath]
+    found: dict[FieldPath, str] = field(default_factory=dict)
 
-    def want(self, path: Path | None, hint: str | None = None) -> str | None:
+    def want(self, path: FieldPath | None, hint: str | None = None) -> str | None:
         if path is None or path not in self.wanted:
             return None
         name = self.names.new(hint or "_".join(str(p) for seg in path for p in seg if p is not None))
         self.found[path] = name
         return name
 
-    def wants_inside(self, path: Path | None) -> bool:
+    def wants_inside(self, path: FieldPath | None) -> bool:
         return path is not None and any(p[:len(path)] == path for p in self.wanted)
 
 
@@ -156,7 +156,7 @@ class _Reader:
             self.bits, self.bitmode = 0, False
             return
         self.close_group()
-        self.bits = _ceil8(self.bits)
+        self.bits = ceil8(self.bits)
 
     # -- runs and groups (byte mode)
     def item(self, code: str, nbits: int, target: str | None) -> None:
@@ -178,9 +178,9 @@ class _Reader:
         if not self.run:
             self.run_bits = self.group_start
         pieces, shift = [], 0
-        for size in _piece_sizes(nbytes):
+        for size in piece_sizes(nbytes):
             piece = self.s.names.new("bits")
-            self.run.append((_UNSIGNED[size * 8], piece))
+            self.run.append((UNSIGNED_FORMATS[size * 8], piece))
             pieces.append(piece if not shift else f"{piece} << {shift}")
             shift += size * 8
         word = pieces[0]
@@ -209,10 +209,10 @@ class _Reader:
         if t.kind == "bool":
             return f"({raw}) == 1"
         if t.kind == "int":
-            return _signed(f"({raw})", t.bits)
+            return signed_expr(f"({raw})", t.bits)
         if t.kind == "float":
-            unpack = self.s.consts.struct("<" + _FLOAT[t.bits])
-            pack = self.s.consts.struct("<" + _UNSIGNED[t.bits])
+            unpack = self.s.consts.struct("<" + FLOAT_FORMATS[t.bits])
+            pack = self.s.consts.struct("<" + UNSIGNED_FORMATS[t.bits])
             return f"{unpack}.unpack({pack}.pack({raw}))[0]"
         return f"({raw})"
 
@@ -224,7 +224,7 @@ class _Reader:
                 self.lines.append(f"{target} = {self.convert(self.bigint(), self.bit_at(self.bits), t)}")
             self.bits += t.bits
             return
-        code = _STD.get((t.kind, t.bits))
+        code = STD_FORMATS.get((t.kind, t.bits))
         if code and self.bits % 8 == 0:
             self.close_group()  # a group ends where an aligned standard primitive starts
             self.item(code, t.bits, target)
@@ -236,9 +236,9 @@ class _Reader:
         if self.bits % 8 == 0 and not any(tg for _, _, tg in self.group):
             self.close_group()  # a byte boundary: skipped bits become pad bytes
 
-    def read_struct(self, struct_: DsdlStruct, prefix: Path | None) -> None:
+    def read_struct(self, struct_: DsdlStruct, prefix: FieldPath | None) -> None:
         """The fields of a composite, from an aligned position; ends aligned (with the bit length check)."""
-        check = _has_delimited(struct_, self.s.lookup)
+        check = has_delimited(struct_, self.s.lookup)
         start = None
         if check:  # where it starts, for the bit length check at its end
             start = self.s.names.new("start")
@@ -258,14 +258,14 @@ class _Reader:
             self.lines += [f"if {end} - {start} > {limit}:",
                            f"    raise WireError('{struct_.name}: longer than its largest size')"]
 
-    def read_field(self, t: DsdlType, path: Path | None) -> None:
+    def read_field(self, t: DsdlType, path: FieldPath | None) -> None:
         if t.kind == "composite":
-            nested = _struct_of(self.s.lookup, t.composite)
+            nested = struct_of(self.s.lookup, t.composite)
             if not t.array:
                 self.read_composite(nested, path)
             elif t.array == "fixed":
                 for i in range(t.capacity or 0):
-                    self.read_composite(nested, None if path is None else _elem_path(path, i))
+                    self.read_composite(nested, None if path is None else elem_path(path, i))
             else:
                 self.read_composite_array(nested, t.capacity or 0, path)
         elif t.array == "fixed":
@@ -275,13 +275,13 @@ class _Reader:
         else:
             self.prim(t, None if t.kind == "void" else self.s.want(path))
 
-    def read_fixed(self, t: DsdlType, path: Path | None) -> None:
+    def read_fixed(self, t: DsdlType, path: FieldPath | None) -> None:
         e, n = t.element, t.capacity or 0
         whole = self.s.want(path, path[-1][0] if path else None)
-        targets = [self.s.want(_elem_path(path, i)) if path else None for i in range(n)]
+        targets = [self.s.want(elem_path(path, i)) if path else None for i in range(n)]
         if whole:
             targets = [tg or self.s.names.new(f"{path[-1][0]}_{i}") for i, tg in enumerate(targets)]  # type: ignore[index]
-        code = _STD.get((e.kind, e.bits))
+        code = STD_FORMATS.get((e.kind, e.bits))
         if code and not self.bitmode and self.bits % 8 == 0 and not any(targets):
             self.close_group()
             self.item(code, e.bits * n, None)  # skipped in one
@@ -294,15 +294,15 @@ class _Reader:
                 value = f"memoryview(bytes({value}))"
             (self.lines if self.bitmode else self.post).append(f"{whole} = {value}")
 
-    def read_var(self, t: DsdlType, path: Path | None) -> None:
+    def read_var(self, t: DsdlType, path: FieldPath | None) -> None:
         e, cap = t.element, t.capacity or 0
         pb = prefix_bits(cap)
         count = self.s.names.new("count")
         target = self.s.want(path, path[-1][0] if path else None)
-        fast = not self.bitmode and self.bits % 8 == 0 and (e.kind, e.bits) in _STD
+        fast = not self.bitmode and self.bits % 8 == 0 and (e.kind, e.bits) in STD_FORMATS
         if fast:
             self.close_group()
-            self.item(_UNSIGNED[pb], pb, count)
+            self.item(UNSIGNED_FORMATS[pb], pb, count)
             off = self.fold()
             self.check_count(count, cap, t)
             buf = self.buf
@@ -312,7 +312,7 @@ class _Reader:
                 elif e.bits == 8 and e.kind in ("uint", "byte"):
                     self.lines.append(f"{target} = list({buf}[{off}:{off} + {count}])")
                 else:
-                    code = _STD[(e.kind, e.bits)]
+                    code = STD_FORMATS[(e.kind, e.bits)]
                     self.lines.append(f"{target} = list(_struct.unpack_from(f'<{{{count}}}{code}', {buf}, {off}))")
             self.lines.append(f"{off} += {count}" + (f" * {e.bits // 8}" if e.bits > 8 else ""))
             return
@@ -334,7 +334,7 @@ class _Reader:
     def check_count(self, count: str, cap: int, t: DsdlType) -> None:
         self.lines += [f"if {count} > {cap}:", f"    raise WireError('array length prefix beyond {t}')"]
 
-    def read_composite(self, nested: DsdlStruct, path: Path | None) -> None:
+    def read_composite(self, nested: DsdlStruct, path: FieldPath | None) -> None:
         self.align()
         if nested.sealed:
             self.read_struct(nested, path)
@@ -347,7 +347,7 @@ class _Reader:
                        f"    raise WireError('{nested.name}: delimiter header beyond the payload')"]
         sub = self.s.names.new("nested")
         room = max_bits(nested, self.s.lookup) // 8 + 8
-        room_expr = f"{header} + {room}" if _has_delimited(nested, self.s.lookup) else str(room)
+        room_expr = f"{header} + {room}" if has_delimited(nested, self.s.lookup) else str(room)
         self.lines.append(f"{sub} = _extend({self.buf}[{off}:{off} + {header}], {room_expr})")
         inner = _Reader(self.s, sub, header)
         inner.read_struct(nested, path)
@@ -355,13 +355,13 @@ class _Reader:
         self.lines.extend(inner.lines)
         self.lines.append(f"{off} += {header}")
 
-    def read_composite_array(self, nested: DsdlStruct, cap: int, path: Path | None) -> None:
+    def read_composite_array(self, nested: DsdlStruct, cap: int, path: FieldPath | None) -> None:
         if self.s.wants_inside(path):
             raise NotImplementedError(f"{path}: reading into a variable-length array of composites")
         self.align()
         self.close_group()
         count = self.s.names.new("count")
-        self.item(_UNSIGNED[prefix_bits(cap)], prefix_bits(cap), count)
+        self.item(UNSIGNED_FORMATS[prefix_bits(cap)], prefix_bits(cap), count)
         off = self.fold()
         self.check_count(count, cap, DsdlType("composite", composite=nested.name, array="bounded", capacity=cap))
         self.loop(f"for _ in range({count}):", off, lambda r: r.read_composite(nested, None))
@@ -379,13 +379,13 @@ class _Reader:
         self.lines.append(head)
         self.lines.extend("    " + line for line in inner.lines or ["pass"])
 
-    def read_union(self, union: DsdlStruct, path: Path | None) -> None:
+    def read_union(self, union: DsdlStruct, path: FieldPath | None) -> None:
         if self.s.wants_inside(path):
             raise NotImplementedError(f"{path}: reading into a union")
-        tag_bits = _tag_bits(len(union.declared_fields))
+        tag_bits = union_tag_bits(len(union.declared_fields))
         tag = self.s.names.new("tag")
         self.close_group()
-        self.item(_UNSIGNED[tag_bits], tag_bits, tag)
+        self.item(UNSIGNED_FORMATS[tag_bits], tag_bits, tag)
         off = self.fold()
         variants = union.declared_fields
         self.lines += [f"if {tag} >= {len(variants)}:", f"    raise WireError('{union.name}: bad union tag')"]
@@ -395,13 +395,13 @@ class _Reader:
             self.loop(f"{'if' if i == 0 else 'elif'} {tag} == {i}:", off, lambda r, t=t: r.read_field(t, None))
 
 
-def cyphal_reader(struct_: DsdlStruct, wanted: Iterable[Path], lookup: Lookup, names: Names, consts: Constants,
-                  payload: str) -> tuple[list[str], dict[Path, str]]:
+def cyphal_reader(struct_: DsdlStruct, wanted: Iterable[FieldPath], lookup: Lookup, names: Names, consts: Constants,
+                  payload: str) -> tuple[list[str], dict[FieldPath, str]]:
     """Statements that decode `payload` (a serialized `struct_`) into locals for the `wanted` leaves."""
     shared = _Shared(lookup, names, consts, set(wanted))
     buf, size = names.new("buf"), names.new("size")
     room = max_bits(struct_, lookup) // 8 + 8
-    room_expr = f"{size} + {room}" if _has_delimited(struct_, lookup) else str(room)
+    room_expr = f"{size} + {room}" if has_delimited(struct_, lookup) else str(room)
     r = _Reader(shared, buf, size)
     r.lines += [f"{size} = len({payload})", f"{buf} = _extend({payload}, {room_expr})"]
     r.read_struct(struct_, ())

@@ -9,21 +9,21 @@ from typing import Any
 
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType
-from sam_codegen.targets.wire.code import NO_VALUE, Constants, Names, Path, literal_value
+from sam_codegen.targets.wire.code import NO_VALUE, Constants, FieldPath, Names, literal_value
 from sam_codegen.targets.wire.cyphal_layout import (
-    _FLOAT,
-    _STD,
-    _UNSIGNED,
+    FLOAT_FORMATS,
+    STD_FORMATS,
+    UNSIGNED_FORMATS,
     Lookup,
-    _ceil8,
-    _elem_path,
-    _is_fixed_size,
-    _piece_sizes,
-    _struct_of,
-    _tag_bits,
-    _touches,
+    ceil8,
+    elem_path,
+    is_fixed_size,
     max_bits,
+    piece_sizes,
     prefix_bits,
+    struct_of,
+    touches,
+    union_tag_bits,
 )
 
 __all__ = ["cyphal_writer"]
@@ -44,9 +44,9 @@ class _Writer:
     standard primitives gathered in groups packed as one word; bit mode (after a variable-length array that
     leaves the position unaligned): one integer accumulated with shifts, flushed as bytes at the next alignment."""
 
-    def __init__(self, lookup: Lookup, names: Names, consts: Constants, values: dict[Path, str]) -> None:
+    def __init__(self, lookup: Lookup, names: Names, consts: Constants, values: dict[FieldPath, str]) -> None:
         self.lookup, self.names, self.consts, self.values = lookup, names, consts, values
-        self.used: set[Path] = set()
+        self.used: set[FieldPath] = set()
         self.lines: list[str] = []
         self.parts: list[str] = []
         self.run: list[tuple[str, str | None, Any]] = []  # (code, expression or None for pad, literal value)
@@ -57,7 +57,7 @@ class _Writer:
         self.acc: str | None = None
         self.var: str | None = None  # bit mode: the bit offset local (None: 0)
 
-    def value(self, path: Path | None) -> tuple[str | None, Any]:
+    def value(self, path: FieldPath | None) -> tuple[str | None, Any]:
         if path is None or path not in self.values:
             return None, NO_VALUE
         self.used.add(path)
@@ -85,14 +85,15 @@ class _Writer:
         mask = (1 << t.bits) - 1
         if term.value is not NO_VALUE:
             if t.kind == "float":
-                raw = struct.unpack("<" + _UNSIGNED[t.bits], struct.pack("<" + _FLOAT[t.bits], term.value))[0]
+                packed = struct.pack("<" + FLOAT_FORMATS[t.bits], term.value)
+                raw = struct.unpack("<" + UNSIGNED_FORMATS[t.bits], packed)[0]
                 return None, raw
             return None, int(term.value) & mask
         if t.kind == "bool":
             return f"{term.expr}", 0
         if t.kind == "float":
-            unpack = self.consts.struct("<" + _UNSIGNED[t.bits])
-            pack = self.consts.struct("<" + _FLOAT[t.bits])
+            unpack = self.consts.struct("<" + UNSIGNED_FORMATS[t.bits])
+            pack = self.consts.struct("<" + FLOAT_FORMATS[t.bits])
             return f"{unpack}.unpack({pack}.pack({term.expr}))[0]", 0
         if t.kind == "int":
             return f"({term.expr} & {mask})", 0
@@ -110,25 +111,25 @@ class _Writer:
             if expr is not None:
                 terms.append(f"{expr} << {term.offset}" if term.offset else expr)
         if not terms:
-            for size in _piece_sizes(nbytes):
-                self.run.append((_UNSIGNED[size * 8], repr(constant & ((1 << size * 8) - 1)),
+            for size in piece_sizes(nbytes):
+                self.run.append((UNSIGNED_FORMATS[size * 8], repr(constant & ((1 << size * 8) - 1)),
                                  constant & ((1 << size * 8) - 1)))
                 constant >>= size * 8
             return
         if constant:
             terms.append(str(constant))
         word = " | ".join(terms)
-        sizes = _piece_sizes(nbytes)
+        sizes = piece_sizes(nbytes)
         if len(sizes) == 1:
-            self.run.append((_UNSIGNED[sizes[0] * 8], word, NO_VALUE))
+            self.run.append((UNSIGNED_FORMATS[sizes[0] * 8], word, NO_VALUE))
             return
         local = self.names.new("bits")
         self.lines.append(f"{local} = {word}")
         shift = 0
         for size in sizes:
             mask = (1 << size * 8) - 1
-            self.run.append((_UNSIGNED[size * 8], f"{local} >> {shift} & {mask}" if shift else f"{local} & {mask}",
-                             NO_VALUE))
+            piece = f"{local} >> {shift} & {mask}" if shift else f"{local} & {mask}"
+            self.run.append((UNSIGNED_FORMATS[size * 8], piece, NO_VALUE))
             shift += size * 8
 
     def prim(self, t: DsdlType, expr: str | None, value: Any) -> None:
@@ -146,7 +147,7 @@ class _Writer:
                 self.lines.append(f"{self.acc} |= {constant} << ({at})")
             self.bits += t.bits
             return
-        code = _STD.get((t.kind, t.bits))
+        code = STD_FORMATS.get((t.kind, t.bits))
         if code and self.bits % 8 == 0 and t.kind != "utf8":
             self.close_group()
             self.run.append((code, expr, value))
@@ -179,9 +180,9 @@ class _Writer:
             self.bitmode, self.acc, self.var, self.bits = False, None, None, 0
             return
         if self.group is not None:
-            self.bits = _ceil8(self.bits)
+            self.bits = ceil8(self.bits)
             self.close_group()
-        self.bits = _ceil8(self.bits)
+        self.bits = ceil8(self.bits)
 
     def fold(self) -> str:
         assert self.bitmode
@@ -194,12 +195,12 @@ class _Writer:
         return self.var
 
     # -- fields
-    def write_struct(self, struct_: DsdlStruct, prefix: Path | None) -> None:
+    def write_struct(self, struct_: DsdlStruct, prefix: FieldPath | None) -> None:
         if struct_.union:
             if prefix is not None and any(p[:len(prefix)] == prefix for p in self.values):
                 raise NotImplementedError(f"{prefix}: writing into a union")
             variants = struct_.declared_fields
-            tag_bits = _tag_bits(len(variants))
+            tag_bits = union_tag_bits(len(variants))
             self.prim(DsdlType("uint", tag_bits), "0", 0)
             first = variants[0].type
             assert isinstance(first, DsdlType)
@@ -211,17 +212,17 @@ class _Writer:
                 self.write_field(t, (*prefix, (f.name, None)) if f.name and prefix is not None else None)
         self.align()
 
-    def write_field(self, t: DsdlType, path: Path | None) -> None:
+    def write_field(self, t: DsdlType, path: FieldPath | None) -> None:
         if t.kind == "composite":
-            nested = _struct_of(self.lookup, t.composite)
+            nested = struct_of(self.lookup, t.composite)
             expr, _ = self.value(path)
             if not t.array:
                 self.write_composite(nested, path)
             elif t.array == "fixed":
                 for i in range(t.capacity or 0):
-                    self.write_composite(nested, None if path is None else _elem_path(path, i))
+                    self.write_composite(nested, None if path is None else elem_path(path, i))
             else:
-                if expr is not None or _touches(self.values, path):
+                if expr is not None or touches(self.values, path):
                     raise NotImplementedError(f"{path}: writing a variable-length array of composites")
                 self.align()
                 pb = prefix_bits(t.capacity or 0)
@@ -236,10 +237,10 @@ class _Writer:
             expr, value = self.value(path)
             self.prim(t, expr, value)
 
-    def write_fixed(self, t: DsdlType, path: Path | None) -> None:
+    def write_fixed(self, t: DsdlType, path: FieldPath | None) -> None:
         e, n = t.element, t.capacity or 0
         whole, _ = self.value(path)
-        code = _STD.get((e.kind, e.bits))
+        code = STD_FORMATS.get((e.kind, e.bits))
         if whole is not None:
             if code and not self.bitmode and self.bits % 8 == 0:
                 self.close_group()
@@ -255,10 +256,10 @@ class _Writer:
                 self.prim(e, f"{local}[{i}]", NO_VALUE)
             return
         for i in range(n):
-            expr, value = self.value(None if path is None else _elem_path(path, i))
+            expr, value = self.value(None if path is None else elem_path(path, i))
             self.prim(e, expr, value)
 
-    def write_var(self, t: DsdlType, path: Path | None) -> None:
+    def write_var(self, t: DsdlType, path: FieldPath | None) -> None:
         e, cap = t.element, t.capacity or 0
         pb = prefix_bits(cap)
         expr, _ = self.value(path)
@@ -268,15 +269,16 @@ class _Writer:
         local = self.names.new(path[-1][0] if path else "array")
         byte_like = e.bits == 8 and e.kind in ("uint", "byte", "utf8")
         self.lines.append(f"{local} = bytes({expr})" if byte_like else f"{local} = {expr}")
-        fast = not self.bitmode and self.bits % 8 == 0 and (e.kind, e.bits) in _STD
+        fast = not self.bitmode and self.bits % 8 == 0 and (e.kind, e.bits) in STD_FORMATS
         if fast:
             self.flush_run()
-            prefix = self.consts.struct("<" + _UNSIGNED[pb])
+            prefix = self.consts.struct("<" + UNSIGNED_FORMATS[pb])
             if byte_like:
                 self.parts.append(f"{prefix}.pack(len({local})) + {local}")
             else:
-                code = _STD[(e.kind, e.bits)]
-                self.parts.append(f"_struct.pack(f'<{_UNSIGNED[pb]}{{len({local})}}{code}', len({local}), *{local})")
+                code = STD_FORMATS[(e.kind, e.bits)]
+                count = UNSIGNED_FORMATS[pb]
+                self.parts.append(f"_struct.pack(f'<{count}{{len({local})}}{code}', len({local}), *{local})")
             return
         if not self.bitmode:
             self.to_bitmode()
@@ -288,12 +290,12 @@ class _Writer:
         term_expr, _ = self.term_bits(_Term(0, e, "x", NO_VALUE))
         self.lines += [f"for x in {local}:", f"    {self.acc} |= {term_expr} << {q}", f"    {q} += {e.bits}"]
 
-    def write_composite(self, nested: DsdlStruct, path: Path | None) -> None:
+    def write_composite(self, nested: DsdlStruct, path: FieldPath | None) -> None:
         self.align()
         if nested.sealed:
             self.write_struct(nested, path)
             return
-        if _is_fixed_size(nested, self.lookup):
+        if is_fixed_size(nested, self.lookup):
             size = max_bits(nested, self.lookup) // 8
             self.prim(DsdlType("uint", 32), str(size), size)
             self.write_struct(nested, path)
@@ -309,7 +311,7 @@ class _Writer:
         self.parts.append(f"{self.consts.struct('<I')}.pack(len({local})) + {local}")
 
 
-def cyphal_writer(struct_: DsdlStruct, values: dict[Path, str], lookup: Lookup, names: Names, consts: Constants
+def cyphal_writer(struct_: DsdlStruct, values: dict[FieldPath, str], lookup: Lookup, names: Names, consts: Constants
                   ) -> tuple[list[str], str]:
     """Statements and the expression of the serialized `struct_` with `values` (unset: zero / empty)."""
     w = _Writer(lookup, names, consts, values)
