@@ -109,6 +109,34 @@ def _cmd_ros_install(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_plot(args: argparse.Namespace) -> int:
+    try:  # the report needs matplotlib and mcap: the `runtime` extra
+        from sam_runtime.report.plot import RecordingError, limits_from_params, plot_run
+    except ImportError as exc:
+        print(f"sam-codegen plot: the runtime is not installed ({exc}); install with the [runtime] extra",
+              file=sys.stderr)
+        return 1
+    recording = Path(args.recording)
+    out = Path(args.output) if args.output else recording.with_suffix(".png")
+    params = Path(args.params_file) if args.params_file else None
+    if params is None:  # the project's generated parameters, when the command runs in one
+        try:
+            found = sorted((_workspace(args, need_spec=False).generated / "params").glob("*.params.yaml"))
+        except (WorkspaceError, CyphalPathError, OSError):
+            found = []
+        params = found[0] if found else None
+    try:
+        limits = limits_from_params(params) if params is not None else {}
+        plot_run(recording, out, limits=limits)
+    except (RecordingError, ValueError, OSError) as exc:
+        print(f"sam-codegen plot: {exc}", file=sys.stderr)
+        return 1
+    note = f" (limits from {_shown(params.resolve(), Path.cwd().resolve())})" if params is not None else \
+        " (no parameters file: no depth/altitude limits)"
+    print(f"sam-codegen: {out}{note}")
+    return 0
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -133,6 +161,14 @@ def make_parser() -> argparse.ArgumentParser:
     p.add_argument("--build-dir", default=None,
                    help="parent of the CMake build folders (default: .sam-codegen-cache/ros-build in the project)")
     p.set_defaults(func=_cmd_ros_install)
+    p = sub.add_parser("plot", help="draw a recorded run (an MCAP) as one PNG/SVG report: track, depth, altitude, "
+                       "commands, battery, abort, node states")
+    common(p)
+    p.add_argument("recording", help="the run's MCAP recording (sam-codegen run --record FILE.mcap)")
+    p.add_argument("-o", "--output", help="the picture, .png or .svg (default: the recording's name with .png)")
+    p.add_argument("--params-file", help="the parameters with the depth/altitude limits (default: "
+                   "generated/params/*.params.yaml of the project)")
+    p.set_defaults(func=_cmd_plot)
     return parser
 
 

@@ -1,0 +1,106 @@
+"""`sam-codegen plot`: a recorded run as one picture, from a synthetic dive written with mcap_ros2 (rosbag2's
+conventions); missing topics give "not recorded" panels, a damaged file plots what is readable or is a clear error."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("mcap_ros2")
+pytest.importorskip("matplotlib")
+
+from helpers.mcap_fixture import write_dive
+
+from sam_codegen.cli import main as codegen_main
+from sam_runtime.report.plot import limits_from_params, plot_run, track
+from sam_runtime.report.recording import RecordingError, read_recording
+
+REPO = Path(__file__).resolve().parents[3]
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def dive(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_dive(tmp_path_factory.mktemp("dive") / "dive.mcap", chunk_size=4096)
+
+
+def test_the_recording_reads_back_per_topic_in_time_order(dive: Path) -> None:
+    rec = read_recording(dive)
+    assert not rec.problems and rec.end_s == pytest.approx(60.0)
+    assert rec.types["/abort"] == "sam_msgs/msg/Abort" and len(rec.get("/nav_goal")) == 2
+    times = [t for t, _ in rec.get("/tf")]
+    assert times == sorted(times) and times[0] == 0.0
+
+
+def test_the_track_composes_world_odom_and_odom_base_link(dive: Path) -> None:
+    frame, points = track(read_recording(dive))
+    assert frame == "world"
+    t, x, y, depth = points[-1]
+    # The fixture's odom -> base_link is (x - 0.5, y, -depth) and world -> odom (0.5, 0, 0): world (20, 5) at the end.
+    assert (t, x, y, depth) == pytest.approx((60.0, 20.0, 5.0, 0.0))
+    assert max(p[3] for p in points) == pytest.approx(3.0)
+
+
+def test_limits_come_from_the_generated_parameters() -> None:
+    limits = limits_from_params(REPO / "generated" / "params" / "sam.params.yaml")
+    assert limits == {"safe_depth": 50.0, "critical_depth": 60.0, "safe_altitude": 5.0, "critical_altitude": 2.0}
+
+
+def test_a_node_own_value_overrides_the_wildcard(tmp_path: Path) -> None:
+    params = tmp_path / "p.yaml"
+    params.write_text("/**:\n  ros__parameters: {safe_depth: 10.0}\n"
+                      "performance_monitor:\n  ros__parameters: {safe_depth: 12, critical_depth: 20.0}\n")
+    assert limits_from_params(params) == {"safe_depth": 12.0, "critical_depth": 20.0}
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+def test_plot_writes_the_picture(dive: Path, tmp_path: Path, suffix: str) -> None:
+    out = plot_run(dive, tmp_path / f"run{suffix}", limits={"safe_depth": 2.5, "critical_depth": 60.0})
+    data = out.read_bytes()
+    assert data.startswith(PNG_MAGIC) if suffix == ".png" else b"<svg" in data[:2000]
+    if suffix == ".svg":  # the panels and what they say are in the picture
+        text = data.decode()
+        for words in ("safe_depth 2.5 m", "critical_depth 60 m", "battery below min_battery_percent",
+                      "depth [m]", "speed [rpm]", "charge [%]", "performance_monitor"):
+            assert words in text, words
+
+
+def test_missing_topics_are_not_recorded_panels(tmp_path: Path) -> None:
+    mcap = write_dive(tmp_path / "few.mcap", skip=("/altitude", "/battery_state", "/thruster_rpms", "/diagnostics"))
+    svg = plot_run(mcap, tmp_path / "few.svg").read_text()
+    assert svg.count("not recorded") == 4  # altitude, battery, RPMs, and the node states (the abort is there)
+
+
+def test_a_cut_recording_plots_what_was_read(tmp_path: Path) -> None:
+    whole = write_dive(tmp_path / "whole.mcap", chunk_size=4096).read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(whole[: len(whole) // 2])  # a run killed mid-recording: no summary, a torn last chunk
+    rec = read_recording(cut)
+    assert rec.problems and 5 < rec.end_s < 55
+    svg = plot_run(cut, tmp_path / "cut.svg").read_text()
+    assert "cut short or damaged" in svg
+
+
+def test_not_an_mcap_or_nothing_readable_is_a_clear_error(tmp_path: Path, dive: Path,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.mcap"
+    bad.write_text("not a recording")
+    with pytest.raises(RecordingError, match="not an MCAP file"):
+        read_recording(bad)
+    stub = tmp_path / "stub.mcap"
+    stub.write_bytes(dive.read_bytes()[:100])
+    with pytest.raises(RecordingError, match="no message"):
+        read_recording(stub)
+    assert codegen_main(["plot", str(bad), "-o", str(tmp_path / "x.png")]) == 1
+    assert "not an MCAP file" in capsys.readouterr().err and not (tmp_path / "x.png").exists()
+
+
+def test_the_command_writes_beside_the_recording_with_the_projects_limits(dive: Path, tmp_path: Path,
+                                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    mcap = tmp_path / "run.mcap"
+    mcap.write_bytes(dive.read_bytes())
+    assert codegen_main(["plot", str(mcap), "--params-file", str(REPO / "generated/params/sam.params.yaml")]) == 0
+    assert (tmp_path / "run.png").read_bytes().startswith(PNG_MAGIC)
+    assert "limits from" in capsys.readouterr().out
+    assert codegen_main(["plot", str(mcap), "-o", str(tmp_path / "run.pdf")]) == 1
