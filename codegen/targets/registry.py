@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from sam_codegen.targets import dsdl, dsdl_v0, nodes, ros
-from sam_codegen.targets.docs import graph as docs
+from sam_codegen.targets import docs, dsdl, dsdl_v0, nodes, ros
 from sam_codegen.targets.python import convert, convert_v0
 from sam_codegen.targets.wire import codec, codec_v0
 from sam_codegen.validate import Resolved

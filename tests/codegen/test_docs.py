@@ -18,7 +18,9 @@ import yaml
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.model.diagnostics import SpecError
 from sam_codegen.render.filters import md_cell, md_code, one_line
-from sam_codegen.targets.docs.graph import MD_PATH, SVG_PATH, describe_step, emit, mermaid_label
+from sam_codegen.targets.docs import MD_PATH, SVG_PATH, emit
+from sam_codegen.targets.docs.graph import mermaid_label
+from sam_codegen.targets.docs.wording import describe_step
 from sam_codegen.validate.resolve import Resolved, validate
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -1,15 +1,21 @@
-"""The DroneCAN (UAVCAN v0) part of the interface reference: layouts, the devices' DroneCAN firmware, the spec's own
-v0 types and the DroneCAN mappings."""
+"""The DroneCAN (UAVCAN v0) part of the interface reference (docs/interfaces.md): the layouts, the devices' DroneCAN
+firmware, the spec's own v0 types and the DroneCAN mappings.
+
+dronecan_context gives the template's `dronecan` variable, None when the spec has no DroneCAN at all (one layout, no
+DroneCAN device, type or mapping), so a Cyphal-only reference has no DroneCAN section. A mapping's field table is
+worded by wording.field_rows, as for Cyphal mappings. Imported only by the package (emit).
+"""
 
 from __future__ import annotations
 
-from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS, fmt_number, fmt_rate
-from sam_codegen.targets.docs.markdown import _field_rows
+from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
+from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
 from sam_codegen.validate.mapping_rules import format_path
 from sam_codegen.validate.resolve import Resolved
 
 
 def dronecan_context(resolved: Resolved) -> dict[str, object]:
+    """{"dronecan": the DroneCAN sections of the reference, or None when there is nothing to show}."""
     spec = resolved.spec
     devices_by_id = spec.devices_by_node_id()
     layouts = [{
@@ -37,7 +43,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
     for rm in resolved.dronecan_mappings:
         m = rm.mapping
         to_ros = m.direction == UAVCAN_TO_ROS
-        rows = _field_rows(rm)  # select rows first
+        rows = field_rows(rm)  # select rows first
         mappings.append({
             "name": m.name, "to_ros": to_ros, "direction": "UAVCAN → ROS" if to_ros else "ROS → UAVCAN",
             "data_type": m.data_type, "topic": m.topic, "ros_type": rm.ros_message.full_name,
@@ -50,3 +56,6 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
         })
     return {"dronecan": {"layouts": layouts, "devices": devices, "types": types, "mappings": mappings}
             if devices or types or mappings or len(layouts) > 1 else None}
+
+
+__all__ = ["dronecan_context"]

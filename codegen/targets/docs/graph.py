@@ -1,53 +1,29 @@
-"""Documentation emitter: the interface reference (Markdown) and the dataflow picture (SVG).
+"""The dataflow graph of the docs target, shared by the Mermaid block of interfaces.md and by dataflow.svg.
 
-`emit(resolved)` returns {path under generated/: text}:
+Holds the edge kinds (which are also the CSS classes, arrow markers and colours of both pictures), Edge and Graph,
+PortIndex (who publishes and subscribes each subject, and at what rates), mapping_devices, build_graph, and the
+Mermaid form of the graph (mermaid_label, mermaid_context).
 
-- docs/interfaces.md: the document's `type / topic / contents` tables generated from the spec: topics,
-  messages, parameters, frames, devices, DSDL types and the bridge's mappings with their conversions;
-- docs/dataflow.svg: a picture like the document's Fig. 1, devices -> bridge -> topics -> nodes, laid out
-  here (columns, barycentric rows) so that it needs no graphviz and comes out byte for byte the same.
+Invariants:
 
-Everything that comes from the spec reaches the output through md_cell / md_code / xml_text in the
-templates; this module only computes structure, numbers and the conversion wording.
+- build_graph computes structure only; it adds each edge once (same kind, ends and label) and keeps spec order, so
+  both pictures come out byte for byte the same for the same spec.
+- Graph.topics is in layout order: topics the bridge links, in the order of the devices they come from or go to,
+  then the rest in spec order.
+- Every Graph.links entry (one per bridge mapping whose topic exists) names edges of Graph.edges by index.
+- Names from the spec reach Mermaid only through mermaid_label; the SVG escapes in its template (xml_text).
 """
 
 from __future__ import annotations
 
-import json
-import math
 import re
 from dataclasses import dataclass, field
-from decimal import Decimal
 
-from sam_codegen.conversion_plan import (
-    TO_ROS,
-    TO_UAVCAN,
-    Clamp,
-    Constant,
-    Convert,
-    DecodeUtf8,
-    FixedLength,
-    Limits,
-    LinkPlan,
-    MaxLength,
-    Offset,
-    Pad,
-    Scale,
-    Table,
-    TimestampFromRos,
-    TimestampToRos,
-    Utf8Length,
-    lower_link,
-)
-from sam_codegen.model.spec import Device, Mapping, Scalar, Spec
-from sam_codegen.render.templating import render
-from sam_codegen.validate.mapping_rules import Step
+from sam_codegen.model.spec import Device, Mapping, Spec
 from sam_codegen.validate.nodes import node_published_topics, node_subscribed_topics
 from sam_codegen.validate.resolve import Resolved
 
-MD_PATH = "docs/interfaces.md"
-SVG_PATH = "docs/dataflow.svg"
-SVG_NAME = "dataflow.svg"
+SVG_NAME = "dataflow.svg"  # the picture's file name, beside interfaces.md (which links it)
 
 # Edge kinds, also the CSS class and arrow marker of each.
 UAVCAN_TO_ROS = "uavcan_to_ros"
@@ -69,122 +45,12 @@ LEGEND = [
 TEENSY_COLOUR = "#f39c12"
 
 
-# ---- numbers and conversions -------------------------------------------------------------------------
-
-def fmt_number(value: Scalar | None) -> str:
-    """A number as a reader expects it: exact, short, powers of ten as 1e-4.
-
-    >>> [fmt_number(v) for v in (1.0e-4, 1.0e-8, 0.01, -273.15, 5.0, 100, float("nan"), True, "ok")]
-    ['1e-4', '1e-8', '0.01', '-273.15', '5.0', '100', 'NaN', 'true', '"ok"']
-    """
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "NaN"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e6):
-            return format(Decimal(repr(value)).normalize(), "e")
-        return repr(value)
-    return repr(value)
-
-
-def fmt_rate(rate: float) -> str:
-    """A nominal rate.
-
-    >>> fmt_rate(100.0), fmt_rate(2.5)
-    ('100 Hz', '2.5 Hz')
-    """
-    return f"{int(rate) if float(rate).is_integer() else rate} Hz"
-
-
-def _arithmetic(op: Scale | Offset) -> str:
-    """Scale and offset as the bridge applies them: ros = uavcan × scale + offset, and the inverse."""
-    if isinstance(op, Scale):
-        return f"{'÷' if op.inverse else '×'} {fmt_number(op.factor)}"
-    subtract = (op.amount < 0) != op.inverse
-    return ("- " if subtract else "+ ") + fmt_number(abs(op.amount))
-
-
-def _policy(link: LinkPlan, saturated: str) -> str:
-    return "rejected" if link.reject else saturated
-
-
-def describe_link(link: LinkPlan) -> str:
-    """The conversion of one field link in words, from its planned operations (conversion_plan), in the
-    direction the bridge runs it. Out-of-range handling follows the mapping's on_out_of_range."""
-    step, ops, to_ros = link.step, link.ops, link.to_ros
-    first = ops[0] if ops else None
-    if isinstance(first, Constant):
-        return f"constant {fmt_number(first.value)}"
-    ros = step.ros_type
-    uav = step.uavcan_type
-    assert uav is not None
-    if isinstance(first, TimestampToRos):
-        return f"usec → {ros.base} (0 = receive time)"
-    if isinstance(first, TimestampFromRos):
-        return f"{ros.base} → usec"
-    src, dst = (str(uav), str(ros)) if to_ros else (str(ros), str(uav))
-    if isinstance(first, DecodeUtf8):
-        return f"{src} → {dst} (invalid UTF-8 replaced)"
-    cut = link.first(Utf8Length)
-    if isinstance(cut, Utf8Length):
-        return f"{src} → {dst} (longer than {cut.capacity} bytes {_policy(link, 'cut')})"
-    src_elem, dst_elem = (uav.base_name, ros.base) if to_ros else (ros.base, uav.base_name)
-    text = f"{src} → {dst}" if step.kind == "array" else f"{src_elem} → {dst_elem}"
-    notes: list[str] = []
-    if isinstance(first, Table):
-        pairs = ", ".join(f"{k}: {v}" for k, v in first.pairs)
-        if first.default is not None:  # the inverse rejects what has no key
-            pairs += f", default: {first.default}"
-        text += f" inverse of table {{{pairs}}}" if first.inverse else f" table {{{pairs}}}"
-        if not step.exact:
-            notes.append("not one to one")
-        return text + (f" ({', '.join(notes)})" if notes else "")
-    arithmetic: list[str] = []
-    for op in [*ops, None]:
-        if isinstance(op, (Scale, Offset)):
-            arithmetic.append(_arithmetic(op))
-            continue
-        if arithmetic:  # a run of scale / offset: "× s + o" to ROS, "- o, then ÷ s" to UAVCAN
-            text += " " + (" " if to_ros else ", then ").join(arithmetic)
-            arithmetic = []
-        if isinstance(op, Limits):  # in ROS units, before the inverse scale / offset
-            text += f" limits [{fmt_number(op.declared[0])}, {fmt_number(op.declared[1])}]"
-    convert = link.first(Convert)
-    change = convert.change if isinstance(convert, Convert) else ""
-    if change in ("narrowed", "rounded") or (change and not link.has(Scale, Offset)):
-        notes.append(change)
-    if link.has(Limits, Clamp):  # values beyond the limits or the target's range
-        policy = "out of range rejected" if link.reject else "saturating"
-        notes = [f"{notes[0]}, {policy}"] if notes else [policy]
-    for op in ops:
-        if isinstance(op, Pad):
-            notes.append(f"padded to {op.size}")
-        elif isinstance(op, FixedLength):
-            notes.append(f"other lengths {_policy(link, 'padded or cut')}")
-        elif isinstance(op, MaxLength):
-            notes.append(f"over {op.capacity} elements {_policy(link, 'cut')}")
-    return text + (f" ({', '.join(notes)})" if notes else "")
-
-
-def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
-    """The conversion of one field link in words, in the direction the bridge runs it (its plan, described)."""
-    plan_direction = TO_ROS if direction == UAVCAN_TO_ROS else TO_UAVCAN
-    return describe_link(lower_link(step, plan_direction, "", on_out_of_range == "reject"))
-
-
 # ---- the graph (shared by the Mermaid block and the SVG) -----------------------------------------------
 
 @dataclass
 class Edge:
+    """One arrow: a box (kind, name) to another, with the subject id as label on the device side of the bridge."""
+
     kind: str  # UAVCAN_TO_ROS | ROS_TO_UAVCAN | SUBSCRIBE | PUBLISH
     src: tuple[str, str]  # (box kind, name)
     dst: tuple[str, str]
@@ -193,6 +59,9 @@ class Edge:
 
 @dataclass
 class Graph:
+    """The boxes of the four columns (devices, the bridge, topics, nodes), the edges between them, and how each
+    bridge mapping runs through the bridge."""
+
     devices: list[str]
     bridge: str | None
     topics: list[str]  # in layout order
@@ -235,6 +104,8 @@ def mapping_devices(spec: Spec, mapping: Mapping, index: PortIndex | None = None
 
 
 def build_graph(resolved: Resolved) -> Graph:
+    """The dataflow of the spec: devices -> bridge -> topics for each mapping (reversed for ROS -> UAVCAN), and the
+    topics each node subscribes or publishes. Topics the spec does not declare are left out."""
     spec = resolved.spec
     bridge = spec.bridge
     mappings = bridge.mappings if bridge is not None else []
@@ -318,6 +189,8 @@ def mermaid_label(text: str) -> str:
 
 
 def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
+    """The Mermaid flowchart of the graph for interfaces.md: vertices with unique ids, edges, and the link styles and
+    classes that colour them like the SVG."""
     spec = resolved.spec
     ids: dict[tuple[str, str], str] = {}
     used: set[str] = set()
@@ -334,22 +207,20 @@ def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
             ids[key] = candidate
         return ids[key]
 
-    vertices = []
+    vertices: list[dict[str, str]] = []
+
+    def vertex(kind: str, name: str, shape: tuple[str, str], cls: str, label: list[str]) -> None:
+        vertices.append({"id": node_id(kind, name), "open": shape[0], "close": shape[1], "cls": cls,
+                         "text": "<br/>".join(mermaid_label(part) for part in label)})
+
     for name in graph.devices:
-        d = spec.devices[name]
-        vertices.append({"id": node_id("device", name), "open": '["', "close": '"]', "cls": "device",
-                         "label": [name, f"node {d.node_id}"]})
+        vertex("device", name, ('["', '"]'), "device", [name, f"node {spec.devices[name].node_id}"])
     if graph.bridge is not None and spec.bridge is not None:
-        vertices.append({"id": node_id("bridge", graph.bridge), "open": '[["', "close": '"]]', "cls": "bridge",
-                         "label": [graph.bridge, f"node {spec.bridge.node_id}"]})
+        vertex("bridge", graph.bridge, ('[["', '"]]'), "bridge", [graph.bridge, f"node {spec.bridge.node_id}"])
     for name in graph.topics:
-        vertices.append({"id": node_id("topic", name), "open": '(["', "close": '"])', "cls": "topic",
-                         "label": [name, spec.topics[name].type]})
+        vertex("topic", name, ('(["', '"])'), "topic", [name, spec.topics[name].type])
     for name in graph.nodes:
-        vertices.append({"id": node_id("node", name), "open": '("', "close": '")', "cls": "rosnode",
-                         "label": [name]})
-    for v in vertices:
-        v["text"] = "<br/>".join(mermaid_label(part) for part in v["label"])
+        vertex("node", name, ('("', '")'), "rosnode", [name])
     edges = []
     for e in graph.edges:
         edges.append({"src": node_id(*e.src), "dst": node_id(*e.dst),
@@ -367,18 +238,6 @@ def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     return {"vertices": vertices, "edges": edges, "link_styles": styles, "classes": classes}
 
 
-def emit(resolved: Resolved) -> dict[str, str]:
-    """The documentation files, by path under generated/."""
-    from sam_codegen.targets.docs.dronecan import dronecan_context  # they import this module's helpers
-    from sam_codegen.targets.docs.markdown import markdown_context
-    from sam_codegen.targets.docs.svg import svg_context
-
-    graph = build_graph(resolved)
-    return {
-        MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph),
-                        **dronecan_context(resolved)).rstrip("\n") + "\n",
-        SVG_PATH: render("docs/dataflow.svg.j2", **svg_context(resolved, graph)),
-    }
-
-
-__all__ = ["MD_PATH", "SVG_PATH", "describe_link", "describe_step", "emit", "fmt_number"]
+__all__ = ["EDGE_COLOURS", "LEGEND", "PUBLISH", "ROS_TO_UAVCAN", "SUBSCRIBE", "SVG_NAME", "TEENSY_COLOUR",
+           "UAVCAN_TO_ROS", "Edge", "Graph", "PortIndex", "build_graph", "mapping_devices", "mermaid_context",
+           "mermaid_label"]

@@ -1,0 +1,194 @@
+"""The docs target's words for numbers and conversions: how a value, a rate, a field link and a mapping's field table
+read in the interface reference.
+
+Holds fmt_number and fmt_rate (numbers as a reader expects them), describe_link / describe_step (one field link in
+words) and field_rows (the field table of one Cyphal or DroneCAN mapping).
+
+Invariants:
+
+- The words come from the conversion plan (conversion_plan.lower_link / lower_mapping), the same operations the
+  generated converters run, so the reference cannot describe a conversion the bridge does not do.
+- Every conversion is worded in the direction the bridge runs it (UAVCAN -> ROS or ROS -> UAVCAN), and out-of-range
+  handling follows the mapping's on_out_of_range ("rejected" or the saturating / cutting policy).
+- The text here is plain: nothing is escaped for Markdown or XML. The templates escape everything that comes from the
+  spec (md_cell / md_code / xml_text).
+- Pure functions of their arguments: no state, no I/O.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from decimal import Decimal
+
+from sam_codegen.conversion_plan import (
+    Clamp,
+    Convert,
+    DecodeUtf8,
+    FixedLength,
+    Limits,
+    LinkPlan,
+    MaxLength,
+    Offset,
+    Pad,
+    PlanDirection,
+    ReceiveTime,
+    Scale,
+    SetConstant,
+    Table,
+    TimestampFromRos,
+    TimestampToRos,
+    Utf8Length,
+    lower_link,
+    lower_mapping,
+)
+from sam_codegen.model.spec import Scalar
+from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
+from sam_codegen.validate.mapping_rules import ResolvedMapping, Step, format_path
+
+
+def fmt_number(value: Scalar | None) -> str:
+    """A number as a reader expects it: exact, short, powers of ten as 1e-4.
+
+    >>> [fmt_number(v) for v in (1.0e-4, 1.0e-8, 0.01, -273.15, 5.0, 100, float("nan"), True, "ok")]
+    ['1e-4', '1e-8', '0.01', '-273.15', '5.0', '100', 'NaN', 'true', '"ok"']
+    """
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "NaN"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e6):
+            return format(Decimal(repr(value)).normalize(), "e")
+        return repr(value)
+    return repr(value)
+
+
+def fmt_rate(rate: float) -> str:
+    """A nominal rate.
+
+    >>> fmt_rate(100.0), fmt_rate(2.5)
+    ('100 Hz', '2.5 Hz')
+    """
+    return f"{int(rate) if float(rate).is_integer() else rate} Hz"
+
+
+def _arithmetic(op: Scale | Offset) -> str:
+    """Scale and offset as the bridge applies them: ros = uavcan × scale + offset, and the inverse."""
+    if isinstance(op, Scale):
+        return f"{'÷' if op.inverse else '×'} {fmt_number(op.factor)}"
+    subtract = (op.amount < 0) != op.inverse
+    return ("- " if subtract else "+ ") + fmt_number(abs(op.amount))
+
+
+def _policy(link: LinkPlan, saturated: str) -> str:
+    return "rejected" if link.reject else saturated
+
+
+def describe_link(link: LinkPlan) -> str:
+    """The conversion of one field link in words, from its planned operations (conversion_plan), in the
+    direction the bridge runs it. Out-of-range handling follows the mapping's on_out_of_range."""
+    step, ops, to_ros = link.step, link.ops, link.to_ros
+    first = ops[0] if ops else None
+    if isinstance(first, SetConstant):
+        return f"constant {fmt_number(first.value)}"
+    ros = step.ros_type
+    uav = step.uavcan_type
+    assert uav is not None
+    if isinstance(first, TimestampToRos):
+        return f"usec → {ros.base} (0 = receive time)"
+    if isinstance(first, TimestampFromRos):
+        return f"{ros.base} → usec"
+    src, dst = (str(uav), str(ros)) if to_ros else (str(ros), str(uav))
+    if isinstance(first, DecodeUtf8):
+        return f"{src} → {dst} (invalid UTF-8 replaced)"
+    cut = link.first(Utf8Length)
+    if isinstance(cut, Utf8Length):
+        return f"{src} → {dst} (longer than {cut.capacity} bytes {_policy(link, 'cut')})"
+    src_elem, dst_elem = (uav.base_name, ros.base) if to_ros else (ros.base, uav.base_name)
+    text = f"{src} → {dst}" if step.kind == "array" else f"{src_elem} → {dst_elem}"
+    notes: list[str] = []
+    if isinstance(first, Table):
+        pairs = ", ".join(f"{k}: {v}" for k, v in first.pairs)
+        if first.default is not None:  # the inverse rejects what has no key
+            pairs += f", default: {first.default}"
+        text += f" inverse of table {{{pairs}}}" if first.inverse else f" table {{{pairs}}}"
+        if not step.exact:
+            notes.append("not one to one")
+        return text + (f" ({', '.join(notes)})" if notes else "")
+    arithmetic: list[str] = []
+    for op in [*ops, None]:
+        if isinstance(op, (Scale, Offset)):
+            arithmetic.append(_arithmetic(op))
+            continue
+        if arithmetic:  # a run of scale / offset: "× s + o" to ROS, "- o, then ÷ s" to UAVCAN
+            text += " " + (" " if to_ros else ", then ").join(arithmetic)
+            arithmetic = []
+        if isinstance(op, Limits):  # in ROS units, before the inverse scale / offset
+            text += f" limits [{fmt_number(op.declared[0])}, {fmt_number(op.declared[1])}]"
+    convert = link.first(Convert)
+    change = convert.change if isinstance(convert, Convert) else ""
+    if change in ("narrowed", "rounded") or (change and not link.has(Scale, Offset)):
+        notes.append(change)
+    if link.has(Limits, Clamp):  # values beyond the limits or the target's range
+        policy = "out of range rejected" if link.reject else "saturating"
+        notes = [f"{notes[0]}, {policy}"] if notes else [policy]
+    for op in ops:
+        if isinstance(op, Pad):
+            notes.append(f"padded to {op.size}")
+        elif isinstance(op, FixedLength):
+            notes.append(f"other lengths {_policy(link, 'padded or cut')}")
+        elif isinstance(op, MaxLength):
+            notes.append(f"over {op.capacity} elements {_policy(link, 'cut')}")
+    return text + (f" ({', '.join(notes)})" if notes else "")
+
+
+def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
+    """The conversion of one field link in words, in the direction the bridge runs it (its plan, described)."""
+    plan_direction: PlanDirection = "to_ros" if direction == UAVCAN_TO_ROS else "to_uavcan"
+    return describe_link(lower_link(step, plan_direction, "", on_out_of_range == "reject"))
+
+
+def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
+    """The field table of a mapping (Cyphal or DroneCAN), worded from its conversion plan in the mapping's direction:
+    DroneCAN's select, the header the bridge fills, then each link, the constants it sets and the ignored fields."""
+    m = rm.mapping
+    plan = lower_mapping(rm)
+    to_ros = m.direction == UAVCAN_TO_ROS
+    arrow = "←" if to_ros else "→"
+    rows: list[dict[str, object]] = [
+        {"ros": None, "arrow": "", "uavcan": format_path(list(fs.path)), "conversion": f"select {fs.op.value}"}
+        for fs in plan.uavcan_fields if isinstance(fs.op, SetConstant) and fs.op.select]
+
+    def link_row(link: LinkPlan) -> dict[str, object]:
+        return {"ros": link.step.ros, "arrow": arrow, "uavcan": link.step.uavcan or None,
+                "conversion": describe_link(link)}
+
+    links = list(plan.to_ros if to_ros else plan.to_uavcan)
+    if to_ros and rm.has_header:
+        stamp = next((link for link in links if link.step.ros == "header.stamp"), None)
+        if stamp is not None:
+            links.remove(stamp)
+            rows.append(link_row(stamp))
+        for fs in plan.ros_fields:  # the receive-time stamp (when no link sets it), the frame id
+            text = "receive time" if isinstance(fs.op, ReceiveTime) else f"constant {fs.op.value}"
+            rows.append({"ros": format_path(list(fs.path)), "arrow": arrow, "uavcan": None, "conversion": text})
+    rows.extend(link_row(link) for link in links)
+    for fs in plan.uavcan_fields:
+        if isinstance(fs.op, SetConstant) and not fs.op.select:
+            rows.append({"ros": None, "arrow": arrow, "uavcan": format_path(list(fs.path)),
+                         "conversion": f"constant {fmt_number(fs.op.value)}"})
+    for ignored in m.ignore:
+        rows.append({"ros": None, "arrow": "", "uavcan": ignored, "conversion": "ignored"})
+    return rows
+
+
+__all__ = ["describe_link", "describe_step", "field_rows", "fmt_number", "fmt_rate"]
