@@ -72,8 +72,9 @@ def used_types(resolved: Resolved) -> list[V0Struct]:
             names |= {p.type for p in [*device.dronecan_publishes, *device.dronecan_subscribes]}
     result = []
     for name in sorted(names):
-        struct = catalog.signed(name)
+        struct = catalog.get(name)
         assert isinstance(struct, V0Struct), name
+        catalog.signature(name)
         result.append(struct)
     return result
 
