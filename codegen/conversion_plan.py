@@ -267,11 +267,6 @@ class SetConstant:
     select: bool = False
 
 
-# The old name, for targets/docs until it imports SetConstant (it is another engineer's): remove then. It collides with
-# model.spec.Constant, a declared constant of a type, which is why SetConstant is the name.
-Constant = SetConstant
-
-
 @dataclass(frozen=True)
 class StaticFrameId:
     """header.frame_id: the mapping's frame_id."""

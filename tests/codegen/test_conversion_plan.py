@@ -25,9 +25,9 @@ from sam_codegen.conversion_plan import (
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.targets.docs.wording import describe_link
-from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
-from sam_codegen.targets.python.module import ConvertModule
-from sam_codegen.targets.python.names import LocalNames, ros_aliases
+from sam_codegen.targets.python.convert import convert_module, object_emitter
+from sam_codegen.targets.python.mapping import RosReads
+from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.python.statements import Assign, Statement
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved, validate
@@ -69,10 +69,9 @@ def test_docs_word_the_planned_operations(path: Path) -> None:
 def test_converters_render_the_planned_operations(path: Path) -> None:
     """A ROS -> UAVCAN number link gets a check statement exactly when its plan has a check operation."""
     resolved = _resolved(path)
-    module = ConvertModule(resolved)
-    module.ros_aliases = ros_aliases(resolved)
+    module = convert_module(resolved)
     for rm in resolved.mappings:
-        emitter = MappingEmitter(module, rm)
+        emitter = object_emitter(module, rm)
         for link in emitter.plan.to_uavcan:
             if link.step.kind != "number":
                 continue

@@ -21,21 +21,34 @@ from typing import Any
 
 from sam_codegen.render.templating import render
 from sam_codegen.targets.python.factories import dsdl_factory, ros_factory
-from sam_codegen.targets.python.mapping import MappingEmitter
-from sam_codegen.targets.python.module import ConvertModule
+from sam_codegen.targets.python.mapping import CyphalObjectReader, MappingEmitter, ObjectSignatures, RosObjectReader
+from sam_codegen.targets.python.module import ConvertModule, PycyphalObjects
 from sam_codegen.targets.python.names import isort_key, py_attr, referenced_roots, ros_aliases
 from sam_codegen.targets.python.tables import tables_context
+from sam_codegen.validate.mapping_rules import ResolvedMapping
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["emit"]
+__all__ = ["convert_module", "emit", "object_emitter"]
 
 
 # ---- convert.py ----------------------------------------------------------------------------------------------
 
 
+def convert_module(resolved: Resolved) -> ConvertModule:
+    """convert.py's module: pycyphal objects and ROS messages, the Cyphal mappings' ROS classes aliased."""
+    aliases = ros_aliases(resolved)
+    return ConvertModule(resolved, PycyphalObjects(resolved, aliases), ros_aliases=aliases)
+
+
+def object_emitter(module: ConvertModule, rm: ResolvedMapping) -> MappingEmitter:
+    """The emitter of one Cyphal mapping's object converters."""
+    return MappingEmitter(module, rm, CyphalObjectReader(), RosObjectReader(), ObjectSignatures())
+
+
 def _convert_context(resolved: Resolved) -> dict[str, Any]:
-    module = ConvertModule(resolved)
-    module.ros_aliases = ros_aliases(resolved)
+    module = convert_module(resolved)
+    objects = module.build
+    assert isinstance(objects, PycyphalObjects)
     roots = {resolved.spec.dsdl_root, "uavcan", "reg"} | referenced_roots(resolved)
     for rm in resolved.mappings:
         module.dsdl_ref(rm.dsdl_struct)
@@ -48,7 +61,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
     )
     functions = []
     for rm in resolved.mappings:
-        emitter = MappingEmitter(module, rm)
+        emitter = object_emitter(module, rm)
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
     ros_imports: dict[str, list[str]] = {}
     for full, alias in sorted(module.ros_aliases.items()):
@@ -56,18 +69,18 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         ros_imports.setdefault(package, []).append(name if alias == name else f"{name} as {alias}")
     for names in ros_imports.values():
         names.sort(key=isort_key)
-    factories = [ros_factory(module, full) for full in sorted(module.ros_aliases)]
+    factories = [ros_factory(objects, full) for full in sorted(module.ros_aliases)]
     done: set[str] = set()
-    while len(done) < len(module.dsdl_factories):  # a constructor's defaults may bring in nested ones
-        for name in sorted(set(module.dsdl_factories) - done):
-            factories.append(dsdl_factory(module, module.dsdl_factories[name]))
+    while len(done) < len(objects.dsdl_factories):  # a constructor's defaults may bring in nested ones
+        for name in sorted(set(objects.dsdl_factories) - done):
+            factories.append(dsdl_factory(objects, objects.dsdl_factories[name]))
             done.add(name)
     if any(f.uses_numpy for f in factories):
-        module.dsdl_modules.add("numpy as _np")
+        objects.dsdl_modules.add("numpy as _np")
     return {
         "factories": factories,
         "uses_copy": any(f.uses_copy for f in factories),
-        "dsdl_imports": sorted(module.dsdl_modules),
+        "dsdl_imports": sorted(objects.dsdl_modules),
         "ros_imports": sorted(ros_imports.items()),
         "tables": module.tables,
         "functions": functions,

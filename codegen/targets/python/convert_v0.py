@@ -17,7 +17,9 @@ from sam_codegen.model.spec import V0Struct
 from sam_codegen.render.filters import py_str
 from sam_codegen.render.templating import render
 from sam_codegen.targets import dsdl_v0
-from sam_codegen.targets.python.mapping_v0 import TYPENAMES, V0ConvertModule, V0MappingEmitter
+from sam_codegen.targets.python.mapping import MappingEmitter, ObjectSignatures, RosObjectReader
+from sam_codegen.targets.python.mapping_v0 import TYPENAMES, DroneCanObjects, V0ObjectReader, matches
+from sam_codegen.targets.python.module import ConvertModule
 from sam_codegen.targets.python.names import isort_key, ros_aliases
 from sam_codegen.validate.resolve import Resolved
 
@@ -25,9 +27,10 @@ __all__ = ["emit", "used_types"]
 
 
 def _convert_context(resolved: Resolved) -> dict[str, Any]:
-    module = V0ConvertModule(resolved)
-    module.used_ros = {rm.ros_message.full_name for rm in resolved.dronecan_mappings}
-    module.ros_aliases = ros_aliases(resolved, resolved.dronecan_mappings)
+    aliases = ros_aliases(resolved, resolved.dronecan_mappings)
+    objects = DroneCanObjects(resolved, aliases)
+    objects.used_ros = {rm.ros_message.full_name for rm in resolved.dronecan_mappings}
+    module = ConvertModule(resolved, objects, ros_aliases=aliases)
     module.module_names = (
         set(module.ros_aliases.values())
         | {f"{rm.mapping.name}_to_ros" for rm in resolved.dronecan_mappings}
@@ -36,16 +39,16 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {"CONVERTERS", "MATCHES", "TYPES", "CUSTOM_DSDL_DIRS", "ConversionStats", "Callable", "Any", "Path",
            "_NAN", "_INF", TYPENAMES, "dronecan", "_item", "_always", "check_types", "load_types", "_support"}
     )
-    functions, matches = [], []
+    functions, predicates = [], []
     for rm in resolved.dronecan_mappings:
-        emitter = V0MappingEmitter(module, rm)
+        emitter = MappingEmitter(module, rm, V0ObjectReader(), RosObjectReader(), ObjectSignatures())
         to_ros = emitter.to_ros()
         to_uavcan = emitter.to_uavcan()
         functions.append((to_ros, to_uavcan))
-        matches.append((rm.mapping.name, emitter.matches()))
+        predicates.append((rm.mapping.name, matches(emitter)))
     ros_imports: dict[str, list[str]] = {}
     for full, alias in sorted(module.ros_aliases.items()):
-        if full not in module.used_ros:
+        if full not in objects.used_ros:
             continue  # built by its parent's class
         package, name = full.split("/")
         ros_imports.setdefault(package, []).append(name if alias == name else f"{name} as {alias}")
@@ -55,7 +58,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         "ros_imports": sorted(ros_imports.items()),
         "tables": module.tables,
         "functions": functions,
-        "matches": matches,
+        "matches": predicates,
         "types": [(py_str(t.name), str(t.data_type_id), f"0x{t.signature:016X}") for t in used_types(resolved)],
         "custom_dirs": [py_str(d) for d in dsdl_v0.load_dirs(resolved)],
     }

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from sam_codegen.render.pysource import LINE_LIMIT, typed_literal
-from sam_codegen.targets.python.module import ConvertModule
+from sam_codegen.targets.python.module import PycyphalObjects
 from sam_codegen.targets.python.names import dsdl_factory_name, py_attr, ros_factory_name
 
 # rosidl_generator_py keeps fixed-size arrays of these in numpy arrays (`char` is uint8 in ROS 2 IDL).
@@ -54,7 +54,7 @@ def _factory_field(slot: str, param: str, default: str, given: list[tuple[str | 
     return FactoryField(branches=((f"{param} is None", f"_m.{slot} = {default}"), *given))
 
 
-def ros_factory(module: ConvertModule, full: str) -> Factory:
+def ros_factory(module: PycyphalObjects, full: str) -> Factory:
     """What templates/python/convert.py.j2 needs to write the fast constructor of one ROS message class.
 
     Scalars, strings and nested messages go straight into their slots, as rosidl_generator_py's setters put them
@@ -111,7 +111,7 @@ def _numpy_dtype(t: DsdlType) -> str:
     return f"_np.{t.kind}{bits}"
 
 
-def dsdl_factory(module: ConvertModule, struct: DsdlStruct) -> Factory:
+def dsdl_factory(module: PycyphalObjects, struct: DsdlStruct) -> Factory:
     """What templates/python/convert.py.j2 needs to write the fast constructor of one pycyphal class.
 
     Values go straight into the attributes pycyphal's properties keep them in (`_<name>`), converted as its

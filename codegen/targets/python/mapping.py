@@ -1,9 +1,23 @@
-"""One mapping's conversion plan said in Python: its to_ros and to_uavcan functions of convert.py."""
+"""One mapping's conversion plan said in Python: its to_ros and to_uavcan functions.
+
+MappingEmitter holds the value semantics (every check, saturation, stats key, table and stamp) and is the same for
+every variant; what differs between convert.py, convert_v0.py, codec.py and codec_v0.py is composed in, as
+strategies per variant (object or wire x Cyphal or DroneCAN), the way pycyphal combines transport and media:
+
+- a UavcanReader: how the to_ros function reads the UAVCAN side (object attributes, or locals decoded from bytes);
+- a RosReader: how the to_uavcan function reads the ROS side (message fields, or locals decoded from CDR);
+- Signatures: the functions' names, parameters and docstrings;
+- the ConvertModule's Construction: how the result tree becomes the return (module.py).
+
+Object converters: CyphalObjectReader and RosObjectReader here, V0ObjectReader in mapping_v0; the wire codecs'
+readers are in targets/wire.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 from sam_codegen.conversion_plan import (
     CHECK_OPS,
@@ -57,9 +71,48 @@ class RosReads:
     time: Callable[[tuple], tuple[str, str]]
 
 
+class UavcanReader(Protocol):
+    """How a to_ros function reads the received UAVCAN message."""
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> dict[tuple, str]:
+        """Bind what the steps read (fn.decode, fn.binds); return the locals of arrays read by index."""
+        ...
+
+    def access(self, path: tuple) -> str:
+        """The expression of the field at `path`."""
+        ...
+
+    def as_list(self, expr: str) -> str:
+        """An array field's expression as a list of plain Python values."""
+        ...
+
+
+class RosReader(Protocol):
+    """How a to_uavcan function reads the ROS message."""
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads: ...
+
+    def array_read(self, expr: str, ros_type: RosType) -> str:
+        """A ROS array field read as `expr`, as a list of plain Python values."""
+        ...
+
+
+class Signatures(Protocol):
+    """The name, parameters, return type and docstring of a mapping's two functions (bodies empty)."""
+
+    def to_ros(self, em: MappingEmitter) -> FunctionDraft: ...
+
+    def to_uavcan(self, em: MappingEmitter) -> FunctionDraft: ...
+
+
 class MappingEmitter:
-    def __init__(self, module: ConvertModule, rm: ResolvedMapping) -> None:
+    """One mapping's two functions, in the variant its module's Construction and the given strategies make."""
+
+    def __init__(self, module: ConvertModule, rm: ResolvedMapping, uavcan: UavcanReader, ros: RosReader,
+                 signatures: Signatures) -> None:
         self.module, self.rm = module, rm
+        self.uavcan, self.ros, self.signatures = uavcan, ros, signatures
+        module.start(rm)
         self.mapping = rm.mapping
         self.name = rm.mapping.name
         self.reject = rm.mapping.on_out_of_range == "reject"
@@ -83,21 +136,16 @@ class MappingEmitter:
         """Values first (every check and drop before anything is built), then one nested constructor call."""
         rm = self.rm
         names = LocalNames(self.module.module_names)
-        fn = FunctionDraft(
-            f"{self.name}_to_ros",
-            [f"src: {self.dsdl_ref}", "receive_ns: int", "stats: ConversionStats"],
-            f"{self.ros_class} | None",
-            [f"Mapping {self.name!r}, UAVCAN -> ROS.", "", f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"],
-        )
+        fn = self.signatures.to_ros(self)
         steps = list(rm.steps)
-        listed = self.bind_uavcan_arrays(fn, names, steps)
+        listed = self.uavcan.bind(self, fn, names, steps)
 
         def uav_read(path: tuple) -> str:
             if path[-1][1] is not None:
                 array_path = (*path[:-1], (path[-1][0], None))
                 if array_path in listed:
                     return f"{listed[array_path]}[{path[-1][1]}]"
-            return self.uav_access("src", path)
+            return self.uavcan.access(path)
 
         root = self.module.ros_ctor(rm.ros_message)
         for fs in self.plan.ros_fields:
@@ -109,30 +157,8 @@ class MappingEmitter:
         for s in steps:
             for path, value in self.step_to_ros(s, names, uav_read, fn.statements):
                 self.module.insert(root, path, value)
-        fn.result = self.module.format_return(root)
+        fn.result = self.module.format_return(root, names)
         return fn
-
-    def bind_uavcan_arrays(self, fn: FunctionDraft, names: LocalNames, steps: list[Step],
-                           listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
-        """Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one list each (beside those
-        in `listed` already)."""
-        listed = {} if listed is None else listed
-        for s in steps:
-            if s.kind in ("number", "table") and s.uavcan_path and s.uavcan_path[-1][1] is not None:
-                array_path = (*s.uavcan_path[:-1], (s.uavcan_path[-1][0], None))
-                if array_path not in listed:
-                    listed[array_path] = names.new(format_path(list(array_path)))
-                    fn.binds.append(Assign(listed[array_path],
-                                        self.uav_list(self.uav_access("src", array_path))))
-        return listed
-
-    def uav_access(self, base: str, path: tuple) -> str:
-        """The expression reading a field of a received UAVCAN object."""
-        return access(base, path, py_attr)
-
-    def uav_list(self, expr: str) -> str:
-        """A UAVCAN array as a list of plain Python values (pycyphal keeps them in numpy arrays)."""
-        return f"{expr}.tolist()"
 
     def step_to_ros(self, s: Step, names: LocalNames, uav_read, statements: list[Statement]
                     ) -> list[tuple[tuple, str]]:
@@ -169,7 +195,7 @@ class MappingEmitter:
             return [(s.ros_path, var)]
         # array: the elements, their float32 range, then the padding
         elem = pys.to_ros_expr("x", ops, ros_base)
-        base_list = self.uav_list(read)
+        base_list = self.uavcan.as_list(read)
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
         pad = link.first(Pad)
         overflow = link.has(Clamp)
@@ -202,14 +228,9 @@ class MappingEmitter:
     def to_uavcan(self) -> FunctionDraft:
         rm = self.rm
         names = LocalNames(self.module.module_names)
-        fn = FunctionDraft(
-            f"{self.name}_to_uavcan",
-            [f"src: {self.ros_class}", "stats: ConversionStats"],
-            f"{self.dsdl_ref} | None",
-            [f"Mapping {self.name!r}, ROS -> UAVCAN.", "", f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"],
-        )
+        fn = self.signatures.to_uavcan(self)
         steps = [s for s in rm.steps if s.uavcan_path]
-        reads = self.ros_reader(fn, names, steps)
+        reads = self.ros.bind(self, fn, names, steps)
         root = self.module.dsdl_ctor(rm.dsdl_struct)
         for s in steps:
             value = self.step_to_uavcan(s, names, reads, fn.statements)
@@ -217,59 +238,8 @@ class MappingEmitter:
         for fs in self.plan.uavcan_fields:  # uavcan_values, then DroneCAN's select
             assert isinstance(fs.op, SetConstant) and isinstance(fs.type, DsdlType)
             self.module.insert(root, fs.path, dsdl_literal(fs.op.value, fs.type))
-        fn.result = self.module.format_return(root)
+        fn.result = self.module.format_return(root, names)
         return fn
-
-    def ros_reader(self, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
-        """The to_uavcan reads: binds what the steps read (appended to fn.binds) and returns how to read a path.
-        Overridden by the wire codecs, which read from CDR bytes."""
-        # Locals for ROS parents read more than once, and one .tolist() per ROS array read by index.
-        reads: dict[tuple, int] = {}
-        for s in steps:
-            if s.kind == "time":
-                reads[s.ros_path] = reads.get(s.ros_path, 0) + 2
-            elif len(s.ros_path) > 1:
-                reads[s.ros_path[:-1]] = reads.get(s.ros_path[:-1], 0) + 1
-        parent_local: dict[tuple, str] = {}
-        for parent, count in reads.items():
-            if count >= 2 and all(index is None for _, index in parent):
-                parent_local[parent] = names.new(parent[-1][0])
-                fn.binds.append(Assign(parent_local[parent], access("src", parent)))
-        listed: dict[tuple, str] = {}
-        for s in steps:
-            if s.kind in ("number", "table") and s.ros_path[-1][1] is not None:
-                array_path = (*s.ros_path[:-1], (s.ros_path[-1][0], None))
-                if array_path not in listed:
-                    listed[array_path] = names.new(format_path(list(array_path)))
-                    fn.binds.append(Assign(listed[array_path],
-                                        self.ros_array_read(access("src", array_path), s.ros_type)))
-
-        def ros_read(path: tuple) -> str:
-            if path in parent_local:
-                return parent_local[path]
-            if path[-1][1] is not None:
-                array_path = (*path[:-1], (path[-1][0], None))
-                if array_path in listed:
-                    return f"{listed[array_path]}[{path[-1][1]}]"
-            parent = path[:-1]
-            if parent in parent_local:
-                return access(parent_local[parent], path[-1:])
-            return access("src", path)
-
-        def time_read(path: tuple) -> tuple[str, str]:
-            stamp = ros_read(path)
-            return f"{stamp}.sec", f"{stamp}.nanosec"
-
-        return RosReads(ros_read, time_read)
-
-    def ros_array_read(self, expr: str, ros_type: RosType) -> str:
-        """A ROS array field as a list of plain Python values."""
-        base = ros_type.base
-        if base == "byte":
-            return f"[b[0] for b in {expr}]"
-        if base == "bool":
-            return f"list({expr})"
-        return f"{expr}.tolist()"
 
     def step_to_uavcan(self, s: Step, names: LocalNames, reads: RosReads, statements: list[Statement]) -> str:
         """Append the statements of one link (its planned operations); return the expression of the UAVCAN
@@ -304,7 +274,7 @@ class MappingEmitter:
         elem_uav = uav.element
         var = names.new(s.uavcan)
         elem = pys.to_uavcan_expr("x", ops)
-        base_list = self.ros_array_read(read, s.ros_type)
+        base_list = self.ros.array_read(read, s.ros_type)
         expr = base_list if elem == "x" else f"[{elem} for x in {base_list}]"
         statements.append(Assign(var, expr))
         for op in ops:
@@ -338,3 +308,109 @@ class MappingEmitter:
         if pending:
             statements.append(Assign(var, pys.to_uavcan_expr(var, pending)))
         return var
+
+
+# ---- convert.py's strategies -------------------------------------------------------------------------------------
+
+
+def bind_indexed_arrays(reader: UavcanReader, fn: FunctionDraft, names: LocalNames, steps: list[Step],
+                        listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
+    """Locals for UAVCAN primitive arrays read by index (rate_gyro_latest[0..2]): one list each (beside those in
+    `listed` already)."""
+    listed = {} if listed is None else listed
+    for s in steps:
+        if s.kind in ("number", "table") and s.uavcan_path and s.uavcan_path[-1][1] is not None:
+            array_path = (*s.uavcan_path[:-1], (s.uavcan_path[-1][0], None))
+            if array_path not in listed:
+                listed[array_path] = names.new(format_path(list(array_path)))
+                fn.binds.append(Assign(listed[array_path], reader.as_list(reader.access(array_path))))
+    return listed
+
+
+class CyphalObjectReader:
+    """A received pycyphal object: attributes (pycyphal's names), numpy arrays read with .tolist()."""
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> dict[tuple, str]:
+        return bind_indexed_arrays(self, fn, names, steps)
+
+    def access(self, path: tuple) -> str:
+        return access("src", path, py_attr)
+
+    def as_list(self, expr: str) -> str:
+        return f"{expr}.tolist()"
+
+
+class RosObjectReader:
+    """A ROS message object: its fields, parents read more than once bound to a local."""
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
+        # Locals for ROS parents read more than once, and one .tolist() per ROS array read by index.
+        reads: dict[tuple, int] = {}
+        for s in steps:
+            if s.kind == "time":
+                reads[s.ros_path] = reads.get(s.ros_path, 0) + 2
+            elif len(s.ros_path) > 1:
+                reads[s.ros_path[:-1]] = reads.get(s.ros_path[:-1], 0) + 1
+        parent_local: dict[tuple, str] = {}
+        for parent, count in reads.items():
+            if count >= 2 and all(index is None for _, index in parent):
+                parent_local[parent] = names.new(parent[-1][0])
+                fn.binds.append(Assign(parent_local[parent], access("src", parent)))
+        listed: dict[tuple, str] = {}
+        for s in steps:
+            if s.kind in ("number", "table") and s.ros_path[-1][1] is not None:
+                array_path = (*s.ros_path[:-1], (s.ros_path[-1][0], None))
+                if array_path not in listed:
+                    listed[array_path] = names.new(format_path(list(array_path)))
+                    fn.binds.append(Assign(listed[array_path],
+                                        self.array_read(access("src", array_path), s.ros_type)))
+
+        def ros_read(path: tuple) -> str:
+            if path in parent_local:
+                return parent_local[path]
+            if path[-1][1] is not None:
+                array_path = (*path[:-1], (path[-1][0], None))
+                if array_path in listed:
+                    return f"{listed[array_path]}[{path[-1][1]}]"
+            parent = path[:-1]
+            if parent in parent_local:
+                return access(parent_local[parent], path[-1:])
+            return access("src", path)
+
+        def time_read(path: tuple) -> tuple[str, str]:
+            stamp = ros_read(path)
+            return f"{stamp}.sec", f"{stamp}.nanosec"
+
+        return RosReads(ros_read, time_read)
+
+    def array_read(self, expr: str, ros_type: RosType) -> str:
+        """A ROS array field as a list of plain Python values."""
+        base = ros_type.base
+        if base == "byte":
+            return f"[b[0] for b in {expr}]"
+        if base == "bool":
+            return f"list({expr})"
+        return f"{expr}.tolist()"
+
+
+class ObjectSignatures:
+    """convert.py's and convert_v0.py's functions: `<mapping>_to_ros(src, receive_ns, stats)` and
+    `<mapping>_to_uavcan(src, stats)`."""
+
+    def to_ros(self, em: MappingEmitter) -> FunctionDraft:
+        rm = em.rm
+        return FunctionDraft(
+            f"{em.name}_to_ros",
+            [f"src: {em.dsdl_ref}", "receive_ns: int", "stats: ConversionStats"],
+            f"{em.ros_class} | None",
+            [f"Mapping {em.name!r}, UAVCAN -> ROS.", "", f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"],
+        )
+
+    def to_uavcan(self, em: MappingEmitter) -> FunctionDraft:
+        rm = em.rm
+        return FunctionDraft(
+            f"{em.name}_to_uavcan",
+            [f"src: {em.ros_class}", "stats: ConversionStats"],
+            f"{em.dsdl_ref} | None",
+            [f"Mapping {em.name!r}, ROS -> UAVCAN.", "", f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"],
+        )

@@ -7,6 +7,7 @@ convert_v0.used_types) and import nothing of it. Every spec text reaches the out
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from sam_codegen.model.spec import Port, Qos, V0Struct
@@ -21,6 +22,7 @@ from sam_codegen.render.pysource import (
 )
 from sam_codegen.targets import dsdl_v0
 from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
+from sam_codegen.targets.python import table_types
 from sam_codegen.targets.python.convert_v0 import used_types
 from sam_codegen.targets.python.names import py_class_name, py_module
 from sam_codegen.targets.ros import build_order
@@ -28,7 +30,7 @@ from sam_codegen.validate.mapping_rules import format_path
 from sam_codegen.validate.nodes import class_name, node_topic_qos
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["cyphal_context", "dronecan_context", "nodes_context", "tables_context"]
+__all__ = ["cyphal_context", "dronecan_context", "nodes_context", "table_types_source", "tables_context"]
 
 
 def _ros_type_parts(full: str) -> tuple[str, str, str]:
@@ -206,6 +208,14 @@ def nodes_context(resolved: Resolved) -> dict[str, Any]:
     }
 
 
+def table_types_source() -> str:
+    """The classes of table_types.py as source text: the module after its docstring, copied into tables.py."""
+    assert table_types.__file__ is not None
+    text = Path(table_types.__file__).read_text(encoding="utf-8")
+    return text[text.index("from __future__ import annotations"):].rstrip("\n")
+
+
 def tables_context(resolved: Resolved) -> dict[str, Any]:
     """Everything templates/python/tables.py.j2 renders."""
-    return {**cyphal_context(resolved), **nodes_context(resolved), **dronecan_context(resolved)}
+    return {"table_types": table_types_source(), **cyphal_context(resolved), **nodes_context(resolved),
+            **dronecan_context(resolved)}

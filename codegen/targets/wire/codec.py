@@ -6,18 +6,20 @@ Per mapping ``m`` of the spec's Cyphal mappings, both directions:
   message's CDR bytes (encapsulation header included) and its header stamp in ns (-1 without a header);
 - ``m_ros_to_wire(cdr, stats) -> payload | None``: CDR bytes (as a raw subscription gives them) -> the payload.
 
-The value semantics are convert.py's, literally: the emitter is targets.python's ``MappingEmitter`` with the reads
-and the result replaced. Reads come from the payload / CDR decoded by cyphal_read / cdr_read into locals (the
-function's `decode` lines), and are handed to the emitter as values (``RosReads``, ``uav_access``); the result tree
-(``CtorNode``) is written by the wire writers instead of calling constructors; the statements between them (checks,
-saturation, stats keys, tables, stamps) are the same typed statements, rendered by the same
-templates/python/statements.j2. Nothing is patched in generated text. codec.py imports the standard library only.
+The value semantics are convert.py's, literally: the emitter is targets.python's ``MappingEmitter`` composed with
+this module's reads (CyphalWireReader, CdrReader) and result (CyphalWire) instead of the object ones. Reads come
+from the payload / CDR decoded by cyphal_read / cdr_read into locals (the function's `decode` lines) and reach the
+emitter as values (expressions per path, RosReads); the result tree (``CtorNode``) is written by the wire writers
+instead of calling constructors; the statements between them (checks, saturation, stats keys, tables, stamps) are
+the same typed statements, rendered by the same templates/python/statements.j2. Nothing is patched in generated
+text. codec.py imports the standard library only.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import DsdlType, RosType
@@ -27,10 +29,11 @@ from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode
 from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
-from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
+from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["HEADER", "WireCtorNode", "codec_context", "emit", "stamp_ns", "tree_values", "wrap_body"]
+__all__ = ["HEADER", "CdrReader", "CyphalWire", "CyphalWireReader", "WireCtorNode", "WireSignatures", "codec_context",
+           "emit", "stamp_ns", "tree_values", "wrap_body"]
 
 HEADER = "std_msgs/Header"
 PAYLOAD, CDR = "payload", "cdr"
@@ -47,14 +50,22 @@ class WireCtorNode(CtorNode):
         self.of = of
 
 
-class _CodecModule(ConvertModule):
-    """codec.py's view of types: nothing imported, nothing constructed; trees become bytes."""
+class CyphalWire:
+    """codec.py's Construction: nothing imported, nothing constructed; the result tree is written as CDR (to_ros)
+    or as a Cyphal payload (to_uavcan) by the wire writers, with module constants from `consts`."""
 
-    consts: Constants
-    names: LocalNames  # the locals of the function being emitted (its writers take names from it too)
+    sized_by_use: ClassVar[bool] = False
+
+    def __init__(self, resolved: Resolved, consts: Constants) -> None:
+        self.resolved, self.consts = resolved, consts
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return struct.name
+
+    def struct(self, name: str) -> DsdlStruct:
+        struct = self.resolved.dsdl.get(name)
+        assert struct is not None, name
+        return struct
 
     def dsdl_ctor(self, struct: DsdlStruct) -> CtorNode:
         return WireCtorNode(struct, [(f.name, f.type) for f in struct.fields])
@@ -65,10 +76,9 @@ class _CodecModule(ConvertModule):
     def element_default(self, t: DsdlType | RosType) -> str:
         return "None"  # an element nobody sets: the writers give the type's default
 
-    def format_return(self, root: CtorNode) -> list[str]:
+    def format_return(self, module: ConvertModule, root: CtorNode, names: LocalNames) -> list[str]:
         assert isinstance(root, WireCtorNode)
         values = tree_values(root)
-        names = self.names
         if isinstance(root.of, RosMessage):
             lines, expr = cdr_writer(root.of, values, self.resolved.ros.get, names, self.consts)
             return wrap_body([*lines, f"return {expr}, {stamp_ns(root.of, values)}"])
@@ -129,86 +139,94 @@ def stamp_ns(message: RosMessage, values: dict[tuple, str]) -> str:
     return f"{sec} * 1_000_000_000 + {nanosec}"
 
 
-class _CodecEmitter(MappingEmitter):
-    module: _CodecModule
+class CyphalWireReader:
+    """A Cyphal payload: the fields the mapping reads, decoded into locals (lists for arrays). One per mapping."""
 
-    def __init__(self, module: _CodecModule, rm: ResolvedMapping) -> None:
-        super().__init__(module, rm)
+    def __init__(self, build: CyphalWire) -> None:
+        self.build = build
         self.reads: dict[tuple, str] = {}
-        self.stamps: dict[str, tuple[str, str]] = {}  # token -> (sec local, nanosec local)
 
-    # -- UAVCAN -> ROS: the reads come out of the payload
-    def bind_uavcan_arrays(self, fn: FunctionDraft, names: LocalNames, steps: list[Step],
-                           listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> dict[tuple, str]:
         wanted = {tuple(s.uavcan_path) for s in steps if s.kind != "value" and s.uavcan_path}
-        self.module.names = names
-        lines, self.reads = cyphal_reader(self.rm.dsdl_struct, wanted, self.module.resolved.dsdl.get, names,
-                                          self.module.consts, PAYLOAD)
+        lines, self.reads = cyphal_reader(em.rm.dsdl_struct, wanted, self.build.resolved.dsdl.get, names,
+                                          self.build.consts, PAYLOAD)
         fn.decode = wrap_body(lines)
         return {}
 
-    def uav_access(self, base: str, path: tuple) -> str:
+    def access(self, path: tuple) -> str:
         return self.reads[tuple(path)]
 
-    def uav_list(self, expr: str) -> str:
+    def as_list(self, expr: str) -> str:
         return expr  # the reader's locals are lists already
 
-    # -- ROS -> UAVCAN: the reads come out of the CDR
-    def ros_reader(self, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
+
+class CdrReader:
+    """ROS CDR bytes: the fields the mapping reads, decoded into locals (a Time as its sec and nanosec)."""
+
+    def __init__(self, resolved: Resolved, consts: Constants) -> None:
+        self.resolved, self.consts = resolved, consts
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
         wanted: set[tuple] = set()
         for s in steps:
             if s.kind == "time":
                 wanted |= {(*s.ros_path, ("sec", None)), (*s.ros_path, ("nanosec", None))}
             else:
                 wanted.add(tuple(s.ros_path))
-        self.module.names = names
-        lines, found = cdr_reader(self.rm.ros_message, wanted, self.module.resolved.ros.get, names,
-                                  self.module.consts, CDR)
+        lines, found = cdr_reader(em.rm.ros_message, wanted, self.resolved.ros.get, names, self.consts, CDR)
         fn.decode = wrap_body(lines)
         return RosReads(lambda path: found[tuple(path)],
                         lambda path: (found[(*path, ("sec", None))], found[(*path, ("nanosec", None))]))
 
-    def ros_array_read(self, expr: str, ros_type: RosType) -> str:
+    def array_read(self, expr: str, ros_type: RosType) -> str:
         return expr  # the reader's locals are lists of plain values already (byte arrays as ints)
 
-    # -- the functions, named and typed as codec.py's API says
-    def wire_to_ros(self) -> FunctionDraft:
-        fn = self.to_ros()
-        rm = self.rm
-        fn.name = f"{self.name}_wire_to_ros"
-        fn.params = ["payload: bytes | bytearray | memoryview", "receive_ns: int", "stats: Any"]
-        fn.returns = "tuple[bytes, int] | None"
-        fn.doc = [f"Mapping {self.name!r}, UAVCAN -> ROS, payload bytes -> CDR bytes and stamp [ns].", "",
-                  f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"]
-        return fn
 
-    def ros_to_wire(self) -> FunctionDraft:
-        fn = self.to_uavcan()
-        rm = self.rm
-        fn.name = f"{self.name}_ros_to_wire"
-        fn.params = ["cdr: bytes | memoryview", "stats: Any"]
-        fn.returns = "bytes | None"
-        fn.doc = [f"Mapping {self.name!r}, ROS -> UAVCAN, CDR bytes -> payload bytes.", "",
-                  f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"]
-        return fn
+@dataclass(frozen=True)
+class WireSignatures:
+    """The codecs' functions: `<mapping>_wire_to_ros(payload, receive_ns, stats)` and
+    `<mapping>_ros_to_wire(cdr, stats)`; `to_ros_doc` / `to_uavcan_doc` end their docstrings' first lines."""
+
+    to_ros_doc: str = ", payload bytes -> CDR bytes and stamp [ns]."
+    to_uavcan_doc: str = ", CDR bytes -> payload bytes."
+
+    def to_ros(self, em: MappingEmitter) -> FunctionDraft:
+        rm = em.rm
+        return FunctionDraft(
+            f"{em.name}_wire_to_ros",
+            ["payload: bytes | bytearray | memoryview", "receive_ns: int", "stats: Any"],
+            "tuple[bytes, int] | None",
+            [f"Mapping {em.name!r}, UAVCAN -> ROS{self.to_ros_doc}", "",
+             f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"],
+        )
+
+    def to_uavcan(self, em: MappingEmitter) -> FunctionDraft:
+        rm = em.rm
+        return FunctionDraft(
+            f"{em.name}_ros_to_wire",
+            ["cdr: bytes | memoryview", "stats: Any"],
+            "bytes | None",
+            [f"Mapping {em.name!r}, ROS -> UAVCAN{self.to_uavcan_doc}", "",
+             f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"],
+        )
 
 
 def codec_context(resolved: Resolved) -> dict[str, Any]:
-    module = _CodecModule(resolved)
-    module.consts = Constants("_W")
-    module.ros_aliases = {}
+    consts = Constants("_W")
+    build = CyphalWire(resolved, consts)
+    module = ConvertModule(resolved, build)
     for rm in resolved.mappings:
         module.ros_aliases.setdefault(rm.ros_message.full_name, rm.ros_message.full_name)
     module.module_names = set(MODULE_NAMES) | {f"{rm.mapping.name}_wire_to_ros" for rm in resolved.mappings} \
         | {f"{rm.mapping.name}_ros_to_wire" for rm in resolved.mappings}
     functions = []
     for rm in resolved.mappings:
-        emitter = _CodecEmitter(module, rm)
-        functions.append((emitter.wire_to_ros(), emitter.ros_to_wire()))
+        emitter = MappingEmitter(module, rm, CyphalWireReader(build), CdrReader(resolved, consts), WireSignatures())
+        functions.append((emitter.to_ros(), emitter.to_uavcan()))
     return {
-        "uses_array": "array" in module.consts.imports,
+        "uses_array": "array" in consts.imports,
         "prelude": [*MODULE_PRELUDE, *CYPHAL_PRELUDE],
-        "constants": module.consts.lines(),
+        "constants": consts.lines(),
         "tables": module.tables,
         "functions": functions,
         "mappings": [rm.mapping.name for rm in resolved.mappings],

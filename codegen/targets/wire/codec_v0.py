@@ -4,11 +4,12 @@ Per mapping, ``<mapping>_wire_to_ros(payload, receive_ns, stats)`` (v0 payload b
 stamp) and ``<mapping>_ros_to_wire(cdr, stats)`` (CDR -> payload bytes), and ``WIRE_MATCHES``: convert_v0.py's
 converters and MATCHES on bytes instead of objects.
 
-The value semantics are convert_v0's, not re-implemented: the mapping emitters here are emit_python_v0's, with only
-what they read and what they build replaced. Reads come from locals that wire_v0's reader decodes from the payload
-(wire_cdr's from the CDR); the tree of values the converter would pass to the constructors goes to wire_cdr's
-writer (ROS) or wire_v0_writer (DroneCAN) instead. The checks, saturation, stats keys, tables and stamps are the
-same statements, rendered by the same templates/python/statements.j2.
+The value semantics are convert_v0's, not re-implemented: the emitter is targets.python's MappingEmitter composed with
+this module's reads and result instead of the object ones. Reads come from locals that v0_read decodes from the
+payload (V0WireReader; the DroneCAN elements a mapping needs are bound by mapping_v0.bind_required_elements, as for
+objects) and cdr_read from the CDR (V0CdrReader); the tree of values the converter would pass to the constructors goes
+to cdr_write (ROS) or v0_write (DroneCAN) instead (DroneCanWire). The checks, saturation, stats keys, tables and
+stamps are the same typed statements, rendered by the same templates/python/statements.j2.
 
 Where the object path refuses a payload, the codec raises WireError: where dronecan's decoding raises (see
 wire_v0), and where a decoded array reaches a ROS sequence beyond its bound (rclpy refuses to serialize it). A ROS
@@ -18,41 +19,50 @@ fixed array gets the first elements of a longer one, as rclpy serializes it.
 from __future__ import annotations
 
 import ast
-from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
-from sam_codegen.model.spec import RosMessage, V0Struct
+from sam_codegen.model.spec import DsdlStruct, RosMessage, V0Struct
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.render.templating import render
-from sam_codegen.targets.python.mapping import RosReads
-from sam_codegen.targets.python.mapping_v0 import KeyedItems, V0ConvertModule, V0MappingEmitter
-from sam_codegen.targets.python.module import ArrayNode, CtorNode, FunctionDraft
+from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
+from sam_codegen.targets.python.mapping_v0 import bind_required_elements, matches
+from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft, KeyedItems
 from sam_codegen.targets.python.names import LocalNames, ros_aliases
-from sam_codegen.targets.python.statements import FindItem
 from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_writer
 from sam_codegen.targets.wire.code import Constants
-from sam_codegen.targets.wire.codec import WireCtorNode, stamp_ns, wrap_body
+from sam_codegen.targets.wire.codec import WireCtorNode, WireSignatures, stamp_ns, wrap_body
 from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
 from sam_codegen.targets.wire.v0_read import WirePath, v0_reader
 from sam_codegen.targets.wire.v0_write import HELPERS, V0Items, V0Node, v0_writer
 from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, Step
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["emit"]
+__all__ = ["DroneCanWire", "V0CdrReader", "V0WireReader", "emit", "wire_matches"]
 
 _DEFAULT = "<default>"  # an element left at its default (never rendered: the writers know the defaults)
 
 
-class _CodecV0Module(V0ConvertModule):
-    """codec_v0.py's view: the same tree of values as convert_v0, written as bytes."""
+class DroneCanWire:
+    """codec_v0.py's Construction: the same tree of values as convert_v0's, written as CDR (to_ros) or as a v0
+    payload (to_uavcan) by the wire writers, with module constants from `consts`."""
 
-    consts: Constants
-    layout: V0Layout
-    names: LocalNames  # the locals of the function being emitted
+    sized_by_use: ClassVar[bool] = True
 
-    def dsdl_ctor(self, struct: Any) -> CtorNode:
+    def __init__(self, resolved: Resolved, consts: Constants, layout: V0Layout) -> None:
+        self.resolved, self.consts, self.layout = resolved, consts, layout
+
+    def dsdl_ref(self, struct: DsdlStruct) -> str:
+        return "Any"
+
+    def struct(self, name: str) -> DsdlStruct:
+        assert self.resolved.dronecan is not None
+        struct = self.resolved.dronecan.get(name)
+        assert struct is not None, name
+        return struct
+
+    def dsdl_ctor(self, struct: DsdlStruct) -> CtorNode:
         return WireCtorNode(struct, [(f.name, f.type) for f in struct.fields])
 
     def ros_ctor(self, message: RosMessage) -> CtorNode:
@@ -63,7 +73,7 @@ class _CodecV0Module(V0ConvertModule):
             return _DEFAULT if t.kind == "composite" else typed_literal(0, "float" if t.kind == "float" else t.kind)
         return _DEFAULT if not t.is_primitive else typed_literal(0, t.base)
 
-    def format_return(self, root: CtorNode) -> list[str]:
+    def format_return(self, module: ConvertModule, root: CtorNode, names: LocalNames) -> list[str]:
         assert isinstance(root, WireCtorNode)
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
@@ -72,8 +82,10 @@ class _CodecV0Module(V0ConvertModule):
         values: dict[tuple, str] = {}
         checks: list[str] = []
         _ros_values(root, (), values, checks)
-        lines, expr = cdr_writer(root.of, values, self.resolved.ros.get, self.names, self.consts)
+        lines, expr = cdr_writer(root.of, values, self.resolved.ros.get, names, self.consts)
         return _lines([*checks, *lines, f"return {expr}, {stamp_ns(root.of, values)}"])
+
+
 
 
 def _lines(lines: list[str]) -> list[str]:
@@ -133,15 +145,15 @@ def _ros_values(node: CtorNode, prefix: tuple, out: dict[tuple, str], checks: li
             out[path] = value
 
 
-class _CodecV0MappingEmitter(V0MappingEmitter):
-    module: _CodecV0Module
+class V0WireReader:
+    """A v0 payload: the fields the mapping reads (or MATCHES checks), decoded into locals; arrays of composites as
+    lists of records (tuples), their fields by position. One per function."""
 
-    def __init__(self, module: _CodecV0Module, rm: ResolvedMapping) -> None:
-        super().__init__(module, rm)
+    def __init__(self, build: DroneCanWire, rm: ResolvedMapping) -> None:
+        self.build, self.rm = build, rm
         self.wire: dict[WirePath, str] = {}  # wire path -> the local the payload is decoded into
-        self.found: dict[tuple, str] = {}  # ROS path -> the local the CDR is decoded into
+        self.items: dict[tuple, str] = {}  # path ending in an item chosen by key -> its local
 
-    # -- reading the payload
     def wire_path(self, path: tuple) -> WirePath:
         """The top-level wire path holding a mapping path: names through composites, to an array or a leaf."""
         struct: V0Struct = self.rm.dsdl_struct  # type: ignore[assignment]
@@ -153,7 +165,7 @@ class _CodecV0MappingEmitter(V0MappingEmitter):
             t: DsdlType = f.type  # type: ignore[assignment]
             if t.array or t.kind != "composite":
                 return names
-            struct = self.module.layout.struct(t)
+            struct = self.build.layout.struct(t)
         return names
 
     def wanted(self, matches: bool = False) -> set[WirePath]:
@@ -166,37 +178,29 @@ class _CodecV0MappingEmitter(V0MappingEmitter):
         return {self.wire_path(p) for p in paths}
 
     def decode(self, names: LocalNames, wanted: set[WirePath]) -> list[str]:
-        lines, self.wire = v0_reader(self.rm.dsdl_struct, wanted, self.module.layout,  # type: ignore[arg-type]
-                                     self.module.consts, "payload", names.new)
+        lines, self.wire = v0_reader(self.rm.dsdl_struct, wanted, self.build.layout,  # type: ignore[arg-type]
+                                     self.build.consts, "payload", names.new)
         return _lines(lines)
 
-    def bind_uavcan_arrays(self, fn: FunctionDraft, names: LocalNames, steps: list[Step],
-                           listed: dict[tuple, str] | None = None) -> dict[tuple, str]:
-        self.module.names = names
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> dict[tuple, str]:
         fn.decode = self.decode(names, self.wanted())
-        result = super().bind_uavcan_arrays(fn, names, steps)
-        for i, st in enumerate(fn.binds):
-            if isinstance(st, FindItem):  # records: the key field by position
-                struct = self.item_struct(st.var)
-                fn.binds[i] = replace(st, field=str(record_index(struct, ast.literal_eval(st.field))))
-        return result
+        return bind_required_elements(self, em, fn, names, steps)
 
-    def item_struct(self, local: str) -> V0Struct:
-        path = next(p for p, v in self.items.items() if v == local)
-        return self.element_struct(path)
+    def item_field(self, item_path: tuple, name: str) -> str:
+        return str(record_index(self.element_struct(item_path), name))  # records: the key field by position
 
     def element_struct(self, array_path: tuple) -> V0Struct:
         struct: V0Struct = self.rm.dsdl_struct  # type: ignore[assignment]
         for name, _index in array_path:
             f = struct.field(name)
             assert f is not None
-            struct = self.module.layout.struct(f.type)  # type: ignore[arg-type]
+            struct = self.build.layout.struct(f.type)  # type: ignore[arg-type]
         return struct
 
-    def uav_list(self, expr: str) -> str:
+    def as_list(self, expr: str) -> str:
         return f"list({expr})"
 
-    def uav_access(self, base: str, path: tuple) -> str:
+    def access(self, path: tuple) -> str:
         for cut in range(len(path), 0, -1):
             local = self.items.get(tuple(path[:cut]))
             if local is not None:
@@ -215,8 +219,8 @@ class _CodecV0MappingEmitter(V0MappingEmitter):
                     return expr
                 expr += f"[{index}]"
                 rest = path[k + 1:]
-                return expr + (self.record_access(self.module.layout.struct(t), rest) if rest else "")
-            struct = self.module.layout.struct(t)
+                return expr + (self.record_access(self.build.layout.struct(t), rest) if rest else "")
+            struct = self.build.layout.struct(t)
         raise AssertionError(f"{path}: a composite read whole")
 
     def record_access(self, struct: V0Struct, rest: tuple) -> str:
@@ -226,103 +230,89 @@ class _CodecV0MappingEmitter(V0MappingEmitter):
             f = struct.field(name)
             assert f is not None
             if f.type.kind == "composite":  # type: ignore[union-attr]
-                struct = self.module.layout.struct(f.type)  # type: ignore[arg-type]
+                struct = self.build.layout.struct(f.type)  # type: ignore[arg-type]
             if index is not None:
                 text += f"[{index}]"
         return text
 
-    def to_ros(self) -> FunctionDraft:
-        fn = super().to_ros()
-        fn.name = f"{self.name}_wire_to_ros"
-        fn.params = ["payload: bytes | bytearray | memoryview", "receive_ns: int", "stats: Any"]
-        fn.returns = "tuple[bytes, int] | None"
-        fn.doc = [f"Mapping {self.name!r}, UAVCAN -> ROS: payload -> (CDR, stamp in ns).", "",
-                  f"{self.rm.dsdl_struct.name} -> {self.rm.ros_message.full_name}"]
-        return fn
 
-    # -- reading the CDR
-    def ros_reader(self, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
-        self.module.names = names
+class V0CdrReader:
+    """ROS CDR bytes for a DroneCAN mapping: as CdrReader, and a sequence element read by index is checked
+    (the object converter fails on a shorter sequence); arrays are copied (converters may trim them)."""
+
+    def __init__(self, build: DroneCanWire) -> None:
+        self.build = build
+        self.found: dict[tuple, str] = {}  # ROS path -> the local the CDR is decoded into
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
         wanted: set[tuple] = set()
         sequences: dict[tuple, int] = {}  # a sequence element read by index -> the index
         for s in steps:
             if s.kind == "time":
                 wanted |= {(*s.ros_path, ("sec", None)), (*s.ros_path, ("nanosec", None))}
-            elif s.ros_path[-1][1] is not None and self.ros_type(whole := (*s.ros_path[:-1], (
+            elif s.ros_path[-1][1] is not None and self.ros_type(em, whole := (*s.ros_path[:-1], (
                     s.ros_path[-1][0], None))).array != "fixed":
                 wanted.add(whole)
                 sequences[s.ros_path] = s.ros_path[-1][1]
             else:
                 wanted.add(s.ros_path)
-        lines, self.found = cdr_reader(self.rm.ros_message, wanted, self.module.resolved.ros.get, names,
-                                       self.module.consts, "cdr")
+        lines, self.found = cdr_reader(em.rm.ros_message, wanted, self.build.resolved.ros.get, names,
+                                       self.build.consts, "cdr")
         for path, index in sequences.items():  # the object path fails (IndexError) on a shorter sequence
             whole = self.found[(*path[:-1], (path[-1][0], None))]
             lines += [f"if len({whole}) <= {index}:",
                       f"    raise WireError({f'{path[-1][0]}: no element {index}'!r})"]
             self.found[path] = f"{whole}[{index}]"
         fn.decode = _lines(lines)
-        return RosReads(lambda path: self.found[tuple(path)],
-                        lambda path: (self.found[(*path, ("sec", None))], self.found[(*path, ("nanosec", None))]))
+        found = self.found
+        return RosReads(lambda path: found[tuple(path)],
+                        lambda path: (found[(*path, ("sec", None))], found[(*path, ("nanosec", None))]))
 
-    def ros_type(self, path: tuple) -> RosType:
-        message = self.rm.ros_message
+    def ros_type(self, em: MappingEmitter, path: tuple) -> RosType:
+        message = em.rm.ros_message
         t: Any = None
         for name, _ in path:
             f = message.field(name)
             assert f is not None
             t = f.type
             if not t.is_primitive:
-                message = self.module.ros_message(t.base)
+                message = em.module.ros_message(t.base)
         return t
 
-    def ros_array_read(self, expr: str, ros_type: RosType) -> str:
+    def array_read(self, expr: str, ros_type: RosType) -> str:
         return f"list({expr})"  # the CDR reader's list (byte arrays as ints), copied: converters may trim it
 
-    def to_uavcan(self) -> FunctionDraft:
-        fn = super().to_uavcan()
-        fn.name = f"{self.name}_ros_to_wire"
-        fn.params = ["cdr: bytes | memoryview", "stats: Any"]
-        fn.returns = "bytes | None"
-        fn.doc = [f"Mapping {self.name!r}, ROS -> UAVCAN: CDR -> payload.", "",
-                  f"{self.rm.ros_message.full_name} -> {self.rm.dsdl_struct.name}"]
-        return fn
 
-    # -- WIRE_MATCHES
-    def wire_matches(self) -> dict[str, Any] | None:
-        """MATCHES' predicate on the payload: the same conditions (select values, the elements read are there);
-        WireError where the payload does not decode."""
-        if self.matches() is None:
-            return None
-        names = LocalNames(self.module.module_names)
-        saved_wire, saved_items = self.wire, self.items
-        self.items = {}
-        decode = self.decode(names, self.wanted(matches=True))
-        conditions = []
-        for path, leaf, value in self.rm.select:
-            conditions.append(f"{self.uav_access('payload', path)} == "
-                              f"{typed_literal(value, 'float' if leaf.kind == 'float' else leaf.kind)}")
-        for array_path, uses in self.rm.elements.items():
-            if any(i is not None for _, i in array_path):
-                continue  # inside an item: the converter checks it
-            source = self.uav_access("payload", array_path)
-            if uses and isinstance(uses[0], Key):
-                struct = self.element_struct(array_path)
-                conditions += [f"_item({source}, {record_index(struct, k.field)}, {py_literal(k.value)}) is not None"
-                               for k in uses]
-            else:
-                conditions.append(f"len({source}) > {max(uses)}")
-        self.wire, self.items = saved_wire, saved_items
-        return {"name": f"_wire_matches_{self.name}", "decode": decode, "conditions": conditions}
+def wire_matches(em: MappingEmitter, build: DroneCanWire) -> dict[str, Any] | None:
+    """MATCHES' predicate on the payload: the same conditions (select values, the elements read are there);
+    WireError where the payload does not decode. Its own reader: it decodes what MATCHES needs, no more."""
+    if matches(em) is None:
+        return None
+    rm = em.rm
+    reader = V0WireReader(build, rm)
+    decode = reader.decode(LocalNames(em.module.module_names), reader.wanted(matches=True))
+    conditions = []
+    for path, leaf, value in rm.select:
+        conditions.append(f"{reader.access(path)} == "
+                          f"{typed_literal(value, 'float' if leaf.kind == 'float' else leaf.kind)}")
+    for array_path, uses in rm.elements.items():
+        if any(i is not None for _, i in array_path):
+            continue  # inside an item: the converter checks it
+        source = reader.access(array_path)
+        if uses and isinstance(uses[0], Key):
+            struct = reader.element_struct(array_path)
+            conditions += [f"_item({source}, {record_index(struct, k.field)}, {py_literal(k.value)}) is not None"
+                           for k in uses]
+        else:
+            conditions.append(f"len({source}) > {max(uses)}")
+    return {"name": f"_wire_matches_{em.name}", "decode": decode, "conditions": conditions}
 
 
 def _context(resolved: Resolved) -> dict[str, Any]:
-    module = _CodecV0Module(resolved)
-    module.consts = Constants("_K")
+    consts = Constants("_K")
     assert resolved.dronecan is not None
-    module.layout = V0Layout(resolved.dronecan.get)
-    module.used_ros = set()
-    module.ros_aliases = ros_aliases(resolved, resolved.dronecan_mappings)
+    build = DroneCanWire(resolved, consts, V0Layout(resolved.dronecan.get))
+    module = ConvertModule(resolved, build, ros_aliases=ros_aliases(resolved, resolved.dronecan_mappings))
     mappings = resolved.dronecan_mappings
     module.module_names = (
         {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
@@ -330,17 +320,18 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         | {"CODECS", "WIRE_MATCHES", "WireError", "ConversionStats", "Callable", "Any", "payload", "cdr",
            "_NAN", "_INF", "_item", "_struct", "_array", "_ZEROS", "_support"}
     )
-    functions, matches = [], []
+    signatures = WireSignatures(": payload -> (CDR, stamp in ns).", ": CDR -> payload.")
+    functions, predicates = [], []
     for rm in mappings:
-        emitter = _CodecV0MappingEmitter(module, rm)
+        emitter = MappingEmitter(module, rm, V0WireReader(build, rm), V0CdrReader(build), signatures)
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
-        matches.append((rm.mapping.name, emitter.wire_matches()))
+        predicates.append((rm.mapping.name, wire_matches(emitter, build)))
     return {
-        "uses_array": "array" in module.consts.imports,
+        "uses_array": "array" in consts.imports,
         "tables": module.tables,
         "functions": functions,
-        "matches": matches,
-        "constants": module.consts.lines(),
+        "matches": predicates,
+        "constants": consts.lines(),
         "prelude": MODULE_PRELUDE,
         "helpers": HELPERS.strip("\n").splitlines(),
     }
