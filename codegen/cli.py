@@ -34,6 +34,16 @@ def _shown(path: Path, cwd: Path) -> str:
         return str(path)
 
 
+def _print_budget(lines: list[str]) -> None:
+    """The bus budget's lines, after the build's verdict: a layout's figures on stdout, a warning
+    (`file:line:col: warning: ...`) on stderr."""
+    for line in lines:
+        if ": warning: " in line:
+            print(line, file=sys.stderr)
+        else:
+            print(f"sam-codegen: {line}")
+
+
 def _cmd_build(args: argparse.Namespace) -> int:
     from sam_codegen.build import build
 
@@ -43,7 +53,8 @@ def _cmd_build(args: argparse.Namespace) -> int:
     cwd = Path.cwd().resolve()
     out, spec = _shown(ws.generated, cwd), _shown(ws.spec, cwd)
     try:
-        stale = build(ws.spec, ws.generated, check=args.check)
+        budget: list[str] = []
+        stale = build(ws.spec, ws.generated, check=args.check, report=budget.append)
     except SpecError as exc:
         for diagnostic in exc.diagnostics:
             print(diagnostic, file=sys.stderr)
@@ -58,8 +69,10 @@ def _cmd_build(args: argparse.Namespace) -> int:
             print(f"sam-codegen: {out} is stale; run `sam-codegen build`", file=sys.stderr)
             return 1
         print(f"sam-codegen: {out} is up to date with {spec}")
+        _print_budget(budget)
         return 0
     print(f"sam-codegen: {out} {'updated' if stale else 'already up to date'} from {spec}")
+    _print_budget(budget)
     if stale and (cwd == ws.generated or ws.generated in cwd.parents):
         print(f"sam-codegen: note: {ws.generated} is a new folder now; a shell inside the old one needs `cd {cwd}`")
     return 0

@@ -351,8 +351,10 @@ class LayoutBudget:
         """A spec error when the bus cannot carry the layout (over 100 % with worst-case stuffing)."""
         if self.load_worst_case <= 1.0:
             return None
+        top = max(self.nodes, key=lambda n: n.load(self.bus, worst_case=True))
         return Diagnostic(self.pos, f"layout {self.layout!r} needs {100 * self.load_worst_case:.0f} % of its bus "
-                          f"({self.bus.describe()}, worst-case bit stuffing; {self.frames_per_s:,.0f} frames/s)",
+                          f"({self.bus.describe()}, worst-case bit stuffing; {self.frames_per_s:,.0f} frames/s; "
+                          f"most from {top.name}: {100 * top.load(self.bus, worst_case=True):.0f} %)",
                           "a load of at most 100 %: lower rates, smaller types, CAN FD or a faster bus")
 
     def warning(self) -> str | None:
@@ -424,6 +426,10 @@ def layout_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str
                 if layout.devices(protocol):  # a bridge node per protocol its devices speak
                     nodes.append(NodeBudget(spec.bridge.name, spec.bridge.node_id, protocol,
                                             (*commands, _liveness(protocol))))
-        pos = bus.pos or (spec.layouts[layout.name].pos if layout.name in spec.layouts else Pos(spec.file))
+        # Where an overload is reported: the `bus` key that sets the bus, else the named layout, else (the implicit
+        # default layout has no place in the file) the device that loads the bus most.
+        heaviest = max((n for n in nodes if n.name in spec.devices), key=lambda n: n.load(bus), default=None)
+        pos = bus.pos or (spec.layouts[layout.name].pos if layout.name in spec.layouts else
+                          spec.devices[heaviest.name].pos if heaviest is not None else Pos(spec.file))
         result.append(LayoutBudget(layout.name, bus, tuple(nodes), pos))
     return result

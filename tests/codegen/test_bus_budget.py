@@ -215,4 +215,33 @@ def test_warning_above_the_threshold_and_error_above_capacity() -> None:
     diagnostic = over.diagnostic()
     assert over.verdict == "over capacity" and over.warning() is None and diagnostic is not None
     assert str(diagnostic).startswith("spec.yaml:3:5: error: layout 'test' needs 113 % of its bus (classic CAN "
-                                      "1 Mbit/s, worst-case bit stuffing; 7,200 frames/s)")
+                                      "1 Mbit/s, worst-case bit stuffing; 7,200 frames/s; most from imu: 113 %)")
+
+
+def _minimal(tmp_path: Path, rate: str) -> Path:
+    text = (REPO / "tests" / "specs" / "minimal.yaml").read_text()
+    assert "type: buoy.Level.0.1, rate_hz: 10}" in text
+    spec = tmp_path / "spec" / "interfaces.yaml"
+    spec.parent.mkdir(parents=True)
+    spec.write_text(text.replace("type: buoy.Level.0.1, rate_hz: 10}", f"type: buoy.Level.0.1, rate_hz: {rate}}}"))
+    return spec
+
+
+def test_build_prints_the_budget_and_refuses_a_bus_it_overloads(tmp_path: Path) -> None:
+    from sam_codegen.build import generate
+    from sam_codegen.model.diagnostics import SpecError
+
+    lines: list[str] = []
+    generate(_minimal(tmp_path / "ok", "10"), report=lines.append)
+    assert lines == ["bus budget: layout default: 24 frames/s on classic CAN 1 Mbit/s, load 0.3 % (0.4 % with "
+                     "worst-case stuffing): ok"]
+    lines.clear()
+    spec = _minimal(tmp_path / "busy", "3000")  # one frame each: 3000 x 160 bits = 48 % worst case + the rest
+    generate(spec, report=lines.append)
+    assert lines[-1].startswith(f"{spec}:") and ": warning: layout 'default' uses" in lines[-1]
+    with pytest.raises(SpecError) as info:
+        generate(_minimal(tmp_path / "over", "8000"))
+    (diagnostic,) = info.value.diagnostics
+    text = (tmp_path / "over" / "spec" / "interfaces.yaml").read_text().splitlines()
+    assert "buoy.Level.0.1, rate_hz: 8000" in "\n".join(text[diagnostic.pos.line - 1: diagnostic.pos.line + 6])
+    assert "error: layout 'default' needs" in str(diagnostic) and "most from" in str(diagnostic)

@@ -18,6 +18,7 @@ in the templates (templates/docs/); the modules compute structure, numbers and t
 from __future__ import annotations
 
 from sam_codegen.render.templating import render
+from sam_codegen.targets.docs.budget import budget_context
 from sam_codegen.targets.docs.dronecan import dronecan_context
 from sam_codegen.targets.docs.graph import SVG_NAME, build_graph
 from sam_codegen.targets.docs.markdown import markdown_context
@@ -33,7 +34,7 @@ def emit(resolved: Resolved) -> dict[str, str]:
     graph = build_graph(resolved)
     return {
         MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph),
-                        **dronecan_context(resolved)).rstrip("\n") + "\n",
+                        **dronecan_context(resolved), **budget_context(resolved)).rstrip("\n") + "\n",
         SVG_PATH: render("docs/dataflow.svg.j2", **svg_context(resolved, graph)),
     }
 
