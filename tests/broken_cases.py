@@ -431,6 +431,112 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:53:9: error: mapping 'level', field 'level': limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping passes on what the device measured",
         ),
     ),
+    # The YAML reader refuses what would make it hang or overflow the stack (issue 20), at the place in the text.
+    Case(
+        'yaml_alias_expansion',  # "billion laughs": 9 levels of 10 aliases each would be 10^9 nodes
+        '  base_link: {}\n',
+        '  base_link: {}\n' + ''.join(f'  l{i}: &l{i} [' + ', '.join([f'*l{i - 1}'] * 10 if i else ['lol'] * 10) + ']\n'
+                                      for i in range(9)),
+        (
+            "minimal.yaml:27:47: error: alias *l2 would copy 1111 more nodes, past the 10000 that aliases may add to this spec (8997 so far) (expected aliases that copy at most 10000 nodes in all, or 10 per node written in a larger spec)",
+        ),
+    ),
+    Case(
+        'yaml_nesting_lists',
+        '  base_link: {}',
+        '  base_link: ' + '[' * 5000 + ']' * 5000,
+        (
+            "minimal.yaml:23:112: error: the YAML nests deeper than 100 levels (expected at most 100 lists and mappings inside each other)",
+        ),
+    ),
+    Case(
+        'yaml_nesting_mappings',
+        '  base_link: {}',
+        '  base_link: ' + '{a: ' * 5000 + '{}' + '}' * 5000,
+        (
+            "minimal.yaml:23:406: error: the YAML nests deeper than 100 levels (expected at most 100 lists and mappings inside each other)",
+        ),
+    ),
+    Case(
+        'yaml_nesting_unclosed',  # libyaml gives up at 1000 levels; the limit speaks first
+        '  base_link: {}',
+        '  base_link: ' + '[' * 5000,
+        (
+            "minimal.yaml:23:112: error: the YAML nests deeper than 100 levels (expected at most 100 lists and mappings inside each other)",
+        ),
+    ),
+    Case(
+        'yaml_alias_nesting',  # each alias one level deeper than its anchor: deep without deep text
+        '  base_link: {}\n',
+        '  base_link: {}\n  d0: &d0 [[]]\n' + ''.join(f'  d{i}: &d{i} [*d{i - 1}]\n' for i in range(1, 120)),
+        (
+            "minimal.yaml:121:14: error: alias *d96 nests the YAML deeper than 100 levels (expected at most 100 lists and mappings inside each other)",
+        ),
+    ),
+    Case(
+        'yaml_alias_loop',
+        '  base_link: {}',
+        '  base_link: &b {parent: *b}',
+        (
+            "minimal.yaml:23:26: error: alias *b is inside the node it names: a spec is a tree, not a loop (expected an alias after the end of its anchor's node)",
+        ),
+    ),
+    Case(
+        'yaml_alias_undefined',
+        '  base_link: {}',
+        '  base_link: *b',
+        (
+            'minimal.yaml:23:14: error: alias *b names no anchor (expected &b on a node before it)',
+        ),
+    ),
+    Case(
+        'yaml_anchor_twice',
+        '  base_link: {}',
+        '  base_link: &b {}\n  odom: &b {}',
+        (
+            'minimal.yaml:24:9: error: anchor &b is defined twice (first at line 23) (expected a new name for each anchor)',
+        ),
+    ),
+    Case(
+        'yaml_merge_scalar',
+        '  base_link: {}',
+        '  base_link: {<<: 3}',
+        (
+            "minimal.yaml:23:19: error: a merge key '<<' takes a mapping or a list of mappings (expected an alias of a mapping, or a list of such aliases)",
+        ),
+    ),
+    Case(
+        'yaml_merge_list_of_scalars',
+        '  base_link: {}',
+        '  base_link: &b {}\n  odom: {<<: [*b, 3]}',
+        (
+            "minimal.yaml:24:19: error: a merge key '<<' takes a mapping or a list of mappings (expected an alias of a mapping, or a list of such aliases)",
+        ),
+    ),
+    Case(
+        'yaml_merge_applies',  # the merged default is overridden, and the rule sees the result
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}\n  /alarm_level: {type: double, unit: m, default: 2.0, min: 0.0, max: 10.0}',
+        '  /warn_level: &warn {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}\n  /alarm_level: {<<: *warn, default: 0.5}',
+        (
+            'minimal.yaml:31:5: error: inconsistent parameter limits: /alarm_level = 0.5 must be > /warn_level = 1.0',
+        ),
+    ),
+    Case(
+        'yaml_two_documents',
+        'spec_version: 1\n',
+        'spec_version: 1\n---\nspec_version: 1\n',
+        (
+            'minimal.yaml:3:1: error: a second YAML document in the spec file (expected a single document)',
+        ),
+    ),
+    Case(
+        'yaml_complex_key',
+        '  base_link: {}',
+        '  ? [base_link]\n  : {}',
+        (
+            'minimal.yaml:23:5: error: a mapping key must be a plain scalar',
+        ),
+    ),
 )
 
 
