@@ -116,8 +116,8 @@ def _lines(ax: Any, rec: Recording, topic: str, fields: list[tuple[str, str]], *
 
 
 def _limit_lines(ax: Any, limits: Mapping[str, float], names: tuple[str, str], top: float) -> None:
-    """Horizontal limit lines inside the plotted range; the ones beyond it are named in a note (a 60 m limit would
-    flatten a 3 m dive to a line)."""
+    """Horizontal limit lines inside the plotted range; the ones beyond it are named in the panel's title (a 60 m
+    limit would flatten a 3 m dive to a line)."""
     styles = {names[0]: ("#f39c12", "--"), names[1]: ("#c0392b", "-.")}
     off_scale = []
     for name in names:
@@ -130,8 +130,7 @@ def _limit_lines(ax: Any, limits: Mapping[str, float], names: tuple[str, str], t
         else:
             off_scale.append(f"{name} {value:g} m")
     if off_scale:
-        ax.text(0.99, 0.03, "beyond the plotted range: " + ", ".join(off_scale), transform=ax.transAxes, ha="right",
-                va="bottom", fontsize=8, color="#7f8c8d")
+        ax.set_title(f"{ax.get_title()}\n(beyond the plotted range: {', '.join(off_scale)})", fontsize=10)
 
 
 def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None, title: str | None = None) -> Path:
@@ -153,7 +152,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
 
     fig = plt.figure(figsize=(15, 19), dpi=100)
     grid = fig.add_gridspec(5, 2, height_ratios=[1.15, 1.15, 1, 1, 1.05], hspace=0.42, wspace=0.2,
-                            left=0.11, right=0.93, top=0.94, bottom=0.05)
+                            left=0.12, right=0.93, top=0.94, bottom=0.05)
     ax_track = fig.add_subplot(grid[0:2, 0])
     ax_depth = fig.add_subplot(grid[0, 1])
     ax_alt = fig.add_subplot(grid[1, 1], sharex=ax_depth)
@@ -180,15 +179,19 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         for a, _, _ in spans:
             at = min(points, key=lambda p: abs(p[0] - a))
             ax_track.plot(at[1], at[2], "X", color=ABORT_COLOUR, ms=11, label=f"abort at {a:.0f} s")
-    if goals:
-        for k, (t, p) in enumerate(goals, 1):
-            z = "surface" if p.z == 0 else f"depth {-p.z:g} m" if p.z < 0 else f"altitude {p.z:g} m"
-            ax_track.plot(p.x, p.y, "*", color="#8e44ad", ms=15, label="goal (/nav_goal)" if k == 1 else None)
-            ax_track.annotate(f"goal {k} at {t:.0f} s, {z}", (p.x, p.y), textcoords="offset points",
-                              xytext=(8, 6), fontsize=8, color="#8e44ad")
+    # A mission sends a goal again until the planner has it: one star per distinct goal, with when it came first.
+    distinct: dict[tuple[float, float, float], float] = {}
+    for t, p in goals:
+        distinct.setdefault((round(p.x, 2), round(p.y, 2), round(p.z, 2)), t)
+    for k, ((x, y, z), t) in enumerate(distinct.items(), 1):
+        where = "surface" if z == 0 else f"depth {-z:g} m" if z < 0 else f"altitude {z:g} m"
+        ax_track.plot(x, y, "*", color="#8e44ad", ms=15, label="goal (/nav_goal)" if k == 1 else None)
+        ax_track.annotate(f"goal {k}: {where}, from {t:.0f} s", (x, y), textcoords="offset points",
+                          xytext=(0, -16 if k % 2 else 9), ha="center", fontsize=8, color="#8e44ad")
     if points or goals:
         ax_track.set_xlabel(f"x (east) in {frame} [m]")
         ax_track.set_ylabel(f"y (north) in {frame} [m]")
+        ax_track.margins(0.15)  # room for the goals' labels at the edges
         ax_track.set_aspect("equal", adjustable="datalim")
         ax_track.grid(alpha=0.3)
         ax_track.legend(loc="best", fontsize=8)
@@ -218,7 +221,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         ax_depth.set_ylim(top, min(-0.2, -0.05 * top))  # depth grows downward
         ax_depth.set_ylabel("depth [m]")
         ax_depth.grid(alpha=0.3)
-        ax_depth.legend(loc="lower left", fontsize=8)
+        ax_depth.legend(loc="best", fontsize=8)
         _shade_aborts(ax_depth, spans)
     else:
         _not_recorded(ax_depth, "/tf and /pressure")
@@ -238,7 +241,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         ax_alt.set_ylim(0, top)
         ax_alt.set_ylabel("altitude [m]")
         ax_alt.grid(alpha=0.3)
-        ax_alt.legend(loc="lower left", fontsize=8)
+        ax_alt.legend(loc="best", fontsize=8)
         _shade_aborts(ax_alt, spans)
     else:
         _not_recorded(ax_alt, "/altitude")
@@ -248,7 +251,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     if _lines(ax_rpm, rec, "/thruster_rpms", [("thruster_1_rpm", "thruster 1"), ("thruster_2_rpm", "thruster 2")]):
         ax_rpm.set_ylabel("speed [rpm]")
         ax_rpm.grid(alpha=0.3)
-        ax_rpm.legend(loc="upper right", fontsize=8)
+        ax_rpm.legend(loc="best", fontsize=8)
         _shade_aborts(ax_rpm, spans)
     else:
         _not_recorded(ax_rpm, "/thruster_rpms")
@@ -262,7 +265,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     if drawn:
         ax_ang.set_ylabel("angle [deg]")
         ax_ang.grid(alpha=0.3)
-        ax_ang.legend(loc="upper right", fontsize=8, ncol=2)
+        ax_ang.legend(loc="best", fontsize=8, ncol=2)
         _shade_aborts(ax_ang, spans)
     else:
         _not_recorded(ax_ang, "/thruster_angles and /ballast_angles")
@@ -273,7 +276,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         ax_pct.set_ylabel("position [%]")
         ax_pct.set_ylim(-5, 105)
         ax_pct.grid(alpha=0.3)
-        ax_pct.legend(loc="lower left", fontsize=8)
+        ax_pct.legend(loc="best", fontsize=8)
         _shade_aborts(ax_pct, spans)
     else:
         _not_recorded(ax_pct, "/buoyancy_piston_position and /longitudinal_weight_position")
@@ -292,7 +295,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         volts.set_ylabel("voltage [V]")
         handles = ax_bat.get_legend_handles_labels()
         more = volts.get_legend_handles_labels()
-        ax_bat.legend(handles[0] + more[0], handles[1] + more[1], loc="lower left", fontsize=8)
+        ax_bat.legend(handles[0] + more[0], handles[1] + more[1], loc="best", fontsize=8)
         _shade_aborts(ax_bat, spans)
     else:
         _not_recorded(ax_bat, "/battery_state")
@@ -325,7 +328,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         if not names:
             ax_state.text(0.5, 0.5, "/diagnostics not recorded", transform=ax_state.transAxes, ha="center",
                           color="#7f8c8d")
-        ax_state.set_yticks(range(len(labels)), labels)
+        ax_state.set_yticks(range(len(labels)), labels, fontsize=9)
         ax_state.set_ylim(-0.7, len(labels) + 0.2)
         ax_state.set_xlim(0, end)
         ax_state.legend(handles=[Patch(color=c, label=n) for n, c in LEVELS.values()]

@@ -136,9 +136,10 @@ def write_dive(path: Path, *, seconds: float = 60.0, skip: tuple[str, ...] = (),
                 statuses.append({"level": level, "name": name, "message": "ok", "hardware_id": "",
                                  "values": []})
             add(t, "/diagnostics", {"header": _header(t), "status": statuses})
-    add(0.5, "/nav_goal", {"header": _header(0.5, "world"),
-                           "pose": {"position": {"x": 20.0, "y": 5.0, "z": -3.0},
-                                    "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}})
+    for t in (0.5, 1.0):  # sent again, as the mission does until the planner has it
+        add(t, "/nav_goal", {"header": _header(t, "world"),
+                             "pose": {"position": {"x": 20.0, "y": 5.0, "z": -3.0},
+                                      "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}})
     add(38.0, "/nav_goal", {"header": _header(38.0, "world"),
                             "pose": {"position": {"x": 0.0, "y": 0.0, "z": 0.0},
                                      "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}})

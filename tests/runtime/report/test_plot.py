@@ -28,7 +28,7 @@ def dive(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_the_recording_reads_back_per_topic_in_time_order(dive: Path) -> None:
     rec = read_recording(dive)
     assert not rec.problems and rec.end_s == pytest.approx(60.0)
-    assert rec.types["/abort"] == "sam_msgs/msg/Abort" and len(rec.get("/nav_goal")) == 2
+    assert rec.types["/abort"] == "sam_msgs/msg/Abort" and len(rec.get("/nav_goal")) == 3
     times = [t for t, _ in rec.get("/tf")]
     assert times == sorted(times) and times[0] == 0.0
 
@@ -61,9 +61,11 @@ def test_plot_writes_the_picture(dive: Path, tmp_path: Path, suffix: str) -> Non
     assert data.startswith(PNG_MAGIC) if suffix == ".png" else b"<svg" in data[:2000]
     if suffix == ".svg":  # the panels and what they say are in the picture
         text = data.decode()
-        for words in ("safe_depth 2.5 m", "critical_depth 60 m", "battery below min_battery_percent",
-                      "depth [m]", "speed [rpm]", "charge [%]", "performance_monitor"):
+        for words in ("safe_depth 2.5 m", "beyond the plotted range: critical_depth 60 m",
+                      "battery below min_battery_percent", "depth [m]", "speed [rpm]", "charge [%]",
+                      "performance_monitor", "goal 1: depth 3 m, from 0 s", "goal 2: surface, from 38 s"):
             assert words in text, words
+        assert "goal 3" not in text  # a goal sent again is one goal
 
 
 def test_missing_topics_are_not_recorded_panels(tmp_path: Path) -> None:
