@@ -15,14 +15,14 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from typing import Literal
+from typing import Final, Literal
 
 from sam_codegen.model.spec import Scalar
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from sam_codegen.validate.mapping_rules import Key, PathSeg, ResolvedMapping, Step
 
-TO_ROS = "to_ros"
-TO_UAVCAN = "to_uavcan"
+TO_ROS: Final = "to_ros"
+TO_UAVCAN: Final = "to_uavcan"
 PlanDirection = Literal["to_ros", "to_uavcan"]
 
 FLOAT16_MAX = 65504.0

@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any
 
 from sam_codegen.model.spec import Scalar
 from sam_codegen.model.types import ROS_FLOAT_BITS
 from sam_codegen.render.filters import py_str
 
-__all__ = ["LINE_LIMIT", "float_literal", "frozenset_literal", "py_literal", "text_literal", "tuple_literal",
-           "typed_literal"]
+__all__ = ["LINE_LIMIT", "PY_FILTERS", "Call", "call_literal", "float_literal", "frozenset_literal", "py_literal",
+           "text_literal", "tuple_literal", "typed_literal"]
 
 LINE_LIMIT = 110  # of every generated Python file (ruff's line-length for generated/)
 
@@ -108,3 +110,38 @@ def frozenset_literal(values: Iterable[int]) -> str:
     """
     ordered = sorted(set(values))
     return "frozenset({" + ", ".join(map(str, ordered)) + "})" if ordered else "frozenset()"
+
+
+@dataclass(frozen=True)
+class Call:
+    """A call of rendered arguments, `func(arg, ...)`; `keywords` name the arguments when the call wraps."""
+
+    func: str
+    args: tuple[str, ...]
+    keywords: tuple[str, ...] = ()
+
+
+def call_literal(call: Call, indent: int, prefix: int = 0) -> str:
+    """`call` at column `indent`, after `prefix` characters on its line and before a comma: on one line if it fits,
+    else one argument per line.
+
+    >>> call_literal(Call("P", ("1", "2")), 8)
+    'P(1, 2)'
+    >>> print(call_literal(Call("P", ("1" * 60, "2" * 60), ("a", "b")), 0))
+    P(
+        a=111111111111111111111111111111111111111111111111111111111111,
+        b=222222222222222222222222222222222222222222222222222222222222,
+    )
+    """
+    one = f"{call.func}(" + ", ".join(call.args) + ")"
+    if indent + prefix + len(one) + 1 <= LINE_LIMIT:
+        return one
+    pad = " " * (indent + 4)
+    keywords = call.keywords or ("",) * len(call.args)
+    lines = "".join(f"{pad}{k + '=' if k else ''}{v},\n" for k, v in zip(keywords, call.args, strict=True))
+    return f"{call.func}(\n" + lines + " " * indent + ")"
+
+
+# The Jinja filters of this module: a template says where a literal starts (`{{ text | text_literal(8) }}`).
+PY_FILTERS: dict[str, Callable[..., Any]] = {"text_literal": text_literal, "tuple_literal": tuple_literal,
+                                             "call_literal": call_literal}

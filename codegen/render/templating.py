@@ -8,6 +8,7 @@ from pathlib import Path
 import jinja2
 
 from sam_codegen.render.filters import FILTERS
+from sam_codegen.render.pysource import PY_FILTERS
 
 
 def template_dir() -> Path:
@@ -33,6 +34,7 @@ def environment() -> jinja2.Environment:
         extensions=["jinja2.ext.do"],
     )
     env.filters.update(FILTERS)
+    env.filters.update(PY_FILTERS)
     return env
 
 

@@ -27,7 +27,7 @@ from typing import Any
 
 from sam_codegen.model.spec import Parameter, Qos, Spec
 from sam_codegen.render.filters import natural_key, one_line, py_str
-from sam_codegen.render.pysource import float_literal, text_literal
+from sam_codegen.render.pysource import float_literal
 from sam_codegen.render.templating import environment, render
 from sam_codegen.validate.nodes import (
     TF_STATIC_TOPIC,
@@ -110,7 +110,7 @@ def qos_args(qos: Qos) -> str:
 
 def _value_literal(p: Parameter) -> str:
     if p.type == "double":
-        return float_literal(p.default)
+        return float_literal(float(p.default))
     return py_str(p.default) if p.type == "string" else repr(p.default)
 
 
@@ -160,13 +160,12 @@ def _parameter_spec(spec: Spec, p: Parameter) -> dict[str, Any]:
     readers = [n.name for n in spec.nodes.values() if p.name in n.parameters]
     args = [f"name={py_str(p.name)}", f"type={py_str(p.type)}", f"default={_value_literal(p)}",
             f"minimum={'None' if p.minimum is None else float_literal(p.minimum)}",
-            f"maximum={'None' if p.maximum is None else float_literal(p.maximum)}", f"unit={py_str(p.unit)}",
-            f"description={text_literal(p.description, 8 + len('description='))}",
-            "readers=(" + "".join(f"{py_str(r)}, " for r in readers).rstrip(" ") + ")"]
-    return {"args": args, "name": p.name, "ros_name": ros_parameter_name(p.name),
-            "attr": parameter_identifier(p.name), "py_type": PY_TYPES[p.type], "unit": p.unit,
-            "range": _range_text(p), "default": _value_literal(p), "description": one_line(p.description),
-            "readers": readers}
+            f"maximum={'None' if p.maximum is None else float_literal(p.maximum)}", f"unit={py_str(p.unit)}"]
+    after = ["readers=(" + "".join(f"{py_str(r)}, " for r in readers).rstrip(" ") + ")"]
+    return {"args": args, "description_text": p.description, "args_after": after, "name": p.name,
+            "ros_name": ros_parameter_name(p.name), "attr": parameter_identifier(p.name), "py_type": PY_TYPES[p.type],
+            "unit": p.unit, "range": _range_text(p), "default": _value_literal(p),
+            "description": one_line(p.description), "readers": readers}
 
 
 def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
@@ -203,8 +202,8 @@ def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
     partners = [spec.parameters[p] for p in rule_partners(spec, node)]
     involved = set(node.parameters)
     rules = [r for r in spec.parameter_rules if r.left in involved or r.right in involved]
-    rule_items = [{"args": [f"left={py_str(r.left)}", f"op={py_str(r.op)}", f"right={py_str(r.right)}",
-                            f"description={text_literal(r.description, 8 + len('description='))}"],
+    rule_items = [{"args": [f"left={py_str(r.left)}", f"op={py_str(r.op)}", f"right={py_str(r.right)}"],
+                   "description_text": r.description, "args_after": [],
                    "text": f"{ros_parameter_name(r.left)} {r.op} {ros_parameter_name(r.right)}",
                    "description": one_line(r.description)} for r in rules]
     return {

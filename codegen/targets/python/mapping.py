@@ -31,6 +31,7 @@ from sam_codegen.conversion_plan import (
     MaxLength,
     Offset,
     Pad,
+    PlanDirection,
     ReceiveTime,
     Scale,
     SetConstant,
@@ -124,12 +125,12 @@ class MappingEmitter:
     def policy(self, path: str) -> Policy:
         return Policy(repr(f"{self.name}.{path}"), self.reject)
 
-    def link(self, s: Step, direction: str) -> LinkPlan:
+    def link(self, s: Step, direction: PlanDirection) -> LinkPlan:
         """The plan of one link (lowered here for a step that is not the mapping's own)."""
         found = self._links.get((id(s), direction))
         if found is not None and found.step == s:
             return found
-        return lower_link(s, direction, self.name, self.reject)  # type: ignore[arg-type]
+        return lower_link(s, direction, self.name, self.reject)
 
     # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
     def to_ros(self) -> FunctionDraft:

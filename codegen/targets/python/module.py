@@ -212,12 +212,12 @@ class ConvertModule:
                 lines[-1] += ","
             lines.append(" " * indent + "]")
             return lines
-        parts = [(k, self.format_node(v, indent + 4)) for k, v in node.arguments()]
-        one = f"{node.ref}(" + ", ".join(f"{k}={p[0]}" for k, p in parts) + ")"
-        if all(len(p) == 1 for _, p in parts) and indent + len(one) <= LINE_LIMIT - 20:
+        keyed = [(k, self.format_node(v, indent + 4)) for k, v in node.arguments()]
+        one = f"{node.ref}(" + ", ".join(f"{k}={p[0]}" for k, p in keyed) + ")"
+        if all(len(p) == 1 for _, p in keyed) and indent + len(one) <= LINE_LIMIT - 20:
             return [one]
         lines = [f"{node.ref}("]
-        for k, p in parts:
+        for k, p in keyed:
             lines.append(" " * (indent + 4) + f"{k}={p[0]}")
             lines.extend(p[1:])
             lines[-1] += ","

@@ -1,5 +1,7 @@
 """The whole context of tables.py: the Cyphal devices, topics, mappings, parameters and frames, the DroneCAN devices,
-types, mappings and layouts, and the nodes' QoS, transforms and endpoints, as Python literals.
+types, mappings and layouts, and the nodes' QoS, transforms and endpoints, as Python literals; texts (descriptions),
+lists of literals and calls (Call) are left for templates/python/tables.py.j2 to place and wrap (render.pysource's
+filters).
 
 This module owns tables.py: the other targets give it names (targets.nodes, targets.ros, targets.dsdl_v0,
 convert_v0.used_types) and import nothing of it. Every spec text reaches the output through py_str (repr: inert).
@@ -12,14 +14,7 @@ from typing import Any
 
 from sam_codegen.model.spec import Port, Qos, V0Struct
 from sam_codegen.render.filters import py_str
-from sam_codegen.render.pysource import (
-    LINE_LIMIT,
-    float_literal,
-    frozenset_literal,
-    py_literal,
-    text_literal,
-    tuple_literal,
-)
+from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
 from sam_codegen.targets import dsdl_v0
 from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
 from sam_codegen.targets.python import table_types
@@ -39,34 +34,28 @@ def _ros_type_parts(full: str) -> tuple[str, str, str]:
     return f"{package}/msg/{name}", f"{package}.msg", name
 
 
-def _port_info(resolved: Resolved, port: Port, indent: int, prefix: int = 0) -> str:
-    """A PortInfo(...) at `indent`, after `prefix` characters on its line and before a comma."""
+def _port_info(resolved: Resolved, port: Port) -> Call:
     struct = resolved.dsdl.get(port.type)
     assert struct is not None, port.type
-    args = [str(port.subject_id), py_str(port.type), py_str(py_module(struct.namespace)),
-            py_str(py_class_name(struct)), py_literal(float(port.rate_hz))]
-    one = "PortInfo(" + ", ".join(args) + ")"
-    if indent + prefix + len(one) + 1 <= LINE_LIMIT:
-        return one
-    names = ("subject_id", "dsdl_type", "dsdl_module", "dsdl_class", "rate_hz")
-    pad = " " * (indent + 4)
-    return "PortInfo(\n" + "".join(f"{pad}{k}={v},\n" for k, v in zip(names, args, strict=True)) + " " * indent + ")"
+    args = (str(port.subject_id), py_str(port.type), py_str(py_module(struct.namespace)),
+            py_str(py_class_name(struct)), py_literal(float(port.rate_hz)))
+    return Call("PortInfo", args, ("subject_id", "dsdl_type", "dsdl_module", "dsdl_class", "rate_hz"))
 
 
 def cyphal_context(resolved: Resolved) -> dict[str, Any]:
     """The Cyphal part of tables.py and what every spec has (topics, parameters, frames, the bridge)."""
     spec = resolved.spec
     devices = [{
-        "name": py_str(d.name), "node_id": str(d.node_id), "description": text_literal(d.description, 8),
-        "publishes": [_port_info(resolved, p, 12) for p in d.publishes],
-        "subscribes": [_port_info(resolved, p, 12) for p in d.subscribes],
+        "name": py_str(d.name), "node_id": str(d.node_id), "description": d.description,
+        "publishes": [_port_info(resolved, p) for p in d.publishes],
+        "subscribes": [_port_info(resolved, p) for p in d.subscribes],
     } for d in spec.devices.values() if "cyphal" in d.protocols]
     topics = []
     for topic in spec.topics.values():
         ros_type, module, cls = _ros_type_parts(topic.type)
         topics.append({"name": py_str(topic.name), "ros_type": py_str(ros_type), "ros_module": py_str(module),
-                       "ros_class": py_str(cls), "description": text_literal(topic.description, 8)})
-    ports = {}
+                       "ros_class": py_str(cls), "description": topic.description})
+    ports: dict[int, Port] = {}
     for d in spec.devices.values():
         for p in [*d.publishes, *d.subscribes]:
             ports.setdefault(p.subject_id, p)
@@ -78,28 +67,27 @@ def cyphal_context(resolved: Resolved) -> dict[str, Any]:
         sources = sorted(set(m.source_node_ids))
         mappings.append({
             "name": py_str(m.name), "direction": py_str(m.direction), "topic": py_str(m.topic),
-            "port": _port_info(resolved, ports[m.subject_id], 8, len("port=")),
+            "port": _port_info(resolved, ports[m.subject_id]),
             "source_node_ids": "frozenset({" + ", ".join(map(str, sources)) + "})" if sources else "frozenset()",
             "destination_node_id": py_literal(m.destination_node_id),
             "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
             "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
-            "exact_uavcan_fields": tuple_literal(exact, 8), "linked_uavcan_fields": tuple_literal(linked, 8),
+            "exact_uavcan_fields": exact, "linked_uavcan_fields": linked,
         })
     parameters = []
-    for p in spec.parameters.values():
-        default = p.default
-        if p.type == "double":
-            default = float(default)
+    for param in spec.parameters.values():
+        default = float(param.default) if param.type == "double" else param.default
         parameters.append({
-            "name": py_str(p.name), "type": py_str(p.type),
-            "default": text_literal(default, 8) if isinstance(default, str) else py_literal(default),
-            "minimum": py_literal(None if p.minimum is None else float(p.minimum)),
-            "maximum": py_literal(None if p.maximum is None else float(p.maximum)),
-            "unit": py_str(p.unit), "description": text_literal(p.description, 8),
+            "name": py_str(param.name), "type": py_str(param.type),
+            # text is the template's to wrap; other values are literals already
+            "default_text": default if isinstance(default, str) else None, "default": py_literal(default),
+            "minimum": py_literal(None if param.minimum is None else float(param.minimum)),
+            "maximum": py_literal(None if param.maximum is None else float(param.maximum)),
+            "unit": py_str(param.unit), "description": param.description,
         })
     rules = [{"left": py_str(r.left), "op": py_str(r.op), "right": py_str(r.right),
-              "description": text_literal(r.description, 8)} for r in spec.parameter_rules]
+              "description": r.description} for r in spec.parameter_rules]
     frames = [(py_str(f.name), py_str(f.parent) if f.parent is not None else "None") for f in spec.frames.values()]
     bridge = spec.bridge
     return {
@@ -121,12 +109,8 @@ def _type_ref(struct: V0Struct) -> str:
     return f"_DRONECAN_TYPE[{py_str(struct.name)}]"
 
 
-def _dronecan_port_info(struct: V0Struct, rate_hz: float, indent: int) -> str:
-    one = f"DroneCanPortInfo({_type_ref(struct)}, {py_literal(float(rate_hz))})"
-    if indent + len(one) + 1 <= LINE_LIMIT:
-        return one
-    pad = " " * (indent + 4)
-    return f"DroneCanPortInfo(\n{pad}{_type_ref(struct)},\n{pad}{py_literal(float(rate_hz))},\n{' ' * indent})"
+def _dronecan_port_info(struct: V0Struct, rate_hz: float) -> Call:
+    return Call("DroneCanPortInfo", (_type_ref(struct), py_literal(float(rate_hz))))
 
 
 def dronecan_context(resolved: Resolved) -> dict[str, Any]:
@@ -139,9 +123,9 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
         if "dronecan" not in d.protocols:
             continue
         devices.append({
-            "name": py_str(d.name), "node_id": str(d.node_id), "description": text_literal(d.description, 8),
-            "publishes": [_dronecan_port_info(types[p.type], p.rate_hz, 12) for p in d.dronecan_publishes],
-            "subscribes": [_dronecan_port_info(types[p.type], p.rate_hz, 12) for p in d.dronecan_subscribes],
+            "name": py_str(d.name), "node_id": str(d.node_id), "description": d.description,
+            "publishes": [_dronecan_port_info(types[p.type], p.rate_hz) for p in d.dronecan_publishes],
+            "subscribes": [_dronecan_port_info(types[p.type], p.rate_hz) for p in d.dronecan_subscribes],
         })
     mappings = []
     for rm in resolved.dronecan_mappings:
@@ -151,20 +135,20 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
         elements = [py_str(f"{format_path(list(path))}[{u}]") for path, uses in rm.elements.items() for u in uses]
         mappings.append({
             "name": py_str(m.name), "direction": py_str(m.direction), "topic": py_str(m.topic),
-            "data_type": _type_ref(struct), "select": tuple_literal(select, 8), "elements": tuple_literal(elements, 8),
+            "data_type": _type_ref(struct), "select": select, "elements": elements,
             "source_node_ids": frozenset_literal(m.source_node_ids),
             "destination_node_ids": frozenset_literal(m.destination_node_ids),
             "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
             "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
-            "exact_uavcan_fields": tuple_literal([py_str(s.uavcan) for s in rm.steps if s.uavcan_path and s.exact], 8),
-            "linked_uavcan_fields": tuple_literal([py_str(s.uavcan) for s in rm.steps if s.uavcan_path], 8),
+            "exact_uavcan_fields": [py_str(s.uavcan) for s in rm.steps if s.uavcan_path and s.exact],
+            "linked_uavcan_fields": [py_str(s.uavcan) for s in rm.steps if s.uavcan_path],
         })
     layouts = [{
-        "name": py_str(layout.name), "description": text_literal(layout.description, 8),
-        "protocols": tuple_literal([f"({py_str(d)}, {py_str(p)})" for d, p in layout.protocols.items()], 8),
-        "cyphal_mappings": tuple_literal([py_str(n) for n in layout.cyphal_mappings], 8),
-        "dronecan_mappings": tuple_literal([py_str(n) for n in layout.dronecan_mappings], 8),
+        "name": py_str(layout.name), "description": layout.description,
+        "protocols": [f"({py_str(d)}, {py_str(p)})" for d, p in layout.protocols.items()],
+        "cyphal_mappings": [py_str(n) for n in layout.cyphal_mappings],
+        "dronecan_mappings": [py_str(n) for n in layout.dronecan_mappings],
     } for layout in resolved.layouts]
     return {
         "dronecan_dirs": [py_str(d) for d in dsdl_v0.load_dirs(resolved)],
@@ -189,7 +173,7 @@ def nodes_context(resolved: Resolved) -> dict[str, Any]:
     nodes = []
     for n in spec.nodes.values():
         nodes.append({
-            "name": py_str(n.name), "description": text_literal(n.description, 8),
+            "name": py_str(n.name), "description": n.description,
             "module": py_str(f"{package}.{n.name}"), "base_class": py_str(class_name(n.name)),
             "publishes": endpoints(n.publish_items), "subscribes": endpoints(n.subscribe_items),
             "parameters": [py_str(p) for p in n.parameters],

@@ -101,9 +101,9 @@ def flatten(message: RosMessage, lookup: Callable[[str], RosMessage | None], pre
         elif t.is_primitive and t.base != "string":
             out.append(Leaf("seq", path, t.base, bound=t.capacity if t.array == "bounded" else None))
         else:
-            nested = None if t.base == "string" else nested_message(lookup, t.base)
+            element = None if t.base == "string" else nested_message(lookup, t.base)
             out.append(Leaf("msgseq", path, t.base, bound=t.capacity if t.array == "bounded" else None,
-                             message=nested))
+                             message=element))
     return out
 
 

@@ -233,9 +233,9 @@ class _Writer:
             self.phase.advance(4 + len(data))
             return
         self.flush()
-        data = self.names.new("text")
-        self.lines.append(f"{data} = {expr}.encode().partition(b'\\0')[0]")
-        self.emit(f"{self.consts.struct('<I')}.pack(len({data}) + 1) + {data} + b'\\0'")
+        text = self.names.new("text")
+        self.lines.append(f"{text} = {expr}.encode().partition(b'\\0')[0]")
+        self.emit(f"{self.consts.struct('<I')}.pack(len({text}) + 1) + {text} + b'\\0'")
         self.phase.unknown()
 
     def write_seq(self, leaf: Leaf) -> None:

@@ -246,7 +246,7 @@ class V0CdrReader:
 
     def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
         wanted: set[tuple] = set()
-        sequences: dict[tuple, int] = {}  # a sequence element read by index -> the index
+        sequences: dict[tuple, Any] = {}  # a sequence element read by index -> the index
         for s in steps:
             if s.kind == "time":
                 wanted |= {(*s.ros_path, ("sec", None)), (*s.ros_path, ("nanosec", None))}
@@ -259,10 +259,10 @@ class V0CdrReader:
         lines, self.found = cdr_reader(em.rm.ros_message, wanted, self.build.resolved.ros.get, names,
                                        self.build.consts, "cdr")
         for path, index in sequences.items():  # the object path fails (IndexError) on a shorter sequence
-            whole = self.found[(*path[:-1], (path[-1][0], None))]
-            lines += [f"if len({whole}) <= {index}:",
+            local = self.found[(*path[:-1], (path[-1][0], None))]
+            lines += [f"if len({local}) <= {index}:",
                       f"    raise WireError({f'{path[-1][0]}: no element {index}'!r})"]
-            self.found[path] = f"{whole}[{index}]"
+            self.found[path] = f"{local}[{index}]"
         fn.decode = _lines(lines)
         found = self.found
         return RosReads(lambda path: found[tuple(path)],

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from functools import partial
 
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType
@@ -390,9 +391,8 @@ class _Reader:
         variants = union.declared_fields
         self.lines += [f"if {tag} >= {len(variants)}:", f"    raise WireError('{union.name}: bad union tag')"]
         for i, f in enumerate(variants):
-            t = f.type
-            assert isinstance(t, DsdlType)
-            self.loop(f"{'if' if i == 0 else 'elif'} {tag} == {i}:", off, lambda r, t=t: r.read_field(t, None))
+            assert isinstance(f.type, DsdlType)
+            self.loop(f"{'if' if i == 0 else 'elif'} {tag} == {i}:", off, partial(_read_variant, t=f.type))
 
 
 def cyphal_reader(struct_: DsdlStruct, wanted: Iterable[FieldPath], lookup: Lookup, names: Names, consts: Constants,
@@ -410,3 +410,7 @@ def cyphal_reader(struct_: DsdlStruct, wanted: Iterable[FieldPath], lookup: Look
     if missing:
         raise ValueError(f"{struct_.name}: no field at {sorted(map(str, missing))}")
     return prune(r.lines, shared.found.values()), shared.found
+
+
+def _read_variant(r: _Reader, t: DsdlType) -> None:
+    r.read_field(t, None)

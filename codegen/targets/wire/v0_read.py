@@ -294,9 +294,9 @@ class _Reader(_Code):
         self.check(req)
         # Segments of atoms read by struct (byte-multiple widths) and of atoms read with bit operations.
         segment: list[int] = []
-        for i, a in enumerate([*atoms, None]):
-            by_struct = a is not None and struct_code(a.t) is not None
-            if segment and (a is None or by_struct != (struct_code(atoms[segment[0]].t) is not None)):
+        for i, atom in enumerate([*atoms, None]):
+            by_struct = atom is not None and struct_code(atom.t) is not None
+            if segment and (atom is None or by_struct != (struct_code(atoms[segment[0]].t) is not None)):
                 wanted = [j for j in segment if atoms[j].want]
                 if wanted:
                     span = [atoms[j] for j in range(wanted[0], wanted[-1] + 1)]
@@ -305,7 +305,7 @@ class _Reader(_Code):
                     else:
                         self.bit_segment(span, starts[wanted[0]])
                 segment = []
-            if a is not None:
+            if atom is not None:
                 segment.append(i)
         self.advance(pos)
         self.past_end = pos > req if req else self.past_end or pos > 0

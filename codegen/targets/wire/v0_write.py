@@ -338,10 +338,10 @@ class _Writer:
                 expr = self.combine(group)
                 value = literal_value(expr)
                 if value is _NO:
-                    bits = expr if expr.isidentifier() else self.temp()
-                    if bits != expr:
-                        self.lines.append(f"{bits} = {expr}")
-                    self.parts.append(f"{bits}.to_bytes({total // 8}, 'big')")
+                    local = expr if expr.isidentifier() else self.temp()
+                    if local != expr:
+                        self.lines.append(f"{local} = {expr}")
+                    self.parts.append(f"{local}.to_bytes({total // 8}, 'big')")
                 else:
                     self.parts.append(int(value).to_bytes(total // 8, "big"))
                 group = []
