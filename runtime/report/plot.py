@@ -27,9 +27,12 @@ from sam_runtime.physics.geo import depth_from_pressure
 from sam_runtime.report.recording import Recording, RecordingError, read_recording
 from sam_runtime.tf_buffer import Transform
 
-__all__ = ["LIMITS", "RecordingError", "limits_from_params", "plot_run", "track"]
+__all__ = ["LIMITS", "TOPICS", "RecordingError", "limits_from_params", "plot_run", "track"]
 
 LIMITS = ("safe_depth", "critical_depth", "safe_altitude", "critical_altitude")
+# What the picture shows: only these are decoded (a run's /imu and raw bus are most of its messages).
+TOPICS = ("/tf", "/nav_goal", "/pressure", "/altitude", "/thruster_rpms", "/thruster_angles", "/ballast_angles",
+          "/buoyancy_piston_position", "/longitudinal_weight_position", "/battery_state", "/abort", "/diagnostics")
 LEVELS = {0: ("OK", "#2e8b57"), 1: ("WARN", "#f39c12"), 2: ("ERROR", "#c0392b"), 3: ("STALE", "#95a5a6")}
 ABORT_COLOUR = "#c0392b"
 
@@ -145,7 +148,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     out = Path(out)
     if out.suffix.lower() not in (".png", ".svg"):
         raise ValueError(f"{out}: the report is a .png or .svg picture")
-    rec = read_recording(Path(mcap))
+    rec = read_recording(Path(mcap), TOPICS)
     limits = dict(limits or {})
     spans = _abort_spans(rec)
     end = max(rec.end_s, 1.0)
