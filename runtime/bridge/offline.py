@@ -1,0 +1,203 @@
+"""The bridge's UAVCAN -> ROS path without a bus or ROS: recorded transfers in, the CDR it would publish out
+(``sam-codegen replay``).
+
+The same parts as the live bridge on the wire path: :func:`~.wiring.in_groups` (the generated codecs, one group per
+port, ``select`` / element matching), :class:`~.inbound.Inbound` (source node filter, stamps, out-of-order,
+``unselected``, drops and saturation counted in :class:`~.counters.MappingStats`) and :class:`~.loss.TransferLoss`
+(gaps in transfer ids; Cyphal/UDP ids never wrap, DroneCAN's wrap at 32). Only the two ends are stand-ins: the
+backend records each port's handler instead of subscribing, and each mapping's publisher collects what it is given.
+
+Invariants: :meth:`OfflineBridge.feed` returns, in publication order, exactly what the live bridge with the same
+generated package would have published for that transfer had it received it at ``receive_ns``; with each output
+the same conversion at a receive time one second and a bit later, so a caller can tell the fields that depend on
+the receive time (a device stamp of 0 becomes the receive time) from the others. Never raises for any payload
+(a payload the codec refuses is counted as ``deserialization_failures`` below the bridge, as live).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from sam_runtime.bridge.backend import Backend, BelowBridge, BridgeConfigError, DeviceStatus, Inlet, Outlet
+from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+from sam_runtime.bridge.inbound import Inbound, InMapping
+from sam_runtime.bridge.layout import select
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.wiring import in_groups, missing_codecs, nominal_rates
+from sam_runtime.genpkg import GeneratedPackage
+
+__all__ = ["RECEIVE_TIME_PROBE_NS", "OfflineBridge", "Published"]
+
+log = logging.getLogger("sam_runtime.bridge.offline")
+RECEIVE_TIME_PROBE_NS = 1_000_000_007  # the second conversion's receive time is this much later
+
+
+@dataclass(frozen=True)
+class Published:
+    """One publication of the offline bridge."""
+
+    topic: str
+    ros_type: str
+    mapping: str
+    cdr: bytes
+    cdr_later: bytes  # the same conversion at receive_ns + RECEIVE_TIME_PROBE_NS
+
+
+class _Inlet(Inlet):
+    def __init__(self, name: str, port_id: int) -> None:
+        self.port_name, self.port_id, self.below = name, port_id, BelowBridge()
+
+
+class _Backend(Backend):
+    """Subscriptions remembered by port; nothing is ever sent or opened."""
+
+    def __init__(self, protocol: str) -> None:
+        self.protocol = protocol
+        self.label = protocol
+        self.node_id = 0
+        self.handlers: dict[int, Callable[[Any, int | None, int, float], None]] = {}
+        self.inlets: dict[int, _Inlet] = {}
+
+    def describe(self) -> str:
+        return "a recording"
+
+    def subscribe(self, name: str, port_id: int, dtype: Any, handler: Any, *, raw: bool = False) -> Inlet:
+        self.handlers[port_id] = handler
+        self.inlets[port_id] = inlet = _Inlet(name, port_id)
+        return inlet
+
+    def advertise(self, name: str, port_id: int, dtype: Any, *, raw: bool = False) -> Outlet:
+        raise BridgeConfigError("the offline bridge publishes nothing on the bus")
+
+    def on_device_status(self, handler: Callable[[DeviceStatus], None]) -> None:
+        pass
+
+    async def open(self) -> None:
+        pass
+
+    async def close(self) -> None:
+        pass
+
+    def link_problem(self) -> str | None:
+        return None
+
+    @property
+    def transfer_id_modulo(self) -> int:
+        return 32 if self.protocol == "dronecan" else 2**64
+
+
+class _Collector:
+    """A mapping's publisher: keeps what the inbound path publishes."""
+
+    def __init__(self, bridge: OfflineBridge, im: InMapping) -> None:
+        self._bridge, self._im = bridge, im
+
+    def publish(self, out: Any) -> None:
+        self._bridge.collect(self._im, bytes(out))
+
+
+class _Scratch:
+    """The stats of the probe conversion: counted nowhere."""
+
+    def saturate(self, key: str) -> None:
+        pass
+
+    def reject(self, key: str) -> None:
+        pass
+
+
+class _Ros:
+    """What Inbound asks of the ROS side: publishers and the receive clock."""
+
+    def __init__(self) -> None:
+        self.now_ns = 0
+
+    def receive_ns(self) -> int:
+        return self.now_ns
+
+    def publisher(self, topic: Any, cls: Any) -> Any:
+        return None  # replaced per mapping by a _Collector once started
+
+
+class OfflineBridge:
+    """:param gen: the generated package (its tables and wire codecs; its ROS classes must be importable).
+    :param layout: the spec's layout; :param protocol: the half of a mixed layout (as :class:`~.composition.Bridge`).
+    """
+
+    def __init__(self, gen: GeneratedPackage, *, layout: str | None = None, protocol: str | None = None) -> None:
+        tables = gen.tables()
+        self.selection = sel = select(tables, layout, protocol)
+        self.protocol = sel.protocol
+        codec = gen.codec(sel.protocol)
+        missing = missing_codecs(codec, sel.mappings)
+        if missing:
+            raise BridgeConfigError(f"the generated package {gen.root} has no wire codecs for "
+                                    f"{', '.join(missing)}: run `sam-codegen build`")
+        if sel.protocol == "cyphal":
+            gen.compile_dsdl()  # the groups name the ports' compiled classes
+        self.rlog = RateLimitedLog(log)
+        lock = threading.Lock()
+        self.counters = {m.name: MappingStats(lock, m.name, self.rlog) for m in sel.mappings}
+        self.lifetime = Lifetime(f"{tables.BRIDGE_NAME}_offline", self.rlog)
+        self._backend = _Backend(sel.protocol)
+        self._ros = _Ros()
+        rates = nominal_rates(tables, sel.device_infos)
+        backend = self._backend
+
+        def loss(port_id: int) -> TransferLoss:
+            return TransferLoss(port_id, rates, lambda: backend.transfer_id_modulo, lambda nid: None, lambda: (),
+                                lambda nid: self.inbound.forget_stamps(nid))
+
+        groups = in_groups(gen, None, self.counters, loss, sel.mappings, codec)
+        self.inbound = Inbound(self.lifetime, groups, self._ros, backend)
+        self.inbound.attach()
+        asyncio.run(self.lifetime.start())  # the start hooks: publishers and subscriptions, nothing periodic
+        self._ros_type = {m.name: m.topic.ros_type for m in sel.mappings}
+        for group in self.inbound.groups.values():
+            for im in group.mappings:
+                im.ros_publisher = _Collector(self, im)
+        self._out: list[tuple[InMapping, bytes]] = []
+
+    @property
+    def topics(self) -> dict[str, str]:
+        """topic -> ROS type of every UAVCAN -> ROS mapping."""
+        return {im.info.topic.name: im.info.topic.ros_type for g in self.inbound.groups.values() for im in g.mappings}
+
+    @property
+    def ports(self) -> set[int]:
+        return set(self._backend.handlers)
+
+    def collect(self, im: InMapping, cdr: bytes) -> None:
+        self._out.append((im, cdr))
+
+    def feed(self, port_id: int, payload: bytes, source_node_id: int | None, transfer_id: int, monotonic_s: float,
+             receive_ns: int) -> list[Published]:
+        """One transfer of a subscribed port (others: nothing), as the live bridge handles it."""
+        handler = self._backend.handlers.get(port_id)
+        if handler is None:
+            return []
+        self._out = []
+        self._ros.now_ns = receive_ns
+        handler(payload, source_node_id, transfer_id, monotonic_s)
+        out = []
+        for im, cdr in self._out:
+            try:
+                later = im.to_ros(payload, receive_ns + RECEIVE_TIME_PROBE_NS, _Scratch())
+            except Exception:  # it converted once: the probe cannot fail differently, but never raise
+                later = None
+            out.append(Published(im.info.topic.name, im.info.topic.ros_type, im.info.name, cdr,
+                                 bytes(later[0]) if later else cdr))
+        return out
+
+    def stats(self) -> dict[str, Any]:
+        """Per mapping the live bridge's counters; per port what was refused below the bridge."""
+        below = {str(pid): inlet.below.snapshot()[0] for pid, inlet in self._backend.inlets.items()
+                 if inlet.below.snapshot()[0]}
+        self.rlog.flush(force=True)
+        return {"mappings": {name: st.snapshot() for name, st in self.counters.items()}, "below_bridge": below}

@@ -1,0 +1,146 @@
+"""Reading a recording back, whole or cut short (a recorder killed mid-run), and laying it out for rosbags.
+
+Invariants:
+
+- :func:`read_recording` streams the file record by record (mcap's ``StreamReader``: no summary or footer needed)
+  and stops at the first record it cannot read: a cut file yields every message of every complete chunk, in file
+  order, and ``Recording.complete`` says whether the file ended with its footer.
+- :func:`rosbag2_folder` makes a folder that rosbags' rosbag2 ``Reader`` opens (it reads only rosbag2 folders with
+  a ``metadata.yaml``, and only MCAP files with a footer): the recording itself (a symbolic link) when complete,
+  else a complete copy of everything readable (as ``mcap recover`` does); the metadata lists the ROS topics (CDR)
+  with their message counts, as rosbag2 writes it (version 9).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from sam_runtime.recording.schemas import TRANSFER_TYPE, Transfer, decode_transfer
+
+__all__ = ["RecordedMessage", "Recording", "read_recording", "rosbag2_folder"]
+
+
+@dataclass(frozen=True)
+class RecordedMessage:
+    topic: str
+    log_time: int
+    publish_time: int
+    data: bytes
+    sequence: int
+
+
+@dataclass
+class Recording:
+    """What a recording holds, in file order."""
+
+    schemas: dict[int, Any] = field(default_factory=dict)  # id -> mcap.records.Schema
+    channels: dict[int, Any] = field(default_factory=dict)  # id -> mcap.records.Channel
+    messages: list[RecordedMessage] = field(default_factory=list)
+    attachments: dict[str, bytes] = field(default_factory=dict)
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    complete: bool = False  # the file ended with its footer
+    stopped_by: str | None = None  # why reading stopped early (a cut file)
+
+    def schema_of(self, topic: str) -> Any:
+        ch = next((c for c in self.channels.values() if c.topic == topic), None)
+        return None if ch is None else self.schemas.get(ch.schema_id)
+
+    def topics(self) -> dict[str, str]:
+        """topic -> schema name (the ROS type)."""
+        return {c.topic: (self.schemas[c.schema_id].name if c.schema_id in self.schemas else "")
+                for c in self.channels.values()}
+
+    def by_topic(self) -> dict[str, list[RecordedMessage]]:
+        out: dict[str, list[RecordedMessage]] = {}
+        for m in self.messages:
+            out.setdefault(m.topic, []).append(m)
+        return out
+
+    def transfers(self) -> list[tuple[RecordedMessage, Transfer]]:
+        """The raw bus: every recorded UAVCAN transfer with its envelope decoded, in file order."""
+        raw = {c.topic for c in self.channels.values()
+               if c.schema_id in self.schemas and self.schemas[c.schema_id].name == TRANSFER_TYPE}
+        return [(m, decode_transfer(m.data)) for m in self.messages if m.topic in raw]
+
+
+def read_recording(path: Path) -> Recording:
+    """Everything readable in the file (see the module docstring)."""
+    from mcap.records import Attachment, Channel, Footer, Message, Metadata, Schema
+    from mcap.stream_reader import StreamReader
+
+    rec = Recording()
+    topic_of: dict[int, str] = {}
+    with open(path, "rb") as fh:
+        try:
+            for r in StreamReader(fh, skip_magic=False, emit_chunks=False).records:
+                if isinstance(r, Schema):
+                    rec.schemas[r.id] = r
+                elif isinstance(r, Channel):
+                    rec.channels[r.id] = r
+                    topic_of[r.id] = r.topic
+                elif isinstance(r, Message):
+                    rec.messages.append(RecordedMessage(topic_of.get(r.channel_id, ""), r.log_time,
+                                                        r.publish_time, bytes(r.data), r.sequence))
+                elif isinstance(r, Attachment):
+                    rec.attachments[r.name] = bytes(r.data)
+                elif isinstance(r, Metadata):
+                    rec.metadata[r.name] = dict(r.metadata)
+                elif isinstance(r, Footer):
+                    rec.complete = True
+                    break  # only the closing magic follows
+        except Exception as ex:  # a cut file ends inside a record: everything before it is kept
+            rec.stopped_by = f"{type(ex).__name__}: {ex}".rstrip(": ")
+    return rec
+
+
+def rosbag2_folder(mcap_path: Path, folder: Path) -> Path:
+    """``folder`` holding the recording and a rosbag2 ``metadata.yaml`` (see the module docstring); returns it."""
+    from mcap.writer import CompressionType, Writer
+
+    mcap_path = Path(mcap_path).absolute()
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rec = read_recording(mcap_path)
+    target = folder / mcap_path.name
+    if target.exists() or target.is_symlink():
+        target.unlink()
+    if rec.complete:
+        os.symlink(mcap_path, target)
+    else:
+        with open(target, "wb") as fh:
+            w = Writer(fh, compression=CompressionType.ZSTD)
+            w.start(profile="ros2", library="sam-codegen recover")
+            sids = {sid: w.register_schema(s.name, s.encoding, s.data) for sid, s in rec.schemas.items()}
+            cids = {c.topic: w.register_channel(c.topic, c.message_encoding, sids.get(c.schema_id, 0), c.metadata)
+                    for c in rec.channels.values()}
+            for m in rec.messages:
+                w.add_message(cids[m.topic], m.log_time, m.data, m.publish_time, m.sequence)
+            for name, data in rec.attachments.items():
+                w.add_attachment(0, 0, name, "text/plain", data)
+            for name, meta in rec.metadata.items():
+                w.add_metadata(name, meta)
+            w.finish()
+    counts = Counter(m.topic for m in rec.messages)
+    times = [m.log_time for m in rec.messages] or [0]
+    topics: list[dict[str, Any]] = []
+    for c in rec.channels.values():
+        if c.message_encoding != "cdr":
+            continue
+        qos = c.metadata.get("offered_qos_profiles", "")
+        topics.append({"topic_metadata": {"name": c.topic, "type": rec.schemas[c.schema_id].name,
+                                          "serialization_format": "cdr", "offered_qos_profiles": qos,
+                                          "type_description_hash": ""},
+                       "message_count": counts.get(c.topic, 0)})
+    info: dict[str, Any] = {"rosbag2_bagfile_information": {
+        "version": 9, "storage_identifier": "mcap", "relative_file_paths": [target.name],
+        "duration": {"nanoseconds": max(times) - min(times)}, "starting_time": {"nanoseconds_since_epoch": min(times)},
+        "message_count": sum(t["message_count"] for t in topics), "topics_with_message_count": topics,
+        "compression_format": "", "compression_mode": "", "files": [], "custom_data": {}, "ros_distro": "jazzy"}}
+    # JSON is YAML: no YAML writer needed, and every string is quoted safely.
+    (folder / "metadata.yaml").write_text(json.dumps(info, indent=1) + "\n")
+    return folder

@@ -1,0 +1,365 @@
+"""Replay: the raw bus of a recording through a spec's bridge conversion, without a simulator or a bus, into a new
+MCAP, with a per-topic difference report against the ROS topics the recording holds.
+
+The conversion is given (:class:`Converter`, e.g. ``sam_runtime.bridge.offline.OfflineBridge``, one per protocol):
+this module reads, paces, writes and compares, and knows nothing of the bridge.
+
+Invariants:
+
+- Transfers are fed in the recording's file order (the order the listener received them), each with its recorded
+  receive time as the bridge's receive time; ``speed="recorded"`` paces them by their log times, ``"max"`` not.
+- The new file has every topic the converters publish, as the recording's ROS channels are written (ros2msg
+  schemas, CDR as a subscriber receives it: padded to a multiple of 4 bytes, log_time = publish_time = the
+  transfer's receive time), plus the recording's raw bus channels, its
+  attachments and metadata, so it is itself a recording.
+- The report matches the recorded and the replayed messages of each topic in order, from the replayed message
+  that corresponds to the first recorded one (the bus side of a recording starts earlier and ends later than its
+  ROS side: the replayed messages outside it are counted apart, ``outside``); after a pair that differs, a gap of
+  up to :data:`_RESYNC_WINDOW` messages on either side is skipped when the pairs after it agree again.
+  ``identical``: the same CDR bytes; ``receive_time``: they differ only in fields that depend on the receive time
+  (those that change when the same transfer is converted at a later receive time: the bridge stamps a message
+  whose device stamp is 0 with its own receive time, which the listener's cannot equal); ``differing``: other
+  fields differ (named); ``missing``: recorded, not replayed; ``extra``: replayed, not recorded.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+from sam_runtime.recording.reading import Recording, read_recording
+from sam_runtime.recording.schemas import KIND_MESSAGE, TRANSFER_TYPE, qos_yaml
+from sam_runtime.recording.writer import RecordingWriter
+
+__all__ = ["Converter", "ReplayReport", "TopicDiff", "field_differences", "replay"]
+
+SPEEDS = ("recorded", "max")
+_MAX_EXAMPLES = 5
+
+
+class Converter(Protocol):
+    """One protocol's UAVCAN -> ROS conversion (what ``sam_runtime.bridge.offline.OfflineBridge`` offers)."""
+
+    protocol: str
+
+    @property
+    def topics(self) -> dict[str, str]: ...
+
+    def feed(self, port_id: int, payload: bytes, source_node_id: int | None, transfer_id: int, monotonic_s: float,
+             receive_ns: int) -> Sequence[Any]:
+        """The publications (``.topic``, ``.ros_type``, ``.cdr``, ``.cdr_later``) for one transfer."""
+        ...
+
+    def stats(self) -> dict[str, Any]: ...
+
+
+@dataclass
+class TopicDiff:
+    topic: str
+    recorded: int = 0
+    replayed: int = 0
+    identical: int = 0
+    receive_time: int = 0
+    differing: int = 0
+    missing: int = 0
+    extra: int = 0
+    before: int = 0  # replayed from transfers before the ROS side of the recording began (not compared)
+    after: int = 0  # ... after it ended
+    fields: Counter[str] = field(default_factory=Counter)  # field path -> messages where it differs
+    receive_time_fields: Counter[str] = field(default_factory=Counter)
+    examples: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def same(self) -> bool:
+        """Nothing but receive-time fields differs, and nothing is missing or extra."""
+        return not (self.differing or self.missing or self.extra)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"recorded": self.recorded, "replayed": self.replayed, "identical": self.identical,
+                "receive_time_only": self.receive_time, "differing": self.differing, "missing": self.missing,
+                "extra": self.extra, "outside_ros_recording": self.before + self.after,
+                "differing_fields": dict(self.fields),
+                "receive_time_fields": dict(self.receive_time_fields), "examples": self.examples}
+
+
+@dataclass
+class ReplayReport:
+    input: str
+    output: str | None
+    transfers: int
+    recorded_span_s: float
+    replay_s: float
+    topics: dict[str, TopicDiff]
+    bridge: dict[str, Any]
+
+    @property
+    def same(self) -> bool:
+        return all(d.same for d in self.topics.values())
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"input": self.input, "output": self.output, "transfers": self.transfers,
+                "recorded_span_s": round(self.recorded_span_s, 3), "replay_s": round(self.replay_s, 3),
+                "same": self.same, "topics": {t: d.as_dict() for t, d in sorted(self.topics.items())},
+                "bridge": self.bridge}
+
+    def lines(self) -> list[str]:
+        out = [f"replayed {self.transfers} transfers ({self.recorded_span_s:.1f} s recorded) in {self.replay_s:.2f} s"
+               + (f" -> {self.output}" if self.output else ""),
+               f"{'TOPIC':32} {'RECORDED':>8} {'REPLAYED':>8} {'SAME':>6} {'RX-TIME':>7} {'DIFFER':>6} "
+               f"{'MISSING':>7} {'EXTRA':>5} {'OUTSIDE':>7}  FIELDS"]
+        for t, d in sorted(self.topics.items()):
+            fields = ", ".join(f"{k} ({n})" for k, n in d.fields.most_common(6))
+            out.append(f"{t:32} {d.recorded:8d} {d.replayed:8d} {d.identical:6d} {d.receive_time:7d} "
+                       f"{d.differing:6d} {d.missing:7d} {d.extra:5d} {d.before + d.after:7d}  {fields}")
+        rt = sorted({k for d in self.topics.values() for k in d.receive_time_fields})
+        if rt:
+            out.append(f"receive-time fields (differ only because the recorder's receive time is not the bridge's): "
+                       f"{', '.join(rt)}")
+        out.append("same as recorded" if self.same else "DIFFERENT from the recording")
+        return out
+
+
+# ============================================================================================ field comparison
+def _flatten(obj: Any, prefix: str, out: dict[str, Any]) -> None:
+    if hasattr(obj, "__slots__") or (hasattr(obj, "__dict__") and not isinstance(obj, type)):
+        names = getattr(obj, "__slots__", None) or list(vars(obj))
+        for n in names:
+            if not n.startswith("_"):
+                _flatten(getattr(obj, n), f"{prefix}.{n}" if prefix else n, out)
+    elif isinstance(obj, list | tuple):
+        if all(isinstance(x, int | float | bool | str) for x in obj):
+            out[prefix] = list(obj)
+        else:
+            out[f"{prefix}.length"] = len(obj)
+            for i, x in enumerate(obj):
+                _flatten(x, f"{prefix}[{i}]", out)
+    elif isinstance(obj, bytes | bytearray | memoryview):
+        out[prefix] = bytes(obj)
+    else:
+        out[prefix] = obj
+
+
+def _same_value(a: Any, b: Any) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and a != a and b != b:  # NaN == NaN here
+        return True
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same_value(x, y) for x, y in zip(a, b, strict=True))
+    return bool(a == b)
+
+
+def field_differences(decode_a: Any, a: bytes, decode_b: Any, b: bytes) -> list[str]:
+    """The field paths whose values differ between two CDR messages (decoded by ``decode_a`` / ``decode_b``);
+    ``["<undecodable>"]`` when either does not decode."""
+    try:
+        fa: dict[str, Any] = {}
+        fb: dict[str, Any] = {}
+        _flatten(decode_a(a), "", fa)
+        _flatten(decode_b(b), "", fb)
+    except Exception:
+        return ["<undecodable>"]
+    return sorted(k for k in fa.keys() | fb.keys() if k not in fa or k not in fb or not _same_value(fa[k], fb[k]))
+
+
+class _Decoders:
+    """CDR decoders per schema, built from the schema text (mcap-ros2-support), cached."""
+
+    def __init__(self) -> None:
+        from mcap_ros2.decoder import DecoderFactory
+
+        self._factory = DecoderFactory()
+        self._cache: dict[tuple[str, bytes], Any] = {}
+
+    def get(self, schema: Any) -> Any:
+        key = (schema.name, bytes(schema.data))
+        if key not in self._cache:
+            self._cache[key] = self._factory.decoder_for("cdr", schema)
+        return self._cache[key]
+
+
+# ============================================================================================ replay
+_ALIGN_WINDOW = 40  # replayed messages before the time-based guess that may be the first recorded one
+_ALIGN_PROBE = 30  # pairs compared to score an alignment
+_RESYNC_WINDOW = 8  # messages one side may lack before the sequences are matched again
+_RESYNC_CONFIRM = 3  # pairs that must agree after such a gap
+
+
+@dataclass(frozen=True)
+class _Out:
+    cdr: bytes
+    cdr_later: bytes
+    log_time: int  # the transfer's receive time
+
+
+class _Matcher:
+    """Classifies a (recorded, replayed) pair: "identical", "receive_time" or the differing fields."""
+
+    def __init__(self, schema_rec: Any, schema_new: Any, decoders: _Decoders) -> None:
+        self.dec_rec = decoders.get(schema_rec) if schema_rec is not None else None
+        self.dec_new = decoders.get(schema_new) if schema_new is not None else self.dec_rec
+
+    def classify(self, old: bytes, out: _Out) -> tuple[str, list[str], set[str]]:
+        if old == out.cdr:
+            return "identical", [], set()
+        if self.dec_rec is None:
+            return "differing", ["<no schema>"], set()
+        diff = field_differences(self.dec_rec, old, self.dec_new, out.cdr)
+        rt = set(field_differences(self.dec_new, out.cdr, self.dec_new, out.cdr_later)) if out.cdr_later != out.cdr \
+            else set()
+        if diff and set(diff) <= rt:
+            return "receive_time", diff, rt
+        return "differing", [f for f in diff if f not in rt], rt
+
+
+def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher) -> tuple[int, int]:
+    """(i, j): the recorded message i and the replayed message j that correspond, where the comparison begins.
+
+    The ROS side of a recording starts when the recorder's subscriptions have matched the bridge's publishers, its
+    bus side before: the bus holds transfers whose publications the recording does not. The bridge publishes a
+    transfer after the listener received it, so the first recorded message comes from one of the last transfers
+    received before it (by the listener's clock, which may lag the bridge's by some milliseconds): of the offsets
+    within :data:`_ALIGN_WINDOW` of that guess, the one after which most pairs are the same (identical or
+    receive-time only) wins, the nearest on a tie; when none is (a changed conversion), the time alone decides. A
+    negative offset means the first recorded messages have no transfer (a recording whose bus side began later)."""
+    if not recorded or not replayed:
+        return 0, 0
+    first = recorded[0].log_time
+    guess = max(0, sum(1 for o in replayed if o.log_time <= first) - 1)
+    best, best_score = guess, 0
+    for off in sorted(range(guess - _ALIGN_WINDOW, guess + _ALIGN_WINDOW + 1), key=lambda o: abs(o - guess)):
+        i0, j0 = max(0, -off), max(0, off)
+        if j0 >= len(replayed) or i0 >= len(recorded):
+            continue
+        score = sum(1 for old, out in zip(recorded[i0:i0 + _ALIGN_PROBE], replayed[j0:j0 + _ALIGN_PROBE],
+                                          strict=False) if matcher.classify(old.data, out)[0] != "differing")
+        if score > best_score:
+            best, best_score = off, score
+    return max(0, -best), max(0, best)
+
+
+def _diff_topic(topic: str, recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher) -> TopicDiff:
+    d = TopicDiff(topic, len(recorded), len(replayed))
+    i0, k = _align(recorded, replayed, matcher)
+    d.before = k
+    d.missing = i0  # recorded before the bus side began: no transfer to replay
+    last = recorded[-1].log_time if recorded else 0
+    window = list(replayed[k:])
+    while len(window) > len(recorded) and window[-1].log_time > last:  # after the ROS side stopped recording
+        window.pop()
+        d.after += 1
+    cache: dict[tuple[int, int], tuple[str, list[str], set[str]]] = {}
+
+    def classify(i: int, j: int) -> tuple[str, list[str], set[str]]:
+        if (i, j) not in cache:
+            cache[(i, j)] = matcher.classify(recorded[i].data, window[j])
+        return cache[(i, j)]
+
+    def agrees(i: int, j: int) -> bool:
+        """Pairs from (i, j) on are the same for :data:`_RESYNC_CONFIRM` steps (or to the end)."""
+        n = min(_RESYNC_CONFIRM, len(recorded) - i, len(window) - j)
+        return n > 0 and all(classify(i + s, j + s)[0] != "differing" for s in range(n))
+
+    i, j = i0, 0
+    while i < len(recorded) and j < len(window):
+        kind, fields, _ = classify(i, j)
+        if kind == "differing":
+            # a transfer the listener lost (recorded, not replayed) or the bridge never published (replayed, not
+            # recorded): skip it when the pairs after the gap agree again; else the pair differs
+            skip = next(((0, g) for g in range(1, _RESYNC_WINDOW + 1) if agrees(i, j + g)), None) or \
+                next(((g, 0) for g in range(1, _RESYNC_WINDOW + 1) if agrees(i + g, j)), None)
+            if skip is not None:
+                d.missing += skip[0]
+                d.extra += skip[1]
+                i, j = i + skip[0], j + skip[1]
+                continue
+        if kind == "identical":
+            d.identical += 1
+        elif kind == "receive_time":
+            d.receive_time += 1
+            d.receive_time_fields.update(fields)
+        else:
+            d.differing += 1
+            d.fields.update(fields)
+            if len(d.examples) < _MAX_EXAMPLES:
+                d.examples.append({"index": i, "fields": fields})
+        i, j = i + 1, j + 1
+    d.missing += len(recorded) - i
+    d.extra += len(window) - j
+    return d
+
+
+def _as_delivered(cdr: bytes) -> bytes:
+    """The CDR as a ROS subscriber (the recorder) receives it: Fast DDS pads every serialized payload with zeros to
+    a multiple of 4 bytes (the encapsulation options left 0), so the live bridge's publication of the codec's bytes
+    arrives padded.
+
+    >>> _as_delivered(bytes([0, 1, 0, 0, 7])).hex()
+    '0001000007000000'
+    """
+    return cdr + bytes(-len(cdr) % 4)
+
+
+def replay(path: Path, converters: Iterable[Converter], *, out: Path | None = None, speed: str = "max",
+           recording: Recording | None = None) -> ReplayReport:
+    """Replay ``path`` through ``converters`` (one per protocol); write ``out`` when given; the report."""
+    if speed not in SPEEDS:
+        raise ValueError(f"speed {speed!r}: expected one of {', '.join(SPEEDS)}")
+    rec = recording if recording is not None else read_recording(path)
+    by_protocol = {c.protocol: c for c in converters}
+    topics: dict[str, str] = {}
+    for c in by_protocol.values():
+        topics.update(c.topics)
+    writer = RecordingWriter(out) if out is not None else None
+    schema_new: dict[str, Any] = {}
+    if writer is not None:
+        for topic, ros_type in topics.items():
+            old = rec.schema_of(topic)
+            if old is None or old.name != ros_type:
+                continue  # a type the recording does not define: written by the caller's tools, not here
+            writer.add_channel(topic, ros_type, "ros2msg", old.data,
+                               metadata={"offered_qos_profiles": qos_yaml("reliable", "volatile", 1000)})
+        for ch in rec.channels.values():
+            s = rec.schemas.get(ch.schema_id)
+            if s is not None and s.name == TRANSFER_TYPE:
+                writer.add_channel(ch.topic, s.name, s.encoding, s.data, ch.message_encoding, dict(ch.metadata))
+        for name, data in rec.attachments.items():
+            writer.add_attachment(name, data)
+        for name, meta in rec.metadata.items():
+            writer.add_metadata(name, {**meta, "replayed_from": str(path)})
+    for topic, ros_type in topics.items():
+        old = rec.schema_of(topic)
+        schema_new[topic] = old if old is not None and old.name == ros_type else None
+    replayed: dict[str, list[_Out]] = {t: [] for t in topics}
+    transfers = rec.transfers()
+    t0_wall = time.monotonic()
+    first_log = transfers[0][0].log_time if transfers else 0
+    for msg, tr in transfers:
+        if writer is not None:  # the bus goes into the new file too: it is a recording in its turn
+            writer.write(msg.topic, msg.data, msg.log_time, msg.publish_time)
+        conv = by_protocol.get(tr.protocol)
+        if conv is None or tr.kind != KIND_MESSAGE:
+            continue
+        if speed == "recorded":
+            wait = (msg.log_time - first_log) * 1e-9 - (time.monotonic() - t0_wall)
+            if wait > 0:
+                time.sleep(wait)
+        for pub in conv.feed(tr.port_id, tr.payload, tr.source_node_id, tr.transfer_id, tr.timestamp_ns * 1e-9,
+                             tr.timestamp_ns):
+            cdr = _as_delivered(pub.cdr)
+            replayed.setdefault(pub.topic, []).append(_Out(cdr, _as_delivered(pub.cdr_later), msg.log_time))
+            if writer is not None:
+                writer.write(pub.topic, cdr, msg.log_time, msg.log_time)
+    elapsed = time.monotonic() - t0_wall
+    if writer is not None:
+        writer.close()
+    recorded = rec.by_topic()
+    decoders = _Decoders()
+    diffs = {t: _diff_topic(t, recorded.get(t, []), replayed.get(t, []),
+                            _Matcher(rec.schema_of(t), schema_new.get(t) or rec.schema_of(t), decoders))
+             for t in topics}
+    span = (transfers[-1][0].log_time - first_log) * 1e-9 if transfers else 0.0
+    return ReplayReport(str(path), None if out is None else str(out), len(transfers), span, elapsed, diffs,
+                        {c.protocol: c.stats() for c in by_protocol.values()})

@@ -1,0 +1,246 @@
+"""The recording's file, without processes: the envelope and the ROS definitions decode with the stock readers
+(mcap-ros2-support, rosbags), a cut or a full-disk file reads up to its last chunk with both, an unwritable path is
+one clear error, and the replay's report tells identical, receive-time-only, differing, missing and extra apart."""
+
+from __future__ import annotations
+
+import errno
+import io
+from pathlib import Path
+from types import SimpleNamespace as NS
+from typing import Any
+
+import pytest
+
+pytest.importorskip("mcap")
+pytest.importorskip("mcap_ros2")
+
+from mcap.records import Schema
+from mcap.stream_reader import StreamReader
+from mcap_ros2.decoder import DecoderFactory
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+from sam_codegen.catalogs.ros import ros_share_dirs
+from sam_runtime.recording.reading import read_recording, rosbag2_folder
+from sam_runtime.recording.replay import field_differences, replay
+from sam_runtime.recording.schemas import (
+    CYPHAL_TOPIC,
+    TRANSFER_MSG,
+    TRANSFER_TYPE,
+    Transfer,
+    decode_transfer,
+    encode_transfer,
+    qos_yaml,
+    ros2msg_definition,
+)
+from sam_runtime.recording.target import RecordingTargetError, check_target
+from sam_runtime.recording.writer import RecordingWriter
+
+JAZZY = get_typestore(Stores.ROS2_JAZZY)
+IMU = "sensor_msgs/msg/Imu"
+
+
+def _imu_cdr(sec: int, frame: str = "imu_link", x: float = 0.0) -> bytes:
+    t = JAZZY.types
+    hdr = t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=sec, nanosec=5), frame_id=frame)
+    q = t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
+    v = t["geometry_msgs/msg/Vector3"](x=x, y=0.0, z=0.0)
+    import numpy as np
+
+    msg = t[IMU](header=hdr, orientation=q, orientation_covariance=np.zeros(9), angular_velocity=v,
+                 angular_velocity_covariance=np.zeros(9), linear_acceleration=v,
+                 linear_acceleration_covariance=np.zeros(9))
+    return bytes(JAZZY.serialize_cdr(msg, IMU))
+
+
+def _transfer(i: int) -> Transfer:
+    return Transfer("cyphal", 1100, "sam.sensor.RawIMU.0.1", 11, i, 4, 1_000_000_000 + i, bytes([i % 256]) * 9)
+
+
+def _write(path: Path, n: int, *, chunk_size: int = 2048, stream: Any = None) -> RecordingWriter:
+    w = RecordingWriter(path, chunk_size=chunk_size, stream=stream)
+    w.add_channel("/imu", IMU, "ros2msg", ros2msg_definition(IMU, ros_share_dirs()),
+                  metadata={"offered_qos_profiles": qos_yaml("best_effort", "volatile", 10)})
+    w.add_channel(CYPHAL_TOPIC, TRANSFER_TYPE, "ros2msg", TRANSFER_MSG)
+    w.add_attachment("dsdl/sam/sensor/RawIMU.0.1.dsdl", b"# a definition\n")
+    w.add_metadata("sam_codegen.recording", {"format": "sam-recording/1"})
+    for i in range(n):
+        w.write("/imu", _imu_cdr(i), 1_000_000_000 + i, 999_000_000 + i)
+        w.write(CYPHAL_TOPIC, encode_transfer(_transfer(i)), 1_000_000_000 + i)
+    return w
+
+
+def test_the_envelope_decodes_with_both_stock_readers() -> None:
+    t = Transfer("dronecan", 1034, "uavcan.equipment.esc.Status", 21, 31, 16, 123456789, b"\x01\x02\x03", 0, None,
+                 0xA9AF28AEA2FBB254)
+    data = encode_transfer(t)
+    assert decode_transfer(data) == t
+    schema = Schema(id=1, name=TRANSFER_TYPE, encoding="ros2msg", data=TRANSFER_MSG.encode())
+    got = DecoderFactory().decoder_for("cdr", schema)(data)
+    assert (got.protocol, got.port_id, got.data_type, got.source_node_id, got.destination_node_id, got.transfer_id,
+            got.priority, got.timestamp_ns, bytes(got.payload), got.data_type_signature) == (
+        "dronecan", 1034, "uavcan.equipment.esc.Status", 21, -1, 31, 16, 123456789, b"\x01\x02\x03",
+        0xA9AF28AEA2FBB254)
+    store = get_typestore(Stores.ROS2_JAZZY)
+    store.register(get_types_from_msg(TRANSFER_MSG, TRANSFER_TYPE))
+    assert bytes(store.deserialize_cdr(data, TRANSFER_TYPE).payload) == b"\x01\x02\x03"
+
+
+def test_ros_definitions_are_concatenated_as_rosbag2_writes_them() -> None:
+    text = ros2msg_definition(IMU, ros_share_dirs())
+    assert [ln for ln in text.splitlines() if ln.startswith("MSG: ")] == [
+        "MSG: std_msgs/Header", "MSG: builtin_interfaces/Time", "MSG: geometry_msgs/Quaternion",
+        "MSG: geometry_msgs/Vector3"]
+    assert "=" * 80 + "\nMSG: std_msgs/Header\n" in text
+    schema = Schema(id=1, name=IMU, encoding="ros2msg", data=text.encode())
+    got = DecoderFactory().decoder_for("cdr", schema)(_imu_cdr(7, x=2.5))
+    assert (got.header.stamp.sec, got.header.frame_id, got.angular_velocity.x) == (7, "imu_link", 2.5)
+
+
+def test_a_complete_file_reads_with_mcap_and_rosbags(tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    _write(path, 200).close()
+    rec = read_recording(path)
+    assert rec.complete and len(rec.by_topic()["/imu"]) == 200
+    assert [t.transfer_id for _, t in rec.transfers()] == list(range(200))
+    assert rec.attachments == {"dsdl/sam/sensor/RawIMU.0.1.dsdl": b"# a definition\n"}
+    assert rec.metadata["sam_codegen.recording"] == {"format": "sam-recording/1"}
+    from mcap.reader import make_reader
+
+    with open(path, "rb") as fh:
+        reader = make_reader(fh)
+        assert reader.get_header().profile == "ros2"
+        counts = reader.get_summary().statistics.channel_message_counts
+        assert sorted(counts.values()) == [200, 200]
+    with Reader(rosbag2_folder(path, tmp_path / "bag")) as bag:
+        assert {c.topic: c.msgcount for c in bag.connections} == {"/imu": 200, CYPHAL_TOPIC: 200}
+        imu = next(c for c in bag.connections if c.topic == "/imu")
+        stamps = [JAZZY.deserialize_cdr(raw, IMU).header.stamp.sec for _, _, raw in bag.messages([imu])]
+        assert stamps == list(range(200))
+
+
+def test_a_cut_file_reads_up_to_its_last_chunk(tmp_path: Path) -> None:
+    """What SIGKILL leaves: no summary, no footer, the last chunk cut in the middle."""
+    path = tmp_path / "cut.mcap"
+    w = _write(path, 300)  # never closed: chunks of 2 KiB are in the file, the one in progress is not
+    size = path.stat().st_size
+    assert size > 10_000
+    with open(path, "r+b") as fh:
+        fh.truncate(size - 700)  # into the last chunk written
+    rec = read_recording(path)
+    assert not rec.complete and rec.stopped_by
+    imu = rec.by_topic()["/imu"]
+    assert 100 < len(imu) < 300
+    assert [m.log_time for m in imu] == [1_000_000_000 + i for i in range(len(imu))]  # a prefix, in order
+    # mcap's own streaming reader gives the same messages before it meets the cut
+    seen = 0
+    with open(path, "rb") as fh, pytest.raises(Exception):  # noqa: B017  (its error at the cut)
+        for r in StreamReader(fh).records:
+            seen += type(r).__name__ == "Message"
+    assert seen == len(rec.messages)
+    with Reader(rosbag2_folder(path, tmp_path / "bag")) as bag:  # rosbags: through the recovered copy
+        counts = {c.topic: c.msgcount for c in bag.connections}
+        assert counts["/imu"] == len(imu)
+        assert sum(1 for _ in bag.messages()) == len(rec.messages)
+    del w
+
+
+class _FullDisk(io.RawIOBase):
+    """A file on a disk that fills up after ``room`` bytes."""
+
+    def __init__(self, path: Path, room: int) -> None:
+        self._fh = open(path, "wb", buffering=0)
+        self.room = room
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, data: Any) -> int:
+        if self._fh.tell() + len(data) > self.room:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return int(self._fh.write(data))
+
+    def tell(self) -> int:
+        return int(self._fh.tell())
+
+    def close(self) -> None:
+        self._fh.close()
+        super().close()
+
+
+def test_a_full_disk_stops_the_recording_counted_never_raised(tmp_path: Path,
+                                                               caplog: pytest.LogCaptureFixture) -> None:
+    path = tmp_path / "full.mcap"
+    w = _write(path, 400, stream=_FullDisk(path, 20_000))
+    assert w.error is not None and "No space left" in w.error
+    assert w.not_recorded > 0
+    assert w.written["/imu"] + w.written[CYPHAL_TOPIC] + w.not_recorded == 800
+    w.close()  # no raise either
+    assert sum(1 for r in caplog.records if "stopped" in r.getMessage()) == 1  # logged once
+    rec = read_recording(path)
+    # everything counted as written before the error is there (the message whose write met it may be too)
+    assert 0 < w.written["/imu"] + w.written[CYPHAL_TOPIC] - 2 * 10 <= len(rec.messages)
+    assert len(rec.messages) <= w.written["/imu"] + w.written[CYPHAL_TOPIC] + 1
+
+
+def test_an_unwritable_path_is_one_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(RecordingTargetError, match="does not exist"):
+        check_target(tmp_path / "no" / "such" / "x.mcap")
+    with pytest.raises(RecordingTargetError, match="is a folder"):
+        check_target(tmp_path)
+    with pytest.raises(RecordingTargetError, match="not writable"):
+        check_target(Path("/proc/sys/x.mcap"))  # read-only even for root
+    assert check_target(tmp_path / "ok.mcap") == tmp_path / "ok.mcap"
+    assert not (tmp_path / "ok.mcap").exists()
+
+
+# ============================================================================================ replay report
+class _FakeConverter:
+    """Publishes /imu per transfer: the recorded message, changed as ``change`` says for some transfer ids."""
+
+    protocol = "cyphal"
+
+    def __init__(self, change: dict[int, str]) -> None:
+        self.change = change
+
+    @property
+    def topics(self) -> dict[str, str]:
+        return {"/imu": IMU}
+
+    def feed(self, port_id: int, payload: bytes, src: int | None, tid: int, mono: float, rx: int) -> list[Any]:
+        how = self.change.get(tid, "same")
+        if how == "drop":
+            return []
+        cdr = _imu_cdr(tid, x=9.0 if how == "value" else 0.0) if how != "stamp" else _imu_cdr(tid + 1000)
+        later = _imu_cdr(tid + 2000) if how == "stamp" else cdr  # the stamp follows the receive time
+        out = [NS(topic="/imu", ros_type=IMU, cdr=cdr, cdr_later=later)]
+        return out * 2 if how == "twice" else out
+
+    def stats(self) -> dict[str, Any]:
+        return {}
+
+
+def test_the_report_classifies_every_message(tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    _write(path, 10).close()
+    same = replay(path, [_FakeConverter({})], out=tmp_path / "same.mcap")
+    assert same.same and same.topics["/imu"].identical == 10
+    assert len(read_recording(tmp_path / "same.mcap").by_topic()["/imu"]) == 10
+    mixed = replay(path, [_FakeConverter({2: "stamp", 4: "value"})]).topics["/imu"]
+    assert (mixed.identical, mixed.receive_time, mixed.differing) == (8, 1, 1)
+    assert dict(mixed.fields) == {"angular_velocity.x": 1, "linear_acceleration.x": 1}
+    assert set(mixed.receive_time_fields) == {"header.stamp.sec"}
+    short = replay(path, [_FakeConverter({9: "drop"})])
+    assert not short.same and short.topics["/imu"].missing == 1
+    extra = replay(path, [_FakeConverter({9: "twice"})])
+    assert extra.topics["/imu"].extra == 1
+    assert "DIFFERENT" in extra.lines()[-1]
+
+
+def test_field_differences_names_paths() -> None:
+    schema = Schema(id=1, name=IMU, encoding="ros2msg", data=ros2msg_definition(IMU, ros_share_dirs()).encode())
+    dec = DecoderFactory().decoder_for("cdr", schema)
+    assert field_differences(dec, _imu_cdr(1), dec, _imu_cdr(1)) == []
+    assert field_differences(dec, _imu_cdr(1), dec, _imu_cdr(1, frame="x")) == ["header.frame_id"]
+    assert field_differences(dec, b"junk", dec, _imu_cdr(1)) == ["<undecodable>"]
