@@ -59,6 +59,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         "tables": module.tables,
         "functions": functions,
         "matches": predicates,
+        "mappings": [rm.mapping.name for rm in resolved.dronecan_mappings],
         "types": [(py_str(t.name), str(t.data_type_id), f"0x{t.signature:016X}") for t in used_types(resolved)],
         "custom_dirs": [py_str(d) for d in dsdl_v0.load_dirs(resolved)],
     }

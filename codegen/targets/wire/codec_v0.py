@@ -331,6 +331,7 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         "tables": module.tables,
         "functions": functions,
         "matches": predicates,
+        "mappings": [rm.mapping.name for rm in mappings],
         "constants": consts.lines(),
         "prelude": MODULE_PRELUDE,
         "helpers": HELPERS.strip("\n").splitlines(),
