@@ -22,6 +22,9 @@ from sam_codegen.validate.values import check_dsdl_value, python_safe
 V0_NODE_IDS = range(1, 126)  # 0 is anonymous, 126 and 127 are kept for maintenance tools
 V0_FIELD_NAME = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
 DEFAULT_LAYOUT = "default"
+# Types inside types: the cycle check, the signatures and the codecs walk them recursively, a few frames a level,
+# and a spec whose YAML is flat can still chain thousands. The standard DroneCAN types nest at most ~4 levels.
+_MAX_NESTING = 32
 
 
 @dataclass
@@ -152,12 +155,21 @@ class DronecanValidator:
                 self.catalog.signature(struct.name)
 
     def check_type_cycles(self) -> None:
+        too_deep: list[str] = []
+
         def visit(name: str, stack: tuple[str, ...]) -> bool:
             struct = self.spec.dronecan_types.get(name)
             if struct is None:
                 return False
             if name in stack:
                 self.error(struct.pos, f"DroneCAN type {name} contains itself: {' -> '.join((*stack, name))}")
+                return True
+            if len(stack) == _MAX_NESTING:
+                if not too_deep:  # one error is enough: a chain of N types would give N - 32
+                    too_deep.append(name)
+                    self.error(self.spec.dronecan_types[stack[0]].pos, f"DroneCAN type {stack[0]} nests types more "
+                               f"than {_MAX_NESTING} levels deep ({stack[0]} -> {stack[1]} -> ... -> {name})",
+                               f"at most {_MAX_NESTING} levels of types inside types")
                 return True
             return any(visit(f.type.composite, (*stack, name)) for f in struct.fields  # type: ignore[union-attr]
                        if isinstance(f.type, DsdlType) and f.type.composite)

@@ -34,6 +34,9 @@ from sam_codegen.validate.values import python_safe as _python_safe
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _PARAM_NAME = ROS_TOPIC_NAME
 _CONVERTER_LOCALS = frozenset({"src", "msg", "stats", "receive_ns", "us", "stamp", "typing", "collections"})
+# Types inside types: the cycle check, the layouts and the codecs walk them recursively, a few frames a level, and
+# a spec whose YAML is flat can still chain thousands. ROS's own messages nest at most ~6 levels.
+_MAX_NESTING = 32
 
 
 @dataclass
@@ -189,12 +192,21 @@ class _Validator:
         return sorted(self.spec.messages.values(), key=lambda m: m.name)
 
     def check_message_cycles(self) -> None:
+        too_deep: list[str] = []
+
         def visit(name: str, stack: tuple[str, ...]) -> None:
             message = self.spec.messages.get(name)
             if message is None:
                 return
             if name in stack:
                 self.error(message.pos, f"message {name} contains itself: {' -> '.join((*stack, name))}")
+                return
+            if len(stack) == _MAX_NESTING:
+                if not too_deep:  # one error is enough: a chain of N messages would give N - 32
+                    too_deep.append(name)
+                    self.error(self.spec.messages[stack[0]].pos, f"message {stack[0]} nests messages more than "
+                               f"{_MAX_NESTING} levels deep ({stack[0]} -> {stack[1]} -> ... -> {name})",
+                               f"at most {_MAX_NESTING} levels of messages inside messages")
                 return
             for f in message.fields:
                 assert isinstance(f.type, RosType)

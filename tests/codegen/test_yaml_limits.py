@@ -252,3 +252,32 @@ def test_deepest_allowed_values_are_errors_not_crashes(tmp_path: Path, old: str,
     with pytest.raises(SpecError) as caught:
         validate(load_spec_file(path))
     assert all(str(d).startswith(str(path)) for d in caught.value.diagnostics)
+
+
+# ---- types chained in flat YAML: the validators refuse them before any recursive walk -----------------------------
+
+def _chain(base: str, section: str, name: str, first: str, count: int) -> str:
+    types = "".join(f"  {name.format(i)}:\n    fields:\n"
+                    f"      - {{name: x, type: {name.format(i - 1) if i else first}}}\n" for i in range(count))
+    assert f"\n{section}:\n" in base
+    return base.replace(f"\n{section}:\n", f"\n{section}:\n{types}", 1)
+
+
+@pytest.mark.parametrize(("spec", "section", "name", "first", "error"), [
+    ("minimal.yaml", "messages", "M{}", "int32",
+     "minimal.yaml:103:3: error: message buoy_msgs/M32 nests messages more than 32 levels deep (buoy_msgs/M32 -> "
+     "buoy_msgs/M31 -> ... -> buoy_msgs/M0) (expected at most 32 levels of messages inside messages)"),
+    ("minimal_v0.yaml", "dronecan_types", "skiff.C{}", "uint8",
+     "minimal_v0.yaml:108:3: error: DroneCAN type skiff.C32 nests types more than 32 levels deep (skiff.C32 -> "
+     "skiff.C31 -> ... -> skiff.C0) (expected at most 32 levels of types inside types)"),
+], ids=["ros", "dronecan"])
+def test_types_chained_in_flat_yaml_are_an_error(tmp_path: Path, spec: str, section: str, name: str, first: str,
+                                                 error: str) -> None:
+    """3000 types each holding the previous one: 2 levels of YAML, 3000 of types, one error and no RecursionError."""
+    path = tmp_path / spec
+    path.write_text(_chain((SPECS / spec).read_text(encoding="utf-8"), section, name, first, 3000), encoding="utf-8")
+    with pytest.raises(SpecError) as caught:
+        validate(load_spec_file(path))
+    assert [str(d).replace(str(path), spec) for d in caught.value.diagnostics] == [error]
+    path.write_text(_chain((SPECS / spec).read_text(encoding="utf-8"), section, name, first, 32), encoding="utf-8")
+    validate(load_spec_file(path))  # 32 levels are allowed
