@@ -67,7 +67,8 @@ from sam_runtime.recording.schemas import (
 )
 from sam_runtime.recording.writer import RecordingWriter
 
-__all__ = ["DIAGNOSTICS_TOPIC", "METADATA_NAME", "Recorder", "RecorderConfig", "layout_protocols", "topic_qos"]
+__all__ = ["DIAGNOSTICS_TOPIC", "METADATA_NAME", "DroneCanTaps", "Recorder", "RecorderConfig", "layout_protocols",
+           "topic_qos"]
 
 log = logging.getLogger("sam_runtime.recording")
 
@@ -120,7 +121,7 @@ def topic_qos(tables: Any) -> dict[str, tuple[str, str, str, int]]:
     return out
 
 
-class _SniffTaps(TransferTaps):
+class DroneCanTaps(TransferTaps):
     """Takes every completed v0 transfer (messages and services) and hands it to ``on_transfer``."""
 
     def __init__(self, drops: DropCounter, on_transfer: Callable[[Transfer], None]) -> None:
@@ -130,6 +131,7 @@ class _SniffTaps(TransferTaps):
 
     def take(self, frames: list[Any]) -> bool:
         import dronecan
+        from dronecan.dsdl import CompoundType
 
         ident = frames[0].id
         service = bool(ident & 0x80)
@@ -138,11 +140,11 @@ class _SniffTaps(TransferTaps):
             dtid = (ident >> 16) & 0xFF
             kind = KIND_REQUEST if ident & 0x8000 else KIND_RESPONSE
             dst: int | None = (ident >> 8) & 0x7F
-            dtype = dronecan.DATATYPES.get((dtid, 1))  # dsdl.CompoundType.KIND_SERVICE
+            dtype = dronecan.DATATYPES.get((dtid, CompoundType.KIND_SERVICE))
         else:
             dtid = (ident >> 8) & 0xFFFF if src else (ident >> 8) & 0x3
             kind, dst = KIND_MESSAGE, None
-            dtype = dronecan.DATATYPES.get((dtid, 0)) if src else None  # KIND_MESSAGE
+            dtype = dronecan.DATATYPES.get((dtid, CompoundType.KIND_MESSAGE)) if src else None
         signature = dtype.get_data_type_signature() if dtype is not None else 0
         if len(frames) == 1:
             payload = bytes(frames[0].data[:-1])
@@ -188,7 +190,7 @@ class Recorder:
         self._tasks: list[asyncio.Task[None]] = []
         self._dronecan_stop = threading.Event()
         self._dronecan_thread: threading.Thread | None = None
-        self._taps: _SniffTaps | None = None
+        self._taps: DroneCanTaps | None = None
         self._dronecan_drops: DropCounter | None = None
         self.subjects: dict[int, str] = {}
         self.ros_errors: list[str] = []
@@ -353,7 +355,7 @@ class Recorder:
             if self.writer.write(DRONECAN_TOPIC, encode_transfer(t), t.timestamp_ns, t.timestamp_ns):
                 self.counts.transfers["dronecan"] += 1
 
-        self._taps = gate.taps = _SniffTaps(drops, on_transfer)
+        self._taps = gate.taps = DroneCanTaps(drops, on_transfer)
         self._dronecan_drops = drops
 
         def run() -> None:

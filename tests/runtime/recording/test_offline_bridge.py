@@ -71,3 +71,37 @@ class _Stats:
 
     def reject(self, key: str) -> None:
         pass
+
+
+def test_the_dronecan_listener_records_every_transfer_checked() -> None:
+    """Messages and services, multi-frame ones CRC-checked with the data type's signature, as dronecan checks."""
+    import dronecan
+    from dronecan import transport
+    from dronecan.driver.common import CANFrame
+
+    from sam_runtime.dronecan_io.drops import DropCounter
+    from sam_runtime.recording.recorder import DroneCanTaps
+    from sam_runtime.recording.schemas import KIND_MESSAGE, KIND_REQUEST
+
+    got: list[Any] = []
+    taps = DroneCanTaps(DropCounter(), got.append)
+
+    def frames(t: Any) -> list[CANFrame]:
+        return [CANFrame(f.message_id, bytearray(f.bytes), True) for f in t.to_frames()]
+
+    raw_imu = dronecan.TYPENAMES["uavcan.equipment.ahrs.RawIMU"]
+    imu = transport.Transfer(payload=raw_imu(), source_node_id=11, transfer_id=5, transfer_priority=20,
+                             service_not_message=False)
+    assert taps.take(frames(imu))
+    info = dronecan.TYPENAMES["uavcan.protocol.GetNodeInfo"]
+    request = transport.Transfer(payload=info.Request(), source_node_id=100, dest_node_id=21, transfer_id=3,
+                                 transfer_priority=30, service_not_message=True, request_not_response=True)
+    assert taps.take(frames(request))
+    bad = frames(imu)
+    bad[0].data[0] ^= 0xFF  # the transfer CRC
+    assert taps.take(bad)
+    assert [(t.kind, t.port_id, t.data_type, t.source_node_id, t.destination_node_id, t.transfer_id, t.priority)
+            for t in got] == [(KIND_MESSAGE, 1003, "uavcan.equipment.ahrs.RawIMU", 11, None, 5, 20),
+                              (KIND_REQUEST, 1, "uavcan.protocol.GetNodeInfo", 100, 21, 3, 30)]
+    assert got[0].payload == bytes(imu.payload) and got[0].data_type_signature == raw_imu.get_data_type_signature()
+    assert dict(taps.crc_failures) == {"uavcan.equipment.ahrs.RawIMU": 1}
