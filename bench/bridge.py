@@ -214,7 +214,7 @@ def wire_steps(rig: Rig, pub: Any, t: Callable[[Any], float]) -> dict[str, float
 async def measure_transport(gen: Any, kind: str, *, reps: int, window_s: float, latency_hz: float,
                             latency_s: float, mix_s: float, drain_s: float, mix: bool = True,
                             object_reps: int = 3, object_latency_reps: int = 1) -> dict[str, Any]:
-    from sam_runtime.bridge import quiet_late_media_completions
+    from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 
     quiet_late_media_completions(asyncio.get_running_loop())
     pid = os.getpid()

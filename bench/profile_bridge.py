@@ -134,8 +134,8 @@ async def ab(kind: str, seconds: float, reps: int, variants: list[str]) -> None:
     from bench.bridge_blocks import PATHS
     from bench.bridge_rig import Rig
     from bench.common import generated_package, median
-    from sam_runtime.bridge import quiet_late_media_completions
     from sam_runtime.bridge.ros_side import RosSide
+    from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 
     quiet_late_media_completions(asyncio.get_running_loop())
     gen = generated_package()

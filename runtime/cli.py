@@ -29,24 +29,21 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sam_runtime.cli_support import (  # noqa: F401  (PARENT_ENV_VAR, ORPHAN_GRACE_S, _PARENT_POLL_S: the tests')
-    _PARENT_POLL_S,
+from sam_runtime.cli_support import (
     EXIT_ERROR,
     EXIT_OK,
     EXIT_USAGE,
-    ORPHAN_GRACE_S,
-    PARENT_ENV_VAR,
-    _add_generated_args,
-    _add_transport_args,
-    _generated,
-    _parse_params,
-    _require_runtime,
-    _serve,
-    _setup_logging,
-    _stay_with_parent,
-    _transport_kind,
-    _wait,
-    _write_json_atomic,
+    add_generated_args,
+    add_transport_args,
+    generated_package,
+    parse_params,
+    require_runtime,
+    serve,
+    setup_logging,
+    stay_with_parent,
+    transport_kind,
+    wait_for_stop,
+    write_json_atomic,
 )
 
 __all__ = ["bridge_main", "main", "nodes_main", "run_main", "sim_main"]
@@ -71,8 +68,8 @@ def _add_wire_arg(p: argparse.ArgumentParser) -> None:
 
 def _bridge_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="sam-bridge", description="The UAVCAN (Cyphal) <-> ROS 2 bridge of the spec.")
-    _add_generated_args(p)
-    _add_transport_args(p)
+    add_generated_args(p)
+    add_transport_args(p)
     p.add_argument("--node-id", type=int, default=None,
                    help="Cyphal node id (default: UAVCAN__NODE__ID with --transport env, else the spec's)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
@@ -102,20 +99,20 @@ def _bridge_parser() -> argparse.ArgumentParser:
 
 def bridge_main(argv: Sequence[str] | None = None) -> int:
     args = _bridge_parser().parse_args(argv)
-    _require_runtime("bridge")
-    _stay_with_parent()
-    _setup_logging(args.log_level)
+    require_runtime("bridge")
+    stay_with_parent()
+    setup_logging(args.log_level)
     from sam_runtime.bridge import Bridge, BridgeConfigError, TransportConfig
     from sam_runtime.cyphal_io.transport import TransportConfigError
     from sam_runtime.genpkg import GeneratedPackageError
 
     async def run(stop: asyncio.Event) -> int:
         bridge = Bridge(
-            _generated(args),
+            generated_package(args),
             node_id=args.node_id,
-            transport=TransportConfig(_transport_kind(args), args.iface, args.mtu),
+            transport=TransportConfig(transport_kind(args), args.iface, args.mtu),
             ros_args=args.ros_args,
-            parameter_overrides=_parse_params(args.param),
+            parameter_overrides=parse_params(args.param),
             qos_depth=args.qos_depth,
             command_reliability=args.command_qos,
             **({} if args.rx_queue_size is None else {"rx_queue_size": args.rx_queue_size}),
@@ -135,25 +132,25 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
                 left = None if deadline is None else deadline - time.monotonic()
                 if left is not None and left <= 0:
                     break
-                await _wait(stop, 1.0 if left is None else min(1.0, left))
+                await wait_for_stop(stop, 1.0 if left is None else min(1.0, left))
                 if args.stats_file:
-                    _write_json_atomic(args.stats_file, bridge.stats())
+                    write_json_atomic(args.stats_file, bridge.stats())
         finally:
             snapshot = bridge.stats()
             await bridge.close()
             if args.stats_file:
-                _write_json_atomic(args.stats_file, snapshot)
+                write_json_atomic(args.stats_file, snapshot)
         return EXIT_OK
 
-    return _serve("sam-bridge", run, (BridgeConfigError, GeneratedPackageError, TransportConfigError))
+    return serve("sam-bridge", run, (BridgeConfigError, GeneratedPackageError, TransportConfigError))
 
 
 # ============================================================================================ sim
 def _sim_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="sam-sim", description="Simulated devices of the spec, one node each (Cyphal or "
                                 "DroneCAN, as the layout says).")
-    _add_generated_args(p)
-    _add_transport_args(p)
+    add_generated_args(p)
+    add_transport_args(p)
     p.add_argument("--layout", default="default", metavar="NAME",
                    help="the spec's layout: which firmware (cyphal, dronecan) each device runs (default: default, "
                         "every device on its own protocol)")
@@ -229,15 +226,15 @@ def _vehicle_options(args: argparse.Namespace) -> dict[str, Any]:
 
 def sim_main(argv: Sequence[str] | None = None) -> int:
     args = _sim_parser().parse_args(argv)
-    _require_runtime("sim")
-    _stay_with_parent()
-    _setup_logging(args.log_level)
+    require_runtime("sim")
+    stay_with_parent()
+    setup_logging(args.log_level)
     from sam_runtime.cyphal_io.transport import TransportConfigError
     from sam_runtime.genpkg import GeneratedPackageError
     from sam_runtime.sim.simulator import SimConfig, Simulator
 
     async def run(stop: asyncio.Event) -> int:
-        kind = _transport_kind(args)
+        kind = transport_kind(args)
         cfg = SimConfig(
             kind=kind, iface=args.iface, mtu=args.mtu, environ=dict(os.environ) if kind == "env" else None,
             bridge_node_id=args.bridge_node_id,
@@ -245,13 +242,13 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
             rate_scale=args.rate_scale, record=args.record, layout=args.layout, dronecan_iface=args.dronecan_iface,
             **_vehicle_options(args),
         )
-        sim = Simulator(_generated(args), cfg)
+        sim = Simulator(generated_package(args), cfg)
         await sim.start()
         print(f"READY sim devices={len(sim.devices)} transport={kind}", flush=True)
         try:
             if args.start_file is not None:
                 while not args.start_file.exists() and not stop.is_set():
-                    await _wait(stop, 0.01)
+                    await wait_for_stop(stop, 0.01)
             if not stop.is_set():
                 sim.start_publishing(duration=args.duration)
                 print("PUBLISHING", flush=True)
@@ -268,11 +265,11 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
             report = sim.report()
             await sim.close()
             if args.report:
-                _write_json_atomic(args.report, report)
+                write_json_atomic(args.report, report)
         print("DONE " + json.dumps({k: v["published"] for k, v in report["devices"].items()}), flush=True)
         return EXIT_OK
 
-    return _serve("sam-sim", run, (GeneratedPackageError, TransportConfigError, ValueError))
+    return serve("sam-sim", run, (GeneratedPackageError, TransportConfigError, ValueError))
 
 
 # ============================================================================================ nodes
@@ -301,7 +298,7 @@ def _nodes_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="sam-nodes", description="The node host: the spec's nodes that have an implementation, in one process "
                                       "(one rclpy context and executor, each node its own ROS node).")
-    _add_generated_args(p)
+    add_generated_args(p)
     p.add_argument("--params-file", type=Path, default=None,
                    help="ROS 2 parameters file (default: the generated params/<vehicle>.params.yaml)")
     p.add_argument("--only", default=None, metavar="A,B",
@@ -314,16 +311,16 @@ def _nodes_parser() -> argparse.ArgumentParser:
 
 def nodes_main(argv: Sequence[str] | None = None) -> int:
     args = _nodes_parser().parse_args(argv)
-    _require_runtime("nodes")
-    _stay_with_parent()
-    _setup_logging(args.log_level)
+    require_runtime("nodes")
+    stay_with_parent()
+    setup_logging(args.log_level)
     from sam_runtime.genpkg import GeneratedPackageError
     from sam_runtime.nav.mission import MissionError
     from sam_runtime.nodes.host import HostConfigError, NodeHost, plan_host
 
     try:
         goals = _mission_goals(args)
-        gen = _generated(args)
+        gen = generated_package(args)
         only = None if args.only is None else [n.strip() for n in args.only.split(",") if n.strip()]
         plan = plan_host(gen.tables(), only)
     except (GeneratedPackageError, HostConfigError, MissionError) as ex:
@@ -360,7 +357,7 @@ def _run_parser() -> argparse.ArgumentParser:
         description="Build, start the simulated devices and the bridge, and show live what flows (Ctrl-C stops).")
     p.add_argument("--spec", type=Path, default=None,
                    help="the spec (default: spec/interfaces.yaml in the working directory or its nearest parent)")
-    _add_generated_args(p, "the generated folder (default: generated/ in the project of --spec when it is given, "
+    add_generated_args(p, "the generated folder (default: generated/ in the project of --spec when it is given, "
                            "else $SAM_GENERATED_DIR, else generated/ of the project the working directory is in)")
     p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface of sim and bridge (default 127.0.0.1)")
     _add_layout_args(p)
@@ -398,8 +395,8 @@ def _sim_vehicle_argv(args: argparse.Namespace) -> list[str]:
 
 def run_main(argv: Sequence[str] | None = None) -> int:
     args = _run_parser().parse_args(argv)
-    _require_runtime("run")
-    _setup_logging(args.log_level)
+    require_runtime("run")
+    setup_logging(args.log_level)
     from sam_runtime.main_job.job import RunOptions, run
     from sam_runtime.nav.mission import MissionError
 

@@ -33,7 +33,7 @@ _RUNTIME_MODULES = {
 # Set by the main job (`run`) in its children's environment: the pid they must not outlive.
 PARENT_ENV_VAR = "SAM_RUN_PARENT_PID"
 _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
-_PARENT_POLL_S = 0.25
+PARENT_POLL_S = 0.25
 # An orphan gets this long to stop cleanly after its SIGTERM, then it exits at once.
 ORPHAN_GRACE_S = 5.0
 
@@ -51,7 +51,7 @@ def _missing_runtime(command: str) -> list[str]:
     return missing
 
 
-def _require_runtime(command: str) -> None:
+def require_runtime(command: str) -> None:
     """Exit with one clear line when the [runtime] extra is not installed (instead of an ImportError's traceback)."""
     missing = _missing_runtime(command)
     if missing:
@@ -60,7 +60,7 @@ def _require_runtime(command: str) -> None:
         raise SystemExit(EXIT_ERROR)
 
 
-def _stay_with_parent() -> None:
+def stay_with_parent() -> None:
     """A child of the main job ends when the main job ends, however it ends (a crash, SIGKILL, a closed terminal):
     left running, a second run would find two of every device and the rates doubled.
 
@@ -83,14 +83,14 @@ def _stay_with_parent() -> None:
 
 def _watch_parent(parent: int) -> None:
     while os.getppid() == parent:
-        time.sleep(_PARENT_POLL_S)
+        time.sleep(PARENT_POLL_S)
     with contextlib.suppress(OSError):
         os.kill(os.getpid(), signal.SIGTERM)
     time.sleep(ORPHAN_GRACE_S)
     os._exit(EXIT_ERROR)
 
 
-def _setup_logging(level: str) -> None:
+def setup_logging(level: str) -> None:
     logging.basicConfig(
         level=getattr(logging, level.upper(), logging.INFO),
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
@@ -104,13 +104,13 @@ _GENERATED_HELP = ("the generated folder (default: $SAM_GENERATED_DIR, else gene
                    "directory is in)")
 
 
-def _add_generated_args(p: argparse.ArgumentParser, generated_help: str = _GENERATED_HELP) -> None:
+def add_generated_args(p: argparse.ArgumentParser, generated_help: str = _GENERATED_HELP) -> None:
     p.add_argument("--generated", type=Path, default=None, help=generated_help)
     p.add_argument("--package", default=None, help="python package name under generated/python (default: the "
                    "only *_bridge package)")
 
 
-def _add_transport_args(p: argparse.ArgumentParser) -> None:
+def add_transport_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--transport", choices=("udp", "can", "loopback", "env"), default=None,
                    help="Cyphal transport (default: env if UAVCAN__*__IFACE is set, else udp)")
     p.add_argument("--iface", default=None,
@@ -119,7 +119,7 @@ def _add_transport_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--log-level", default="INFO")
 
 
-def _transport_kind(args: argparse.Namespace) -> str:
+def transport_kind(args: argparse.Namespace) -> str:
     if args.transport:
         return str(args.transport)
     if args.iface:
@@ -129,7 +129,7 @@ def _transport_kind(args: argparse.Namespace) -> str:
     return "udp"
 
 
-def _generated(args: argparse.Namespace) -> Any:
+def generated_package(args: argparse.Namespace) -> Any:
     from sam_runtime.genpkg import GeneratedPackage, default_generated_dir
 
     return GeneratedPackage(args.generated or default_generated_dir(), args.package)
@@ -141,13 +141,13 @@ def _install_stop_handlers(loop: asyncio.AbstractEventLoop, stop: asyncio.Event)
             loop.add_signal_handler(sig, stop.set)
 
 
-def _write_json_atomic(path: Path, data: Any) -> None:
+def write_json_atomic(path: Path, data: Any) -> None:
     tmp = path.with_name(path.name + f".tmp{os.getpid()}")
     tmp.write_text(json.dumps(data, indent=1, sort_keys=True, default=str))
     os.replace(tmp, path)
 
 
-async def _wait(stop: asyncio.Event, seconds: float | None) -> None:
+async def wait_for_stop(stop: asyncio.Event, seconds: float | None) -> None:
     if seconds is None:
         await stop.wait()
     else:
@@ -193,7 +193,7 @@ def _run_async(main: Any, drain_timeout: float = 3.0) -> int:
             loop.close()
 
 
-def _parse_params(items: Sequence[str]) -> dict[str, Any]:
+def parse_params(items: Sequence[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for item in items:
         if "=" not in item:
@@ -212,7 +212,7 @@ def _parse_params(items: Sequence[str]) -> dict[str, Any]:
     return out
 
 
-def _serve(prog: str, body: Any, errors: tuple[type[BaseException], ...]) -> int:
+def serve(prog: str, body: Any, errors: tuple[type[BaseException], ...]) -> int:
     """Run ``body(stop)`` on a fresh loop, `stop` set by SIGINT/SIGTERM; `errors` become one line and exit 1."""
 
     async def run() -> int:

@@ -24,7 +24,9 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from sam_codegen.project.ros_install import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
 from sam_codegen.project.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
+from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
 
 __all__ = [
     "GENERATED_ENV_VAR",
@@ -33,6 +35,7 @@ __all__ = [
     "default_generated_dir",
     "ensure_ros_package",
     "ros_package_hash",
+    "same_interfaces",
 ]
 
 _HASH_STAMP = ".sam_codegen_source_hash"
@@ -74,7 +77,6 @@ def _find_python_package(python_dir: Path, name: str | None) -> str:
 @dataclass
 class GeneratedPackage:
     """One generated package; modules are imported lazily and cached."""
-
     root: Path = field(default_factory=default_generated_dir)
     package: str | None = None  # python package name, e.g. "sam_bridge"; default: the only *_bridge found
 
@@ -126,7 +128,6 @@ class GeneratedPackage:
     def compile_dsdl(self) -> Path:
         """Compile the generated DSDL + ``uavcan`` (cached) and put it on sys.path. Call before importing
         ``uavcan`` or ``pycyphal.application`` anywhere in the process."""
-        from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
 
         dirs = self.dsdl_dirs
         if not dirs:
@@ -140,7 +141,7 @@ class GeneratedPackage:
             try:
                 self._convert = self._import("convert")
             except ModuleNotFoundError as ex:
-                ros_pkg = getattr(self.tables(), "ROS_PACKAGE", "?")
+                ros_pkg = self.tables().ROS_PACKAGE
                 if ex.name and ex.name.split(".")[0] == ros_pkg:
                     raise GeneratedPackageError(
                         f"the ROS message package {ros_pkg!r} is not importable: build it "
@@ -161,7 +162,7 @@ class GeneratedPackage:
                     raise GeneratedPackageError(f"{self.root} has no DroneCAN converters (the spec declares no "
                                                 f"dronecan mappings)") from None
                 raise
-            from sam_runtime.dronecan_io.types import ensure_types
+            from sam_runtime.dronecan_io.types import ensure_types  # needs dronecan (the runtime extra)
 
             try:  # beside the types loaded already (dronecan.load_dsdl would replace them all: see that module)
                 ensure_types(self)
@@ -207,7 +208,7 @@ def ros_package_hash(package_dir: Path) -> str:
     return h.hexdigest()[:24]
 
 
-def _same_interfaces(src: Path, installed: Path) -> bool:
+def same_interfaces(src: Path, installed: Path) -> bool:
     """Whether an install (e.g. by ``sam-codegen ros-install``) holds exactly the source's interface files."""
     def files(root: Path) -> dict[str, bytes]:
         return {p.relative_to(root).as_posix(): p.read_bytes()
@@ -230,7 +231,6 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
     directory); an install is stamped with its sources' hash, so a changed spec triggers a rebuild and an unchanged
     one costs a few ms.
     """
-    from sam_codegen.project.ros_install import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
 
     prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
     own = gen.ros_package_dir()
@@ -247,7 +247,7 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
         stamp = prefix / "share" / name / _HASH_STAMP
         if is_installed(name, prefix) and (
             (stamp.is_file() and stamp.read_text().strip() == digest)
-            or _same_interfaces(pkg_dir, prefix / "share" / name)
+            or same_interfaces(pkg_dir, prefix / "share" / name)
         ):
             continue
         if log is not None:

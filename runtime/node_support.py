@@ -450,7 +450,8 @@ class NodeSupport:
         from rclpy.clock import Clock, ClockType
 
         self.node = node
-        self.level, self.message, self.values = Level.OK, "running", {}
+        self.level, self.message = Level.OK, "running"
+        self.values: dict[str, Any] = {}
         self.counters: dict[str, int] = {}
         self._errors_since_report: list[str] = []
         self._logged: dict[str, float] = {}

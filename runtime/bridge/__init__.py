@@ -21,18 +21,23 @@ module                 job
 ``composition``        :class:`Bridge`: creates the parts, wires their handlers, attaches them in start order
 ``lifetime``           start/close hooks in order, periodic jobs, the bridge's error counters
 ``backend``            the interface a protocol backend implements, its device status events
-``cyphal_backend``     Cyphal v1 through pycyphal: transports, node, registers/ports, heartbeats, pycyphal's counters
+``backends``           the only protocol-specific part, imported by ``composition`` alone: ``backends.cyphal``
+                       (Cyphal v1 through pycyphal: transports, node, registers/ports, heartbeats, pycyphal's
+                       counters; its wire path ``backends.cyphal_wire``), ``backends.dronecan`` (DroneCAN through
+                       sam_runtime.dronecan_io; its node duties ``backends.dronecan_duties``)
 ``ros_side``           the ROS node: parameters, each topic's QoS, the receive clock, the executor thread
 ``inbound``            the UAVCAN -> ROS path (source filter, conversion, stamps, publish)
 ``outbound``           the ROS -> UAVCAN path (conversion, bounded queues, workers)
 ``handoff``            the rclpy thread -> asyncio loop hand-off, one wake-up per batch
 ``loss``               transfer-loss accounting from the gaps in transfer ids
 ``health``             device health from heartbeats: offline timers, restarts
-``silence``            mappings silent while their device is alive (rules: sam_runtime.bridge.liveness)
+``silence``            mappings silent while their device is alive (rules: ``liveness``)
 ``link``               the backend's link opened, watched, reopened with back-off
-``counters``           per-mapping counters and drop reasons, the bounded-rate log
+``counters``           per-mapping counters and drop reasons; the bounded-rate log is sam_runtime.common.rate_log
 ``reporting``          the stats snapshot and /diagnostics publishing; ``diagnostics`` builds the message
 ``wiring``             the generated tables and converters -> run-time mappings
+``layout``             which mappings and devices a bridge serves under a layout (one protocol of a mixed one)
+``liveness``           the silence rules (grace per mapping, silent while the device is alive), used by ``silence``
 =====================  ==============================================================================================
 
 Cyphal v1 messages carry no destination: a command reaches its configured destination node because the
@@ -132,12 +137,10 @@ import os
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 from sam_runtime.bridge.backend import BridgeConfigError
-from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportConfig, quiet_late_media_completions
+from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportConfig
 from sam_runtime.bridge.composition import Bridge
-from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, DROP_REASONS, MappingStats, RateLimitedLog
-from sam_runtime.bridge.lifetime import cancel_and_wait
+from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, DROP_REASONS, MappingStats
 from sam_runtime.bridge.outbound import DEFAULT_QUEUE_SIZE
-from sam_runtime.node_support import ros_parameter_name
 
 __all__ = [
     "DEFAULT_LOG_INTERVAL_S",
@@ -147,9 +150,5 @@ __all__ = [
     "Bridge",
     "BridgeConfigError",
     "MappingStats",
-    "RateLimitedLog",
     "TransportConfig",
-    "cancel_and_wait",
-    "quiet_late_media_completions",
-    "ros_parameter_name",
 ]

@@ -10,13 +10,9 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend, BridgeConfigError
-from sam_runtime.bridge.backends.cyphal import (
-    DEFAULT_RX_QUEUE_SIZE,
-    CyphalBackend,
-    TransportConfig,
-    quiet_late_media_completions,
-)
-from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, RateLimitedLog, log
+from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
+from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
+from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
 from sam_runtime.bridge.layout import select
@@ -28,6 +24,8 @@ from sam_runtime.bridge.reporting import Reporter
 from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.bridge.silence import SilenceWatch
 from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
+from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 from sam_runtime.genpkg import GeneratedPackage
 
 __all__ = ["Bridge"]
@@ -58,8 +56,8 @@ class Bridge:
         :mod:`.layout`); default: the layout's only protocol.
     :param dronecan_iface: the DroneCAN interface (sam_runtime.dronecan_io: ``mcast-lo:`` between processes on this
         machine, ``socketcan:can0``, ``slcan:/dev/ttyACM0``).
-    :param dronecan_services: the DroneCAN node duties of :mod:`.dronecan_duties` (GetNodeInfo and RestartNode of
-        the devices as ROS services, Panic both ways; options ``time_sync`` and ``dna_server``).
+    :param dronecan_services: the DroneCAN node duties of :mod:`.backends.dronecan_duties` (GetNodeInfo and
+        RestartNode of the devices as ROS services, Panic both ways; options ``time_sync`` and ``dna_server``).
     :param wire: ``codec`` (default): the generated wire codecs, from the UAVCAN payload bytes straight to the ROS
         message's CDR and back, with raw ROS publishers and subscriptions and the backend's transport-level ports;
         ``object``: the object converters between the protocol library's message objects and ROS messages (the
@@ -101,7 +99,7 @@ class Bridge:
         self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in sel.mappings}
         self.backend: Backend
         if sel.protocol == "dronecan":
-            from sam_runtime.bridge.backends.dronecan import DroneCanBackend
+            from sam_runtime.bridge.backends.dronecan import DroneCanBackend  # needs dronecan (the runtime extra)
 
             self.backend = DroneCanBackend(dronecan_iface, self.node_id, rlog=self.log, errors=self.lifetime.errors,
                                            name=f"org.{tables.VEHICLE}.{self.name}")
@@ -110,7 +108,7 @@ class Bridge:
                                          rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
         self._dronecan_options = dict(dronecan_options or {})
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
-                           rules=getattr(tables, "PARAMETER_RULES", ()), overrides=parameter_overrides,
+                           rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
                            qos_depth=qos_depth, command_reliability=command_reliability)
         self.health = DeviceHealth(sel.devices, self.node_id)
         self.backend.on_device_status(self.health.on_status)
@@ -200,8 +198,6 @@ class Bridge:
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
         if sel.protocol == "dronecan":
-            from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
-
             self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **self._dronecan_options)
             self.duties.attach()
         link.attach()

@@ -1,5 +1,6 @@
 """What the bridge counts: per mapping (received, published, drops by reason, saturated and rejected fields,
-out-of-order stamps) and its bounded-rate log. Both event loops touch the counters: they are thread-safe.
+out-of-order stamps). Both event loops touch the counters: they are thread-safe. The bridge's bounded-rate log is
+a sam_runtime.common.rate_log.RateLimitedLog on :data:`log`.
 
 Every part of the bridge logs to the one logger ``sam_runtime.bridge`` (:data:`log`), whatever module it is in.
 """
@@ -13,74 +14,15 @@ import time
 from collections.abc import Iterable
 from typing import Any
 
-__all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "MappingStats", "RateLimitedLog", "count_handler_error", "log"]
+from sam_runtime.common.rate_log import DEFAULT_INTERVAL_S, RateLimitedLog
+
+__all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "MappingStats", "count_handler_error", "log"]
 
 log = logging.getLogger("sam_runtime.bridge")
 
-DEFAULT_LOG_INTERVAL_S = 10.0
+DEFAULT_LOG_INTERVAL_S = DEFAULT_INTERVAL_S
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
                 "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected")
-
-
-class RateLimitedLog:
-    """At most one log line per key (e.g. (mapping, reason)) per ``interval`` seconds, with the count since the
-    previous line. The first occurrence of a key is logged at once. Thread-safe; formatting is lazy."""
-
-    def __init__(self, logger: logging.Logger, interval: float = DEFAULT_LOG_INTERVAL_S) -> None:
-        self.logger = logger
-        self.interval = float(interval)
-        self._lock = threading.Lock()
-        # key -> [last_emit_monotonic, pending, total, level, msg, args]
-        self._state: dict[tuple[str, str], list[Any]] = {}
-        self.lines: collections.Counter[tuple[str, str]] = collections.Counter()  # lines written per key
-
-    def note(self, key: tuple[str, str], level: int, msg: str, *args: Any, count: int = 1) -> None:
-        now = time.monotonic()
-        emit: tuple[int, float, int] | None = None
-        with self._lock:
-            st = self._state.get(key)
-            if st is None:
-                self._state[key] = [now, 0, count, level, msg, args]
-                emit = (count, 0.0, count)
-            else:
-                st[1] += count
-                st[2] += count
-                st[3], st[4], st[5] = level, msg, args
-                if now - st[0] >= self.interval:
-                    emit = (st[1], now - st[0], st[2])
-                    st[0], st[1] = now, 0
-            if emit is not None:
-                self.lines[key] += 1
-        if emit is not None:
-            self._emit(key, level, msg, args, *emit)
-
-    def flush(self, force: bool = False) -> None:
-        """Write the pending counts whose interval has passed (all of them with ``force``)."""
-        now = time.monotonic()
-        out = []
-        with self._lock:
-            for key, st in self._state.items():
-                if st[1] and (force or now - st[0] >= self.interval):
-                    out.append((key, st[3], st[4], st[5], st[1], now - st[0], st[2]))
-                    st[0], st[1] = now, 0
-                    self.lines[key] += 1
-        for key, level, msg, args, n, dt, total in out:
-            self._emit(key, level, msg, args, n, dt, total)
-
-    def _emit(self, key: tuple[str, str], level: int, msg: str, args: tuple[Any, ...], n: int, dt: float,
-              total: int) -> None:
-        if not self.logger.isEnabledFor(level):
-            return
-        try:
-            detail = msg % args if args else msg
-        except Exception:  # a bad format must not break the caller
-            detail = f"{msg} {args!r}"
-        if dt == 0.0 and n == total:
-            self.logger.log(level, "%s: %s: %s (%d; more are summed at most every %.0f s)", key[0], key[1],
-                            detail, n, self.interval)
-        else:
-            self.logger.log(level, "%s: %s: %d in the last %.1f s (%d in all); the last: %s", key[0], key[1], n,
-                            dt, total, detail)
 
 
 class MappingStats:

@@ -48,7 +48,7 @@ def destinations_of(m: Any) -> tuple[int, ...]:
 
 
 def _layouts(tables: Any) -> dict[str, Any]:
-    return {lay.name: lay for lay in getattr(tables, "LAYOUTS", ())}
+    return {lay.name: lay for lay in tables.LAYOUTS}
 
 
 def protocols_in_use(tables: Any, layout: str) -> list[str]:
@@ -68,7 +68,7 @@ def select(tables: Any, layout: str | None = None, protocol: str | None = None) 
     """The mappings and devices of a bridge for ``layout`` (default: the tables' DEFAULT_LAYOUT) on ``protocol``
     (default: the layout's only protocol)."""
     layouts = _layouts(tables)
-    name = layout or getattr(tables, "DEFAULT_LAYOUT", "default")
+    name = layout or tables.DEFAULT_LAYOUT
     lay = layouts.get(name)
     if lay is None and not (name == "default" and not layouts):
         raise BridgeConfigError(f"the spec has no layout {name!r}; its layouts: {', '.join(sorted(layouts))}")

@@ -18,12 +18,13 @@ import collections
 import inspect
 import logging
 import time
-from collections.abc import Awaitable, Callable, Sequence
-from typing import Any
+from collections.abc import Awaitable, Callable
 
-from sam_runtime.bridge.counters import RateLimitedLog, log
+from sam_runtime.bridge.counters import log
+from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.tasks import cancel_and_wait
 
-__all__ = ["Hook", "Lifetime", "cancel_and_wait"]
+__all__ = ["Hook", "Lifetime"]
 
 Hook = Callable[[], Awaitable[None] | None]
 
@@ -108,21 +109,3 @@ async def _call(hook: Hook) -> None:
     res = hook()
     if inspect.isawaitable(res):
         await res
-
-
-async def cancel_and_wait(tasks: Sequence[asyncio.Task[Any]], timeout: float = 2.0) -> list[asyncio.Task[Any]]:
-    """Cancel tasks and wait for them, cancelling again while they run: on Python 3.11 a cancellation that
-    lands inside pycyphal's ``wait_for`` can be lost, and a plain ``gather`` would then wait forever.
-    Returns the tasks still running at the deadline."""
-    loop = asyncio.get_running_loop()
-    deadline = loop.time() + timeout
-    pending = [t for t in tasks if not t.done()]
-    while pending and loop.time() < deadline:
-        for t in pending:
-            t.cancel()
-        await asyncio.wait(pending, timeout=min(0.05, max(0.0, deadline - loop.time())))
-        pending = [t for t in pending if not t.done()]
-    for t in tasks:
-        if t.done() and not t.cancelled():
-            t.exception()  # retrieved: no "exception was never retrieved" noise
-    return pending

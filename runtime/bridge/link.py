@@ -20,6 +20,7 @@ from typing import Any
 from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.common.tasks import cancel_and_wait
 
 __all__ = ["CHECK_PERIOD_S", "REOPEN_BACKOFF_S", "LinkSupervisor"]
 
@@ -63,8 +64,6 @@ class LinkSupervisor:
 
     async def _close(self) -> None:
         if self._reopen_task is not None:
-            from sam_runtime.bridge.lifetime import cancel_and_wait
-
             await cancel_and_wait([self._reopen_task])
         await self.backend.close()
         self.up, self.state = False, "closed"

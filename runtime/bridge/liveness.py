@@ -3,7 +3,7 @@
 A UAVCAN -> ROS mapping expects its device to publish at the spec's nominal rate. A device whose heartbeat is
 alive but whose subject never arrives (a wrong subject id in its firmware, a port left unconfigured, a sensor
 that failed while the node runs on) or stops arriving used to show as a mapping "ok" (0 received) next to a
-NOMINAL device. :class:`LivenessMonitor` flags it: for each accepted source whose heartbeat is alive, silence
+NOMINAL device. :class:`LivenessCheck` flags it: for each accepted source whose heartbeat is alive, silence
 longer than the mapping's grace (:func:`grace_s`: at least 3 s, the Cyphal heartbeat timeout, and at least 5
 nominal periods) counted from the latest of: the last message, the moment the device's heartbeat (re)appeared,
 the moment the bridge started listening. A device that is not alive is not flagged here: its own status is
@@ -18,7 +18,7 @@ import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 
-__all__ = ["GRACE_PERIODS", "MIN_GRACE_S", "LivenessMonitor", "Silence", "grace_s", "silence_of"]
+__all__ = ["GRACE_PERIODS", "MIN_GRACE_S", "LivenessCheck", "Silence", "grace_s", "silence_of"]
 
 MIN_GRACE_S = 3.0  # uavcan.node.Heartbeat.OFFLINE_TIMEOUT: no quicker than a lost heartbeat is noticed
 GRACE_PERIODS = 5.0
@@ -87,7 +87,7 @@ def silence_of(now: float, *, rate_hz: float, alive_since: float | None, last_me
     return (silent, grace) if silent > grace else None
 
 
-class LivenessMonitor:
+class LivenessCheck:
     """The UAVCAN -> ROS mappings' silence, evaluated on demand; remembers the current finding per mapping so
     that the caller logs and publishes only the changes.
 

@@ -24,12 +24,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend, BelowBridge, BridgeConfigError, DeviceStatus, Inlet, Outlet
-from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.inbound import Inbound, InMapping
 from sam_runtime.bridge.layout import select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
 from sam_runtime.bridge.wiring import in_groups, missing_codecs, nominal_rates
+from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.genpkg import GeneratedPackage
 
 __all__ = ["RECEIVE_TIME_PROBE_NS", "OfflineBridge", "Published"]

@@ -22,7 +22,8 @@ from sam_runtime.bridge.backend import Backend, LinkDownError, Outlet
 from sam_runtime.bridge.counters import MappingStats, count_handler_error, log
 from sam_runtime.bridge.handoff import Handoff
 from sam_runtime.bridge.layout import port_id_of
-from sam_runtime.bridge.lifetime import Lifetime, cancel_and_wait
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.common.tasks import cancel_and_wait
 
 __all__ = ["DEFAULT_QUEUE_SIZE", "OutMapping", "Outbound"]
 

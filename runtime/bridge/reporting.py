@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend
-from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.diagnostics import Naming, diagnostic_array
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
@@ -20,6 +20,7 @@ from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.link import LinkSupervisor
 from sam_runtime.bridge.outbound import Outbound
 from sam_runtime.bridge.silence import SilenceWatch
+from sam_runtime.common.rate_log import RateLimitedLog
 
 __all__ = ["DIAGNOSTICS_TOPIC", "Reporter"]
 

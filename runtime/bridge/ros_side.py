@@ -27,6 +27,7 @@ from typing import Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
 from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.node_support import ParameterConfigError, declare_parameters, qos_profile
 
 __all__ = ["RosSide"]
 
@@ -68,8 +69,6 @@ class RosSide:
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
         from rclpy.signals import SignalHandlerOptions
-
-        from sam_runtime.node_support import ParameterConfigError, declare_parameters
 
         self.context = rclpy.Context()
         rclpy.init(args=[], context=self.context, signal_handler_options=SignalHandlerOptions.NO)
@@ -148,8 +147,6 @@ class RosSide:
     # -------------------------------------------------------------------------------------------- endpoints
     def qos(self, topic: Any, *, command: bool = False) -> Any:
         """The topic's QoS from the spec, with the overrides."""
-        from sam_runtime.node_support import qos_profile
-
         q = topic.qos
         reliability = (self.command_reliability if command else None) or q.reliability
         return qos_profile(reliability, q.durability, q.depth if self.qos_depth is None else self.qos_depth)

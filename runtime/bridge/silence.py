@@ -10,7 +10,7 @@ from typing import Any
 
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
-from sam_runtime.bridge.liveness import LivenessMonitor, Silence
+from sam_runtime.bridge.liveness import LivenessCheck, Silence
 
 __all__ = ["CHECK_PERIOD_S", "SilenceWatch"]
 
@@ -26,7 +26,7 @@ class SilenceWatch:
     def __init__(self, mappings: Iterable[tuple[str, float, Iterable[int]]], device_names: Mapping[int, str], *,
                  alive_since: Callable[[int], float | None], last_message: Callable[[str, int], float | None],
                  listening_since: Callable[[], float]) -> None:
-        self.monitor = LivenessMonitor(mappings, device_names)
+        self.liveness = LivenessCheck(mappings, device_names)
         self._alive_since, self._last_message, self._listening_since = alive_since, last_message, listening_since
         self._handlers: list[Callable[[], None]] = []
 
@@ -38,10 +38,10 @@ class SilenceWatch:
 
     @property
     def findings(self) -> dict[str, Silence | None]:
-        return self.monitor.findings
+        return self.liveness.findings
 
     def check(self) -> None:
-        changes = self.monitor.update(time.monotonic(), alive_since=self._alive_since,
+        changes = self.liveness.update(time.monotonic(), alive_since=self._alive_since,
                                       last_message=self._last_message, listening_since=self._listening_since())
         for name, before, found in changes:
             if found is not None:
@@ -56,7 +56,7 @@ class SilenceWatch:
 
     def entry(self, mapping: str) -> dict[str, Any]:
         """The mapping's liveness for the stats."""
-        silence = self.monitor.findings.get(mapping)
+        silence = self.liveness.findings.get(mapping)
         if silence is None:
             return {"state": "ok"}
         return {"state": silence.state, "message": silence.message(), "node_id": silence.node_id,

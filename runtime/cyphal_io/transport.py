@@ -17,10 +17,13 @@ from __future__ import annotations
 
 import asyncio
 import functools
+import logging
 import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled, find_compiled
 
 if TYPE_CHECKING:  # pragma: no cover
     import pycyphal.application
@@ -35,8 +38,11 @@ __all__ = [
     "make_node",
     "make_node_from_env",
     "make_transport",
+    "quiet_late_media_completions",
     "transport_from_env",
 ]
+
+_log = logging.getLogger(__name__)
 
 TRANSPORT_KINDS = ("udp", "can", "loopback")
 CAN_CLASSIC_MTU = 8
@@ -113,7 +119,7 @@ def make_transport(
     if kind == "udp":
         from pycyphal.transport.udp import UDPTransport
 
-        kw = {} if mtu is None else {"mtu": int(mtu)}
+        kw: dict[str, Any] = {} if mtu is None else {"mtu": int(mtu)}
         for ip in (iface or _DEFAULT_UDP_IFACE).split():
             factories.append(functools.partial(UDPTransport, ip, node_id, **kw))
     else:
@@ -123,7 +129,10 @@ def make_transport(
             raise TransportConfigError("CAN transport needs iface, e.g. 'virtual:vcan0' or 'socketcan:can0'")
         eff_mtu = CAN_FD_MTU if mtu is None else int(mtu)
         for name in iface.split():
-            factories.append(lambda name=name: CANTransport(_can_media(name, eff_mtu), node_id))
+            def can(name: str = name) -> pycyphal.transport.Transport:
+                return CANTransport(_can_media(name, eff_mtu), node_id)
+
+            factories.append(can)
     inferiors: list[pycyphal.transport.Transport] = []
     try:
         for f in factories:
@@ -153,8 +162,6 @@ def make_transport(
 def _ensure_uavcan() -> None:
     """pycyphal.application imports the whole compiled ``uavcan`` namespace: make sure it is importable."""
     import sys
-
-    from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled, find_compiled
 
     if "uavcan" not in sys.modules and find_compiled("uavcan") is None:
         ensure_compiled(())
@@ -250,8 +257,6 @@ def make_node(
     A random unique-ID is drawn per launch unless ``unique_id`` is given.
     """
     if dsdl_dirs:
-        from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
-
         ensure_compiled(dsdl_dirs)
     else:
         _ensure_uavcan()
@@ -350,3 +355,21 @@ def _owner_closed(task: asyncio.Task[Any]) -> bool:
     if "_maybe_task" in getattr(owner, "__dict__", {}):  # HeartbeatPublisher: the task is dropped on close
         return owner._maybe_task is None
     return False
+
+
+def quiet_late_media_completions(loop: asyncio.AbstractEventLoop) -> None:
+    """pycyphal's python-can media completes a frame's future from its TX thread with call_soon_threadsafe;
+    when the awaiting task was cancelled meanwhile (a node closing, a send deadline), ``set_result`` on the
+    cancelled future raises InvalidStateError inside the loop, which asyncio prints as a traceback. Those are
+    harmless: log them at DEBUG level. Installed only when the loop has no exception handler of its own."""
+    if loop.get_exception_handler() is not None:
+        return
+
+    def handler(lp: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
+        exc = context.get("exception")
+        if isinstance(exc, asyncio.InvalidStateError) and "set_" in repr(context.get("handle", "")):
+            _log.debug("late completion of a cancelled Cyphal media future: %s", context.get("handle"))
+            return
+        lp.default_exception_handler(context)
+
+    loop.set_exception_handler(handler)

@@ -13,7 +13,7 @@ The ``dronecan`` package is imported by these modules: install the ``runtime`` e
 """
 
 from sam_runtime.dronecan_io.bus_load import BusLoadMeter, TransferCost, frame_bits, payload_length, transfer_cost
-from sam_runtime.dronecan_io.drops import DropCounter, DropKey, DropReason, RateLimitedLog
+from sam_runtime.dronecan_io.drops import DropCounter, DropKey, DropLog, DropReason
 from sam_runtime.dronecan_io.frame_gate import FrameGate
 from sam_runtime.dronecan_io.iface import Iface, IfaceError, make_driver, make_node, parse_iface
 from sam_runtime.dronecan_io.loopback import Acceptance, LoopbackMulticastDriver
@@ -26,6 +26,7 @@ __all__ = [
     "BusLoadMeter",
     "DropCounter",
     "DropKey",
+    "DropLog",
     "DropReason",
     "FrameGate",
     "HandlerError",
@@ -33,7 +34,6 @@ __all__ = [
     "IfaceError",
     "LoopbackMulticastDriver",
     "NodeLoop",
-    "RateLimitedLog",
     "TransferCost",
     "classify_spin_error",
     "close_node",

@@ -1,7 +1,7 @@
 """Counted drops on a DroneCAN bus: why a frame or transfer was not delivered, how often, from whom.
 
 A drop is counted under a :class:`DropReason` and, where the frame's CAN id tells, the data type id and source node
-that sent it, so that a bridge can later report drops per mapping. :class:`RateLimitedLog` turns drops into log
+that sent it, so that a bridge can later report drops per mapping. :class:`DropLog` turns drops into log
 lines without flooding: the first of a reason at once, then one summary per interval while they keep coming.
 """
 
@@ -12,10 +12,12 @@ import threading
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import StrEnum
 
-__all__ = ["DropCounter", "DropKey", "DropReason", "RateLimitedLog"]
+from sam_runtime.common.rate_log import LogLine, RateLimitedLog
+
+__all__ = ["DropCounter", "DropKey", "DropLog", "DropReason"]
 
 
 class DropReason(StrEnum):
@@ -107,22 +109,15 @@ class DropCounter:
             return sum(self._counts.values())
 
 
-@dataclass
-class _ReasonLog:
-    last_logged: float
-    suppressed: int = 0
-    last_detail: str = ""
-    sources: set[tuple[int | None, int | None]] = field(default_factory=set)
-
-
-class RateLimitedLog:
-    """Logs drops: the first of a reason at once, then at most one summary per ``interval`` per reason.
+class DropLog:
+    """Logs drops: the first of a reason at once, then at most one summary per ``interval`` per reason (a
+    sam_runtime.common.rate_log.RateLimitedLog keyed by reason).
 
     Call :meth:`flush` periodically so that a summary is written also when the drops stop.
 
     >>> lines = []
     >>> now = [0.0]
-    >>> log = RateLimitedLog(interval=10.0, emit=lines.append, clock=lambda: now[0])
+    >>> log = DropLog(interval=10.0, emit=lines.append, clock=lambda: now[0])
     >>> for _ in range(3): log.report(DropKey(DropReason.CRC_MISMATCH, 1003, 10), "CRC mismatch")
     >>> now[0] = 10.0; log.flush()
     >>> print("\\n".join(lines))
@@ -132,40 +127,32 @@ class RateLimitedLog:
 
     def __init__(self, interval: float = 10.0, *, logger: logging.Logger | None = None,
                  emit: Callable[[str], None] | None = None, clock: Callable[[], float] = time.monotonic) -> None:
-        self._interval = interval
         log = logger or logging.getLogger("sam_runtime.dronecan_io")
         self._emit = emit or log.warning
-        self._clock = clock
-        self._state: dict[DropReason, _ReasonLog] = {}
+        self._log = RateLimitedLog(log, interval, write=self._write, clock=clock)
+        # the (data type, source) of the drops of each reason since its last line
+        self._sources: dict[DropReason, set[tuple[int | None, int | None]]] = {}
 
     def report(self, key: DropKey, detail: str) -> None:
-        now = self._clock()
-        st = self._state.get(key.reason)
-        if st is None or (st.suppressed == 0 and now - st.last_logged >= self._interval):
-            self._state[key.reason] = _ReasonLog(last_logged=now)
-            self._emit(f"dronecan drop {key.reason.value}{_origin(key, ' (', ')')}: {detail}")
-            return
-        st.suppressed += 1
-        st.last_detail = detail
-        st.sources.add((key.data_type_id, key.source_node_id))
-        if now - st.last_logged >= self._interval:
-            self._summarize(key.reason, st, now)
+        self._sources.setdefault(key.reason, set()).add((key.data_type_id, key.source_node_id))
+        self._log.note(key.reason, logging.WARNING, "%s: %s", _origin(key, " (", ")"), detail)
 
     def flush(self, *, force: bool = False) -> None:
         """Write the summaries that are due (``force``: all that are pending, e.g. at shutdown)."""
-        now = self._clock()
-        for reason, st in self._state.items():
-            if st.suppressed and (force or now - st.last_logged >= self._interval):
-                self._summarize(reason, st, now)
+        self._log.flush(force)
 
-    def _summarize(self, reason: DropReason, st: _ReasonLog, now: float) -> None:
-        origins = sorted((_origin(DropKey(reason, d, s)) for d, s in st.sources), key=str)
-        origin = "".join(f"{o}; " for o in origins if o)
-        self._emit(f"dronecan drop {reason.value}: {st.suppressed} more in the last {now - st.last_logged:.1f} s "
-                   f"({origin}last: {st.last_detail})")
-        st.suppressed = 0
-        st.sources.clear()
-        st.last_logged = now
+    def _write(self, line: LogLine) -> None:
+        reason = line.key
+        assert isinstance(reason, DropReason)
+        sources = self._sources.pop(reason, set())
+        origin, detail = line.args
+        if line.fresh:
+            self._emit(f"dronecan drop {reason.value}{origin}: {detail}")
+            return
+        origins = sorted((_origin(DropKey(reason, d, s)) for d, s in sources), key=str)
+        prefix = "".join(f"{o}; " for o in origins if o)
+        self._emit(f"dronecan drop {reason.value}: {line.count} more in the last {line.seconds:.1f} s "
+                   f"({prefix}last: {detail})")
 
 
 def _origin(key: DropKey, before: str = "", after: str = "") -> str:

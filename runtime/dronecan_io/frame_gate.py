@@ -78,7 +78,7 @@ class FrameGate(AbstractDriver):
 
     # -- the dronecan driver interface --------------------------------------------------------------------------
 
-    def add_io_hook(self, hook):  # type: ignore[no-untyped-def]  # dronecan's signature
+    def add_io_hook(self, hook):  # dronecan's signature
         return self.inner.add_io_hook(hook)
 
     def send_frame(self, frame: CANFrame) -> None:

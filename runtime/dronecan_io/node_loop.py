@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sam_runtime.dronecan_io.can_id import V0Id
-from sam_runtime.dronecan_io.drops import DropCounter, DropKey, DropReason, RateLimitedLog
+from sam_runtime.dronecan_io.drops import DropCounter, DropKey, DropLog, DropReason
 from sam_runtime.dronecan_io.frame_gate import FrameGate
 
 __all__ = ["HandlerError", "LoopStats", "NodeLoop", "classify_spin_error", "watchable_fd"]
@@ -132,7 +132,7 @@ class NodeLoop:
         self._batch = max_frames_per_wakeup
         self._max_idle = max_idle
         self._poll_interval = poll_interval
-        self._log = RateLimitedLog(log_interval, logger=logger or _log)
+        self._log = DropLog(log_interval, logger=logger or _log)
         self._loop: asyncio.AbstractEventLoop | None = None
         self._fd: int | None = None
         self._timer: asyncio.TimerHandle | None = None

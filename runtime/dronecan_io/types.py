@@ -20,7 +20,7 @@ def type_problems(tables: Any) -> list[str]:
     import dronecan
 
     problems = []
-    for info in getattr(tables, "DRONECAN_TYPES", ()):
+    for info in tables.DRONECAN_TYPES:
         t = dronecan.TYPENAMES.get(info.name)
         if t is None:
             problems.append(f"{info.name}: not loaded")
@@ -38,7 +38,7 @@ def ensure_types(gen: Any) -> None:
     object of the process, the standard ones too, and a handler registered on an old one never fires (a bridge, a
     test's node in the same process). Types that match the tables already are left alone."""
     tables = gen.tables()
-    if type_problems(tables) and getattr(tables, "DRONECAN_DSDL_DIRS", ()):
+    if type_problems(tables) and tables.DRONECAN_DSDL_DIRS:
         add_types([gen.root / folder for folder in tables.DRONECAN_DSDL_DIRS])
     problems = type_problems(tables)
     if problems:

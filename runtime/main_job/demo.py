@@ -1,12 +1,12 @@
 """Demo values for any ROS message, built from the message's own field types (issue 11, defect 4).
 
-The monitor's demo publisher sweeps the command topics of a spec that has no nodes of its own. Its values come
-from each field's rosidl type (``SLOT_TYPES``), never from a guess on the type's name: a fixed-size array gets a
-sequence of exactly its size, a bounded sequence at most its bound, an integer a value inside its width, a bool a
-bool, a byte a one-byte ``bytes``, a string a ``str``, a nested message (or a sequence of them) its own class,
-filled the same way. Every message is also constructed with ``check_fields=True``, so rclpy's own setters check
-each value as it is set: a mistake here raises (and the caller counts and logs it) instead of reaching rclpy's C
-conversion, where a scalar in an array field is a segmentation fault.
+The live view's demo publisher (main_job.job.LiveView) sweeps the command topics of a spec that has no nodes of its
+own. Its values come from each field's rosidl type (``SLOT_TYPES``), never from a guess on the type's name: a
+fixed-size array gets a sequence of exactly its size, a bounded sequence at most its bound, an integer a value inside
+its width, a bool a bool, a byte a one-byte ``bytes``, a string a ``str``, a nested message (or a sequence of them) its
+own class, filled the same way. Every message is also constructed with ``check_fields=True``, so rclpy's own setters
+check each value as it is set: a mistake here raises (and the caller counts and logs it) instead of reaching rclpy's
+C conversion, where a scalar in an array field is a segmentation fault.
 
 Values sweep slowly (a sine of period 30 s) and stay small and non-negative (floats in 0.1..0.9, integers
 0..2) so that they fit the usual limits and tables of a mapping; a few names of SAM's commands get their own
@@ -95,7 +95,7 @@ def _value(slot: Any, name: str, t: float, phase: float, stamp: Any) -> Any:
     raise TypeError(f"field {name!r}: unsupported rosidl type {slot!r}")
 
 
-def demo_message(cls: type, t: float, stamp: Any = None, phase: float = 0.0) -> Any:
+def demo_message(cls: Any, t: float, stamp: Any = None, phase: float = 0.0) -> Any:
     """A message of ``cls`` with every field set to a demo value for time ``t`` [s].
 
     ``stamp`` (a builtin_interfaces/Time) goes into every Time field (header stamps); without it they stay 0.

@@ -10,13 +10,13 @@
 4. starts ``sam-sim`` (with the vehicle options and a truth file), ``sam-bridge`` and, when the spec has nodes with
    an implementation (sam_runtime.nodes), ``sam-nodes`` (the node host, flying the demo mission unless ``--goal`` or
    ``--mission`` says otherwise) as subprocesses on Cyphal/UDP 127.0.0.1 (own sessions, logs under the project's
-   ``.sam-codegen-cache/run-logs``); they never outlive this process (see sam_runtime.cli's ``_stay_with_parent``);
-5. runs an rclpy monitor node in this process: the vehicle, its goal, plan and commands and every node's state
-   (main_job.vehicle_view, when nodes are hosted), every bridged topic's rate over a sliding window and its last
-   value, every device's heartbeat (from the bridge's /diagnostics) and the bridge's drop counters; a refreshing
-   table on a terminal, plain lines every second otherwise. For a spec without node implementations it publishes
-   slow demo sweeps on the command topics instead, so that the simulated actuators move (never on a topic a
-   hosted node publishes);
+   ``.sam-codegen-cache/run-logs``); they never outlive this process (sam_runtime.cli_support.stay_with_parent);
+5. shows it live (:class:`LiveView`, an rclpy node in this process): the vehicle, its goal, plan and commands and
+   every node's state (main_job.vehicle_view, when nodes are hosted), every bridged topic's rate over a sliding
+   window and its last value, every device's heartbeat (from the bridge's /diagnostics) and the bridge's drop
+   counters; a refreshing table on a terminal, plain lines every second otherwise. For a spec without node
+   implementations it publishes slow demo sweeps on the command topics instead (main_job.demo), so that the
+   simulated actuators move (never on a topic a hosted node publishes);
 6. stops on ``--duration``, Ctrl-C, SIGTERM or SIGHUP (the terminal closed): children get SIGTERM together (SIGKILL
    after one deadline), exit 0.
    A child that dies on its own ends the run with exit code 1 and the tail of its log.
@@ -42,9 +42,27 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sam_codegen.build import build
+from sam_codegen.model.diagnostics import SpecError
+from sam_codegen.project.cyphal_path import CyphalPathError
+from sam_codegen.project.ros_install import RosBuildError, ros_runtime_env
+from sam_codegen.project.workspace import (
+    GENERATED_ENV_VAR,
+    WorkspaceError,
+    ensure_state_dir,
+    find_generated,
+    workspace_for,
+)
+from sam_runtime.bridge.layout import protocols_in_use
+from sam_runtime.cli_support import PARENT_ENV_VAR
+from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
+from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, ensure_ros_package
+from sam_runtime.main_job.demo import demo_message
 from sam_runtime.main_job.diag_view import bridge_lines, status_key
+from sam_runtime.main_job.vehicle_view import VehicleView
+from sam_runtime.nodes import implemented, unimplemented
 
-__all__ = ["RunOptions", "TopicMonitor", "run", "summarize_message"]
+__all__ = ["LiveView", "RunOptions", "run", "summarize_message"]
 
 CHILD_STOP_TIMEOUT_S = 8.0
 CHILD_KILL_TIMEOUT_S = 5.0
@@ -134,7 +152,7 @@ def summarize_message(msg: Any, width: int = 70) -> str:
     return " ".join(parts)
 
 
-# ============================================================================================ monitor node
+# ============================================================================================ live view node
 class _TopicState:
     def __init__(self, name: str, direction: str, nominal: float) -> None:
         self.name, self.direction, self.nominal = name, direction, nominal
@@ -161,8 +179,9 @@ class _TopicState:
         return len(self.arrivals) / span if span > 0.2 else 0.0
 
 
-class TopicMonitor:
-    """An rclpy node subscribing to every bridged topic and to /diagnostics (own context)."""
+class LiveView:
+    """An rclpy node subscribing to every bridged topic and to /diagnostics (own context): what the run shows.
+    Its ROS node is ``<bridge>_monitor`` (the name it always had)."""
 
     def __init__(self, tables: Any, gen: Any, *, window: float = 2.0, demo_commands: bool = False,
                  hosted: list[str] | None = None, truth_file: Path | None = None) -> None:
@@ -192,11 +211,9 @@ class TopicMonitor:
         self._demo_t0 = time.monotonic()
         hosted = list(hosted or ())
         # The hosted nodes command the actuators: no demo sweep may compete with them on a topic.
-        seen = {ep.topic for n in getattr(tables, "NODES", ()) if n.name in hosted for ep in n.publishes}
+        seen = {ep.topic for n in tables.NODES if n.name in hosted for ep in n.publishes}
         self.view = None
         if hosted:
-            from sam_runtime.main_job.vehicle_view import VehicleView
-
             self.view = VehicleView(self.node, tables, topics=self.topics, diagnostics=self.diagnostics,
                                     hosted=hosted, truth_file=truth_file)
         if demo_commands:
@@ -227,8 +244,6 @@ class TopicMonitor:
         """One demo command on topic i: every field from its own rosidl type (sam_runtime.main_job.demo), checked by
         rclpy as it is set. A message that cannot be built is counted and logged once, never published."""
         import logging
-
-        from sam_runtime.main_job.demo import demo_message
 
         pub, cls, _rate, name = self._demo[i]
         try:
@@ -301,13 +316,11 @@ class TopicMonitor:
 # ============================================================================================ processes
 class _Child:
     def __init__(self, name: str, cmd: list[str], env: Mapping[str, str], log: Path) -> None:
-        from sam_runtime.cli import PARENT_ENV_VAR
-
         self.name, self.log = name, log
         log.parent.mkdir(parents=True, exist_ok=True)
         self._fh = open(log, "w")
         # Own session: the terminal's Ctrl-C and hangup reach only us, and we stop the children. They end with us
-        # however we end (even SIGKILL or a crash): they watch this pid (sam_runtime.cli._stay_with_parent).
+        # however we end (even SIGKILL or a crash): they watch this pid (sam_runtime.cli_support.stay_with_parent).
         self.proc = subprocess.Popen(cmd, env={**env, PARENT_ENV_VAR: str(os.getpid())}, stdout=self._fh,
                                      stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
 
@@ -364,8 +377,6 @@ def _workspace(opts: RunOptions) -> Any:
     the spec and generated/ as `sam-codegen build` finds them when it
     builds; with --no-build and no --spec, only the generated folder (--generated, $SAM_GENERATED_DIR or found from
     the working directory)."""
-    from sam_codegen.project.workspace import GENERATED_ENV_VAR, find_generated, workspace_for
-
     env_generated = os.environ.get(GENERATED_ENV_VAR, "").strip()
     generated = opts.generated or (Path(env_generated) if env_generated and opts.spec is None else None)
     if opts.build or opts.spec is not None:
@@ -374,21 +385,11 @@ def _workspace(opts: RunOptions) -> Any:
 
 
 def _build(spec: Path, gen_dir: Path, say: Any) -> None:
-    from sam_codegen.build import build
-
     stale = build(spec, gen_dir, check=False)
     say(f"generated {gen_dir} from {spec}: " + (f"{len(stale.lines())} file(s) updated" if stale else "up to date"))
 
 
 def run(opts: RunOptions) -> int:
-    from sam_codegen.model.diagnostics import SpecError
-    from sam_codegen.project.cyphal_path import CyphalPathError
-    from sam_codegen.project.ros_install import RosBuildError, ros_runtime_env
-    from sam_codegen.project.workspace import WorkspaceError, ensure_state_dir
-    from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
-    from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, ensure_ros_package
-    from sam_runtime.nodes import implemented, unimplemented
-
     def say(text: str) -> None:
         print(text, flush=True)
 
@@ -399,7 +400,7 @@ def run(opts: RunOptions) -> int:
 
     old_handlers = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     children: list[_Child] = []
-    monitor: TopicMonitor | None = None
+    live: LiveView | None = None
     exit_code = 0
     try:
         try:
@@ -451,9 +452,7 @@ def run(opts: RunOptions) -> int:
         truth = (opts.truth_file or log_dir / "truth.json").resolve()
         children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth)],
                                env, log_dir / "sim.log"))
-        from sam_runtime.bridge.layout import protocols_in_use
-
-        layout = opts.layout or getattr(tables, "DEFAULT_LAYOUT", "default")
+        layout = opts.layout or tables.DEFAULT_LAYOUT
         protocols = protocols_in_use(tables, layout)
         for proto in protocols if len(protocols) > 1 else [None]:
             name = "bridge" if proto is None else f"bridge_{proto}"
@@ -463,7 +462,7 @@ def run(opts: RunOptions) -> int:
             gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
             children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
                                    log_dir / "nodes.log"))
-        monitor = TopicMonitor(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
+        live = LiveView(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
                                truth_file=truth)
 
         tty = sys.stdout.isatty() and not opts.plain
@@ -482,21 +481,21 @@ def run(opts: RunOptions) -> int:
                 exit_code = 1
                 stop_reason.append("child exited")
                 break
-            monitor.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
+            live.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
             if time.monotonic() >= next_draw:
                 next_draw += refresh
                 header = (f"{tables.VEHICLE} bridge run  t={elapsed:6.1f} s  "
                           + "  ".join(f"{c.name} pid {c.proc.pid}" for c in children)
                           + ("" if opts.duration is None else f"  (stops at {opts.duration:.0f} s)")
                           + ("  Ctrl-C to stop" if tty else ""))
-                lines = monitor.table(header)
+                lines = live.table(header)
                 if tty:
                     cols = shutil.get_terminal_size((120, 40)).columns
                     sys.stdout.write("\x1b[H\x1b[2J" + "\n".join(line[:cols] for line in lines) + "\n")
                     sys.stdout.flush()
                 else:
                     say("\n".join(lines) + "\n")
-        final = monitor.table(f"final ({stop_reason[0] if stop_reason else 'stopped'}) after "
+        final = live.table(f"final ({stop_reason[0] if stop_reason else 'stopped'}) after "
                               f"{time.monotonic() - started:.1f} s")
         say("\n".join(final))
     finally:
@@ -504,9 +503,9 @@ def run(opts: RunOptions) -> int:
         codes = _stop_children(children)
         for s, h in old_handlers.items():
             signal.signal(s, h)
-        if monitor is not None:
+        if live is not None:
             with contextlib.suppress(Exception):  # the children are stopped already; nothing else depends on it
-                monitor.close()
+                live.close()
         with contextlib.suppress(OSError):  # the terminal may be gone (SIGHUP): reporting must not fail the stop
             for c in children:
                 rc = codes[c.name]

@@ -20,6 +20,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from sam_runtime.node_support import stamp_to_ns
+from sam_runtime.physics.geo import depth_from_pressure, euler_from_quaternion, local_from_latlon
+from sam_runtime.tf_buffer import TfBuffer, TfError
+
 __all__ = ["VehicleView"]
 
 _LEVELS = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
@@ -39,8 +43,6 @@ class VehicleView:
         from nav_msgs.msg import Path as PathMsg
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from tf2_msgs.msg import TFMessage
-
-        from sam_runtime.tf_buffer import TfBuffer
 
         self.tables, self.topics, self.diagnostics = tables, topics, diagnostics
         self.hosted, self.truth_file = hosted, truth_file
@@ -68,9 +70,6 @@ class VehicleView:
 
     # ---------------------------------------------------------------------------------- inputs
     def _on_tf(self, msg: Any, static: bool) -> None:
-        from sam_runtime.node_support import stamp_to_ns
-        from sam_runtime.tf_buffer import TfError
-
         for ts in msg.transforms:
             t, r = ts.transform.translation, ts.transform.rotation
             try:
@@ -105,8 +104,6 @@ class VehicleView:
 
     def _world_offset(self, truth: dict[str, Any]) -> tuple[float, float] | None:
         """The sim frame's position of world's origin (SLAM's first fix), from SLAM's status."""
-        from sam_runtime.physics.geo import local_from_latlon
-
         v = self._diag("slam")["values"]
         try:
             lat, lon = float(v["origin_lat"]), float(v["origin_lon"])
@@ -120,9 +117,6 @@ class VehicleView:
 
     # ---------------------------------------------------------------------------------- rendering
     def lines(self) -> list[str]:
-        from sam_runtime.physics.geo import depth_from_pressure, euler_from_quaternion
-        from sam_runtime.tf_buffer import TfError
-
         out = [f"  {'VEHICLE':14} {'estimate (world -> base_link, sensors)':44} true (simulator)"]
         try:
             tr = self.tf.lookup("world", "base_link", now_ns=time.time_ns(), max_age_s=TF_MAX_AGE_S)

@@ -23,12 +23,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 from sam_runtime.physics.geo import euler_from_quaternion, wrap_angle
 
 __all__ = ["Commands", "Controller", "ControllerConfig", "ControllerPose"]
 
 PathPose = tuple[float, ...]  # x, y, z (world, z = -depth) [, qx, qy, qz, qw]
+_Point = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -153,7 +155,7 @@ class Controller:
             if 0.0 < dt <= 1.0:
                 a = min(1.0, dt / self.config.rate_filter)
                 raw = ((p0.z - pose.z) / dt, (pose.pitch - p0.pitch) / dt, wrap_angle(pose.yaw - p0.yaw) / dt)
-                self._rates = tuple(r + a * (m - r) for r, m in zip(self._rates, raw, strict=True))  # type: ignore
+                self._rates = tuple(r + a * (m - r) for r, m in zip(self._rates, raw, strict=True))
             elif dt > 1.0:
                 self._rates = (0.0, 0.0, 0.0)
         self._prev = (t, pose)
@@ -162,7 +164,7 @@ class Controller:
         """The lookahead point and the along-path distance from the closest point to the end."""
         path, la = self.path, self.config.lookahead
         if len(path) == 1:
-            return path[0], math.hypot(path[0][0] - x, path[0][1] - y)
+            return cast(_Point, path[0]), math.hypot(path[0][0] - x, path[0][1] - y)
         best, best_d, best_f = self._index, math.inf, 0.0
         for i in range(self._index, len(path) - 1):
             (ax, ay, _), (bx, by, _) = path[i], path[i + 1]
@@ -185,7 +187,7 @@ class Controller:
                 return (a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])), remaining
             left -= step
             i, f = i + 1, 0.0
-        return path[-1], remaining
+        return cast(_Point, path[-1]), remaining
 
     def step(self, t: float, pose: ControllerPose | None) -> Commands:
         cfg = self.config

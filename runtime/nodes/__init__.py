@@ -3,7 +3,7 @@ logic of :mod:`sam_runtime.nav`, and the host that runs them (:mod:`sam_runtime.
 
 - :mod:`.dead_reckoning`, :mod:`.slam`, :mod:`.motion_planner`, :mod:`.controller`, :mod:`.performance_monitor`:
   the document's five nodes (IV.E-IV.H);
-- :mod:`.mission` (with the pure :mod:`.mission_plan`): the goals, an addition to the document;
+- :mod:`.mission` (its pure logic: :mod:`sam_runtime.nav.mission`): the goals, an addition to the document;
 - :data:`IMPLEMENTATIONS`: which generated nodes package and node name each implements. An implementation
   belongs to one spec's generated interface: another spec's nodes, even of the same name, have none.
 
@@ -37,14 +37,14 @@ class ImplementationError(Exception):
 
 def implemented(tables: Any) -> list[str]:
     """The spec's nodes (the generated tables' NODES, in their order) that have an implementation."""
-    known = IMPLEMENTATIONS.get(getattr(tables, "NODES_PACKAGE", ""), {})
-    return [n.name for n in getattr(tables, "NODES", ()) if n.name in known]
+    known = IMPLEMENTATIONS.get(tables.NODES_PACKAGE, {})
+    return [n.name for n in tables.NODES if n.name in known]
 
 
 def unimplemented(tables: Any) -> list[str]:
     """The spec's nodes without an implementation."""
     have = set(implemented(tables))
-    return [n.name for n in getattr(tables, "NODES", ()) if n.name not in have]
+    return [n.name for n in tables.NODES if n.name not in have]
 
 
 def load_implementation(tables: Any, name: str) -> type:

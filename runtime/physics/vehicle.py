@@ -367,7 +367,7 @@ class Vehicle:
             s.w = max(s.w, 0.0)
             s.floor_contacts += 1
         v_new = ((s.x - x0) / dt, (s.y - y0) / dt, (d0 - s.depth) / dt)
-        s.accel = tuple((n - o) / dt for n, o in zip(v_new, s.velocity, strict=True))  # type: ignore[assignment]
+        s.accel = tuple((n - o) / dt for n, o in zip(v_new, s.velocity, strict=True))
         s.velocity = v_new
         s.max_depth = max(s.max_depth, s.depth)
 

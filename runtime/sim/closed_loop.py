@@ -145,9 +145,9 @@ class ClosedLoop:
         veh = self.vehicle
         if self._due("imu"):
             m = s.imu()
-            dr.on_imu(t, tuple(map(_f16, m.gyro)), tuple(map(_f16, m.accel)))  # type: ignore[arg-type]
+            dr.on_imu(t, tuple(map(_f16, m.gyro)), tuple(map(_f16, m.accel)))
         if self._due("mag"):
-            dr.on_magnetometer(t, tuple(map(_f16, s.magnetometer())))  # type: ignore[arg-type]
+            dr.on_magnetometer(t, tuple(map(_f16, s.magnetometer())))
         if self._due("pressure"):
             p = s.pressure()
             dr.on_pressure(t, p)

@@ -6,12 +6,11 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from sam_runtime.cyphal_io.transport import aclose, make_node, quiet_late_media_completions, transport_from_env
 from sam_runtime.sim.devices import PHYSICS, SAM_ACTUATORS, generic_fill, physics_key
-
-if TYPE_CHECKING:
-    from sam_runtime.sim.simulator import Simulator, _PubPort, _SimDevice, _SubPort
+from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
 
 __all__ = ["CyphalDevices"]
 
@@ -23,28 +22,22 @@ class CyphalDevices:
 
     protocol = "cyphal"
 
-    def __init__(self, sim: Simulator) -> None:
+    def __init__(self, sim: DeviceHost) -> None:
         self.sim = sim
 
     def prepare(self) -> None:
-        from sam_runtime.bridge import quiet_late_media_completions
-
         self.sim.gen.compile_dsdl()
         quiet_late_media_completions(asyncio.get_running_loop())
 
-    def ports(self, dev: _SimDevice) -> None:
-        from sam_runtime.sim.simulator import _PubPort, _SubPort
-
+    def ports(self, dev: SimDevice) -> None:
         gen = self.sim.gen
-        dev.subs += [_SubPort(port, gen.dsdl_class(port)) for port in dev.info.subscribes]
-        dev.pubs += [_PubPort(port, gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type)))
+        dev.subs += [SubPort(port, gen.dsdl_class(port)) for port in dev.info.subscribes]
+        dev.pubs += [PubPort(port, gen.dsdl_class(port), PHYSICS.get(physics_key(port.dsdl_type)))
                      for port in dev.info.publishes]
 
-    def open(self, dev: _SimDevice) -> None:
+    def open(self, dev: SimDevice) -> None:
         """The device's node (heartbeats start at once) and its ports."""
         import uavcan.node
-
-        from sam_runtime.cyphal_io.transport import make_node, transport_from_env
 
         cfg = self.sim.config
         name = f"org.{self.sim.tables.VEHICLE}.sim.{dev.info.name}"[:50]
@@ -58,15 +51,13 @@ class CyphalDevices:
         for sp in dev.subs:
             sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
             sp.subscriber.receive_in_background(
-                lambda msg, tr, dev=dev, sp=sp: self.sim._on_command(dev, sp, msg, tr))
+                lambda msg, tr, dev=dev, sp=sp: self.sim.on_command(dev, sp, msg, tr))
         for pp in dev.pubs:
             pp.publisher = dev.node.make_publisher(pp.dtype, pp.port.subject_id)
             pp.publisher.send_timeout = 1.0
 
-    async def close(self, devices: list[_SimDevice]) -> None:
+    async def close(self, devices: list[SimDevice]) -> None:
         """Close the devices' ports, then their nodes (never raises)."""
-        from sam_runtime.cyphal_io.transport import aclose
-
         ports = [p.publisher for d in devices for p in d.pubs] + [s.subscriber for d in devices for s in d.subs]
         nodes = [d.node for d in devices]
         for d in devices:
@@ -81,18 +72,18 @@ class CyphalDevices:
         except Exception as ex:
             _log.warning("closing the simulated Cyphal nodes: %s: %s", type(ex).__name__, ex)
 
-    def blank(self, pp: _PubPort, t: float, now_us: int) -> Any:
+    def blank(self, pp: PubPort, t: float, now_us: int) -> Any:
         return generic_fill(pp.dtype(), t, now_us, seed=pp.ident)
 
-    def finish(self, dev: _SimDevice, pp: _PubPort, obj: Any, t: float, now_us: int) -> None:
+    def finish(self, dev: SimDevice, pp: PubPort, obj: Any, t: float, now_us: int) -> None:
         pass
 
-    def command_values(self, dev: _SimDevice, sp: _SubPort, msg: Any) -> dict[str, Any] | None:
+    def command_values(self, dev: SimDevice, sp: SubPort, msg: Any) -> dict[str, Any] | None:
         import pycyphal.dsdl
 
-        return pycyphal.dsdl.to_builtin(msg)  # type: ignore[no-any-return]
+        return pycyphal.dsdl.to_builtin(msg)
 
-    def apply(self, dev: _SimDevice, values: dict[str, Any]) -> dict[str, float]:
+    def apply(self, dev: SimDevice, values: dict[str, Any]) -> dict[str, float]:
         dev.state.command.update(values)
         inputs = SAM_ACTUATORS.get(dev.info.name, {})
         return {inputs[k]: float(v) for k, v in values.items() if k in inputs}

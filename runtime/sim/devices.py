@@ -24,7 +24,9 @@ from typing import Any
 
 from sam_runtime.physics.vehicle import SimulatedVehicle, Vehicle
 
-__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "PhysicsFn", "VehicleState", "generic_fill", "physics_key"]
+__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "PhysicsFn", "VehicleState", "fill_altitude", "fill_battery",
+           "fill_gnss", "fill_imu", "fill_magnetometer", "fill_position_feedback", "fill_pressure",
+           "fill_thrust_vector_feedback", "generic_fill", "physics_key", "set_field", "vehicle_actuator"]
 
 _log = logging.getLogger("sam_runtime.sim.simulator")
 
@@ -157,7 +159,7 @@ def generic_fill(obj: Any, tt: float, now_us: int, seed: int = 0) -> Any:
     return obj
 
 
-def _set(obj: Any, name: str, value: Any) -> None:
+def set_field(obj: Any, name: str, value: Any) -> None:
     """Set a field if the type has it (a spec may differ from SAM's); out-of-range values are clipped by the
     caller or left at the generic value."""
     if hasattr(obj, name):
@@ -182,89 +184,89 @@ def _stamp(obj: Any, name: str, us: int) -> None:
 PhysicsFn = Callable[[Any, DeviceState, VehicleState, float, float, random.Random], None]
 
 
-def _imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random, *,
+def fill_imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random, *,
          full_covariance: bool = True) -> None:
     veh.sync(t)
     m = veh.model.sensors.imu()
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "integration_interval", dt)
-    _set(obj, "rate_gyro_latest", list(m.gyro))
-    _set(obj, "rate_gyro_integral", [g * dt for g in m.gyro])
-    _set(obj, "accelerometer_latest", list(m.accel))
-    _set(obj, "accelerometer_integral", [a * dt for a in m.accel])
+    set_field(obj, "integration_interval", dt)
+    set_field(obj, "rate_gyro_latest", list(m.gyro))
+    set_field(obj, "rate_gyro_integral", [g * dt for g in m.gyro])
+    set_field(obj, "accelerometer_latest", list(m.accel))
+    set_field(obj, "accelerometer_integral", [a * dt for a in m.accel])
     # Full 6x6 covariance of [gyro, accel], row major: makes the transfer multi-frame on CAN FD too; or its diagonal
     # (UAVCAN v0: on classic CAN, 36 float16 would more than double the frames of every sample).
     n = veh.model.sensors.noise
     if full_covariance:
-        _set(obj, "covariance", [(n.gyro ** 2 if i < 3 else n.accel ** 2) if i == j else 0.0
+        set_field(obj, "covariance", [(n.gyro ** 2 if i < 3 else n.accel ** 2) if i == j else 0.0
                                  for i in range(6) for j in range(6)])
     else:
-        _set(obj, "covariance", [n.gyro ** 2] * 3 + [n.accel ** 2] * 3)
+        set_field(obj, "covariance", [n.gyro ** 2] * 3 + [n.accel ** 2] * 3)
 
 
-def _magnetometer(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+def fill_magnetometer(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
-    _set(obj, "magnetic_field_ga", list(veh.model.sensors.magnetometer()))
+    set_field(obj, "magnetic_field_ga", list(veh.model.sensors.magnetometer()))
     var = veh.model.sensors.noise.mag ** 2
-    _set(obj, "magnetic_field_covariance", [var if i == j else 0.0 for i in range(3) for j in range(3)])
+    set_field(obj, "magnetic_field_covariance", [var if i == j else 0.0 for i in range(3) for j in range(3)])
 
 
-def _gnss(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+def fill_gnss(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
     fix = veh.model.sensors.gps()
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "latitude_deg_1e8", round(fix.lat * 1e8))
-    _set(obj, "longitude_deg_1e8", round(fix.lon * 1e8))
-    _set(obj, "status", fix.status)
-    _set(obj, "sats_used", fix.sats)
+    set_field(obj, "latitude_deg_1e8", round(fix.lat * 1e8))
+    set_field(obj, "longitude_deg_1e8", round(fix.lon * 1e8))
+    set_field(obj, "status", fix.status)
+    set_field(obj, "sats_used", fix.sats)
     if fix.status == veh.model.sensors.GPS_STATUS_NO_FIX:
-        _set(obj, "height_ellipsoid_mm", 0)
-        _set(obj, "height_msl_mm", 0)
-        _set(obj, "ned_velocity", [0.0, 0.0, 0.0])
-        _set(obj, "pdop", 99.0)
-        _set(obj, "position_covariance", [])  # unknown
+        set_field(obj, "height_ellipsoid_mm", 0)
+        set_field(obj, "height_msl_mm", 0)
+        set_field(obj, "ned_velocity", [0.0, 0.0, 0.0])
+        set_field(obj, "pdop", 99.0)
+        set_field(obj, "position_covariance", [])  # unknown
         return
-    _set(obj, "height_ellipsoid_mm", round((GEOID_HEIGHT_M + fix.height_msl) * 1000))
-    _set(obj, "height_msl_mm", round(fix.height_msl * 1000))
-    _set(obj, "ned_velocity", list(fix.ned_velocity))
-    _set(obj, "pdop", 1.2)
+    set_field(obj, "height_ellipsoid_mm", round((GEOID_HEIGHT_M + fix.height_msl) * 1000))
+    set_field(obj, "height_msl_mm", round(fix.height_msl * 1000))
+    set_field(obj, "ned_velocity", list(fix.ned_velocity))
+    set_field(obj, "pdop", 1.2)
     var = fix.std_m ** 2
-    _set(obj, "position_covariance", [var if i == j else 0.0 for i in range(3) for j in range(3)])
+    set_field(obj, "position_covariance", [var if i == j else 0.0 for i in range(3) for j in range(3)])
 
 
-def _pressure(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+def fill_pressure(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
-    _set(obj, "static_pressure", veh.model.sensors.pressure())
-    _set(obj, "static_pressure_variance", veh.model.sensors.noise.pressure ** 2)
+    set_field(obj, "static_pressure", veh.model.sensors.pressure())
+    set_field(obj, "static_pressure_variance", veh.model.sensors.noise.pressure ** 2)
 
 
-def _altitude(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+def fill_altitude(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "altitude", veh.model.sensors.altitude())
-    _set(obj, "altitude_variance", veh.model.sensors.noise.altitude ** 2)
+    set_field(obj, "altitude", veh.model.sensors.altitude())
+    set_field(obj, "altitude_variance", veh.model.sensors.noise.altitude ** 2)
 
 
-def _battery(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
+def fill_battery(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
     b = veh.model.sensors.battery()
-    _set(obj, "temperature", b.temperature_k)
-    _set(obj, "voltage", b.voltage)
-    _set(obj, "current", b.current)
-    _set(obj, "average_power_10sec", b.power_w)
-    _set(obj, "remaining_capacity_wh", b.remaining_wh)
-    _set(obj, "full_charge_capacity_wh", b.full_wh)
-    _set(obj, "hours_to_full_charge", 0.0)
-    _set(obj, "status_flags", b.status_flags)
-    _set(obj, "state_of_health_pct", b.health_pct)
-    _set(obj, "state_of_charge_pct", round(b.soc * 100))
-    _set(obj, "state_of_charge_pct_stdev", 2)
-    _set(obj, "battery_id", 0)
-    _set(obj, "model_instance_id", 0x5A3_0001)
-    _set(obj, "model_name", b"SAM 6S Li-ion")
+    set_field(obj, "temperature", b.temperature_k)
+    set_field(obj, "voltage", b.voltage)
+    set_field(obj, "current", b.current)
+    set_field(obj, "average_power_10sec", b.power_w)
+    set_field(obj, "remaining_capacity_wh", b.remaining_wh)
+    set_field(obj, "full_charge_capacity_wh", b.full_wh)
+    set_field(obj, "hours_to_full_charge", 0.0)
+    set_field(obj, "status_flags", b.status_flags)
+    set_field(obj, "state_of_health_pct", b.health_pct)
+    set_field(obj, "state_of_charge_pct", round(b.soc * 100))
+    set_field(obj, "state_of_charge_pct_stdev", 2)
+    set_field(obj, "battery_id", 0)
+    set_field(obj, "model_instance_id", 0x5A3_0001)
+    set_field(obj, "model_name", b"SAM 6S Li-ion")
 
 
-def _vehicle_actuator(dev: DeviceState, veh: VehicleState, t: float, command_field: str) -> float | None:
+def vehicle_actuator(dev: DeviceState, veh: VehicleState, t: float, command_field: str) -> float | None:
     """The vehicle model's actuator position for a SAM device's command field, or None for other devices."""
     name = SAM_ACTUATORS.get(dev.name, {}).get(command_field)
     if name is None:
@@ -274,49 +276,49 @@ def _vehicle_actuator(dev: DeviceState, veh: VehicleState, t: float, command_fie
 
 def _thruster_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
                        rng: random.Random) -> None:
-    rpm = _vehicle_actuator(dev, veh, t, "rpm")
+    rpm = vehicle_actuator(dev, veh, t, "rpm")
     if rpm is None:
         rpm = dev.approach("rpm", float(dev.command.get("rpm", 0)), 2000.0, t)  # spins up at 2000 rpm/s
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "rpm", round(max(-131072, min(131071, rpm))))
-    _set(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
-    _set(obj, "temperature_c", int(min(127, 25 + abs(rpm) / 200.0)))
+    set_field(obj, "rpm", round(max(-131072, min(131071, rpm))))
+    set_field(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
+    set_field(obj, "temperature_c", int(min(127, 25 + abs(rpm) / 200.0)))
 
 
-def _thrust_vector_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
+def fill_thrust_vector_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
                             rng: random.Random) -> None:
-    v = _vehicle_actuator(dev, veh, t, "vertical_radians")
-    h = _vehicle_actuator(dev, veh, t, "horizontal_radians")
+    v = vehicle_actuator(dev, veh, t, "vertical_radians")
+    h = vehicle_actuator(dev, veh, t, "horizontal_radians")
     if v is None or h is None:  # 0.5 rad/s servos
         v = dev.approach("vertical", float(dev.command.get("vertical_radians", 0.0)), 0.5, t)
         h = dev.approach("horizontal", float(dev.command.get("horizontal_radians", 0.0)), 0.5, t)
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "vertical_mrad", int(max(-4096, min(4095, round(v * 1000)))))
-    _set(obj, "horizontal_mrad", int(max(-4096, min(4095, round(h * 1000)))))
+    set_field(obj, "vertical_mrad", int(max(-4096, min(4095, round(v * 1000)))))
+    set_field(obj, "horizontal_mrad", int(max(-4096, min(4095, round(h * 1000)))))
 
 
-def _position_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
+def fill_position_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
                        rng: random.Random) -> None:
-    pct = _vehicle_actuator(dev, veh, t, "percent")
+    pct = vehicle_actuator(dev, veh, t, "percent")
     if pct is None:
         target = float(dev.command.get("percent", 50.0))
         pct = dev.approach("percent", max(0.0, min(100.0, target)), 10.0, t, initial=50.0)  # 10 %/s
     _stamp(obj, "timestamp", veh.now_us())
-    _set(obj, "percent", pct)
-    _set(obj, "encoder_count", round(pct * 100))  # 10 000 counts over the full travel
+    set_field(obj, "percent", pct)
+    set_field(obj, "encoder_count", round(pct * 100))  # 10 000 counts over the full travel
 
 
 # Keyed by the DSDL type's full name without the root namespace and version.
 PHYSICS: dict[str, PhysicsFn] = {
-    "sensor.RawIMU": _imu,
-    "sensor.MagneticFieldStrength": _magnetometer,
-    "sensor.GNSSFix": _gnss,
-    "sensor.StaticPressure": _pressure,
-    "sensor.Altitude": _altitude,
-    "power.BatteryInfo": _battery,
+    "sensor.RawIMU": fill_imu,
+    "sensor.MagneticFieldStrength": fill_magnetometer,
+    "sensor.GNSSFix": fill_gnss,
+    "sensor.StaticPressure": fill_pressure,
+    "sensor.Altitude": fill_altitude,
+    "power.BatteryInfo": fill_battery,
     "actuator.ThrusterFeedback": _thruster_feedback,
-    "actuator.ThrustVectorFeedback": _thrust_vector_feedback,
-    "actuator.PositionFeedback": _position_feedback,
+    "actuator.ThrustVectorFeedback": fill_thrust_vector_feedback,
+    "actuator.PositionFeedback": fill_position_feedback,
 }
 
 

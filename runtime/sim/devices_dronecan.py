@@ -30,16 +30,16 @@ from sam_runtime.sim.devices import (
     DeviceState,
     PhysicsFn,
     VehicleState,
-    _altitude,
-    _battery,
-    _gnss,
-    _imu,
-    _magnetometer,
-    _position_feedback,
-    _pressure,
-    _set,
-    _thrust_vector_feedback,
-    _vehicle_actuator,
+    fill_altitude,
+    fill_battery,
+    fill_gnss,
+    fill_imu,
+    fill_magnetometer,
+    fill_position_feedback,
+    fill_pressure,
+    fill_thrust_vector_feedback,
+    set_field,
+    vehicle_actuator,
 )
 
 __all__ = ["PHYSICS_V0", "SAM_ACTUATORS_V0", "Element", "element_value", "ensure_element", "esc_index_of",
@@ -218,20 +218,21 @@ def to_builtin_v0(obj: Any) -> Any:
 # ============================================================================================ SAM physics
 def _fix2(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: Any) -> None:
     """gnss.Fix2: Cyphal's fix, plus its GNSS time and a 6x6 position/velocity covariance (empty without a fix)."""
-    _gnss(obj, dev, veh, t, dt, rng)
-    _set(obj, "mode", 0)  # MODE_SINGLE
-    _set(obj, "sub_mode", 0)
-    _set(obj, "num_leap_seconds", 0)  # unknown
-    _set(obj, "ecef_position_velocity", [])
+    fill_gnss(obj, dev, veh, t, dt, rng)
+    set_field(obj, "mode", 0)  # MODE_SINGLE
+    set_field(obj, "sub_mode", 0)
+    set_field(obj, "num_leap_seconds", 0)  # unknown
+    set_field(obj, "ecef_position_velocity", [])
     if obj.status == veh.model.sensors.GPS_STATUS_NO_FIX:
         obj.gnss_timestamp.usec = 0
-        _set(obj, "gnss_time_standard", 0)  # NONE
-        _set(obj, "covariance", [])
+        set_field(obj, "gnss_time_standard", 0)  # NONE
+        set_field(obj, "covariance", [])
         return
     obj.gnss_timestamp.usec = veh.now_us()
-    _set(obj, "gnss_time_standard", 2)  # UTC
+    set_field(obj, "gnss_time_standard", 2)  # UTC
     pos_var, vel_var = veh.model.sensors.noise.gps ** 2, 0.05 ** 2
-    _set(obj, "covariance", [(pos_var if i < 3 else vel_var) if i == j else 0.0 for i in range(6) for j in range(6)])
+    set_field(obj, "covariance",
+              [(pos_var if i < 3 else vel_var) if i == j else 0.0 for i in range(6) for j in range(6)])
 
 
 def esc_index_of(device: str) -> int | None:
@@ -253,7 +254,7 @@ def _number(value: Any) -> float:
 def _esc_status(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: Any) -> None:
     """esc.Status (what Cyphal's ThrusterFeedback reports, in v0's fields): a SAM thruster's rpm from the vehicle,
     another device's from its own model (spinning up at 2000 rpm/s toward its command)."""
-    rpm = _vehicle_actuator(dev, veh, t, "rpm")
+    rpm = vehicle_actuator(dev, veh, t, "rpm")
     if rpm is None:
         if "rpm" in dev.command:
             target = _number(dev.command["rpm"])
@@ -261,35 +262,35 @@ def _esc_status(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: flo
             target = _number(dev.command.get("cmd", 0)) / 8191.0 * 2000.0
         rpm = dev.approach("rpm", target, 2000.0, t)
     max_rpm = veh.vehicle.params.max_rpm
-    _set(obj, "rpm", round(max(-131072, min(131071, rpm))))
-    _set(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
-    _set(obj, "temperature", 273.15 + min(127, 25 + abs(rpm) / 200.0))  # kelvin
-    _set(obj, "voltage", veh.model.sensors.battery().voltage)
-    _set(obj, "error_count", 0)
-    _set(obj, "power_rating_pct", int(min(100, round(100.0 * abs(rpm) / max_rpm))))
+    set_field(obj, "rpm", round(max(-131072, min(131071, rpm))))
+    set_field(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
+    set_field(obj, "temperature", 273.15 + min(127, 25 + abs(rpm) / 200.0))  # kelvin
+    set_field(obj, "voltage", veh.model.sensors.battery().voltage)
+    set_field(obj, "error_count", 0)
+    set_field(obj, "power_rating_pct", int(min(100, round(100.0 * abs(rpm) / max_rpm))))
     index = esc_index_of(dev.name)
     if index is not None:
-        _set(obj, "esc_index", index)
+        set_field(obj, "esc_index", index)
 
 
 def _raw_imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: Any) -> None:
     """ahrs.RawIMU: Cyphal's IMU sample (the spec maps its axes 1:1 to imu_link, as the Cyphal one) with the diagonal
     of the covariance (6 elements, as its DSDL allows)."""
-    _imu(obj, dev, veh, t, dt, rng, full_covariance=False)
+    fill_imu(obj, dev, veh, t, dt, rng, full_covariance=False)
 
 
 # Keyed by the v0 full name (no version: v0 types have none).
 PHYSICS_V0: dict[str, PhysicsFn] = {
     "uavcan.equipment.ahrs.RawIMU": _raw_imu,
-    "uavcan.equipment.ahrs.MagneticFieldStrength": _magnetometer,
-    "uavcan.equipment.ahrs.MagneticFieldStrength2": _magnetometer,
+    "uavcan.equipment.ahrs.MagneticFieldStrength": fill_magnetometer,
+    "uavcan.equipment.ahrs.MagneticFieldStrength2": fill_magnetometer,
     "uavcan.equipment.gnss.Fix2": _fix2,
-    "uavcan.equipment.air_data.StaticPressure": _pressure,
-    "uavcan.equipment.power.BatteryInfo": _battery,
+    "uavcan.equipment.air_data.StaticPressure": fill_pressure,
+    "uavcan.equipment.power.BatteryInfo": fill_battery,
     "uavcan.equipment.esc.Status": _esc_status,
-    "sam.sensor.Altitude": _altitude,
-    "sam.actuator.ThrustVectorFeedback": _thrust_vector_feedback,
-    "sam.actuator.PositionFeedback": _position_feedback,
+    "sam.sensor.Altitude": fill_altitude,
+    "sam.actuator.ThrustVectorFeedback": fill_thrust_vector_feedback,
+    "sam.actuator.PositionFeedback": fill_position_feedback,
 }
 
 

@@ -29,8 +29,9 @@ import asyncio
 import hashlib
 import logging
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from sam_runtime.dronecan_io import Acceptance, FrameGate, HandlerError, NodeLoop, make_driver, parse_iface
 from sam_runtime.dronecan_io.node_loop import close_node
 from sam_runtime.dronecan_io.types import ensure_types, type_problems
 from sam_runtime.sim.devices_dronecan import (
@@ -44,9 +45,7 @@ from sam_runtime.sim.devices_dronecan import (
     sam_command_fields,
     to_builtin_v0,
 )
-
-if TYPE_CHECKING:
-    from sam_runtime.sim.simulator import Simulator, _PubPort, _SimDevice, _SubPort
+from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
 
 __all__ = ["DroneCanDevices", "ensure_types", "type_problems"]
 
@@ -102,12 +101,7 @@ class DroneCanDevices:
 
     protocol = "dronecan"
 
-    def __init__(self, sim: Simulator) -> None:
-        try:
-            from sam_runtime.dronecan_io import parse_iface
-        except ImportError as ex:  # the dronecan package (the runtime extra)
-            raise ValueError(f"layout {sim.config.layout!r} has DroneCAN devices, which need the dronecan package "
-                             f"(pip extra 'runtime'): {ex}") from None
+    def __init__(self, sim: DeviceHost) -> None:
         self.sim = sim
         self.iface = sim.config.dronecan_iface
         self._kind = parse_iface(self.iface).kind  # IfaceError (a ValueError) for a bad or refused URI
@@ -122,36 +116,34 @@ class DroneCanDevices:
         ensure_types(self.sim.gen)
 
     # ------------------------------------------------------------------------------------------ ports
-    def ports(self, dev: _SimDevice) -> None:
-        from sam_runtime.sim.simulator import _PubPort, _SubPort
-
+    def ports(self, dev: SimDevice) -> None:
         for port in dev.info.publishes:
             t = port.data_type
-            pp = _PubPort(port, t.name, physics_v0(t.name, t.custom), key=f"dronecan:{t.name}", ident=t.data_type_id)
+            pp = PubPort(port, t.name, physics_v0(t.name, t.custom), key=f"dronecan:{t.name}", ident=t.data_type_id)
             pp.extra = self._fixed_values(dev, t.name)
             dev.pubs.append(pp)
         for port in dev.info.subscribes:
             t = port.data_type
-            sp = _SubPort(port, t.name, key=f"dronecan:{t.name}", ident=t.data_type_id)
+            sp = SubPort(port, t.name, key=f"dronecan:{t.name}", ident=t.data_type_id)
             sp.extra = self._addressing(dev, t.name)
             dev.subs.append(sp)
 
-    def _fixed_values(self, dev: _SimDevice, type_name: str) -> tuple[list[tuple[str, Any]], list[Element]]:
+    def _fixed_values(self, dev: SimDevice, type_name: str) -> tuple[list[tuple[str, Any]], list[Element]]:
         """What the bridge's mappings from this device look for in its broadcasts of ``type_name``."""
         select: dict[str, Any] = {}
         elements: dict[str, Element] = {}
-        for m in getattr(self.sim.tables, "DRONECAN_MAPPINGS", ()):
+        for m in self.sim.tables.DRONECAN_MAPPINGS:
             if m.direction == "uavcan_to_ros" and m.data_type.name == type_name and dev.info.node_id in \
                     m.source_node_ids:
                 select.update(m.select)
                 elements.update({e: parse_element(e) for e in m.elements})
         return list(select.items()), list(elements.values())
 
-    def _addressing(self, dev: _SimDevice, type_name: str) -> list[Addressing]:
+    def _addressing(self, dev: SimDevice, type_name: str) -> list[Addressing]:
         name, node_id = dev.info.name, dev.info.node_id
         sam = SAM_ACTUATORS_V0.get(name, {})
         out = []
-        for m in getattr(self.sim.tables, "DRONECAN_MAPPINGS", ()):
+        for m in self.sim.tables.DRONECAN_MAPPINGS:
             if m.direction != "ros_to_uavcan" or m.data_type.name != type_name or node_id not in \
                     m.destination_node_ids:
                 continue
@@ -169,10 +161,8 @@ class DroneCanDevices:
         return out
 
     # ------------------------------------------------------------------------------------------ the node
-    def open(self, dev: _SimDevice) -> None:
+    def open(self, dev: SimDevice) -> None:
         import dronecan
-
-        from sam_runtime.dronecan_io import Acceptance, FrameGate, NodeLoop, make_driver
 
         status = dronecan.TYPENAMES["uavcan.protocol.NodeStatus"]
         name = f"org.{self.sim.tables.VEHICLE}.sim.{dev.info.name}"[:80]
@@ -202,9 +192,7 @@ class DroneCanDevices:
         for sp in dev.subs:
             sp.subscriber = node
 
-    def _message_handler(self, dev: _SimDevice) -> Any:
-        from sam_runtime.dronecan_io import HandlerError
-
+    def _message_handler(self, dev: SimDevice) -> Any:
         subs = {sp.dtype: sp for sp in dev.subs}
 
         def on_transfer(event: Any) -> None:
@@ -215,13 +203,13 @@ class DroneCanDevices:
             if sp is None or dev.node is not event.node:
                 return
             try:
-                self.sim._on_command(dev, sp, event.message, transfer)
+                self.sim.on_command(dev, sp, event.message, transfer)
             except Exception as ex:
                 raise HandlerError(f"{dev.info.name}: {type(ex).__name__}: {ex}") from ex
 
         return on_transfer
 
-    def _restart_handler(self, dev: _SimDevice) -> Any:
+    def _restart_handler(self, dev: SimDevice) -> Any:
         import dronecan
 
         def on_restart(event: Any) -> Any:
@@ -238,7 +226,7 @@ class DroneCanDevices:
 
         return on_restart
 
-    async def close(self, devices: list[_SimDevice]) -> None:
+    async def close(self, devices: list[SimDevice]) -> None:
         """Stop and close the devices' nodes (never raises)."""
         for dev in devices:
             loop, node = dev.extra, dev.node
@@ -250,20 +238,20 @@ class DroneCanDevices:
             close_node(loop, node, _log, f"{dev.info.name}: closing its DroneCAN node")
 
     # ------------------------------------------------------------------------------------------ messages
-    def blank(self, pp: _PubPort, t: float, now_us: int) -> Any:
+    def blank(self, pp: PubPort, t: float, now_us: int) -> Any:
         import dronecan
 
         return generic_fill_v0(dronecan.TYPENAMES[pp.dtype](), t, now_us, seed=pp.ident)
 
-    def finish(self, dev: _SimDevice, pp: _PubPort, obj: Any, t: float, now_us: int) -> None:
+    def finish(self, dev: SimDevice, pp: PubPort, obj: Any, t: float, now_us: int) -> None:
         select, elements = pp.extra
         for path, value in select:
             _put(obj, path, value)
         claimed = {el.value for el in elements if el.key is not None}
         for el in elements:
-            ensure_element(obj, el, claimed, t, now_us)  # type: ignore[arg-type]
+            ensure_element(obj, el, claimed, t, now_us)
 
-    def command_values(self, dev: _SimDevice, sp: _SubPort, msg: Any) -> dict[str, Any] | None:
+    def command_values(self, dev: SimDevice, sp: SubPort, msg: Any) -> dict[str, Any] | None:
         """This device's part of a broadcast command: {element: value} (an item as a dict), the whole message as a
         dict when it is addressed as a whole, or None when it is not meant for this device."""
         if not sp.extra:
@@ -284,7 +272,7 @@ class DroneCanDevices:
                     found[el.text] = to_builtin_v0(value)
         return found
 
-    def apply(self, dev: _SimDevice, values: dict[str, Any]) -> dict[str, float]:
+    def apply(self, dev: SimDevice, values: dict[str, Any]) -> dict[str, float]:
         """Note an accepted command in the device's state; the vehicle model's inputs it sets (SAM's devices)."""
         state = dev.state.command
         state.update(values)

@@ -40,23 +40,22 @@ import logging
 import math
 import os
 import time
-from collections import Counter
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, TextIO
 
+from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.tasks import cancel_and_wait
 from sam_runtime.genpkg import GeneratedPackage
-from sam_runtime.physics.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, VehicleParams
+from sam_runtime.sim.config import SimConfig
+from sam_runtime.sim.cyphal import CyphalDevices
 from sam_runtime.sim.devices import (
     PHYSICS,
     SAM_ACTUATORS,
     DeviceState,
-    PhysicsFn,
     VehicleState,
     generic_fill,
     physics_key,
 )
+from sam_runtime.sim.ports import DeviceAdapter, PubPort, SimDevice, SubPort
 
 # The device models live in sam_runtime.sim.devices; re-exported here, where the tests and benchmarks import them.
 __all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState", "generic_fill",
@@ -66,109 +65,17 @@ _log = logging.getLogger("sam_runtime.sim.simulator")
 
 
 # ============================================================================================ simulator
-@dataclass
-class SimConfig:
-    """``kind``/``iface``/``mtu`` as in :func:`~sam_runtime.cyphal_io.transport.make_transport`
-    (``env``: UAVCAN__UDP__IFACE
-    / UAVCAN__CAN__IFACE / UAVCAN__CAN__MTU from ``environ``; node ids always come from the spec)."""
-
-    kind: str = "udp"
-    iface: str | None = None
-    mtu: int | None = None
-    environ: Mapping[str, str] | None = None
-    layout: str = "default"  # one of the spec's layouts: which devices run Cyphal, which DroneCAN
-    dronecan_iface: str = "mcast-lo:"  # the DroneCAN devices' bus (a sam_runtime.dronecan_io interface URI)
-    bridge_node_id: int | None = None  # commands accepted only from it; default: the spec's bridge
-    devices: Iterable[str] | None = None  # subset of device names; default all
-    rate_scale: float = 1.0
-    record: Path | None = None  # JSON lines of every transmitted/received message
-    # The simulated vehicle (physics.vehicle): noise seed, sea floor, start pose in the sim's world frame
-    # (ENU metres around gps_origin; yaw counter-clockwise from east), battery, time.
-    seed: int = 0
-    sea_floor: SeaFloor = field(default_factory=SeaFloor)
-    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw
-    battery_percent: float = 95.0
-    battery_drain_factor: float = 1.0  # multiplies the power drawn (a scenario can drain the battery quickly)
-    battery_health_pct: int = 98
-    gps_origin: tuple[float, float] = (59.35, 18.07)  # lat, lon of the sim's world origin (KTH, Stockholm)
-    vehicle_params: VehicleParams = field(default_factory=VehicleParams)
-    noise: SensorNoise = field(default_factory=SensorNoise)
-    time_scale: float = 1.0  # vehicle seconds per wall second (rates and stamps follow)
-    truth_file: Path | None = None  # the true state: JSON lines if it ends in .jsonl, else an atomic JSON file
-    truth_rate_hz: float = 5.0  # of vehicle time
-
-    def make_vehicle(self) -> SimulatedVehicle:
-        """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""
-        return SimulatedVehicle(seed=self.seed, sea_floor=self.sea_floor, start=self.start,
-                                battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
-                                battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
-                                params=self.vehicle_params, noise=self.noise)
-    log_interval: float = 10.0  # failed publications: the first logged at once, then a count per interval
-
-
 def layout_protocols(tables: Any, layout: str = "default") -> dict[str, str]:
     """Device name -> ``"cyphal"`` | ``"dronecan"`` under a layout of the spec (the generated ``LAYOUTS``, in spec
     order; ``default``: every device on its own ``protocol``, or on Cyphal for tables without layouts). ValueError
     names the spec's layouts."""
-    layouts = {lay.name: lay for lay in getattr(tables, "LAYOUTS", ())}
+    layouts = {lay.name: lay for lay in tables.LAYOUTS}
     lay = layouts.get(layout)
     if lay is not None:
         return dict(lay.protocols)
     if layout == "default" and not layouts:
         return {d.name: "cyphal" for d in tables.DEVICES}
     raise ValueError(f"the spec has no layout {layout!r}; its layouts: {', '.join(sorted(layouts) or ['default'])}")
-
-
-@dataclass
-class _PubPort:
-    port: Any  # PortInfo (Cyphal) or DroneCanPortInfo
-    dtype: Any  # the pycyphal class, or the v0 type's full name
-    physics: PhysicsFn | None
-    key: str = ""  # in report(): the subject id (Cyphal), "dronecan:<data type name>"
-    ident: int = 0  # the subject id or data type id: the schedule's offset, the generic values' seed
-    publisher: Any = None
-    task: asyncio.Task[None] | None = None
-    sent: int = 0
-    late: int = 0
-    failed: int = 0
-    busy: bool = False  # a publish in flight
-    extra: Any = None  # the protocol adapter's
-
-    def __post_init__(self) -> None:
-        if not self.key:
-            self.key, self.ident = str(self.port.subject_id), int(self.port.subject_id)
-
-
-@dataclass
-class _SubPort:
-    port: Any
-    dtype: Any
-    subscriber: Any = None
-    accepted: int = 0
-    rejected: int = 0
-    rejected_sources: Counter[int] = field(default_factory=Counter)
-    last: dict[str, Any] | None = None
-    key: str = ""
-    ident: int = 0
-    not_addressed: int = 0  # DroneCAN: broadcasts without this device's element
-    extra: Any = None
-
-    def __post_init__(self) -> None:
-        if not self.key:
-            self.key, self.ident = str(self.port.subject_id), int(self.port.subject_id)
-
-
-@dataclass
-class _SimDevice:
-    info: Any  # DeviceInfo (Cyphal) or DroneCanDeviceInfo
-    state: DeviceState
-    node: Any = None
-    pubs: list[_PubPort] = field(default_factory=list)
-    subs: list[_SubPort] = field(default_factory=list)
-    powered: bool = False
-    power_cycles: int = 0
-    protocol: str = "cyphal"
-    extra: Any = None  # the protocol adapter's (DroneCAN: the NodeLoop)
 
 
 class Simulator:
@@ -193,7 +100,7 @@ class Simulator:
         if wanted is not None and wanted - set(protocols):
             raise ValueError(f"unknown device(s) {sorted(wanted - set(protocols))}; the spec has {sorted(protocols)}")
         firmware = {"cyphal": {d.name: d for d in self.tables.DEVICES},
-                    "dronecan": {d.name: d for d in getattr(self.tables, "DRONECAN_DEVICES", ())}}
+                    "dronecan": {d.name: d for d in self.tables.DRONECAN_DEVICES}}
         self.devices = []
         for name, protocol in protocols.items():
             info = firmware.get(protocol, {}).get(name)
@@ -201,16 +108,17 @@ class Simulator:
                 raise ValueError(f"layout {self.config.layout!r} puts {name} on {protocol}, but the spec gives it no "
                                  f"{protocol} firmware")
             if wanted is None or name in wanted:
-                self.devices.append(_SimDevice(info, DeviceState(name, info.node_id), protocol=protocol))
-        self._adapters: dict[str, Any] = {}
+                self.devices.append(SimDevice(info, DeviceState(name, info.node_id), protocol=protocol))
+        self._adapters: dict[str, DeviceAdapter] = {}
         for protocol in {d.protocol for d in self.devices}:
             if protocol == "dronecan":
-                from sam_runtime.sim.dronecan import DroneCanDevices
-
+                try:
+                    from sam_runtime.sim.dronecan import DroneCanDevices  # imports dronecan (the runtime extra)
+                except ImportError as ex:
+                    raise ValueError(f"layout {self.config.layout!r} has DroneCAN devices, which need the dronecan "
+                                     f"package (pip extra 'runtime'): {ex}") from None
                 self._adapters[protocol] = DroneCanDevices(self)
             else:
-                from sam_runtime.sim.cyphal import CyphalDevices
-
                 self._adapters[protocol] = CyphalDevices(self)
         self._go: asyncio.Event | None = None  # created in start() (inside the loop)
         self._running: asyncio.Event | None = None  # cleared by pause()
@@ -218,8 +126,6 @@ class Simulator:
         self._publishing_since: float | None = None
         self._publishing_until: float | None = None
         self._closed = False
-        from sam_runtime.bridge import RateLimitedLog
-
         self.log = RateLimitedLog(_log, self.config.log_interval)  # bounded, like the bridge's
 
     # ---------------------------------------------------------------------------------- lifecycle
@@ -247,19 +153,19 @@ class Simulator:
         if publish_now:
             self.start_publishing()
 
-    def _adapter(self, dev: _SimDevice) -> Any:
+    def _adapter(self, dev: SimDevice) -> DeviceAdapter:
         return self._adapters[dev.protocol]
 
-    def _open_device(self, dev: _SimDevice) -> None:
+    def _open_device(self, dev: SimDevice) -> None:
         """The device's node (heartbeats start at once) and its ports."""
         self._adapter(dev).open(dev)
         dev.powered = True
 
-    def _start_device_tasks(self, dev: _SimDevice, restart: bool = False) -> None:
+    def _start_device_tasks(self, dev: SimDevice, restart: bool = False) -> None:
         for pp in dev.pubs:
             pp.task = asyncio.create_task(self._publish_loop(dev, pp, restart), name=f"sim-{dev.info.name}-{pp.key}")
 
-    def device(self, name: str) -> _SimDevice:
+    def device(self, name: str) -> SimDevice:
         for dev in self.devices:
             if dev.info.name == name:
                 return dev
@@ -268,8 +174,6 @@ class Simulator:
     async def power_off(self, name: str) -> None:
         """Cut the device's power: its node closes, so its heartbeats and publications stop (a device that stops
         sending, for heartbeat-timeout tests). Its counters are kept."""
-        from sam_runtime.bridge import cancel_and_wait
-
         dev = self.device(name)
         if not dev.powered:
             return
@@ -335,8 +239,6 @@ class Simulator:
         if self._closed:
             return
         self._closed = True
-        from sam_runtime.bridge import cancel_and_wait
-
         stuck = await cancel_and_wait([pp.task for d in self.devices for pp in d.pubs if pp.task is not None]
                                       + ([self._truth_task] if self._truth_task is not None else []))
         if self.config.truth_file is not None:
@@ -354,7 +256,7 @@ class Simulator:
         self.log.flush(force=True)  # no count stays unlogged
 
     # ---------------------------------------------------------------------------------- publishing
-    def make_sample(self, dev: _SimDevice, pp: _PubPort, dt: float) -> Any:
+    def make_sample(self, dev: SimDevice, pp: PubPort, dt: float) -> Any:
         """One message of the port: generic values, then the device's physics (if known)."""
         t, now_us = self.vehicle.t(), self.vehicle.now_us()
         adapter = self._adapter(dev)
@@ -365,7 +267,7 @@ class Simulator:
         dev.state.last_update = t
         return obj
 
-    async def _publish_loop(self, dev: _SimDevice, pp: _PubPort, restart: bool = False) -> None:
+    async def _publish_loop(self, dev: SimDevice, pp: PubPort, restart: bool = False) -> None:
         assert self._go is not None
         await self._go.wait()
         rate = float(pp.port.rate_hz) * float(self.config.rate_scale) * self.vehicle.time_scale  # per wall second
@@ -427,7 +329,7 @@ class Simulator:
             k += 1
 
     # ---------------------------------------------------------------------------------- commands
-    def _on_command(self, dev: _SimDevice, sp: _SubPort, msg: Any, transfer: Any) -> None:
+    def on_command(self, dev: SimDevice, sp: SubPort, msg: Any, transfer: Any) -> None:
         adapter = self._adapter(dev)
         values = adapter.command_values(dev, sp, msg)
         if values is None:  # a broadcast without this device's element: not a command for it
@@ -485,7 +387,7 @@ class Simulator:
             await asyncio.sleep(max(0.0, start + k * period - time.monotonic()))
 
     # ---------------------------------------------------------------------------------- reporting
-    def _write_record(self, direction: str, dev: _SimDevice, port: _PubPort | _SubPort, obj: Any,
+    def _write_record(self, direction: str, dev: SimDevice, port: PubPort | SubPort, obj: Any,
                       **extra: Any) -> None:
         fields = self._adapter(dev).record(port, obj, direction == "tx")
         value = fields.pop("value")

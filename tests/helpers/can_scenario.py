@@ -55,7 +55,7 @@ def check_parameters(bridge: Any) -> dict[str, Any]:
     """The bridge's ROS parameters: declared from the spec with ranges; rules enforced."""
     from rclpy.parameter import Parameter
 
-    from sam_runtime.bridge import ros_parameter_name
+    from sam_runtime.node_support import ros_parameter_name
 
     node = bridge.ros.node
     out: dict[str, Any] = {"declared": {}, "sets": []}

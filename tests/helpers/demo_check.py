@@ -5,7 +5,7 @@ python demo_check.py --generated DIR --out RESULT.json [--messages 3] [--timeout
 1. Every ROS message class the spec uses (topics and the ROS package's own messages): demo messages at several
    times have no field rclpy's checks refuse, survive serialize/deserialize with their shapes, and a message
    with a scalar put into an array field (what the old demo publisher did) is caught by the checker.
-2. A TopicMonitor with demo_commands publishes on every command topic until a subscriber in another context has
+2. A LiveView with demo_commands publishes on every command topic until a subscriber in another context has
    received ``--messages`` of each; every received message is checked again.
 Writes a JSON report; exit code 0 when it ran to the end (the checks are the test's business).
 """
@@ -103,7 +103,7 @@ def run_monitor(gen: Any, want: int, timeout: float) -> dict[str, Any]:
     from rclpy.signals import SignalHandlerOptions
 
     from sam_runtime.main_job.demo import field_problems
-    from sam_runtime.main_job.job import TopicMonitor
+    from sam_runtime.main_job.job import LiveView
 
     tables = gen.tables()
     commands = sorted({m.topic.name: m.topic for m in tables.MAPPINGS if m.direction == "ros_to_uavcan"}.items())
@@ -115,7 +115,7 @@ def run_monitor(gen: Any, want: int, timeout: float) -> dict[str, Any]:
         node.create_subscription(gen.ros_class(topic), name, got[name].append, 100)
     executor = SingleThreadedExecutor(context=ctx)
     executor.add_node(node)
-    monitor = TopicMonitor(tables, gen, demo_commands=True)
+    monitor = LiveView(tables, gen, demo_commands=True)
     deadline = time.monotonic() + timeout
     try:
         while time.monotonic() < deadline and any(len(v) < want for v in got.values()):

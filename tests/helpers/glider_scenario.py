@@ -103,7 +103,7 @@ class ScriptedDevice:
         self._task = asyncio.create_task(loop())
 
     async def stop_publishing(self) -> None:
-        from sam_runtime.bridge import cancel_and_wait
+        from sam_runtime.common.tasks import cancel_and_wait
 
         if self._task is not None:
             await cancel_and_wait([self._task])

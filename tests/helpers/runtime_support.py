@@ -73,10 +73,10 @@ def ros_prefix_for(gen: Any) -> Path:
 
 
 def _installed_current(gen: Any, prefix: Path) -> bool:
-    from sam_runtime.genpkg import _same_interfaces
+    from sam_runtime.genpkg import same_interfaces
 
     name = gen.tables().ROS_PACKAGE
-    return _same_interfaces(gen.ros_package_dir(), prefix / "share" / name)
+    return same_interfaces(gen.ros_package_dir(), prefix / "share" / name)
 
 
 def domain_id(offset: int) -> str:

@@ -314,9 +314,9 @@ def stack(tmp: Path, offset: int, *, sim_args: Sequence[str] = (), node_args: Se
         pytest.skip("the probe runs in the test process and needs the generated ROS packages in this environment "
                     "(sam-codegen ros-install)")
     domain = domain_id(offset)
-    from sam_runtime.cli import PARENT_ENV_VAR
+    from sam_runtime.cli_support import PARENT_ENV_VAR
 
-    # The children end with this process however it ends (sam_runtime.cli._stay_with_parent).
+    # The children end with this process however it ends (sam_runtime.cli_support.stay_with_parent).
     env = child_env(prefix, domain, {PARENT_ENV_VAR: str(os.getpid())})
     truth_path = tmp / "truth.jsonl"
     common = ["--generated", str(gen.root), "--transport", "udp", "--iface", "127.0.0.1"]

@@ -401,7 +401,7 @@ def test_diagnostics_content(can_run: dict[str, Any]) -> None:
 
 # ============================================================================================ units
 def test_rate_limited_log_sums_occurrences() -> None:
-    from sam_runtime.bridge import RateLimitedLog
+    from sam_runtime.common.rate_log import RateLimitedLog
 
     records: list[str] = []
 

@@ -28,7 +28,7 @@ from helpers.runtime_support import (
 )
 from helpers.user_project import start_time, wait_gone
 
-from sam_runtime.cli import _PARENT_POLL_S, ORPHAN_GRACE_S
+from sam_runtime.cli_support import ORPHAN_GRACE_S, PARENT_POLL_S
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -90,7 +90,7 @@ def test_the_node_host_ends_with_the_main_job(tmp_path: Path) -> None:
             poll_until(lambda: "READY nodes" in (tmp_path / "nodes.log").read_text(), 60, "the node host")
             os.kill(p.proc.pid, signal.SIGKILL)
             p.wait(10)
-            left = wait_gone(children, _PARENT_POLL_S + ORPHAN_GRACE_S + 10.0)
+            left = wait_gone(children, PARENT_POLL_S + ORPHAN_GRACE_S + 10.0)
             assert not left, f"still running after the main job was killed: {left}"
         finally:
             for pid, started in children.items():
@@ -106,14 +106,14 @@ def test_no_demo_sweep_on_the_topics_of_hosted_nodes(monkeypatch: pytest.MonkeyP
     if ros_prefix_for(gen) != Path(sys.prefix).absolute():
         pytest.skip("needs the generated ROS packages in this environment")
     monkeypatch.setenv("ROS_DOMAIN_ID", domain_id(92))
-    from sam_runtime.main_job.job import TopicMonitor
+    from sam_runtime.main_job.job import LiveView
     from sam_runtime.nodes import implemented
 
     tables = gen.tables()
     commands = sorted({m.topic.name for m in tables.MAPPINGS if m.direction == "ros_to_uavcan"})
 
     def demo_topics(**kwargs: Any) -> tuple[list[str], bool]:
-        monitor = TopicMonitor(tables, gen, demo_commands=True, **kwargs)  # one at a time: one node name
+        monitor = LiveView(tables, gen, demo_commands=True, **kwargs)  # one at a time: one node name
         try:
             return sorted(name for *_, name in monitor._demo), monitor.view is not None
         finally:

@@ -23,13 +23,13 @@ from helpers.runtime_support import child_env, cyphal_udp_lock, domain_id, poll_
 from helpers.user_project import built_project, start_time, wait_gone
 
 from sam_codegen.project.workspace import STATE_DIR_NAME
-from sam_runtime.cli import _PARENT_POLL_S, ORPHAN_GRACE_S, PARENT_ENV_VAR
+from sam_runtime.cli_support import ORPHAN_GRACE_S, PARENT_ENV_VAR, PARENT_POLL_S
 from sam_runtime.main_job.job import CHILD_KILL_TIMEOUT_S, CHILD_STOP_TIMEOUT_S
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 # An orphan ends within ORPHAN_GRACE_S of noticing (one poll); the rest is margin for a loaded machine.
-ORPHAN_BOUND_S = _PARENT_POLL_S + ORPHAN_GRACE_S + 10.0
+ORPHAN_BOUND_S = PARENT_POLL_S + ORPHAN_GRACE_S + 10.0
 # The main job's own stop of its children is bounded by these two deadlines.
 STOP_BOUND_S = CHILD_STOP_TIMEOUT_S + CHILD_KILL_TIMEOUT_S + 10.0
 HEADER = re.compile(r"sim pid (\d+)\s+bridge pid (\d+)")
@@ -99,8 +99,8 @@ def test_children_end_with_the_main_job(skiff: tuple[Path, Path], tmp_path: Path
 # A grandchild bound to its parent, which then ignores SIGTERM (a stop that hangs): it must end anyway.
 _STUBBORN = textwrap.dedent("""\
     import signal, sys, time
-    from sam_runtime.cli import _stay_with_parent
-    _stay_with_parent()
+    from sam_runtime.cli_support import stay_with_parent
+    stay_with_parent()
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     print("bound", flush=True)
     time.sleep(600)

@@ -16,7 +16,6 @@ device status events, pycyphal's per-subject counters, and the signs of a dead t
 
 from __future__ import annotations
 
-import asyncio
 import collections
 import logging
 import os
@@ -36,10 +35,12 @@ from sam_runtime.bridge.backend import (
     Outlet,
 )
 from sam_runtime.bridge.backends.cyphal_wire import RawReceiver, RawSender
-from sam_runtime.bridge.counters import RateLimitedLog, log
+from sam_runtime.bridge.counters import log
+from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.cyphal_io.ports import PortConfigError, register_environment, register_node_id, resolve_subject
+from sam_runtime.cyphal_io.transport import aclose, make_node, make_transport, transport_from_env
 
-__all__ = ["DEFAULT_RX_QUEUE_SIZE", "CyphalBackend", "TransportConfig", "quiet_late_media_completions"]
+__all__ = ["DEFAULT_RX_QUEUE_SIZE", "CyphalBackend", "TransportConfig"]
 
 DEFAULT_RX_QUEUE_SIZE = 1000
 SEND_TIMEOUT_S = 1.0
@@ -92,24 +93,6 @@ class TransportConfig:
                 except ValueError:
                     raise BridgeConfigError(f"UAVCAN__NODE__ID={raw!r} is not an integer") from None
         return int(default)
-
-
-def quiet_late_media_completions(loop: asyncio.AbstractEventLoop) -> None:
-    """pycyphal's python-can media completes a frame's future from its TX thread with call_soon_threadsafe;
-    when the awaiting task was cancelled meanwhile (a node closing, a send deadline), ``set_result`` on the
-    cancelled future raises InvalidStateError inside the loop, which asyncio prints as a traceback. Those are
-    harmless: log them at DEBUG level. Installed only when the loop has no exception handler of its own."""
-    if loop.get_exception_handler() is not None:
-        return
-
-    def handler(lp: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
-        exc = context.get("exception")
-        if isinstance(exc, asyncio.InvalidStateError) and "set_" in repr(context.get("handle", "")):
-            log.debug("late completion of a cancelled Cyphal media future: %s", context.get("handle"))
-            return
-        lp.default_exception_handler(context)
-
-    loop.set_exception_handler(handler)
 
 
 def _error_kinds(session_stats: Any) -> dict[str, int]:
@@ -203,8 +186,9 @@ class _Publication(Outlet):
         if pub is None:
             raise LinkDownError(self.port_name)
         try:
-            if pub is self.raw_sender:
-                return await pub.send(obj, self.send_timeout)
+            sender = self.raw_sender
+            if sender is not None and pub is sender:
+                return await sender.send(obj, self.send_timeout)
             return bool(await pub.publish(obj))
         except pycyphal.transport.ResourceClosedError as ex:
             if self.publisher is pub:  # not replaced by a reopened one meanwhile: the transport is gone
@@ -275,8 +259,6 @@ class CyphalBackend(Backend):
         return None
 
     def _make_transport(self) -> Any:
-        from sam_runtime.cyphal_io.transport import make_transport, transport_from_env
-
         tc = self.transport_config
         if tc.kind == "env":
             env = dict(tc.env())
@@ -297,8 +279,6 @@ class CyphalBackend(Backend):
 
     def _open(self) -> None:
         import uavcan.node
-
-        from sam_runtime.cyphal_io.transport import make_node
 
         tc = self.transport_config
         env = tc.environ if tc.kind == "env" and tc.environ is not None else os.environ
@@ -344,8 +324,6 @@ class CyphalBackend(Backend):
 
     async def close(self) -> None:
         """Close every port and the node (what their subscribers counted is kept)."""
-        from sam_runtime.cyphal_io.transport import aclose
-
         self.poll_statistics()
         receivers = [s.subscriber for s in self._subs if isinstance(s.subscriber, RawReceiver)]
         ports: list[Any] = [s.subscriber for s in self._subs if not isinstance(s.subscriber, RawReceiver)]

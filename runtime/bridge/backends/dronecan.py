@@ -38,7 +38,11 @@ from sam_runtime.bridge.backend import (
     LinkDownError,
     Outlet,
 )
-from sam_runtime.bridge.counters import RateLimitedLog, log
+from sam_runtime.bridge.counters import log
+from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.dronecan_io import DropReason, IfaceError, NodeLoop, close_node
+from sam_runtime.dronecan_io import make_node as default_make_node
+from sam_runtime.dronecan_io.wire import TransferTaps, broadcast_payload
 
 __all__ = ["DroneCanBackend", "node_status"]
 
@@ -101,7 +105,6 @@ class _Subscription(Inlet):
     def malformed(self, src: int | None, detail: str) -> None:
         """Counted where dronecan's failures to unpack are (NodeLoop: ``malformed_payload``), so below the bridge
         both paths report the same reason."""
-        from sam_runtime.dronecan_io import DropReason
 
         if self.drops is None:
             super().malformed(src, detail)
@@ -126,8 +129,6 @@ class _Publication(Outlet):
 
     async def publish(self, obj: Any) -> bool:
         from dronecan.driver.common import DriverError, TxQueueFullError
-
-        from sam_runtime.dronecan_io.wire import broadcast_payload
 
         node = self._backend.node
         if node is None:
@@ -220,10 +221,6 @@ class DroneCanBackend(Backend):
         """The node, its NodeLoop and every declared port (at start and whenever the link is reopened)."""
         import dronecan
 
-        from sam_runtime.dronecan_io import IfaceError, NodeLoop
-        from sam_runtime.dronecan_io import make_node as default_make_node
-        from sam_runtime.dronecan_io.wire import TransferTaps
-
         types = [(sub, _resolve(sub.dtype, sub.spec_id)) for sub in self._subs]
         for pub in self._pubs:
             pub.crc_base = int(_resolve(pub.dtype, pub.spec_id).base_crc)
@@ -260,7 +257,6 @@ class DroneCanBackend(Backend):
         self.poll_statistics()
         loop, node = self.node_loop, self.node
         self.node_loop = self.node = None
-        from sam_runtime.dronecan_io import close_node
 
         close_node(loop, node, log, "closing the DroneCAN node")
 

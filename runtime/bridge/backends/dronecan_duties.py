@@ -98,10 +98,8 @@ class DroneCanDuties:
         base = self.ros.name
         self._node = node = Node(f"{base}_dronecan_duties", context=self.ros.context)
         for nid, name in sorted(self.devices.items()):
-            node.create_service(Trigger, f"/{base}/{name}/get_node_info",
-                                lambda req, resp, nid=nid: self._get_node_info(nid, resp))
-            node.create_service(Trigger, f"/{base}/{name}/restart",
-                                lambda req, resp, nid=nid: self._restart(nid, resp))
+            node.create_service(Trigger, f"/{base}/{name}/get_node_info", _service(self._get_node_info, nid))
+            node.create_service(Trigger, f"/{base}/{name}/restart", _service(self._restart, nid))
         self._panic_pub = node.create_publisher(String, f"/{base}/panic_received", 10)
         node.create_subscription(String, f"/{base}/panic", self._on_ros_panic, 10)
         self._executor = SingleThreadedExecutor(context=self.ros.context)
@@ -262,3 +260,8 @@ class DroneCanDuties:
             return
         self._prev_sync_us = now_us
         self.counts["time_sync_sent"] += 1
+
+
+def _service(answer: Callable[[int, Any], Any], nid: int) -> Callable[[Any, Any], Any]:
+    """A std_srvs/Trigger service callback ``(request, response)`` answering for device ``nid``."""
+    return lambda _request, response: answer(nid, response)

@@ -31,8 +31,9 @@ from helpers.dronecan_support import frames_of, private_iface, until  # noqa: E4
 
 from sam_runtime.bridge.backend import BridgeConfigError  # noqa: E402
 from sam_runtime.bridge.backends.dronecan import DroneCanBackend, node_status  # noqa: E402
-from sam_runtime.bridge.counters import MappingStats, RateLimitedLog  # noqa: E402
+from sam_runtime.bridge.counters import MappingStats  # noqa: E402
 from sam_runtime.bridge.health import DeviceHealth  # noqa: E402
+from sam_runtime.common.rate_log import RateLimitedLog  # noqa: E402
 from sam_runtime.dronecan_io import LoopbackMulticastDriver, NodeLoop, make_node, parse_iface  # noqa: E402
 
 RAW_IMU = "uavcan.equipment.ahrs.RawIMU"

@@ -30,9 +30,10 @@ from helpers.runtime_support import HELPERS, child_env, domain_id, generated_or_
 def _outbound(queue_size: int) -> tuple[Any, Any]:
     """The bridge's ROS -> UAVCAN path, not started, with one mapping whose converter passes the object through
     (no ROS node, no backend)."""
-    from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+    from sam_runtime.bridge.counters import MappingStats
     from sam_runtime.bridge.lifetime import Lifetime
     from sam_runtime.bridge.outbound import Outbound, OutMapping
+    from sam_runtime.common.rate_log import RateLimitedLog
 
     gen = generated_or_skip()
     info = next((m for m in gen.tables().MAPPINGS if m.direction == "ros_to_uavcan"), None)

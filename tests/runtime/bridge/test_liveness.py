@@ -9,7 +9,7 @@ import math
 import pytest
 
 import sam_runtime.bridge.liveness
-from sam_runtime.bridge.liveness import LivenessMonitor, grace_s, silence_of
+from sam_runtime.bridge.liveness import LivenessCheck, grace_s, silence_of
 
 
 def test_doctests() -> None:
@@ -42,7 +42,7 @@ def test_silence_counts_from_the_latest_reason_to_expect_data(alive_since: float
 def test_monitor_reports_changes_only_and_names_the_device() -> None:
     alive: dict[int, float | None] = {22: 0.0, 23: None}
     last: dict[tuple[str, int], float] = {}
-    mon = LivenessMonitor([("altitude", 10.0, [22]), ("ctd", 0.5, [23]), ("both", 10.0, [23, 22])],
+    mon = LivenessCheck([("altitude", 10.0, [22]), ("ctd", 0.5, [23]), ("both", 10.0, [23, 22])],
                           {22: "altimeter"})
 
     def update(now: float) -> list[tuple[str, str | None, str | None]]:

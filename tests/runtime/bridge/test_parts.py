@@ -22,10 +22,11 @@ from typing import Any
 import pytest
 
 from sam_runtime.bridge.backend import DeviceStatus
-from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.common.rate_log import RateLimitedLog
 
 UDP, CAN = 2**64, 32
 

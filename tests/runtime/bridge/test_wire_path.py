@@ -18,9 +18,10 @@ from typing import Any
 import pytest
 
 from sam_runtime.bridge.backend import BelowBridge
-from sam_runtime.bridge.counters import MappingStats, RateLimitedLog
+from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.common.rate_log import RateLimitedLog
 
 
 class _Inlet:

@@ -1,5 +1,5 @@
-"""The performance monitor's state machine (runtime/nav/performance_monitor.py): each emergency condition, latching until
-cleared, and the emergency outputs."""
+"""The performance monitor's state machine (runtime/nav/performance_monitor.py): each emergency condition, latching
+until cleared, and the emergency outputs."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""The simulated vehicle (runtime/physics/vehicle.py): magnitudes plausible for SAM, the contract's signs, hard limits at
-the surface and the sea floor, finite actuator rates, determinism for a seed, and the sensor models."""
+"""The simulated vehicle (runtime/physics/vehicle.py): magnitudes plausible for SAM, the contract's signs, hard limits
+at the surface and the sea floor, finite actuator rates, determinism for a seed, and the sensor models."""
 
 from __future__ import annotations
 

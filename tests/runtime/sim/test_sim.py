@@ -1,5 +1,5 @@
-"""The simulated devices (runtime/sim/simulator.py): one Cyphal node per device of the spec, plausible changing values at
-the nominal rates, actuators that accept only the bridge's commands and move at a finite rate; the SAM devices
+"""The simulated devices (runtime/sim/simulator.py): one Cyphal node per device of the spec, plausible changing values
+at the nominal rates, actuators that accept only the bridge's commands and move at a finite rate; the SAM devices
 measure one shared vehicle that their actuators drive.
 
 The network tests run over python-can ``virtual`` CAN FD in this process (a channel name per test), so they
@@ -126,11 +126,11 @@ def _command(sim: Simulator, device: str, source: int, **values: Any) -> None:
     dev = next(d for d in sim.devices if d.info.name == device)
     if not dev.subs:
         port = dev.info.subscribes[0]
-        from sam_runtime.sim.simulator import _SubPort
+        from sam_runtime.sim.ports import SubPort
 
-        dev.subs.append(_SubPort(port, sim.gen.dsdl_class(port)))
+        dev.subs.append(SubPort(port, sim.gen.dsdl_class(port)))
     sp = dev.subs[0]
-    sim._on_command(dev, sp, sp.dtype(**values), _Transfer(source))
+    sim.on_command(dev, sp, sp.dtype(**values), _Transfer(source))
 
 
 def test_sam_physics_values_are_plausible(gen: Any) -> None:
@@ -406,8 +406,8 @@ def test_a_non_sam_spec_gets_generic_values_and_its_own_actuator_model(tmp_path:
                     samples[pp.port.subject_id] = (pycyphal.dsdl.to_builtin(wire), pycyphal.dsdl.to_builtin(b))
             drive = sim.device("drive")
             sp = drive.subs[0]
-            sim._on_command(drive, sp, sp.dtype(), _Transfer(sim.bridge_node_id))
-            sim._on_command(drive, sp, sp.dtype(), _Transfer(3))
+            sim.on_command(drive, sp, sp.dtype(), _Transfer(sim.bridge_node_id))
+            sim.on_command(drive, sp, sp.dtype(), _Transfer(3))
             return {"report": sim.report(), "samples": samples}
         finally:
             await sim.close()
