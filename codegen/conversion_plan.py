@@ -3,9 +3,9 @@
 `lower_mapping(rm)` decides, for both converters of a mapping (UAVCAN -> ROS and ROS -> UAVCAN), what each link
 does to its value, in order: scale and offset, representation changes, NaN rejection, rounding, clamping with its
 policy (saturate or reject; finite-only for float32, infinities too for float16, round-into-range for float ->
-integer), padding, cutting, tables, timestamps and constants. The renderers only word it: emit_python (through
-python_statements) turns the operations into statements, the wire codecs do the same with their own reads and
-writes, and emit_docs words the same operations in the interface reference. Nothing here knows Python syntax.
+integer), padding, cutting, tables, timestamps and constants. The renderers only word it: targets.python (through
+its statements) turns the operations into statements, the wire codecs do the same with their own reads and
+writes, and targets.docs words the same operations in the interface reference. Nothing here knows Python syntax.
 
 For an array link the value operations apply to every element; Pad, FixedLength and MaxLength to the array.
 """

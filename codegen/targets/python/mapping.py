@@ -46,8 +46,8 @@ from sam_codegen.conversion_plan import (
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.targets.python import statements as pys
-from sam_codegen.targets.python.module import ConvertModule, FunctionDraft
-from sam_codegen.targets.python.names import LocalNames, access, dict_literal, identifier, py_attr
+from sam_codegen.targets.python.module import ConvertModule, FunctionDraft, TableConstant
+from sam_codegen.targets.python.names import LocalNames, access, identifier, py_attr
 from sam_codegen.targets.python.statements import (
     Assign,
     CutToMaxLength,
@@ -210,19 +210,15 @@ class MappingEmitter:
             statements.append(PadArray(var, pad.size, typed_literal(0, ros_base)))
         return [(s.ros_path, var)]
 
-    def module_table(self, s: Step, direction: str) -> str:
+    def module_table(self, s: Step, direction: PlanDirection) -> str:
         """The module constant holding a link's table in `direction` (one per link and direction)."""
         const = f"_{self.name}_{identifier(s.ros)}".upper() + ("_TO_ROS" if direction == TO_ROS else "_TO_UAVCAN")
-        if not any(t["name"] == const for t in self.module.tables):
-            pairs = [(py_literal(k), py_literal(v))
-                     for k, v in Table(s.table, s.table_default, direction != TO_ROS).lookup()]
-            self.module.tables.append({
-                "name": const,
-                "items": pairs,
-                "literal": dict_literal(f"{const}: dict[int, int] = ", pairs),
-                "what": f"{self.name}: {s.uavcan} -> {s.ros}" if direction == TO_ROS
-                else f"{self.name}: {s.ros} -> {s.uavcan} (first key per value)",
-            })
+        if not any(t.name == const for t in self.module.tables):
+            pairs = tuple((py_literal(k), py_literal(v))
+                          for k, v in Table(s.table, s.table_default, direction != TO_ROS).lookup())
+            what = (f"{self.name}: {s.uavcan} -> {s.ros}" if direction == TO_ROS
+                    else f"{self.name}: {s.ros} -> {s.uavcan} (first key per value)")
+            self.module.tables.append(TableConstant(const, pairs, what))
         return const
 
     # -- ROS -> UAVCAN ---------------------------------------------------------------------------------------

@@ -9,7 +9,8 @@ wire codec of DroneCAN (targets/wire/codec_v0), which reads the same elements fr
 from __future__ import annotations
 
 import keyword
-from typing import Any, ClassVar, Protocol
+from dataclasses import dataclass
+from typing import ClassVar, Protocol
 
 from sam_codegen.conversion_plan import RequireItem, SetConstant
 from sam_codegen.model.spec import DsdlStruct, RosMessage
@@ -22,8 +23,8 @@ from sam_codegen.targets.python.statements import Assign, FindItem, RequireMinLe
 from sam_codegen.validate.mapping_rules import Step, format_path
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["TYPENAMES", "DroneCanObjects", "ItemReader", "V0ObjectReader", "bind_required_elements", "matches",
-           "v0_attr"]
+__all__ = ["TYPENAMES", "DroneCanObjects", "ItemReader", "Predicate", "V0ObjectReader", "bind_required_elements",
+           "matches", "v0_attr"]
 
 TYPENAMES = "_TYPENAMES"
 
@@ -129,9 +130,18 @@ class V0ObjectReader:
         return f"list({expr})"
 
 
-def matches(em: MappingEmitter) -> dict[str, Any] | None:
+@dataclass(frozen=True)
+class Predicate:
+    """A MATCHES function: `decode` lines (the wire codec's), then `return` all `conditions`."""
+
+    name: str
+    conditions: tuple[str, ...]
+    decode: tuple[str, ...] = ()
+
+
+def matches(em: MappingEmitter) -> Predicate | None:
     """The predicate of MATCHES: the `select` values, and the elements the mapping reads are there."""
-    conditions = []
+    conditions: list[str] = []
     for fs in em.plan.uavcan_fields:
         if isinstance(fs.op, SetConstant) and fs.op.select:
             assert isinstance(fs.type, DsdlType)
@@ -147,4 +157,4 @@ def matches(em: MappingEmitter) -> dict[str, Any] | None:
             conditions.append(f"len({source}) > {need.length - 1}")
     if not conditions:
         return None
-    return {"name": f"_matches_{em.name}", "conditions": conditions}
+    return Predicate(f"_matches_{em.name}", tuple(conditions))

@@ -20,6 +20,7 @@ from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import LINE_LIMIT, py_literal, typed_literal
 from sam_codegen.targets.python.names import (
     LocalNames,
+    dict_literal,
     dsdl_factory_name,
     dsdl_factory_supported,
     py_attr,
@@ -68,6 +69,19 @@ class ArrayNode:
         self.items: dict[int, Any] = {}
 
 
+@dataclass(frozen=True)
+class TableConstant:
+    """A module-level dict of a table link (int -> int), one per link and direction; `what` is its comment."""
+
+    name: str
+    items: tuple[tuple[str, str], ...]  # (key literal, value literal)
+    what: str
+
+    @property
+    def literal(self) -> str:
+        return dict_literal(f"{self.name}: dict[int, int] = ", list(self.items))
+
+
 class KeyedItems:
     """An array of composites built item by item, each chosen by a key (ArrayCommand.commands[actuator_id=3]):
     DroneCAN's broadcast arrays."""
@@ -110,7 +124,7 @@ class ConvertModule:
     resolved: Resolved
     build: Construction
     ros_aliases: dict[str, str] = field(default_factory=dict)  # pkg/Name -> local class name
-    tables: list[dict[str, Any]] = field(default_factory=list)
+    tables: list[TableConstant] = field(default_factory=list)
     module_names: set[str] = field(default_factory=set)
     lengths: dict[tuple, int] = field(default_factory=dict)  # the current mapping's arrays sized by use
 

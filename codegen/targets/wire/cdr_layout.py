@@ -1,4 +1,4 @@
-"""The layout of a ROS 2 message in CDR as wire_cdr's writer (wire_cdr.py) and reader (wire_cdr_read.py) walk it:
+"""The layout of a ROS 2 message in CDR as cdr_write's writer (cdr_write.py) and reader (cdr_read.py) walk it:
 the primitives' struct codes and sizes, the message flattened into leaves in wire order, and what is known of the
 alignment at each point (XCDR1, little endian; offsets relative to the first byte after the header).
 """
@@ -31,7 +31,7 @@ ARRAY_CODE = {"int8": "b", "int16": "h", "uint16": "H", "int32": "i", "uint32": 
 
 
 def ros_default(f: Field) -> Scalar:
-    """A primitive field's default as the ROS message class has it (what emit_python's `_new_*` factories use):
+    """A primitive field's default as the ROS message class has it (what convert.py's `_new_*` factories use):
     the .msg default, else zero / False / ''.
 
     >>> ros_default(Field("w", RosType("float64"), default=1.0)), ros_default(Field("s", RosType("string")))

@@ -1,4 +1,4 @@
-"""The CDR reader of wire_cdr (its API and the layout rules are in wire_cdr.py's docstring): statements that check
+"""The CDR reader of cdr_write (its API and the layout rules are in cdr_write.py's docstring): statements that check
 CDR bytes and decode the leaves a codec wants, raising WireError on anything that is not a message of the type.
 """
 

@@ -19,7 +19,7 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
 
 - ``Constants``: the module-level constants generated code refers to (one ``struct.Struct`` per run of fixed-layout
   fields, precomputed bytes), deduplicated by content and named deterministically; ``lines()`` renders them.
-  (It lives in wire_code with ``literal_value``, ``NO_VALUE``, ``wrap_line`` and ``prune``; all re-exported here.)
+  (It lives in code.py with ``literal_value``, ``NO_VALUE``, ``wrap_line`` and ``prune``; all re-exported here.)
 - ``cdr_writer(message, values, lookup, names, consts)`` -> ``(lines, expr)``: statements and the final expression
   of the CDR bytes (header included). ``values`` maps leaf paths to Python expressions; a whole-array path takes a
   list expression (``byte`` arrays: a list of 1-byte ``bytes``, as rclpy keeps them), a string path a ``str``
@@ -32,7 +32,7 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
   ints). They raise ``WireError`` (a name the generated module defines) on a wrong header, truncated data, a
   string without its NUL, a length beyond the buffer or a bound exceeded: never another exception.
 - ``lookup(full_name) -> RosMessage`` resolves nested types (``Resolved.ros.get``, external ones included);
-  ``names.new(hint)`` gives a fresh local (emit_python's ``LocalNames``).
+  ``names.new(hint)`` gives a fresh local (targets.python.names.LocalNames).
 
 The generated code needs, in its module, ``import struct as _struct``, ``from array import array as _array``, the
 ``WireError`` class and ``_ZEROS`` (zero bytes, at least 8: ``MODULE_PRELUDE``).
@@ -72,8 +72,8 @@ from sam_codegen.targets.wire.code import (
     wrap_line,
 )
 
-# Constants, literal_value, NO_VALUE, Names, FieldPath, wrap_line and prune live in wire_code, ros_default and
-# MODULE_PRELUDE in wire_cdr_layout, cdr_reader in wire_cdr_read; re-exported here (API).
+# Constants, literal_value, NO_VALUE, Names, FieldPath, wrap_line and prune live in code.py, ros_default and
+# MODULE_PRELUDE in cdr_layout, cdr_reader in cdr_read; re-exported here (API).
 __all__ = [
     "LINE_LIMIT",
     "MODULE_PRELUDE",

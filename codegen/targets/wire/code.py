@@ -1,4 +1,4 @@
-"""Utilities of the generated wire codecs' code, shared by wire_cdr, wire_cyphal and the DroneCAN codec: the
+"""Utilities of the generated wire codecs' code, shared by cdr_write, cyphal_read and the DroneCAN codec: the
 module-level constants generated code refers to, the literals it packs at generation time, its line wrapping,
 and the pruning of assignments nothing reads."""
 

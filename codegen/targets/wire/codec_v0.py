@@ -12,7 +12,7 @@ to cdr_write (ROS) or v0_write (DroneCAN) instead (DroneCanWire). The checks, sa
 stamps are the same typed statements, rendered by the same templates/python/statements.j2.
 
 Where the object path refuses a payload, the codec raises WireError: where dronecan's decoding raises (see
-wire_v0), and where a decoded array reaches a ROS sequence beyond its bound (rclpy refuses to serialize it). A ROS
+v0_read), and where a decoded array reaches a ROS sequence beyond its bound (rclpy refuses to serialize it). A ROS
 fixed array gets the first elements of a longer one, as rclpy serializes it.
 """
 
@@ -27,7 +27,7 @@ from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.render.templating import render
 from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
-from sam_codegen.targets.python.mapping_v0 import bind_required_elements, matches
+from sam_codegen.targets.python.mapping_v0 import Predicate, bind_required_elements, matches
 from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft, KeyedItems
 from sam_codegen.targets.python.names import LocalNames, ros_aliases
 from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_writer
@@ -89,7 +89,7 @@ class DroneCanWire:
 
 
 def _lines(lines: list[str]) -> list[str]:
-    """Statements within the line limit where wire_cdr's wrapping keeps their meaning (the same syntax tree), else
+    """Statements within the line limit where cdr_write's wrapping keeps their meaning (the same syntax tree), else
     as they are, marked (a long bit expression or comprehension)."""
     out: list[str] = []
     for line in lines:
@@ -283,7 +283,7 @@ class V0CdrReader:
         return f"list({expr})"  # the CDR reader's list (byte arrays as ints), copied: converters may trim it
 
 
-def wire_matches(em: MappingEmitter, build: DroneCanWire) -> dict[str, Any] | None:
+def wire_matches(em: MappingEmitter, build: DroneCanWire) -> Predicate | None:
     """MATCHES' predicate on the payload: the same conditions (select values, the elements read are there);
     WireError where the payload does not decode. Its own reader: it decodes what MATCHES needs, no more."""
     if matches(em) is None:
@@ -291,7 +291,7 @@ def wire_matches(em: MappingEmitter, build: DroneCanWire) -> dict[str, Any] | No
     rm = em.rm
     reader = V0WireReader(build, rm)
     decode = reader.decode(LocalNames(em.module.module_names), reader.wanted(matches=True))
-    conditions = []
+    conditions: list[str] = []
     for path, leaf, value in rm.select:
         conditions.append(f"{reader.access(path)} == "
                           f"{typed_literal(value, 'float' if leaf.kind == 'float' else leaf.kind)}")
@@ -305,7 +305,7 @@ def wire_matches(em: MappingEmitter, build: DroneCanWire) -> dict[str, Any] | No
                            for k in uses]
         else:
             conditions.append(f"len({source}) > {max(uses)}")
-    return {"name": f"_wire_matches_{em.name}", "decode": decode, "conditions": conditions}
+    return Predicate(f"_wire_matches_{em.name}", tuple(conditions), tuple(decode))
 
 
 def _context(resolved: Resolved) -> dict[str, Any]:

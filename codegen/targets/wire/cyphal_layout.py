@@ -1,4 +1,4 @@
-"""The Cyphal v1 layout facts wire_cyphal's reader and writer share (pydsdl's rules): struct codes of the standard
+"""The Cyphal v1 layout facts cyphal_read's reader and writer share (pydsdl's rules): struct codes of the standard
 primitives, length prefix and union tag widths, largest sizes, and what makes a composite's size vary."""
 
 from __future__ import annotations

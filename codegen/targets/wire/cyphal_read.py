@@ -26,10 +26,10 @@ Paths are tuples of ``(DSDL field name, index or None)`` (names as in the DSDL, 
   arrays), unset leaves are zero, unset variable-length arrays empty, an unset union its first field. Values are
   assumed in range (the converters' checks ran before).
 - ``max_bits(struct, lookup)``: the largest serialized size in bits (pydsdl's bit length set maximum).
-- ``lookup(full name with version) -> DsdlStruct`` (``Resolved.dsdl.get``); ``names``/``consts`` as in wire_cdr.
+- ``lookup(full name with version) -> DsdlStruct`` (``Resolved.dsdl.get``); ``names``/``consts`` as in cdr_write.
 
 The generated code needs ``_struct``, ``WireError`` and ``_extend`` (``CYPHAL_PRELUDE``) in its module. This module
-holds the reader; the writer is in wire_cyphal_write, the layout rules both follow in wire_cyphal_layout.
+holds the reader; the writer is in cyphal_write, the layout rules both follow in cyphal_layout.
 """
 
 from __future__ import annotations

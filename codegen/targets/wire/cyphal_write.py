@@ -1,5 +1,5 @@
-"""The writer half of wire_cyphal: straight-line Python serializing a Cyphal v1 composite as pycyphal does (see
-wire_cyphal for the layout and the API; ``cyphal_writer`` is re-exported there)."""
+"""The writer half of cyphal_read: straight-line Python serializing a Cyphal v1 composite as pycyphal does (see
+cyphal_read for the layout and the API; ``cyphal_writer`` is re-exported there)."""
 
 from __future__ import annotations
 

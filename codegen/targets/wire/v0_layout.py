@@ -1,7 +1,7 @@
 """The UAVCAN v0 (DroneCAN) layout rules the wire codecs follow, as dronecan (pydronecan 1.0.27,
 ``dronecan/transport.py`` and ``dronecan/dsdl/parser.py``) computes them: bit lengths (``get_min_bitlen``), the
 length prefix of a dynamic array, the tag of a union, when a dynamic array is a tail array (TAO), and which
-primitives struct reads byte for byte. See wire_v0 for the layout itself.
+primitives struct reads byte for byte. See v0_read for the layout itself.
 """
 
 from __future__ import annotations

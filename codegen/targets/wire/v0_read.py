@@ -1,5 +1,5 @@
 """Straight-line Python for UAVCAN v0 (DroneCAN) payloads, generated per data type: the reader (this module) and
-the writer (wire_v0_writer).
+the writer (v0_write).
 
 A payload is the bytes of one complete transfer, its CRC removed. The layout is dronecan's (pydronecan 1.0.27,
 ``dronecan/transport.py``), bit for bit:
@@ -27,12 +27,12 @@ type's end (ignored), void padding cut by the end of the payload, fewer than 8 b
 length prefix larger than the array's capacity (up to what the prefix can hold; all elements are decoded) or a tail
 array longer than its capacity: such arrays are given whole to the mapping, as dronecan's objects give them.
 
-API (used by emit_codec_v0)
+API (used by codec_v0)
 ---------------------------
 Paths are tuples of field names, through nested (non-array) composites, to a primitive field or to an array field:
 ``("timestamp", "usec")``, ``("commands",)``.
 
-- ``V0Layout(lookup)`` (wire_v0_layout): sizes of v0 types as dronecan computes them; ``lookup(full_name) ->
+- ``V0Layout(lookup)`` (v0_layout): sizes of v0 types as dronecan computes them; ``lookup(full_name) ->
   V0Struct``.
 - ``v0_reader(struct, wanted, layout, consts, buf, new_name)`` -> ``(lines, path -> local)``: statements that
   check the payload in ``buf`` as dronecan would and decode the ``wanted`` paths into locals named by

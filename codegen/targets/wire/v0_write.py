@@ -1,5 +1,5 @@
 """Straight-line Python that writes a UAVCAN v0 (DroneCAN) payload from the values of a message: the writer half of
-the v0 codecs (see wire_v0 for the layout; TAO on, classic CAN).
+the v0 codecs (see v0_read for the layout; TAO on, classic CAN).
 
 The bytes are dronecan's, bit for bit (``Transfer(payload=obj).payload`` of the object with the same values): its
 cast on assignment included (a saturated float becomes +-max beyond its range, infinities included; a truncated
@@ -11,7 +11,7 @@ Runs of fields of byte-multiple widths that start on a byte boundary are packed 
 fields are shifted into an integer (its bits are the stream, MSB first) that becomes bytes once the stream is back
 on a byte boundary, or at the end.
 
-API (used by emit_codec_v0)
+API (used by codec_v0)
 ---------------------------
 - ``V0Node(fields)``: a composite's values, field name -> expression (a list expression for a whole array),
   ``V0Node`` or ``V0Items``; ``V0Items(items)``: an array's elements one by one (their number known at generation
