@@ -201,6 +201,17 @@ class _Matcher:
         self.dec_rec = decoders.get(schema_rec) if schema_rec is not None else None
         self.dec_new = decoders.get(schema_new) if schema_new is not None else self.dec_rec
 
+    @staticmethod
+    def fields(decode: Any, data: bytes) -> dict[str, Any]:
+        """The message's leaf fields by path ({} when it does not decode)."""
+        out: dict[str, Any] = {}
+        if decode is not None:
+            try:
+                _flatten(decode(data), "", out)
+            except Exception:
+                return {}
+        return out
+
     def classify(self, old: bytes, out: _Out) -> tuple[str, list[str], set[str]]:
         if old == out.cdr:
             return "identical", [], set()
@@ -222,8 +233,9 @@ def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher)
     transfer after the listener received it, so the first recorded message comes from one of the last transfers
     received before it (by the listener's clock, which may lag the bridge's by some milliseconds): of the offsets
     within :data:`_ALIGN_WINDOW` of that guess, the one after which most pairs are the same (identical or
-    receive-time only) wins, the nearest on a tie; when none is (a changed conversion), the time alone decides. A
-    negative offset means the first recorded messages have no transfer (a recording whose bus side began later)."""
+    receive-time only) wins, the nearest on a tie; when none is (a changed conversion), the one whose pairs have the
+    most equal fields. A negative offset means the first recorded messages have no transfer (a recording whose bus
+    side began later)."""
     if not recorded or not replayed:
         return 0, 0
     first = recorded[0].log_time
@@ -237,7 +249,27 @@ def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher)
                                           strict=False) if matcher.classify(old.data, out)[0] != "differing")
         if score > best_score:
             best, best_score = off, score
+    if best_score == 0:  # no pair is the same anywhere (a changed conversion): the offset where most fields agree
+        best = _align_by_fields(recorded, replayed, matcher, guess)
     return max(0, -best), max(0, best)
+
+
+def _align_by_fields(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher, guess: int) -> int:
+    """The offset (replayed index - recorded index) within :data:`_ALIGN_WINDOW` of ``guess`` whose pairs have the
+    most equal fields (a changed mapping changes some fields, the others still tell the messages apart)."""
+    fields_rec = [matcher.fields(matcher.dec_rec, m.data) for m in recorded[:_ALIGN_PROBE]]
+    lo, hi = max(0, guess - _ALIGN_WINDOW), min(len(replayed), guess + _ALIGN_WINDOW + _ALIGN_PROBE)
+    fields_new = {j: matcher.fields(matcher.dec_new, replayed[j].cdr) for j in range(lo, hi)}
+    best, best_score = guess, -1
+    for off in sorted(range(guess - _ALIGN_WINDOW, guess + _ALIGN_WINDOW + 1), key=lambda o: abs(o - guess)):
+        score = 0
+        for i, a in enumerate(fields_rec):
+            b = fields_new.get(i + off)
+            if b is not None and i + off >= 0:
+                score += sum(1 for k, v in a.items() if k in b and _same_value(v, b[k]))
+        if score > best_score:
+            best, best_score = off, score
+    return best
 
 
 def _diff_topic(topic: str, recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher) -> TopicDiff:
