@@ -22,11 +22,14 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 from sam_codegen.project.ros_install import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
 from sam_codegen.project.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
 from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = [
     "GENERATED_ENV_VAR",
@@ -83,7 +86,7 @@ class GeneratedPackage:
     def __post_init__(self) -> None:
         self.root = Path(self.root).expanduser().resolve()
         self.package = _find_python_package(self.python_dir, self.package)
-        self._tables: ModuleType | None = None
+        self._tables: TablesModule | None = None
         self._convert: ModuleType | None = None
         self._convert_v0: ModuleType | None = None
         self._codecs: dict[str, ModuleType | None] = {}
@@ -119,10 +122,10 @@ class GeneratedPackage:
             )
         return mod
 
-    def tables(self) -> ModuleType:
+    def tables(self) -> TablesModule:
         """``<pkg>.tables`` (standard library only: safe to import anywhere, anytime)."""
         if self._tables is None:
-            self._tables = self._import("tables")
+            self._tables = cast("TablesModule", self._import("tables"))
         return self._tables
 
     def compile_dsdl(self) -> Path:

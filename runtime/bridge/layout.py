@@ -14,9 +14,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["PROTOCOLS", "Selection", "destinations_of", "port_id_of", "select"]
 
@@ -47,11 +50,11 @@ def destinations_of(m: Any) -> tuple[int, ...]:
     return () if m.destination_node_id is None else (int(m.destination_node_id),)
 
 
-def _layouts(tables: Any) -> dict[str, Any]:
+def _layouts(tables: TablesModule) -> dict[str, Any]:
     return {lay.name: lay for lay in tables.LAYOUTS}
 
 
-def protocols_in_use(tables: Any, layout: str) -> list[str]:
+def protocols_in_use(tables: TablesModule, layout: str) -> list[str]:
     """The protocols whose mappings the layout runs, in PROTOCOLS order."""
     lay = _layouts(tables).get(layout)
     if lay is None:
@@ -64,7 +67,7 @@ def protocols_in_use(tables: Any, layout: str) -> list[str]:
     return used
 
 
-def select(tables: Any, layout: str | None = None, protocol: str | None = None) -> Selection:
+def select(tables: TablesModule, layout: str | None = None, protocol: str | None = None) -> Selection:
     """The mappings and devices of a bridge for ``layout`` (default: the tables' DEFAULT_LAYOUT) on ``protocol``
     (default: the layout's only protocol)."""
     layouts = _layouts(tables)

@@ -96,7 +96,7 @@ class Reporter:
                 entry["liveness"] = self.silence.entry(m.name)
                 if inlet is not None:
                     totals, kinds, last_problem = inlet.below.snapshot()
-                    below = {k: totals.get(k, 0) for k in ("transfers", "frames", "errors", "drops",
+                    below: dict[str, Any] = {k: totals.get(k, 0) for k in ("transfers", "frames", "errors", "drops",
                                                            "deserialization_failures", "overruns")}
                     if kinds:
                         below["error_kinds"] = kinds

@@ -6,7 +6,7 @@ devices."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
 from sam_runtime.bridge.counters import MappingStats, log
@@ -15,6 +15,9 @@ from sam_runtime.bridge.layout import destinations_of, port_id_of
 from sam_runtime.bridge.loss import TransferLoss
 from sam_runtime.bridge.outbound import OutMapping
 from sam_runtime.cyphal_io.ports import subscription_names
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["check_destinations", "find_converter", "in_groups", "missing_codecs", "nominal_rates", "out_mappings"]
 
@@ -31,8 +34,8 @@ def find_converter(convert: Any, m: Any, which: int) -> Callable[..., Any]:
     return fn
 
 
-def check_destinations(tables: Any, mappings: Sequence[Any] | None = None, devices: Sequence[Any] | None = None
-                       ) -> None:
+def check_destinations(tables: TablesModule, mappings: Sequence[Any] | None = None,
+                       devices: Sequence[Any] | None = None) -> None:
     """Warn about a ROS -> UAVCAN mapping whose destination is no device, or does not subscribe to its port (the
     subject, or the DroneCAN data type)."""
     by_id = {d.node_id: d for d in (tables.DEVICES if devices is None else devices)}
@@ -57,7 +60,7 @@ def _port_id(p: Any) -> int:
     return int(p.data_type.data_type_id) if hasattr(p, "data_type") else int(p.subject_id)
 
 
-def nominal_rates(tables: Any, devices: Sequence[Any] | None = None) -> dict[tuple[int, int], float]:
+def nominal_rates(tables: TablesModule, devices: Sequence[Any] | None = None) -> dict[tuple[int, int], float]:
     """(device node id, port id) -> the spec's nominal rate of what the device publishes (port id: the subject id,
     or the DroneCAN data type id)."""
     return {(d.node_id, _port_id(p)): float(p.rate_hz) for d in (tables.DEVICES if devices is None else devices)

@@ -10,12 +10,16 @@ from __future__ import annotations
 
 import functools
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
+
 
 __all__ = ["add_types", "ensure_types", "type_problems"]
 
 
-def type_problems(tables: Any) -> list[str]:
+def type_problems(tables: TablesModule) -> list[str]:
     """How the types dronecan has loaded differ from the tables' DRONECAN_TYPES (data type id and signature)."""
     import dronecan
 

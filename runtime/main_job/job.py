@@ -40,7 +40,7 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sam_codegen.build import build
 from sam_codegen.model.diagnostics import SpecError
@@ -61,6 +61,9 @@ from sam_runtime.main_job.demo import demo_message
 from sam_runtime.main_job.diag_view import bridge_lines, status_key
 from sam_runtime.main_job.vehicle_view import VehicleView
 from sam_runtime.nodes import implemented, unimplemented
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["LiveView", "RunOptions", "run", "summarize_message"]
 
@@ -183,7 +186,7 @@ class LiveView:
     """An rclpy node subscribing to every bridged topic and to /diagnostics (own context): what the run shows.
     Its ROS node is ``<bridge>_monitor`` (the name it always had)."""
 
-    def __init__(self, tables: Any, gen: Any, *, window: float = 2.0, demo_commands: bool = False,
+    def __init__(self, tables: TablesModule, gen: Any, *, window: float = 2.0, demo_commands: bool = False,
                  hosted: list[str] | None = None, truth_file: Path | None = None) -> None:
         import rclpy
         from diagnostic_msgs.msg import DiagnosticArray

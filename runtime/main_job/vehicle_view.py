@@ -18,11 +18,14 @@ import json
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sam_runtime.node_support import stamp_to_ns
 from sam_runtime.physics.geo import depth_from_pressure, euler_from_quaternion, local_from_latlon
 from sam_runtime.tf_buffer import TfBuffer, TfError
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["VehicleView"]
 
@@ -37,7 +40,7 @@ def _f(v: float | None, fmt: str = "6.2f", unit: str = "") -> str:
 class VehicleView:
     """Subscribes on ``node`` (an rclpy Node of the main job); ``lines()`` renders the view."""
 
-    def __init__(self, node: Any, tables: Any, *, topics: dict[str, Any], diagnostics: dict[str, Any],
+    def __init__(self, node: Any, tables: TablesModule, *, topics: dict[str, Any], diagnostics: dict[str, Any],
                  hosted: list[str], truth_file: Path | None) -> None:
         from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Path as PathMsg

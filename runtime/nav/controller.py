@@ -22,6 +22,7 @@ successive poses.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -137,7 +138,7 @@ class Controller:
         self._opening = False  # running straight away from a goal inside the turning circles
 
     # ---------------------------------------------------------------------------------- inputs
-    def set_plan(self, stamp: float, poses: list[PathPose] | tuple[PathPose, ...]) -> None:
+    def set_plan(self, stamp: float, poses: Sequence[PathPose]) -> None:
         """A new path (world, z = -depth), received (or stamped) at ``stamp``. An empty path stops the vehicle."""
         self.path = tuple(tuple(float(c) for c in p[:3]) for p in poses)
         self.plan_stamp = stamp
@@ -155,7 +156,7 @@ class Controller:
             if 0.0 < dt <= 1.0:
                 a = min(1.0, dt / self.config.rate_filter)
                 raw = ((p0.z - pose.z) / dt, (pose.pitch - p0.pitch) / dt, wrap_angle(pose.yaw - p0.yaw) / dt)
-                self._rates = tuple(r + a * (m - r) for r, m in zip(self._rates, raw, strict=True))
+                self._rates = cast(_Point, tuple(r + a * (m - r) for r, m in zip(self._rates, raw, strict=True)))
             elif dt > 1.0:
                 self._rates = (0.0, 0.0, 0.0)
         self._prev = (t, pose)

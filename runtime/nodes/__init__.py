@@ -14,7 +14,11 @@ starts anything).
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
+
 
 __all__ = ["IMPLEMENTATIONS", "ImplementationError", "implemented", "load_implementation", "unimplemented"]
 
@@ -35,19 +39,19 @@ class ImplementationError(Exception):
     """An implementation that does not fit the generated interface (not a subclass of its base)."""
 
 
-def implemented(tables: Any) -> list[str]:
+def implemented(tables: TablesModule) -> list[str]:
     """The spec's nodes (the generated tables' NODES, in their order) that have an implementation."""
     known = IMPLEMENTATIONS.get(tables.NODES_PACKAGE, {})
     return [n.name for n in tables.NODES if n.name in known]
 
 
-def unimplemented(tables: Any) -> list[str]:
+def unimplemented(tables: TablesModule) -> list[str]:
     """The spec's nodes without an implementation."""
     have = set(implemented(tables))
     return [n.name for n in tables.NODES if n.name not in have]
 
 
-def load_implementation(tables: Any, name: str) -> type:
+def load_implementation(tables: TablesModule, name: str) -> type:
     """The implementation class of node ``name``, checked to be a subclass of the node's generated base (the
     generated package must be importable: GeneratedPackage.tables() puts it on sys.path)."""
     target = IMPLEMENTATIONS.get(tables.NODES_PACKAGE, {}).get(name)

@@ -19,10 +19,13 @@ import traceback
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sam_runtime.nav.mission import MissionGoal
 from sam_runtime.nodes import ImplementationError, implemented, load_implementation, unimplemented
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["HostConfigError", "HostPlan", "NodeHost", "plan_host"]
 
@@ -43,7 +46,7 @@ class HostPlan:
     missing: tuple[str, ...]
 
 
-def plan_host(tables: Any, only: Sequence[str] | None = None) -> HostPlan:
+def plan_host(tables: TablesModule, only: Sequence[str] | None = None) -> HostPlan:
     """The nodes to run; ``only`` restricts them (HostConfigError for a name the spec does not have, or one
     without an implementation)."""
     names = [n.name for n in tables.NODES]

@@ -29,7 +29,7 @@ import itertools
 import math
 import random
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any
+from typing import Any, cast
 
 from sam_runtime.physics.geo import (
     P_ATM,
@@ -367,7 +367,7 @@ class Vehicle:
             s.w = max(s.w, 0.0)
             s.floor_contacts += 1
         v_new = ((s.x - x0) / dt, (s.y - y0) / dt, (d0 - s.depth) / dt)
-        s.accel = tuple((n - o) / dt for n, o in zip(v_new, s.velocity, strict=True))
+        s.accel = cast(Vec3, tuple((n - o) / dt for n, o in zip(v_new, s.velocity, strict=True)))
         s.velocity = v_new
         s.max_depth = max(s.max_depth, s.depth)
 

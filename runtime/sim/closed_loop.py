@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,7 +22,7 @@ from sam_runtime.nav.dead_reckoning import DeadReckoning, DeadReckoningConfig, D
 from sam_runtime.nav.motion_planner import GoalDecision, Plan, Planner, PlannerConfig
 from sam_runtime.nav.performance_monitor import MonitorLimits, MonitorOutput, PerformanceMonitor
 from sam_runtime.nav.slam import SlamConfig, SlamCorrector
-from sam_runtime.physics.geo import local_from_latlon
+from sam_runtime.physics.geo import Vec3, local_from_latlon
 from sam_runtime.physics.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, VehicleParams
 
 __all__ = ["ClosedLoop", "LoopOptions"]
@@ -31,6 +32,11 @@ TICK_HZ = 100  # the vehicle's step; every rate below divides it
 
 def _f16(v: float) -> float:
     return struct.unpack("<e", struct.pack("<e", v))[0]
+
+
+def _f16_3(v: Sequence[float]) -> Vec3:
+    """A vector as float16 fields carry it."""
+    return _f16(v[0]), _f16(v[1]), _f16(v[2])
 
 
 @dataclass
@@ -145,9 +151,9 @@ class ClosedLoop:
         veh = self.vehicle
         if self._due("imu"):
             m = s.imu()
-            dr.on_imu(t, tuple(map(_f16, m.gyro)), tuple(map(_f16, m.accel)))
+            dr.on_imu(t, _f16_3(m.gyro), _f16_3(m.accel))
         if self._due("mag"):
-            dr.on_magnetometer(t, tuple(map(_f16, s.magnetometer())))
+            dr.on_magnetometer(t, _f16_3(s.magnetometer()))
         if self._due("pressure"):
             p = s.pressure()
             dr.on_pressure(t, p)
@@ -196,9 +202,9 @@ class ClosedLoop:
             veh.command(rpm_1=c.rpm_1, rpm_2=c.rpm_2, vertical_rad=c.vertical_rad, horizontal_rad=c.horizontal_rad,
                         ballast_1_rad=c.ballast_1_rad, ballast_2_rad=c.ballast_2_rad,
                         longitudinal_weight_pct=c.longitudinal_weight_pct, buoyancy_pct=c.buoyancy_pct)
-            out = self.monitor_output
-            if out is not None and out.abort_active:  # the monitor's own commands (same topics)
-                veh.command(rpm_1=out.rpm, rpm_2=out.rpm, buoyancy_pct=out.buoyancy_pct)
+            emergency = self.monitor_output
+            if emergency is not None and emergency.abort_active:  # the monitor's own commands (same topics)
+                veh.command(rpm_1=emergency.rpm, rpm_2=emergency.rpm, buoyancy_pct=emergency.buoyancy_pct)
         if self.tick % round(self.options.record_period * TICK_HZ) == 0:
             self._record(world)
         self.tick += 1

@@ -8,11 +8,14 @@ from __future__ import annotations
 import asyncio
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from sam_runtime.genpkg import GeneratedPackage
 from sam_runtime.sim.config import SimConfig
 from sam_runtime.sim.devices import DeviceState, PhysicsFn
+
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["DeviceAdapter", "DeviceHost", "PubPort", "SimDevice", "SubPort"]
 
@@ -82,7 +85,7 @@ class DeviceHost(Protocol):
     """What a protocol adapter uses of the simulator."""
 
     gen: GeneratedPackage
-    tables: Any
+    tables: TablesModule
     config: SimConfig
     devices: list[SimDevice]
     bridge_node_id: int

@@ -40,7 +40,7 @@ import logging
 import math
 import os
 import time
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.tasks import cancel_and_wait
@@ -57,6 +57,9 @@ from sam_runtime.sim.devices import (
 )
 from sam_runtime.sim.ports import DeviceAdapter, PubPort, SimDevice, SubPort
 
+if TYPE_CHECKING:
+    from sam_codegen.targets.python.tables_api import TablesModule
+
 # The device models live in sam_runtime.sim.devices; re-exported here, where the tests and benchmarks import them.
 __all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState", "generic_fill",
            "layout_protocols", "physics_key"]
@@ -65,7 +68,7 @@ _log = logging.getLogger("sam_runtime.sim.simulator")
 
 
 # ============================================================================================ simulator
-def layout_protocols(tables: Any, layout: str = "default") -> dict[str, str]:
+def layout_protocols(tables: TablesModule, layout: str = "default") -> dict[str, str]:
     """Device name -> ``"cyphal"`` | ``"dronecan"`` under a layout of the spec (the generated ``LAYOUTS``, in spec
     order; ``default``: every device on its own ``protocol``, or on Cyphal for tables without layouts). ValueError
     names the spec's layouts."""
@@ -99,7 +102,7 @@ class Simulator:
         wanted = None if self.config.devices is None else set(self.config.devices)
         if wanted is not None and wanted - set(protocols):
             raise ValueError(f"unknown device(s) {sorted(wanted - set(protocols))}; the spec has {sorted(protocols)}")
-        firmware = {"cyphal": {d.name: d for d in self.tables.DEVICES},
+        firmware: dict[str, dict[str, Any]] = {"cyphal": {d.name: d for d in self.tables.DEVICES},
                     "dronecan": {d.name: d for d in self.tables.DRONECAN_DEVICES}}
         self.devices = []
         for name, protocol in protocols.items():
