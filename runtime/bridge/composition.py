@@ -40,7 +40,7 @@ class Bridge:
     :param gen: the generated package (tables + converters).
     :param node_id: Cyphal node id; default ``UAVCAN__NODE__ID`` for an ``env`` transport, else the spec's
         bridge node id.
-    :param transport: see :class:`~.cyphal_backend.TransportConfig`.
+    :param transport: see :class:`~.backends.cyphal.TransportConfig`.
     :param ros_args: extra ROS arguments (``--ros-args ...``) for rclpy.init, e.g. remappings.
     :param parameter_overrides: initial values of the spec's parameters, by spec or ROS name.
     :param qos_depth: history depth of the ROS publishers and subscriptions (keep-last); default: each topic's

@@ -251,7 +251,7 @@ class LiveView:
         pub, cls, _rate, name = self._demo[i]
         try:
             pub.publish(demo_message(cls, time.monotonic() - self._demo_t0, self.node.get_clock().now().to_msg()))
-        except Exception as ex:  # a value rclpy refuses (a bug of ros_demo) or a closing context: never a crash
+        except Exception as ex:  # a value rclpy refuses (a bug of main_job.demo) or a closing context: never a crash
             self.demo_errors[name] += 1
             if self.demo_errors[name] == 1:
                 logging.getLogger("sam_runtime.main_job.job").error("demo command on %s not published: %s: %s", name,

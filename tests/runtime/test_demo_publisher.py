@@ -35,7 +35,7 @@ from helpers.spec_build import built_spec
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 
-def test_ros_demo_doctests() -> None:
+def test_demo_doctests() -> None:
     import sam_runtime.main_job.demo
 
     assert doctest.testmod(sam_runtime.main_job.demo).failed == 0

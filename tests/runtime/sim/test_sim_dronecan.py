@@ -1,5 +1,5 @@
 """The simulated devices on DroneCAN (UAVCAN v0): under a layout that puts a device on DroneCAN, the simulator runs it
-as a dronecan node on the same simulated vehicle (runtime/sim/dronecan.py, runtime/device_models_v0.py).
+as a dronecan node on the same simulated vehicle (runtime/sim/dronecan.py, runtime/sim/devices_dronecan.py).
 
 Everything is checked against plain dronecan nodes (the library itself, on this repository's loopback driver) on a
 private ``mcast-lo:`` bus of this test session, in this process; the Cyphal side of the mixed layout runs over
