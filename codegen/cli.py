@@ -153,7 +153,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, nodes, run."
+    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, nodes, run, record, replay."
     sub = parser.add_subparsers(dest="command", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:
@@ -185,7 +185,7 @@ def make_parser() -> argparse.ArgumentParser:
     return parser
 
 
-RUNTIME_COMMANDS = ("bridge", "sim", "nodes", "run")
+RUNTIME_COMMANDS = ("bridge", "sim", "nodes", "run", "record", "replay")
 
 
 def main(argv: list[str] | None = None) -> int:

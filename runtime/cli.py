@@ -372,6 +372,9 @@ def _run_parser() -> argparse.ArgumentParser:
     p.add_argument("--params-file", type=Path, default=None,
                    help="the node host's ROS 2 parameters file (default: the generated params/<vehicle>.params.yaml)")
     _add_mission_args(p)
+    p.add_argument("--record", type=Path, default=None, metavar="FILE.mcap",
+                   help="record every ROS topic of the spec and the raw UAVCAN bus into this MCAP file (a child "
+                        "like the others: sam-codegen record)")
     p.add_argument("--window", type=float, default=2.0, help="rate window [s] (default 2)")
     p.add_argument("--plain", action="store_true", help="plain lines every second even on a terminal")
     p.add_argument("--log-dir", type=Path, default=None,
@@ -417,12 +420,28 @@ def run_main(argv: Sequence[str] | None = None) -> int:
         window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
         argv=list(sys.argv[1:] if argv is None else argv), nodes=args.nodes, node_args=node_args,
         sim_args=sim_args, truth_file=args.truth_file, layout=args.layout, dronecan_iface=args.dronecan_iface,
-        wire=args.wire,
+        wire=args.wire, record=args.record,
     ))
 
 
+# ============================================================================================ record, replay
+def record_main(argv: Sequence[str] | None = None) -> int:
+    """``sam-record`` / ``sam-codegen record``: sam_runtime.main_job.record_replay."""
+    from sam_runtime.main_job.record_replay import record_main as main
+
+    return main(argv)
+
+
+def replay_main(argv: Sequence[str] | None = None) -> int:
+    """``sam-replay`` / ``sam-codegen replay``: sam_runtime.main_job.record_replay."""
+    from sam_runtime.main_job.record_replay import replay_main as main
+
+    return main(argv)
+
+
 # ============================================================================================ dispatch
-_COMMANDS = {"bridge": bridge_main, "sim": sim_main, "nodes": nodes_main, "run": run_main}
+_COMMANDS = {"bridge": bridge_main, "sim": sim_main, "nodes": nodes_main, "run": run_main, "record": record_main,
+             "replay": replay_main}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
