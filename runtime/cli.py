@@ -1,8 +1,10 @@
-"""Command line of the runtime: ``bridge``, ``sim``, ``nodes`` (the node host) and ``run`` (the main job).
+"""Command line of the runtime: ``bridge``, ``sim``, ``nodes`` (the node host), ``run`` (the main job), ``record``
+and ``replay`` (sam_runtime.main_job.record_replay).
 
 Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_main`, ``sam-nodes`` =
-:func:`nodes_main`, ``sam-run`` = :func:`run_main`; ``sam-codegen bridge|sim|nodes|run ...`` dispatches to
-:func:`main`. Also ``python -m sam_runtime.cli {bridge,sim,nodes,run} ...``.
+:func:`nodes_main`, ``sam-run`` = :func:`run_main`, ``sam-record`` = :func:`record_main`, ``sam-replay`` =
+:func:`replay_main`; ``sam-codegen bridge|sim|nodes|run|record|replay ...`` dispatches to :func:`main`. Also
+``python -m sam_runtime.cli {bridge,sim,nodes,run,record,replay} ...``.
 
 Where: ``--generated``, else ``$SAM_GENERATED_DIR``, else the generated folder of the project the working directory
 is in (see sam_codegen.project.workspace); ``run`` also finds the spec the way ``sam-codegen build`` does.
