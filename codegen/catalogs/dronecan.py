@@ -6,6 +6,9 @@ uavcan, dronecan, ardupilot, com, cuav), found without importing dronecan (whose
 DRONECAN_DSDL_PATH, folders holding such root namespaces separated by `:`, replaces them (e.g. a DroneCAN/DSDL
 checkout). Files are read on demand; the signature is computed here as dronecan's parser computes it (the tests
 compare the two over every standard type).
+
+Invariant: the catalog changes no struct. `get` gives a type as declared (its `signature` 0); `signed` gives it with
+the data type signature, computed on demand: what an emitter of ids and signatures reads.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import importlib.util
 import os
 import re
 import struct
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
 
@@ -214,6 +217,7 @@ class V0Catalog:
         self._files: dict[str, tuple[Path, int | None]] | None = None
         self._definitions: dict[str, _Definition | None] = {}
         self._signatures: dict[str, int] = {}
+        self._signed: dict[str, V0Struct] = {}
         self.errors: list[str] = []  # standard files that could not be read (reported once by the validator)
 
     @property
@@ -249,6 +253,15 @@ class V0Catalog:
         definition = self._definition(name)
         return definition.struct if definition is not None else None
 
+    def signed(self, name: str) -> V0Struct | None:
+        """The type `name` with its data type signature (0 when a type it nests is unknown or nests itself)."""
+        if name not in self._signed:
+            struct = self.get(name)
+            if struct is None:
+                return None
+            self._signed[name] = replace(struct, signature=self.signature(name))
+        return self._signed[name]
+
     def is_standard(self, name: str) -> bool:
         return name in self.files()
 
@@ -270,15 +283,15 @@ class V0Catalog:
             return self._signatures[name]
         if name in _stack:
             return 0
-        custom = self._spec.dronecan_types.get(name)
-        if custom is not None:
-            layout, response, override = custom.declared_fields, None, None
+        declared = self._spec.dronecan_types.get(name)
+        if declared is not None:
+            layout, response, override, union = declared.declared_fields, None, None, declared.union
         else:
             definition = self._definition(name)
             if definition is None:
                 return 0
             layout, response, override = definition.layout, definition.response, definition.override_signature
-            custom = definition.struct
+            union = definition.struct.union
         fields = layout + (response[0] if response else [])
         nested = []
         for f in fields:
@@ -289,10 +302,9 @@ class V0Catalog:
                     return 0
                 nested.append(inner)
         dsdl = override if override is not None else crc64we(
-            normalized_definition(name, layout, custom.union, response).encode())
+            normalized_definition(name, layout, union, response).encode())
         value = data_type_signature(dsdl, nested)
         self._signatures[name] = value
-        custom.signature = value
         return value
 
 

@@ -1,10 +1,16 @@
-"""ROS message definitions: the spec's own, the spec's external ones and the installed packages' .msg files."""
+"""ROS message definitions: the ones validation derived, the spec's own, the spec's external ones and the installed
+packages' .msg files.
+
+Invariant: a catalog never changes the spec nor a message it returns; what it reads from disk it caches, so one
+name gives one message object for the catalog's life.
+"""
 
 from __future__ import annotations
 
 import os
 import re
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 from sam_codegen.model.diagnostics import Pos
@@ -26,8 +32,8 @@ def _literal(type_name: str, text: str) -> Scalar:
     return text.strip("'\"")
 
 
-def parse_msg(text: str, package: str, name: str, file: str = "") -> RosMessage:
-    """Parse a .msg file (comments kept per field, defaults and constants read).
+def parse_msg(text: str, package: str, name: str, file: str = "", external: bool = False) -> RosMessage:
+    """Parse a .msg file (comments kept per field, defaults and constants read); `external`: it is not the spec's.
 
     >>> m = parse_msg("int8 A=1  # first\\nfloat64[9] cov # row major\\nint8 s -2", "p", "M")
     >>> [(f.name, str(f.type), f.default, f.comment) for f in m.fields], m.constants[0].value
@@ -56,7 +62,7 @@ def parse_msg(text: str, package: str, name: str, file: str = "") -> RosMessage:
         if match["default"] and not type_.array:
             default = _literal(type_.base, match["default"])
         fields.append(Field(match["name"], type_, comment.strip(), pos, default))
-    return RosMessage(package, name, fields, constants, pos=Pos(file))
+    return RosMessage(package, name, fields, constants, external=external, pos=Pos(file))
 
 
 def ros_share_dirs() -> list[Path]:
@@ -72,28 +78,40 @@ def ros_share_dirs() -> list[Path]:
 
 
 class RosCatalog:
-    """Looks ROS message definitions up by `pkg/Name`, caching what it reads."""
+    """Looks ROS message definitions up by `pkg/Name`, caching what it reads.
 
-    def __init__(self, spec: Spec, share_dirs: list[Path] | None = None) -> None:
+    `derived` overlays the spec's messages: the messages validation derived from DSDL types (`derive_from`), by
+    full name, which replace the spec's declarations of them.
+    """
+
+    def __init__(self, spec: Spec, share_dirs: list[Path] | None = None,
+                 derived: Mapping[str, RosMessage] | None = None) -> None:
         self._spec = spec
         self._share_dirs = ros_share_dirs() if share_dirs is None else share_dirs
+        self._derived = dict(derived or {})
         self._cache: dict[str, RosMessage | None] = {}
 
+    @property
+    def messages(self) -> dict[str, RosMessage]:
+        """The spec's own messages by full name, in spec order, each as derived where it is."""
+        return {name: self._derived.get(name, message) for name, message in self._spec.messages.items()}
+
     def get(self, full_name: str) -> RosMessage | None:
+        if full_name in self._derived:
+            return self._derived[full_name]
         if full_name in self._spec.messages:
             return self._spec.messages[full_name]
         if full_name in self._spec.external_messages:
             return self._spec.external_messages[full_name]
         if full_name not in self._cache:
-            self._cache[full_name] = self._read(full_name)
+            self._cache[full_name] = self.read_installed(full_name)
         return self._cache[full_name]
 
-    def _read(self, full_name: str) -> RosMessage | None:
+    def read_installed(self, full_name: str) -> RosMessage | None:
+        """The installed definition of `pkg/Name` (read anew, not cached), whatever the spec declares."""
         package, _, name = full_name.partition("/")
         for share in self._share_dirs:
             path = share / package / "msg" / f"{name}.msg"
             if path.is_file():
-                message = parse_msg(path.read_text(encoding="utf-8"), package, name, str(path))
-                message.external = True
-                return message
+                return parse_msg(path.read_text(encoding="utf-8"), package, name, str(path), external=True)
         return None

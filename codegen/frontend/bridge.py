@@ -4,8 +4,20 @@ from __future__ import annotations
 
 from sam_codegen.frontend.reading import Reader, int_list, map_items, number, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.yaml_source import YNode, YScalar
-from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import PROTOCOLS, Device, FieldLink, Layout, Mapping, Port, V0Port
+from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
+from sam_codegen.model.spec import (
+    DIRECTIONS,
+    PROTOCOLS,
+    ROS_TO_UAVCAN,
+    UAVCAN_TO_ROS,
+    Device,
+    FieldLink,
+    Layout,
+    Mapping,
+    Port,
+    Scalar,
+    V0Port,
+)
 
 __all__ = ["parse_device", "parse_layout", "parse_mapping"]
 
@@ -18,23 +30,26 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
     r = Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round"))
     if not r.ok:
         return None
-    link = FieldLink(ros_path, r.get("from", str, None), pos=pos, round=bool(r.get("round", bool, False)))
-    link.scale = number(r.node("scale"), f"'scale' of {what}", diag)
-    link.offset = number(r.node("offset"), f"'offset' of {what}", diag)
-    if link.scale == 0:
+    uavcan_path = r.get("from", str, None)
+    scale = number(r.node("scale"), f"'scale' of {what}", diag)
+    offset = number(r.node("offset"), f"'offset' of {what}", diag)
+    if scale == 0:
         diag.error(r.key_pos("scale"), f"'scale' of {what} must not be 0 (the reverse conversion divides by it)")
+    value = None
     if r.node("value") is not None:
-        link.value = r.get("value", (bool, int, float, str))
-        if link.uavcan_path is not None:
+        value = r.get("value", (bool, int, float, str))
+        if uavcan_path is not None:
             diag.error(pos, f"{what} has both 'from' and 'value'", "one of them")
-    elif link.uavcan_path is None:
+    elif uavcan_path is None:
         diag.error(pos, f"{what} needs 'from' (a UAVCAN field) or 'value' (a constant)")
     table_node = r.node("table")
+    table: dict[int, int] | None = None
+    table_default = None
     if table_node is not None:
-        table: dict[int, int] = {}
+        table = {}
         for key, key_pos, value_node in map_items(table_node, f"'table' of {what}", diag):
             if key == "default":  # every UAVCAN value the table does not list
-                link.table_default = scalar(value_node, int, f"table default of {what}", diag)
+                table_default = scalar(value_node, int, f"table default of {what}", diag)
                 continue
             try:
                 source = int(key)
@@ -44,15 +59,16 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
             target = scalar(value_node, int, f"table value of {what}", diag)
             if target is not None:
                 table[source] = target
-        link.table = table
     limits_node = r.node("limits")
+    limits = None
     if limits_node is not None:
         values = [number(n, f"'limits' of {what}", diag) for n in seq_items(limits_node, f"'limits' of {what}", diag)]
         if len(values) != 2 or None in values or values[0] >= values[1]:  # type: ignore[operator]
             diag.error(limits_node.pos, f"'limits' of {what} must be [low, high] with low < high")
         else:
-            link.limits = (values[0], values[1])  # type: ignore[assignment]
-    return link
+            limits = (values[0], values[1])
+    return FieldLink(ros_path, uavcan_path, scale, offset, table, table_default, value, limits,  # type: ignore[arg-type]
+                     pos, bool(r.get("round", bool, False)))
 
 
 _MAPPING_KEYS = (
@@ -73,56 +89,60 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
     if not r.ok:
         return None
     direction = r.get("direction", str)
-    if direction not in (None, "uavcan_to_ros", "ros_to_uavcan"):
+    if direction not in (None, *DIRECTIONS):
         diag.error(r.node("direction").pos, f"direction {direction!r} of {what} is unknown",  # type: ignore[union-attr]
-                   "uavcan_to_ros or ros_to_uavcan")
+                   f"{UAVCAN_TO_ROS} or {ROS_TO_UAVCAN}")
         direction = None
     policy = r.get("on_out_of_range", str, "saturate")
     if policy not in ("saturate", "reject"):
         diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range {policy!r} of {what} is unknown",
                    "saturate or reject")
-    mapping = Mapping(
-        name, direction or "uavcan_to_ros", r.get("topic", str) or "",
-        0 if dronecan else r.get("subject_id", int) or 0,
-        int_list(r.node("source_node_ids"), "source_node_ids", what, diag),
-        None if dronecan else r.get("destination_node_id", int, None), r.get("frame_id", str, None),
-        on_out_of_range=policy if policy in ("saturate", "reject") else "saturate", pos=pos, protocol=protocol,
-    )
+    source_node_ids = int_list(r.node("source_node_ids"), "source_node_ids", what, diag)
+    destination_node_id = None if dronecan else r.get("destination_node_id", int, None)
+    data_type, destination_node_ids, select_pos = "", [], NOWHERE
+    select: dict[str, Scalar] = {}
     if dronecan:
-        mapping.data_type = r.get("data_type", str) or ""
-        mapping.destination_node_ids = int_list(r.node("destination_node_ids"), "destination_node_ids", what, diag)
-        mapping.select_pos = r.key_pos("select")
+        data_type = r.get("data_type", str) or ""
+        destination_node_ids = int_list(r.node("destination_node_ids"), "destination_node_ids", what, diag)
+        select_pos = r.key_pos("select")
         for path, _, value_node in map_items(r.node("select"), f"select of {what}", diag):
             value = scalar(value_node, (bool, int), f"select value {path!r} of {what}", diag)
             if value is not None:
-                mapping.select[path] = value
+                select[path] = value
     fields = r.node("fields")
-    if isinstance(fields, YScalar) and fields.value == "auto":
-        mapping.auto = True
-    elif fields is not None:
+    auto = isinstance(fields, YScalar) and fields.value == "auto"
+    links = []
+    if not auto and fields is not None:
         for ros_path, key_pos, link_node in map_items(fields, f"the fields of {what}", diag):
             link = _link(ros_path, key_pos, link_node, name, diag)
             if link is not None:
-                mapping.links.append(link)
-    elif r.ok:
+                links.append(link)
+    elif fields is None and r.ok:
         diag.error(pos, f"missing field 'fields' in {what}", "a mapping of ros_field: uavcan_field, or `auto`")
-    mapping.ignore = [p for p, _ in str_list(r.node("ignore"), f"ignore of {what}", diag)]
+    ignore = [p for p, _ in str_list(r.node("ignore"), f"ignore of {what}", diag)]
+    uavcan_values: dict[str, Scalar] = {}
     for path, _, value_node in map_items(r.node("uavcan_values"), f"uavcan_values of {what}", diag):
         value = scalar(value_node, (bool, int, float), f"uavcan value {path!r} of {what}", diag)
         if value is not None:
-            mapping.uavcan_values[path] = value
+            uavcan_values[path] = value
+    mapping = Mapping(
+        name, direction or UAVCAN_TO_ROS, r.get("topic", str) or "", 0 if dronecan else r.get("subject_id", int) or 0,
+        source_node_ids, destination_node_id, r.get("frame_id", str, None), links, ignore, uavcan_values, auto,
+        policy if policy in ("saturate", "reject") else "saturate", pos, protocol, data_type, destination_node_ids,
+        select, select_pos,
+    )
     destination = "destination_node_ids" if dronecan else "destination_node_id"
-    if direction == "uavcan_to_ros" and r.node(destination) is not None:
+    if direction == UAVCAN_TO_ROS and r.node(destination) is not None:
         diag.error(r.key_pos(destination), f"{what} goes UAVCAN->ROS: it has sources, not a destination",
                    "source_node_ids")
-    if direction == "ros_to_uavcan" and r.node("source_node_ids") is not None:
+    if direction == ROS_TO_UAVCAN and r.node("source_node_ids") is not None:
         diag.error(r.key_pos("source_node_ids"), f"{what} goes ROS->UAVCAN: it has a destination, not sources",
                    destination)
-    if direction == "uavcan_to_ros" and not mapping.source_node_ids:
+    if direction == UAVCAN_TO_ROS and not mapping.source_node_ids:
         diag.error(pos, f"{what} needs source_node_ids: the node ids whose messages it accepts")
-    if direction == "ros_to_uavcan" and not dronecan and mapping.destination_node_id is None:
+    if direction == ROS_TO_UAVCAN and not dronecan and mapping.destination_node_id is None:
         diag.error(pos, f"{what} needs destination_node_id: the node its commands are meant for")
-    if direction == "ros_to_uavcan" and dronecan and not mapping.destination_node_ids:
+    if direction == ROS_TO_UAVCAN and dronecan and not mapping.destination_node_ids:
         diag.error(pos, f"{what} needs destination_node_ids: the nodes its broadcast commands are meant for")
     return mapping
 
@@ -167,11 +187,16 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     r = Reader(node, what, diag, _DEVICE_KEYS)
     node_id = r.get("node_id", int)
     protocol = r.get("protocol", str, "cyphal")
-    device = Device(key, node_id if node_id is not None else -1, text_of(r, "description"), pos=pos,
-                    protocol=protocol, protocol_pos={protocol: pos}, protocols=())
+    protocol_pos = {protocol: pos}
+
+    def device(ports: dict[str, list[Port]], v0_ports: dict[str, list[V0Port]], protocols: tuple[str, ...]) -> Device:
+        return Device(key, node_id if node_id is not None else -1, text_of(r, "description"),
+                      ports.get("publishes", []), ports.get("subscribes", []), pos, protocol, protocols,
+                      v0_ports.get("publishes", []), v0_ports.get("subscribes", []), protocol_pos)
+
     if protocol not in PROTOCOLS:
         diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
-        return device  # its ports would be read in the wrong protocol
+        return device({}, {}, ())  # its ports would be read in the wrong protocol
     sides = [(protocol, r.map)]
     if r.node(protocol) is not None:
         diag.error(r.key_pos(protocol), f"{what} speaks {protocol}: its {protocol} ports are its `publishes` and "
@@ -181,31 +206,33 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
         if other != protocol and section is not None:
             sub = Reader(section, f"the {other} ports of {what}", diag, ("publishes", "subscribes"))
             sides.append((other, sub.map))
-            device.protocol_pos[other] = r.key_pos(other)
+            protocol_pos[other] = r.key_pos(other)
+    cyphal: dict[str, list[Port]] = {}
+    v0: dict[str, list[V0Port]] = {}
     for side, ports in sides:
-        if side == "cyphal":
-            device.publishes = _ports(ports.entries.get("publishes"), what, diag)
-            device.subscribes = _ports(ports.entries.get("subscribes"), what, diag)
-        else:
-            device.dronecan_publishes = _v0_ports(ports.entries.get("publishes"), what, diag)
-            device.dronecan_subscribes = _v0_ports(ports.entries.get("subscribes"), what, diag)
-    device.protocols = tuple(side for side, _ in sides)
-    return device
+        for key_ in ("publishes", "subscribes"):
+            if side == "cyphal":
+                cyphal[key_] = _ports(ports.entries.get(key_), what, diag)
+            else:
+                v0[key_] = _v0_ports(ports.entries.get(key_), what, diag)
+    return device(cyphal, v0, tuple(side for side, _ in sides))
 
 
 def parse_layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
     what = f"layout {key!r}"
     r = Reader(node, what, diag, ("description", "protocol", "devices"))
-    layout = Layout(key, text_of(r, "description"), r.get("protocol", str, None), pos=pos)
-    if layout.protocol is not None and layout.protocol not in PROTOCOLS:
-        diag.error(r.key_pos("protocol"), f"protocol {layout.protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
-        layout.protocol = None
-    for device, device_pos, value in map_items(r.node("devices"), f"the devices of {what}", diag):
+    layout_protocol = r.get("protocol", str, None)
+    if layout_protocol is not None and layout_protocol not in PROTOCOLS:
+        diag.error(r.key_pos("protocol"), f"protocol {layout_protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+        layout_protocol = None
+    devices: dict[str, str] = {}
+    device_pos: dict[str, Pos] = {}
+    for device, key_pos, value in map_items(r.node("devices"), f"the devices of {what}", diag):
         protocol = scalar(value, str, f"the protocol of device {device!r} in {what}", diag)
         if protocol is not None and protocol not in PROTOCOLS:
             diag.error(value.pos, f"protocol {protocol!r} of device {device!r} in {what} is unknown",
                        " or ".join(PROTOCOLS))
         elif protocol is not None:
-            layout.devices[device] = protocol
-            layout.device_pos[device] = device_pos
-    return layout
+            devices[device] = protocol
+            device_pos[device] = key_pos
+    return Layout(key, text_of(r, "description"), layout_protocol, devices, device_pos, pos)

@@ -1,10 +1,14 @@
 """YAML spec -> model: structure, field names and value types. Cross-references are checked in validate.
 
-The top level is read here; its sections in spec_types, spec_bridge and spec_nodes, all with spec_reading's helpers.
+The top level is read here; its sections in frontend.types, frontend.bridge and frontend.nodes, all with
+frontend.reading's helpers. Every model object is built whole from what was read, and the Spec last: nothing is
+changed after it is built (the model is frozen). Each topic's effective QoS is chosen here, once the bridge's
+mappings are known.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mapping
@@ -12,8 +16,24 @@ from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, p
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
 from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
-from sam_codegen.model.diagnostics import Diagnostics, Pos, SpecError
-from sam_codegen.model.spec import Bridge, ParameterRule, RosPackageInfo, Spec, Topic, Transform
+from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
+from sam_codegen.model.spec import (
+    UAVCAN_TO_ROS,
+    Bridge,
+    DsdlStruct,
+    Frame,
+    Mapping,
+    Node,
+    Parameter,
+    ParameterRule,
+    RosMessage,
+    RosPackageInfo,
+    Spec,
+    Topic,
+    Transform,
+    V0Struct,
+    default_qos,
+)
 
 # scalar, parse_qos and QOS_DEPTH_MAX have been importable from here since before the split.
 __all__ = ["QOS_DEPTH_MAX", "load_spec_file", "parse_qos", "parse_spec", "scalar"]
@@ -39,84 +59,106 @@ def parse_spec(root: YNode, file: str) -> Spec:
                   ("package", "version", "description", "maintainer", "maintainer_email", "license"))
     cyphal = Reader(top.node("cyphal") or YMap(top.pos), "cyphal", diag, ("root_namespace",))
     package = ros.get("package", str) or ""
-    spec = Spec(
-        file, vehicle.get("name", str) or "", text_of(vehicle, "description"),
-        RosPackageInfo(package, ros.get("version", str, "0.1.0"), text_of(ros, "description"),
-                       ros.get("maintainer", str, "maintainer"),
-                       ros.get("maintainer_email", str, "maintainer@example.org"), ros.get("license", str, "MIT")),
-        cyphal.get("root_namespace", str) or "",
-    )
+    info = RosPackageInfo(package, ros.get("version", str, "0.1.0"), text_of(ros, "description"),
+                          ros.get("maintainer", str, "maintainer"),
+                          ros.get("maintainer_email", str, "maintainer@example.org"), ros.get("license", str, "MIT"))
+    external_messages: dict[str, RosMessage] = {}
     for key, pos, node in map_items(top.node("external_messages"), "external_messages", diag):
         if "/" not in key:
             diag.error(pos, f"external message {key!r} needs its package", "pkg/Name")
             continue
         message = parse_ros_message(key, pos, node, package, True, diag)
-        spec.external_messages[message.full_name] = message
+        external_messages[message.full_name] = message
+    messages: dict[str, RosMessage] = {}
     for key, pos, node in map_items(top.node("messages"), "messages", diag):
         if "/" in key:
             diag.error(pos, f"message {key!r} is declared in package {package}: give its bare name", "Name")
             continue
         message = parse_ros_message(key, pos, node, package, False, diag)
-        spec.messages[message.full_name] = message
+        messages[message.full_name] = message
+    dsdl_types: dict[str, DsdlStruct] = {}
     for key, pos, node in map_items(top.node("dsdl_types"), "dsdl_types", diag):
-        spec.dsdl_types[key] = parse_dsdl_struct(key, pos, node, diag)
+        dsdl_types[key] = parse_dsdl_struct(key, pos, node, diag)
+    frames: dict[str, Frame] = {}
     for key, pos, node in map_items(top.node("frames"), "frames", diag):
-        spec.frames[key] = parse_frame(key, pos, node, diag)
+        frames[key] = parse_frame(key, pos, node, diag)
+    transforms: list[Transform] = []
     for item in seq_items(top.node("transforms"), "transforms", diag):
         r = Reader(item, "a transform", diag, ("parent", "child", "publisher", "description"))
         parent, child, publisher = r.get("parent", str), r.get("child", str), r.get("publisher", str)
         if parent and child and publisher:
-            spec.transforms.append(Transform(parent, child, publisher, text_of(r, "description"), item.pos))
-    topics = top.node("topics")
-    if isinstance(topics, YMap):
-        for key, pos, again in topics.duplicates:
-            first = topics.entries[key]
-            types = [n.entries["type"].value for n in (first, again)
-                     if isinstance(n, YMap) and isinstance(n.entries.get("type"), YScalar)]
-            diag.error(pos, f"topic {key!r} is declared twice (first at line {topics.key_pos[key].line}"
+            transforms.append(Transform(parent, child, publisher, text_of(r, "description"), item.pos))
+    topics_node = top.node("topics")
+    if isinstance(topics_node, YMap):
+        for key, pos, again in topics_node.duplicates:
+            first = topics_node.entries[key]
+            types = [t.value for n in (first, again) if isinstance(n, YMap)
+                     for t in [n.entries.get("type")] if isinstance(t, YScalar)]
+            diag.error(pos, f"topic {key!r} is declared twice (first at line {topics_node.key_pos[key].line}"
                        + (f", types {' and '.join(map(str, types))}" if types else "")
                        + "): two types on one topic", "one type per topic; give the second its own topic")
-    for key, pos, node in map_items(topics, "topics", diag, duplicates=False):
+    declared_topics: list[Topic] = []  # their effective QoS comes once the bridge is read
+    for key, pos, node in map_items(topics_node, "topics", diag, duplicates=False):
         r = Reader(node, f"topic {key!r}", diag, ("type", "description", "section", "qos"))
         type_ = r.get("type", str)
         qos_node = r.node("qos")
         qos = parse_qos(qos_node, f"the QoS of topic {key!r}", diag) if qos_node is not None else None
         if type_ is not None:
-            spec.topics[key] = Topic(key, type_.replace("/msg/", "/"), text_of(r, "description"),
-                                     str(r.get("section", (str, float, int), "")), pos, qos,
-                                     qos_node.pos if qos_node is not None else pos)
+            declared_topics.append(Topic(key, type_.replace("/msg/", "/"), text_of(r, "description"),
+                                         str(r.get("section", (str, float, int), "")), pos, qos,
+                                         qos_node.pos if qos_node is not None else pos))
+    parameters: dict[str, Parameter] = {}
     for key, pos, node in map_items(top.node("parameters"), "parameters", diag):
-        parse_parameter(spec, key, pos, node, diag)
+        parameter = parse_parameter(key, pos, node, diag)
+        if parameter is not None:
+            parameters[key] = parameter
+    parameter_rules: list[ParameterRule] = []
     for item in seq_items(top.node("parameter_rules"), "parameter_rules", diag):
         r = Reader(item, "a parameter rule", diag, ("left", "op", "right", "description"))
         left, op, right = r.get("left", str), r.get("op", str), r.get("right", str)
         if op is not None and op not in ("<", "<=", ">", ">="):
             diag.error(r.key_pos("op"), f"parameter rule operator {op!r} is unknown", "<, <=, > or >=")
         elif left and op and right:
-            spec.parameter_rules.append(ParameterRule(left, op, right, text_of(r, "description"), item.pos))
+            parameter_rules.append(ParameterRule(left, op, right, text_of(r, "description"), item.pos))
+    dronecan_types: dict[str, V0Struct] = {}
     for key, pos, node in map_items(top.node("dronecan_types"), "dronecan_types", diag):
-        spec.dronecan_types[key] = parse_dronecan_type(key, pos, node, diag)
-    for key, pos, node in map_items(top.node("devices"), "devices", diag):
-        spec.devices[key] = parse_device(key, pos, node, diag)
-    for key, pos, node in map_items(top.node("layouts"), "layouts", diag):
-        spec.layouts[key] = parse_layout(key, pos, node, diag)
+        dronecan_types[key] = parse_dronecan_type(key, pos, node, diag)
+    devices = {key: parse_device(key, pos, node, diag)
+               for key, pos, node in map_items(top.node("devices"), "devices", diag)}
+    layouts = {key: parse_layout(key, pos, node, diag)
+               for key, pos, node in map_items(top.node("layouts"), "layouts", diag)}
     bridge_node = top.node("bridge")
+    bridge = None
     if bridge_node is not None:
         r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings"))
-        bridge = Bridge(r.get("name", str) or "bridge", r.get("node_id", int) or 0, pos=bridge_node.pos)
-        for key, pos, node in map_items(r.node("mappings"), "bridge mappings", diag):
-            mapping = parse_mapping(key, pos, node, diag)
-            if mapping is not None:
-                bridge.mappings.append(mapping)
-        for key, pos, node in map_items(r.node("dronecan_mappings"), "bridge dronecan_mappings", diag):
-            mapping = parse_mapping(key, pos, node, diag, "dronecan")
-            if mapping is not None:
-                bridge.dronecan_mappings.append(mapping)
-        spec.bridge = bridge
+        name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
+        mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
+        for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
+            what = "bridge mappings" if protocol == "cyphal" else "bridge dronecan_mappings"
+            for key, pos, node in map_items(r.node(key_), what, diag):
+                mapping = parse_mapping(key, pos, node, diag, protocol)
+                if mapping is not None:
+                    mappings[protocol].append(mapping)
+        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"])
+    nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
-        parse_node(spec, key, pos, node, diag)
+        nodes[key] = parse_node(key, pos, node, diag)
+    bridged = {m.topic for m in bridge.all_mappings if m.direction == UAVCAN_TO_ROS} if bridge is not None else set()
+    topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
     diag.check()
-    return spec
+    return Spec(
+        file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
+        cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
+        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts,
+    )
+
+
+def _with_effective_qos(topic: Topic, bridged: set[str]) -> Topic:
+    """The topic with the QoS its endpoints use: the declared one, else the ROS-convention default."""
+    if topic.declared_qos is not None:
+        return replace(topic, qos=topic.declared_qos, qos_origin="declared")
+    qos, origin = default_qos(topic, bridged)
+    return replace(topic, qos=qos, qos_origin=origin)
 
 
 def load_spec_file(path: Path) -> Spec:
@@ -124,7 +166,5 @@ def load_spec_file(path: Path) -> Spec:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        from sam_codegen.model.diagnostics import Diagnostic
-
         raise SpecError([Diagnostic(Pos(str(path)), f"cannot read the spec: {exc}")]) from None
     return parse_spec(load_yaml(text, str(path)), str(path))

@@ -17,13 +17,13 @@ from sam_codegen.model.spec import (
     Parameter,
     Qos,
     Scalar,
-    Spec,
 )
 
 __all__ = ["QOS_DEPTH_MAX", "parse_frame", "parse_node", "parse_parameter", "parse_qos"]
 
 
-def parse_parameter(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -> None:
+def parse_parameter(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Parameter | None:
+    """A parameter, or None when it has no usable type or default (reported)."""
     what = f"parameter {key!r}"
     r = Reader(node, what, diag, ("type", "unit", "default", "min", "max", "description", "section"))
     type_ = r.get("type", str)
@@ -32,9 +32,9 @@ def parse_parameter(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnosti
     }
     if type_ is not None and type_ not in kinds:
         diag.error(r.key_pos("type"), f"type {type_!r} of {what} is unknown", "double, integer, bool or string")
-        return
+        return None
     if type_ is None:
-        return
+        return None
     default: Scalar | None = r.get("default", kinds[type_])
     minimum = number(r.node("min"), f"min of {what}", diag)
     maximum = number(r.node("max"), f"max of {what}", diag)
@@ -46,11 +46,12 @@ def parse_parameter(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnosti
         if (minimum is not None and default < minimum) or (maximum is not None and default > maximum):
             diag.error(r.key_pos("default"), f"default {default} of {what} is outside its range",
                        f"a value in [{minimum}, {maximum}]")
-    if default is not None:
-        spec.parameters[key] = Parameter(
-            key, type_, float(default) if type_ == "double" else default, r.get("unit", str, ""),
-            minimum, maximum, text_of(r, "description"), str(r.get("section", (str, int, float), "")), pos,
-        )
+    if default is None:
+        return None
+    return Parameter(
+        key, type_, float(default) if type_ == "double" else default, r.get("unit", str, ""),
+        minimum, maximum, text_of(r, "description"), str(r.get("section", (str, int, float), "")), pos,
+    )
 
 
 _QOS_KEYS = ("reliability", "durability", "depth")
@@ -91,16 +92,17 @@ def parse_qos(node: YNode, what: str, diag: Diagnostics) -> Qos | None:
 def parse_frame(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Frame:
     what = f"frame {key!r}"
     r = Reader(node, what, diag, ("parent", "description", "xyz", "rpy"))
-    frame = Frame(key, r.get("parent", str, None), text_of(r, "description"), pos)
+    parent = r.get("parent", str, None)
+    offsets: dict[str, tuple[float, float, float]] = {}
     for attr in ("xyz", "rpy"):
         value = vector3(r.node(attr), f"{attr} of {what}", diag)
         if value is None:
             continue
-        if frame.parent is None:
+        if parent is None:
             diag.error(r.key_pos(attr), f"{what} has no parent: its {attr} would offset it from nothing",
                        "a `parent` for a static child frame")
-        setattr(frame, attr, value)
-    return frame
+        offsets[attr] = value
+    return Frame(key, parent, text_of(r, "description"), pos, **offsets)
 
 
 def _node_topics(node: YNode | None, what: str, diag: Diagnostics, with_qos: bool) -> list[NodeTopic]:
@@ -136,10 +138,10 @@ def _node_transforms(node: YNode | None, what: str, diag: Diagnostics) -> list[N
 _NODE_KEYS = ("description", "publishes", "subscribes", "parameters", "transforms", "reads_transforms")
 
 
-def parse_node(spec: Spec, key: str, pos: Pos, node: YNode, diag: Diagnostics) -> None:
+def parse_node(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Node:
     what = f"node {key!r}"
     r = Reader(node, what, diag, _NODE_KEYS)
-    spec.nodes[key] = Node(
+    return Node(
         key, text_of(r, "description"),
         _node_topics(r.node("publishes"), f"publishes of {what}", diag, with_qos=False),
         _node_topics(r.node("subscribes"), f"subscribes of {what}", diag, with_qos=True),

@@ -1,17 +1,23 @@
-"""The validated spec: what every emitter and the runtime tables read.
+"""The spec model: what validation checks and every emitter and the runtime tables read.
 
-Built by spec_loader from YAML, checked by validate; positions point back into the YAML for errors.
+Invariants: the frontend (sam_codegen.frontend.loader) builds it from YAML, each object whole and the Spec last; every
+class is frozen, and nothing changes a model object after it is built, so the validators and the emitters may run in
+any order and share it. What validation derives (the messages derived from DSDL types, the resolved mappings) lives
+in validate.Resolved, never in the Spec. Positions point back into the YAML for errors.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Final, Literal
 
 from sam_codegen.model.diagnostics import NOWHERE, Pos
 from sam_codegen.model.types import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
+UAVCAN_TO_ROS: Final[Direction] = "uavcan_to_ros"  # the bridge publishes on ROS what a device sent
+ROS_TO_UAVCAN: Final[Direction] = "ros_to_uavcan"  # the bridge sends to devices what it receives on ROS
+DIRECTIONS: tuple[Direction, ...] = (UAVCAN_TO_ROS, ROS_TO_UAVCAN)
 Reliability = Literal["reliable", "best_effort"]
 Durability = Literal["volatile", "transient_local"]
 OutOfRange = Literal["saturate", "reject"]
@@ -36,7 +42,7 @@ class Constant:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class RosMessage:
     package: str
     name: str
@@ -55,7 +61,7 @@ class RosMessage:
         return next((f for f in self.fields if f.name == name), None)
 
 
-@dataclass
+@dataclass(frozen=True)
 class DsdlStruct:
     """A DSDL composite type: one of the spec's own, or a standard one read from CYPHAL_PATH."""
 
@@ -97,7 +103,7 @@ class DsdlStruct:
         return next((f for f in self.fields if f.name == name), None)
 
 
-@dataclass
+@dataclass(frozen=True)
 class V0Struct(DsdlStruct):
     """A UAVCAN v0 (DroneCAN) composite type: one of the spec's `dronecan_types` or a standard one of dronecan's
     definitions. Its name has no version (`uavcan.equipment.ahrs.RawIMU`); fields hold v0 types (composites by
@@ -152,9 +158,12 @@ QOS_PROFILES: dict[str, Qos] = {
 }
 RELIABILITIES: tuple[Reliability, ...] = ("reliable", "best_effort")
 DURABILITIES: tuple[Durability, ...] = ("volatile", "transient_local")
+TF_TOPIC = "/tf"
+TF_STATIC_TOPIC = "/tf_static"
+TF_MESSAGE = "tf2_msgs/TFMessage"
 
 
-@dataclass
+@dataclass(frozen=True)
 class Topic:
     name: str
     type: str  # pkg/Name
@@ -163,12 +172,33 @@ class Topic:
     pos: Pos = NOWHERE
     declared_qos: Qos | None = None  # the spec's `qos:`, if any
     qos_pos: Pos = NOWHERE
-    # Set by validation: the declared QoS or the default for the topic (validate_nodes.default_qos).
+    # The QoS its endpoints use: the declared one or the default for the topic (default_qos), chosen by the
+    # frontend, which knows the bridge's mappings when it builds the topic. None only for a hand-built Topic.
     qos: Qos | None = None
     qos_origin: str = ""  # why: "declared", or the default rule that chose it
 
 
-@dataclass
+def default_qos(topic: Topic, bridged: set[str]) -> tuple[Qos, str]:
+    """The QoS of a topic without `qos:`, by ROS convention, and why; `bridged`: the topics the bridge publishes
+    from UAVCAN (its uavcan_to_ros mappings).
+
+    >>> default_qos(Topic("/tf_static", "tf2_msgs/TFMessage"), set())[0].profile
+    'latched'
+    >>> default_qos(Topic("/imu", "sensor_msgs/Imu"), {"/imu"})
+    (Qos(reliability='best_effort', durability='volatile', depth=5, profile='sensor_data'), 'a UAVCAN sensor stream')
+    >>> default_qos(Topic("/goal", "geometry_msgs/PoseStamped"), set())[1]
+    'a command, goal or plan'
+    """
+    if topic.name == TF_STATIC_TOPIC:
+        return QOS_PROFILES["latched"], "static transforms (tf2's convention)"
+    if topic.type == TF_MESSAGE:
+        return QOS_PROFILES["tf"], "transforms (tf2's convention)"
+    if topic.name in bridged:
+        return QOS_PROFILES["sensor_data"], "a UAVCAN sensor stream"
+    return QOS_PROFILES["reliable"], "a command, goal or plan"
+
+
+@dataclass(frozen=True)
 class Parameter:
     name: str
     type: str
@@ -181,7 +211,7 @@ class Parameter:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class ParameterRule:
     left: str
     op: str
@@ -190,7 +220,7 @@ class ParameterRule:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class Frame:
     name: str
     parent: str | None = None
@@ -202,7 +232,7 @@ class Frame:
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
-@dataclass
+@dataclass(frozen=True)
 class Transform:
     parent: str
     child: str
@@ -211,7 +241,7 @@ class Transform:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class Port:
     subject_id: int
     type: str  # DSDL full name with version
@@ -219,7 +249,7 @@ class Port:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class V0Port:
     """A UAVCAN v0 (DroneCAN) message a device broadcasts or receives: no subject id, the data type says it all."""
 
@@ -231,7 +261,7 @@ class V0Port:
 PROTOCOLS = ("cyphal", "dronecan")
 
 
-@dataclass
+@dataclass(frozen=True)
 class Device:
     name: str
     node_id: int
@@ -246,7 +276,7 @@ class Device:
     protocol_pos: dict[str, Pos] = field(default_factory=dict)  # where each protocol's ports are declared
 
 
-@dataclass
+@dataclass(frozen=True)
 class Layout:
     """Which protocol each device speaks: the vehicle as one firmware set (a bus may carry both protocols)."""
 
@@ -258,7 +288,7 @@ class Layout:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class FieldLink:
     """One `ros_path: uavcan_source` line of a mapping."""
 
@@ -274,7 +304,7 @@ class FieldLink:
     round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
 
 
-@dataclass
+@dataclass(frozen=True)
 class Mapping:
     name: str
     direction: Direction
@@ -298,7 +328,7 @@ class Mapping:
     select_pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class Bridge:
     name: str
     node_id: int
@@ -336,7 +366,7 @@ class NodeParameter:
     pos: Pos = NOWHERE
 
 
-@dataclass
+@dataclass(frozen=True)
 class Node:
     name: str
     description: str = ""
@@ -368,7 +398,7 @@ class Node:
         return [(item.parent, item.child) for item in self.read_transform_items]
 
 
-@dataclass
+@dataclass(frozen=True)
 class RosPackageInfo:
     name: str
     version: str = "0.1.0"
@@ -378,7 +408,7 @@ class RosPackageInfo:
     license: str = "MIT"
 
 
-@dataclass
+@dataclass(frozen=True)
 class Spec:
     file: str
     vehicle: str

@@ -13,7 +13,19 @@ from sam_codegen.catalogs.dronecan import (
     V0Catalog,
 )
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import PROTOCOLS, Device, Layout, Mapping, Spec, V0Port, V0Struct
+from sam_codegen.model.spec import (
+    PROTOCOLS,
+    ROS_TO_UAVCAN,
+    UAVCAN_TO_ROS,
+    Constant,
+    Device,
+    Field,
+    Layout,
+    Mapping,
+    Spec,
+    V0Port,
+    V0Struct,
+)
 from sam_codegen.model.types import V0_MAX_FULL_NAME, V0_NAMESPACE_COMPONENT, V0_SHORT_NAME, DsdlType
 from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, format_path
 from sam_codegen.validate.mappings import MappingValidator
@@ -27,7 +39,7 @@ DEFAULT_LAYOUT = "default"
 _MAX_NESTING = 32
 
 
-@dataclass
+@dataclass(frozen=True)
 class ResolvedLayout:
     """A layout with every device's protocol and the mappings the bridge runs in it."""
 
@@ -84,8 +96,7 @@ class DronecanValidator:
             self.error(pos, f"DroneCAN type {name!r} of {what} has no data type id: it can only be nested in "
                        "other types", "a message type with a data type id")
             return None
-        self.catalog.signature(name)
-        return struct
+        return self.catalog.signed(name)
 
     # ---- the spec's own types ------------------------------------------------------------------------------
     def check_types(self) -> None:
@@ -122,7 +133,8 @@ class DronecanValidator:
                 else:
                     ids[dtid] = struct.name
             seen: set[str] = set()
-            for f in [*struct.fields, *struct.constants]:
+            members: list[Field | Constant] = [*struct.fields, *struct.constants]
+            for f in members:
                 if not V0_FIELD_NAME.fullmatch(f.name) or not python_safe(f.name):
                     self.error(f.pos, f"{f.name!r} is not a valid DroneCAN field name in {what}",
                                "a letter, then letters, digits and underscores; not a Python keyword")
@@ -171,7 +183,7 @@ class DronecanValidator:
                                f"than {_MAX_NESTING} levels deep ({stack[0]} -> {stack[1]} -> ... -> {name})",
                                f"at most {_MAX_NESTING} levels of types inside types")
                 return True
-            return any(visit(f.type.composite, (*stack, name)) for f in struct.fields  # type: ignore[union-attr]
+            return any(visit(f.type.composite, (*stack, name)) for f in struct.fields
                        if isinstance(f.type, DsdlType) and f.type.composite)
 
         for name in self.spec.dronecan_types:
@@ -217,7 +229,7 @@ class DronecanValidator:
             self.error(mapping.pos, f"{what} uses undeclared topic {mapping.topic!r}", "a topic of `topics`")
         struct = self.message_type(mapping.data_type, mapping.pos, what) if mapping.data_type else None
         rate = 0.0
-        publishing = mapping.direction == "uavcan_to_ros"
+        publishing = mapping.direction == UAVCAN_TO_ROS
         nodes = mapping.source_node_ids if publishing else mapping.destination_node_ids
         role = "source" if publishing else "destination"
         users: dict[int, V0Port] = {}
@@ -250,9 +262,9 @@ class DronecanValidator:
         different `select` values, or distinct items chosen by key (ArrayCommand's actuator ids)."""
         claims: dict[str, list[tuple[ResolvedMapping, dict[str, object], set[str] | None]]] = {}
         for rm in resolved:
-            if rm.mapping.direction != "ros_to_uavcan":
+            if rm.mapping.direction != ROS_TO_UAVCAN:
                 continue
-            select = {format_path(list(p)): v for p, _, v in rm.select}
+            select: dict[str, object] = {format_path(list(p)): v for p, _, v in rm.select}
             items: set[str] | None = None
             if rm.elements and all(isinstance(e, Key) for es in rm.elements.values() for e in es):
                 items = {f"{format_path(list(path))}[{e}]" for path, es in rm.elements.items() for e in es}
@@ -304,13 +316,13 @@ class DronecanValidator:
         if layout.protocol is not None and not any(p == layout.protocol for p in protocols.values()):
             self.error(layout.pos, f"{what}: no device has {layout.protocol} ports", f"devices with a "
                        f"`{layout.protocol}:` section or `protocol: {layout.protocol}`")
-        resolved = ResolvedLayout(layout.name, layout.description, protocols)
+        active_mappings: dict[str, list[str]] = {"cyphal": [], "dronecan": []}
         by_id = s.devices_by_node_id()
-        for protocol, rms, active in (("cyphal", cyphal, resolved.cyphal_mappings),
-                                      ("dronecan", dronecan, resolved.dronecan_mappings)):
+        for protocol, rms in (("cyphal", cyphal), ("dronecan", dronecan)):
+            active = active_mappings[protocol]
             for rm in rms:
                 m = rm.mapping
-                nodes = m.source_node_ids if m.direction == "uavcan_to_ros" else (
+                nodes = m.source_node_ids if m.direction == UAVCAN_TO_ROS else (
                     m.destination_node_ids if protocol == "dronecan" else [m.destination_node_id])
                 devices = [by_id[n].name for n in nodes if n in by_id]
                 speaking = [d for d in devices if protocols[d] == protocol]
@@ -323,11 +335,14 @@ class DronecanValidator:
                     ok = False
                 elif speaking:
                     active.append(m.name)
-        for name in sorted(set(resolved.cyphal_mappings) & set(resolved.dronecan_mappings)):
+        for name in sorted(set(active_mappings["cyphal"]) & set(active_mappings["dronecan"])):
             self.error(layout.pos, f"{what} runs a Cyphal and a DroneCAN mapping both named {name!r}",
                        "distinct names for mappings that run together")
             ok = False
-        return resolved if ok else None
+        if not ok:
+            return None
+        return ResolvedLayout(layout.name, layout.description, protocols, active_mappings["cyphal"],
+                              active_mappings["dronecan"])
 
 
 __all__ = ["DEFAULT_LAYOUT", "PROTOCOLS", "V0_NODE_IDS", "DronecanValidator", "ResolvedLayout"]

@@ -182,8 +182,10 @@ class Step:
         return format_path(list(self.uavcan_path))
 
 
-@dataclass
+@dataclass(frozen=True)
 class ResolvedMapping:
+    """A mapping checked against both types: built whole by validation, never changed after."""
+
     mapping: Mapping
     ros_message: RosMessage
     dsdl_struct: DsdlStruct
@@ -269,9 +271,9 @@ def check_scalar(ros: RosType, uav: DsdlType, link: FieldLink) -> tuple[str, boo
                             f"expected {expected} or wider")
         # An offset moves small values onto a coarser grid (0.001 K - 273.15 loses the 0.001); a scale costs one
         # rounding, harmless only when the ROS float has at least two more mantissa bits than the UAVCAN one.
-        mantissa = {16: 11, 32: 24, 64: 53}
+        mantissas = {16: 11, 32: 24, 64: 53}
         exact = link.offset is None and (
-            link.scale is None or mantissa[ROS_FLOAT_BITS[ros_base]] >= mantissa.get(uav.bits, 53) + 2)
+            link.scale is None or mantissas[ROS_FLOAT_BITS[ros_base]] >= mantissas.get(uav.bits, 53) + 2)
         return "number", exact
     raise RuleError(f"UAVCAN {uav} cannot be linked to a ROS field")
 

@@ -9,13 +9,27 @@ from typing import Any, TypeVar
 from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import Device, DsdlStruct, FieldLink, Mapping, Port, RosMessage, Spec, Topic, V0Struct
+from sam_codegen.model.spec import (
+    ROS_TO_UAVCAN,
+    UAVCAN_TO_ROS,
+    Device,
+    DsdlStruct,
+    FieldLink,
+    Mapping,
+    Port,
+    RosMessage,
+    Scalar,
+    Spec,
+    Topic,
+    V0Struct,
+)
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from sam_codegen.validate.mapping_rules import (
     HEADER,
     TIME,
     TIMESTAMPS,
     Key,
+    PathSeg,
     ResolvedMapping,
     RuleError,
     Step,
@@ -108,7 +122,7 @@ class MappingValidator:
                        "a subject a device publishes or subscribes")
             return None
         port = ports[0][1]
-        if mapping.direction == "uavcan_to_ros":
+        if mapping.direction == UAVCAN_TO_ROS:
             publishers = {d.node_id for d, _, pub in ports if pub}
             for node_id in mapping.source_node_ids:
                 if node_id not in CAN_NODE_IDS:
@@ -155,7 +169,7 @@ class MappingValidator:
         if mapping.frame_id is not None and mapping.frame_id not in s.frames:
             self.error(mapping.pos, f"frame_id {mapping.frame_id!r} of {what} is not a declared frame",
                        "one of " + ", ".join(s.frames))
-        if mapping.direction == "uavcan_to_ros" and has_header and mapping.frame_id is None:
+        if mapping.direction == UAVCAN_TO_ROS and has_header and mapping.frame_id is None:
             self.error(mapping.pos, f"{what} publishes {ros_message.full_name}, which has a header: it needs "
                        "a frame_id")
         links = auto_links(struct, mapping.pos) if mapping.auto else mapping.links
@@ -170,7 +184,9 @@ class MappingValidator:
                 self.error(mapping.pos, f"{what} uses `fields: auto`, but {ros_message.full_name} has no field "
                            + ", ".join(repr(m) for m in missing), f"a ROS message with the fields of {struct.name}")
                 return None
-        resolved = ResolvedMapping(mapping, ros_message, struct, has_header=has_header, rate_hz=rate_hz)
+        steps: list[Step] = []
+        select: list[tuple[tuple[PathSeg, ...], DsdlType, Scalar]] = []
+        uavcan_values: list[tuple[tuple[PathSeg, ...], DsdlType, Scalar]] = []
         ros_targets: dict[str, Pos] = {}
         self.failed_paths: set[str] = set()
         for link in links:
@@ -183,7 +199,7 @@ class MappingValidator:
             if step.ros in ros_targets:
                 self.error(link.pos, f"ROS field {step.ros!r} is set twice in {what}")
             ros_targets[step.ros] = link.pos
-            resolved.steps.append(step)
+            steps.append(step)
         for path_text, value in mapping.select.items():
             try:
                 path = parse_path(path_text)
@@ -198,7 +214,7 @@ class MappingValidator:
                 self.error(mapping.select_pos, f"select of {what}: {exc}")
                 continue
             check_dsdl_value(self.diag, leaf, value, mapping.select_pos, f"select value {path_text!r} of {what}")
-            resolved.select.append((tuple(path), leaf, value))
+            select.append((tuple(path), leaf, value))
         for path_text, value in mapping.uavcan_values.items():
             try:
                 path = parse_path(path_text)
@@ -210,7 +226,7 @@ class MappingValidator:
                 self.error(mapping.pos, f"uavcan_values of {what}: {exc}")
                 continue
             check_dsdl_value(self.diag, leaf, value, mapping.pos, f"uavcan value {path_text!r} of {what}")
-            resolved.uavcan_values.append((tuple(path), leaf, value))
+            uavcan_values.append((tuple(path), leaf, value))
         self.ignored: set[str] = set()
         for ignored in mapping.ignore:
             try:
@@ -222,7 +238,10 @@ class MappingValidator:
                 self.error(mapping.pos, f"ignore of {what}: {exc}")
             else:
                 self.ignored.add(format_path(path))
-        if self.check_elements(resolved, what):  # (else coverage would only repeat the confusion)
+        elements, elements_ok = self.check_elements(mapping, what)
+        resolved = ResolvedMapping(mapping, ros_message, struct, steps, uavcan_values, has_header, rate_hz, select,
+                                   elements)
+        if elements_ok:  # (else coverage would only repeat the confusion)
             self.check_coverage(resolved, what)
         return resolved
 
@@ -292,7 +311,7 @@ class MappingValidator:
             ros_path = parse_path(link.ros_path)
             ros_type = self.ros_leaf(ros_message, ros_path)
             if link.value is not None:
-                if mapping.direction == "ros_to_uavcan":
+                if mapping.direction == ROS_TO_UAVCAN:
                     raise RuleError("a `value` sets a ROS field; a ROS->UAVCAN mapping sets UAVCAN fields with "
                                     "uavcan_values")
                 if ros_type.array or not ros_type.is_primitive:
@@ -313,7 +332,7 @@ class MappingValidator:
                 raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one")
             if link.limits is not None and (ros_type.array or ros_type.base not in {*ROS_INT_RANGES, *ROS_FLOAT_BITS}):
                 raise RuleError("limits apply to numeric scalar fields")
-            if link.limits is not None and mapping.direction == "uavcan_to_ros":  # the converters apply none there
+            if link.limits is not None and mapping.direction == UAVCAN_TO_ROS:  # the converters apply none there
                 raise RuleError("limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping "
                                 "passes on what the device measured")
             if uav_type.kind == "utf8" or ros_type.base == "string":
@@ -324,7 +343,7 @@ class MappingValidator:
                 kind = "array"
             else:
                 kind, exact = check_scalar(ros_type, uav_type, link)
-            if kind == "table" and mapping.direction == "uavcan_to_ros" and link.table_default is None:
+            if kind == "table" and mapping.direction == UAVCAN_TO_ROS and link.table_default is None:
                 self.check_table_covers(uav_type, link, what)
             return Step(kind, tuple(ros_path), ros_type, tuple(uav_path), uav_type, link.scale, link.offset,
                         tuple(sorted((link.table or {}).items())), link.table_default, None, link.limits, exact,
@@ -362,7 +381,7 @@ class MappingValidator:
             return []
         uses = self.element_uses.get(path)
         if uses is not None:  # a DroneCAN array of which the mapping names elements
-            if self.direction == "uavcan_to_ros":
+            if self.direction == UAVCAN_TO_ROS:
                 return []  # it reads its elements; the others are other mappings' (or nobody's)
             if uses["index"]:  # the message is built with exactly the elements up to the last one named
                 return [u for i in range(max(uses["index"]) + 1)
@@ -379,24 +398,26 @@ class MappingValidator:
             return self.uncovered(nested, path + ".", pool)
         return [(path, t)]
 
-    def check_elements(self, resolved: ResolvedMapping, what: str) -> bool:
-        """A DroneCAN array's elements are named by position or by one key field, not both."""
+    def check_elements(self, mapping: Mapping, what: str) -> tuple[dict[tuple[PathSeg, ...], list], bool]:
+        """A DroneCAN array's elements are named by position or by one key field, not both. Returns the arrays
+        named one way (path -> positions or items, in order) and whether every array is."""
         ok = True
+        elements: dict[tuple[PathSeg, ...], list] = {}
         for path, uses in self.elements.items():
             text = format_path(list(path))
             fields = {key.field for key in uses["key"]}
             if uses["index"] and uses["key"]:
-                self.error(resolved.mapping.pos, f"{what} names elements of {text} both by position and by key",
+                self.error(mapping.pos, f"{what} names elements of {text} both by position and by key",
                            "one way for one array")
                 ok = False
             elif len(fields) > 1:
-                self.error(resolved.mapping.pos, f"{what} chooses items of {text} by more than one key field ("
+                self.error(mapping.pos, f"{what} chooses items of {text} by more than one key field ("
                            + ", ".join(sorted(fields)) + ")", "one key field per array")
                 ok = False
             else:
-                resolved.elements[path] = list(uses["index"] or uses["key"])
+                elements[path] = list(uses["index"] or uses["key"])
         self.element_uses = {format_path(list(path)): uses for path, uses in self.elements.items()}
-        return ok
+        return elements, ok
 
     def check_coverage(self, resolved: ResolvedMapping, what: str) -> None:
         mapping = resolved.mapping
@@ -409,7 +430,7 @@ class MappingValidator:
                        "the field in select only")
         linked |= selected
         struct = resolved.dsdl_struct
-        if mapping.direction == "uavcan_to_ros":
+        if mapping.direction == UAVCAN_TO_ROS:
             for path, t in self.uncovered(struct, "", linked | self.ignored):
                 self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
                            f"{struct.name} is neither mapped nor ignored in {what}",

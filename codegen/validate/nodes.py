@@ -1,8 +1,8 @@
 """Checks of the ROS side the nodes see: QoS per topic, the nodes' topics, parameters and transforms.
 
 Run by validate.validate after the topic and frame checks; reports into the same Diagnostics, each error at the
-list item it is about (file:line:col). It also decides each topic's effective QoS (`Topic.qos`): the spec's
-`qos:` or the ROS-convention default of `default_qos`.
+list item it is about (file:line:col). It reads each topic's effective QoS (`Topic.qos`, which the frontend chose:
+the spec's `qos:` or the ROS-convention default of model.spec.default_qos) and changes nothing in the spec.
 
 The names the generated node bases use (on_<topic>, publish_<topic>, lookup_<parent>_to_<child>, a property per
 parameter) are derived here, so that the checks and emit_nodes agree on them.
@@ -17,12 +17,18 @@ from dataclasses import dataclass
 
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import QOS_PROFILES, Node, NodeTopic, Qos, Spec, Topic
+
+# `X as X`: re-exported, importable from here since before they moved down to the model (where the frontend and
+# the runtime reach them).
+from sam_codegen.model.names import ros_parameter_name as ros_parameter_name
+from sam_codegen.model.spec import QOS_PROFILES as QOS_PROFILES
+from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS, Node, NodeTopic, Qos, Spec, Topic
+from sam_codegen.model.spec import TF_MESSAGE as TF_MESSAGE
+from sam_codegen.model.spec import TF_STATIC_TOPIC as TF_STATIC_TOPIC
+from sam_codegen.model.spec import TF_TOPIC as TF_TOPIC
+from sam_codegen.model.spec import default_qos as default_qos
 from sam_codegen.model.types import ROS_PACKAGE_NAME
 
-TF_TOPIC = "/tf"
-TF_STATIC_TOPIC = "/tf_static"
-TF_MESSAGE = "tf2_msgs/TFMessage"
 _NODE_NAME = re.compile(r"[a-z][a-z0-9_]*")
 
 # The public attributes of rclpy's Node (rclpy 7.1, Jazzy) and of the generated base: a parameter property with
@@ -59,15 +65,6 @@ def topic_identifier(topic: str) -> str:
     ('nav_goal', 'thruster_1_feedback')
     """
     return topic.strip("/").replace("/", "_")
-
-
-def ros_parameter_name(spec_name: str) -> str:
-    """A spec parameter (written like a ROS 1 global, /safe_depth) as the node-local ROS 2 name.
-
-    >>> ros_parameter_name("/safe_depth"), ros_parameter_name("/limits/depth")
-    ('safe_depth', 'limits.depth')
-    """
-    return spec_name.lstrip("/").replace("/", ".")
 
 
 def parameter_identifier(spec_name: str) -> str:
@@ -110,32 +107,6 @@ def node_subscribed_topics(spec: Spec, node: Node) -> list[str]:
 # ---- QoS -----------------------------------------------------------------------------------------------------
 
 
-def bridge_published_topics(spec: Spec) -> set[str]:
-    """Topics the bridge publishes from UAVCAN (its uavcan_to_ros mappings)."""
-    if spec.bridge is None:
-        return set()
-    return {m.topic for m in spec.bridge.all_mappings if m.direction == "uavcan_to_ros"}
-
-
-def default_qos(topic: Topic, bridged: set[str]) -> tuple[Qos, str]:
-    """The QoS of a topic without `qos:`, by ROS convention, and why.
-
-    >>> default_qos(Topic("/tf_static", "tf2_msgs/TFMessage"), set())[0].profile
-    'latched'
-    >>> default_qos(Topic("/imu", "sensor_msgs/Imu"), {"/imu"})
-    (Qos(reliability='best_effort', durability='volatile', depth=5, profile='sensor_data'), 'a UAVCAN sensor stream')
-    >>> default_qos(Topic("/goal", "geometry_msgs/PoseStamped"), set())[1]
-    'a command, goal or plan'
-    """
-    if topic.name == TF_STATIC_TOPIC:
-        return QOS_PROFILES["latched"], "static transforms (tf2's convention)"
-    if topic.type == TF_MESSAGE:
-        return QOS_PROFILES["tf"], "transforms (tf2's convention)"
-    if topic.name in bridged:
-        return QOS_PROFILES["sensor_data"], "a UAVCAN sensor stream"
-    return QOS_PROFILES["reliable"], "a command, goal or plan"
-
-
 def incompatibility(offered: Qos, requested: Qos) -> str | None:
     """Why a subscription requesting `requested` gets nothing from a publisher offering `offered` (DDS rules).
 
@@ -175,7 +146,7 @@ def publishers(spec: Spec) -> dict[str, list[Endpoint]]:
             result.setdefault(TF_TOPIC, []).append(Endpoint(f"node {node.name}", node.transform_items[0].pos))
     if spec.bridge is not None:
         for m in spec.bridge.all_mappings:
-            if m.direction == "uavcan_to_ros":
+            if m.direction == UAVCAN_TO_ROS:
                 result.setdefault(m.topic, []).append(Endpoint(f"the bridge (mapping {m.name})", m.pos))
     static = [f for f in spec.frames.values() if f.parent is not None]
     if static:
@@ -231,14 +202,6 @@ class _NodeChecks:
     def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
         self.diag.error(pos, message, expected)
 
-    def resolve_qos(self) -> None:
-        bridged = bridge_published_topics(self.spec)
-        for topic in self.spec.topics.values():
-            if topic.declared_qos is not None:
-                topic.qos, topic.qos_origin = topic.declared_qos, "declared"
-            else:
-                topic.qos, topic.qos_origin = default_qos(topic, bridged)
-
     def check_tf_topics(self) -> None:
         for name in (TF_TOPIC, TF_STATIC_TOPIC):
             topic = self.spec.topics.get(name)
@@ -247,7 +210,6 @@ class _NodeChecks:
                            TF_MESSAGE)
 
     def check(self) -> None:
-        self.resolve_qos()
         self.check_tf_topics()
         self.check_transform_list()
         for node in self.spec.nodes.values():
@@ -398,7 +360,7 @@ class _NodeChecks:
             return
         seen: set[str] = set()
         for m in self.spec.bridge.all_mappings:
-            if m.direction != "ros_to_uavcan" or m.topic in seen or m.topic not in self.spec.topics:
+            if m.direction != ROS_TO_UAVCAN or m.topic in seen or m.topic not in self.spec.topics:
                 continue
             seen.add(m.topic)
             if not self.publishers.get(m.topic):
@@ -418,7 +380,7 @@ def check_external_packages(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> N
             diag.error(message.pos, f"package {message.package!r} of external message {message.name} is not valid",
                        "lower case letters, digits and single underscores, starting with a letter")
             continue
-        installed = ros._read(message.full_name)  # the installed definition, not the spec's override
+        installed = ros.read_installed(message.full_name)  # not the spec's override
         if installed is None:
             continue
         theirs = [(f.name, str(f.type)) for f in installed.fields]
@@ -430,17 +392,17 @@ def check_external_packages(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> N
 
 
 def check_nodes(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> None:
-    """Every check of this module; errors go to diag. Sets Topic.qos of every topic."""
+    """Every check of this module; errors go to diag."""
     check_external_packages(spec, ros, diag)
     _NodeChecks(spec, ros, diag).check()
 
 
 def node_topic_qos(spec: Spec, item: NodeTopic) -> Qos:
-    """The QoS a node's endpoint uses: its own (subscriptions may override) or its topic's (after validation)."""
+    """The QoS a node's endpoint uses: its own (subscriptions may override) or its topic's."""
     if item.qos is not None:
         return item.qos
     qos = spec.topics[item.topic].qos
-    assert qos is not None, "validate first"
+    assert qos is not None, "a topic the frontend built"
     return qos
 
 

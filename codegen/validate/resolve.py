@@ -1,9 +1,14 @@
-"""Cross-reference and rule checks: from a parsed Spec to a Resolved interface, or every error at once."""
+"""Cross-reference and rule checks: from a parsed Spec to a Resolved interface, or every error at once.
+
+Invariants: validation never changes the spec; what it derives (the messages of `derive_from`, the resolved mappings
+and layouts) it returns, in a frozen Resolved whose `ros` catalog overlays the derived messages on the spec's. The
+messages are derived before any check looks a ROS type up, so every check sees the same catalog.
+"""
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from sam_codegen.catalogs.cyphal import DsdlCatalog
@@ -28,8 +33,7 @@ from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.nodes import check_nodes
-from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value
-from sam_codegen.validate.values import python_safe as _python_safe
+from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _PARAM_NAME = ROS_TOPIC_NAME
@@ -39,29 +43,53 @@ _CONVERTER_LOCALS = frozenset({"src", "msg", "stats", "receive_ns", "us", "stamp
 _MAX_NESTING = 32
 
 
-@dataclass
+@dataclass(frozen=True)
 class Resolved:
     """A spec that passed every check, with everything the emitters need resolved."""
 
     spec: Spec
-    ros: RosCatalog
+    ros: RosCatalog  # the derived messages over the spec's, then the external and installed ones
     dsdl: DsdlCatalog
-    messages: list[RosMessage] = field(default_factory=list)  # the spec's package, sorted by name
-    dsdl_types: list[DsdlStruct] = field(default_factory=list)  # the spec's root namespace, sorted by name
-    mappings: list[ResolvedMapping] = field(default_factory=list)  # Cyphal
-    dronecan: V0Catalog | None = None
-    dronecan_types: list[V0Struct] = field(default_factory=list)  # the spec's own, sorted by name
-    dronecan_mappings: list[ResolvedMapping] = field(default_factory=list)
-    layouts: list[ResolvedLayout] = field(default_factory=list)  # the implicit "default" first
+    messages: list[RosMessage]  # the spec's package (as derived), sorted by name
+    dsdl_types: list[DsdlStruct]  # the spec's root namespace, sorted by name
+    mappings: list[ResolvedMapping]  # Cyphal
+    dronecan: V0Catalog | None
+    dronecan_types: list[V0Struct]  # the spec's own, sorted by name
+    dronecan_mappings: list[ResolvedMapping]
+    layouts: list[ResolvedLayout]  # the implicit "default" first
+
+
+def derive_messages(spec: Spec, dsdl: DsdlCatalog, diag: Diagnostics) -> tuple[dict[str, RosMessage], set[str]]:
+    """The messages of the spec that `derive_from` a DSDL type, derived, by full name; and the full names of those
+    that could not be derived (reported into diag)."""
+    derived: dict[str, RosMessage] = {}
+    failed: set[str] = set()
+    for message in spec.messages.values():
+        if message.derived_from is None:
+            continue
+        struct = dsdl.get(message.derived_from)
+        if struct is None:
+            diag.error(message.pos, f"message {message.full_name} derives from unknown DSDL type "
+                       f"{message.derived_from!r}")
+            failed.add(message.full_name)
+            continue
+        try:
+            derived[message.full_name] = derive_message(struct, message.package, message.name, message.description,
+                                                        message.pos)
+        except RuleError as exc:
+            diag.error(message.pos, str(exc))
+            failed.add(message.full_name)
+    return derived, failed
 
 
 class _Validator:
-    def __init__(self, spec: Spec, ros: RosCatalog, dsdl: DsdlCatalog) -> None:
+    def __init__(self, spec: Spec, ros: RosCatalog, dsdl: DsdlCatalog, diag: Diagnostics,
+                 failed_messages: set[str]) -> None:
         self.spec, self.ros, self.dsdl = spec, ros, dsdl
-        self.diag = Diagnostics()
+        self.diag = diag
         # What is reported broken already, so that the checks which use it add no follow-on errors:
         self.bad_dsdl_fields: set[tuple[str, str]] = set()  # (DSDL type, field)
-        self.failed_messages: set[str] = set()  # derived ROS messages that could not be derived
+        self.failed_messages = failed_messages  # derived ROS messages that could not be derived
 
     def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
         self.diag.error(pos, message, expected)
@@ -99,7 +127,7 @@ class _Validator:
             self.error(message.pos, f"{message.name!r} is not a valid ROS message name", "CamelCase, e.g. ThrusterRPMs")
         seen: set[str] = set()
         for f in message.fields:
-            if not ROS_FIELD_NAME.fullmatch(f.name) or not _python_safe(f.name):
+            if not ROS_FIELD_NAME.fullmatch(f.name) or not python_safe(f.name):
                 self.error(f.pos, f"{f.name!r} is not a valid ROS field name in {what}",
                            "lower_case with single underscores, not a Python keyword")
             if f.name in seen:
@@ -143,9 +171,10 @@ class _Validator:
             self.error(struct.pos, f"extent of {what} must be 1..65535 bytes")
         seen: set[str] = set()
         fields = {id(f) for f in struct.fields}
-        for f in [*struct.fields, *struct.constants]:
+        members: list[Field | Constant] = [*struct.fields, *struct.constants]
+        for f in members:
             bad = False
-            if not is_dsdl_identifier(f.name) or not _python_safe(f.name):
+            if not is_dsdl_identifier(f.name) or not python_safe(f.name):
                 self.error(f.pos, f"{f.name!r} is not a valid DSDL identifier in {what}",
                            "letters, digits and underscores, not reserved (e.g. uint8, bool, saturated) "
                            "nor a Python keyword")
@@ -167,35 +196,21 @@ class _Validator:
             check_dsdl_value(self.diag, c.type, c.value, c.pos, f"constant {c.name} of {what}")
 
     # ---- interface ------------------------------------------------------------------------------------
-    def resolve_messages(self) -> list[RosMessage]:
-        for message in list(self.spec.messages.values()):
-            if message.derived_from is None:
-                continue
-            struct = self.dsdl.get(message.derived_from)
-            if struct is None:
-                self.error(message.pos, f"message {message.full_name} derives from unknown DSDL type "
-                           f"{message.derived_from!r}")
-                self.failed_messages.add(message.full_name)
-                continue
-            try:
-                derived = derive_message(struct, message.package, message.name, message.description, message.pos)
-            except RuleError as exc:
-                self.error(message.pos, str(exc))
-                self.failed_messages.add(message.full_name)
-                continue
-            self.spec.messages[message.full_name] = derived
+    def check_messages(self) -> list[RosMessage]:
+        """Checks the external and the spec's own messages (as derived); returns the latter sorted by name."""
+        messages = self.ros.messages
         for message in self.spec.external_messages.values():
             self.check_ros_message(message)
-        for message in self.spec.messages.values():
+        for message in messages.values():
             self.check_ros_message(message)
-        self.check_message_cycles()
-        return sorted(self.spec.messages.values(), key=lambda m: m.name)
+        self.check_message_cycles(messages)
+        return sorted(messages.values(), key=lambda m: m.name)
 
-    def check_message_cycles(self) -> None:
+    def check_message_cycles(self, messages: dict[str, RosMessage]) -> None:
         too_deep: list[str] = []
 
         def visit(name: str, stack: tuple[str, ...]) -> None:
-            message = self.spec.messages.get(name)
+            message = messages.get(name)
             if message is None:
                 return
             if name in stack:
@@ -204,7 +219,7 @@ class _Validator:
             if len(stack) == _MAX_NESTING:
                 if not too_deep:  # one error is enough: a chain of N messages would give N - 32
                     too_deep.append(name)
-                    self.error(self.spec.messages[stack[0]].pos, f"message {stack[0]} nests messages more than "
+                    self.error(messages[stack[0]].pos, f"message {stack[0]} nests messages more than "
                                f"{_MAX_NESTING} levels deep ({stack[0]} -> {stack[1]} -> ... -> {name})",
                                f"at most {_MAX_NESTING} levels of messages inside messages")
                 return
@@ -213,7 +228,7 @@ class _Validator:
                 if not f.type.is_primitive:
                     visit(f.type.base, (*stack, name))
 
-        for name in self.spec.messages:
+        for name in messages:
             visit(name, ())
 
     def check_frames_and_parameters(self) -> None:
@@ -269,7 +284,8 @@ class _Validator:
                 self.error(topic.pos, f"unknown ROS type {topic.type!r} of topic {topic.name}",
                            "a message of this spec, an external_messages entry or an installed ROS message")
 
-    def check_devices(self) -> None:
+    def check_devices(self) -> dict[int, str]:
+        """Checks the devices' Cyphal side; returns who publishes each subject id (the devices)."""
         s = self.spec
         owners: dict[int, str] = {}
         if s.bridge is not None:
@@ -307,27 +323,30 @@ class _Validator:
                         self.error(port.pos, f"duplicate subject id {port.subject_id}: already published by "
                                    f"{publishers[port.subject_id]}", "one publisher per subject")
                     publishers[port.subject_id] = f"device {device.name}"
-        self.publishers = publishers
+        return publishers
 
-    def mapping_validator(self, v0: V0Catalog) -> MappingValidator:
-        return MappingValidator(self.spec, self.ros, self.dsdl, self.diag, self.publishers,
+    def mapping_validator(self, v0: V0Catalog, publishers: dict[int, str]) -> MappingValidator:
+        return MappingValidator(self.spec, self.ros, self.dsdl, self.diag, publishers,
                                 self.bad_dsdl_fields, self.failed_messages, v0)
 
 
 def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots: list[Path] | None = None,
              dronecan_roots: list[Path] | None = None) -> Resolved:
     """Check a parsed spec; raises SpecError with every problem, or returns the resolved interface."""
-    ros, dsdl, v0 = RosCatalog(spec, ros_share_dirs), DsdlCatalog(spec, dsdl_roots), V0Catalog(spec, dronecan_roots)
-    v = _Validator(spec, ros, dsdl)
+    dsdl, v0 = DsdlCatalog(spec, dsdl_roots), V0Catalog(spec, dronecan_roots)
+    diag = Diagnostics()
+    derived, failed_messages = derive_messages(spec, dsdl, diag)
+    ros = RosCatalog(spec, ros_share_dirs, derived)
+    v = _Validator(spec, ros, dsdl, diag, failed_messages)
     v.check_header()
     for struct in spec.dsdl_types.values():
         v.check_dsdl_struct(struct)
-    messages = v.resolve_messages()
+    messages = v.check_messages()
     v.check_frames_and_parameters()
     v.check_topics_and_nodes()
-    check_nodes(spec, ros, v.diag)  # nodes, QoS, TF topics, external packages (validate_nodes)
-    v.check_devices()
-    dronecan = DronecanValidator(spec, v0, v.diag, v.mapping_validator(v0))
+    check_nodes(spec, ros, v.diag)  # nodes, QoS, TF topics, external packages (validate.nodes)
+    publishers = v.check_devices()
+    dronecan = DronecanValidator(spec, v0, v.diag, v.mapping_validator(v0, publishers))
     dronecan.check_types()
     dronecan.check_devices()
     mappings = dronecan.mappings.resolve_mappings()
@@ -336,8 +355,10 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")
     v.diag.check()
+    # Every type of the spec passed its checks, so each has its signature (computed in check_types).
+    dronecan_types = [v0.signed(t.name) for t in sorted(spec.dronecan_types.values(), key=lambda t: t.name)]
     return Resolved(spec, ros, dsdl, messages, sorted(spec.dsdl_types.values(), key=lambda t: t.name), mappings,
-                    v0, sorted(spec.dronecan_types.values(), key=lambda t: t.name), dronecan_mappings, layouts)
+                    v0, [t for t in dronecan_types if t is not None], dronecan_mappings, layouts)
 
 
 __all__ = ["CAN_NODE_IDS", "SUBJECT_IDS", "Constant", "Field", "Resolved", "validate"]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -97,9 +98,7 @@ def test_signature_of_a_definition_text(union: bool, tmp_path: Path) -> None:
     (tmp_path / "demo").mkdir()
     (tmp_path / "demo" / "20198.Thing.uavcan").write_text(text, encoding="utf-8")
     theirs = _parse_with_dronecan(tmp_path / "demo")["demo.Thing"]
-    spec = _empty_spec()
-    parsed.struct.standard = False
-    spec.dronecan_types["demo.Thing"] = parsed.struct
+    spec = replace(_empty_spec(), dronecan_types={"demo.Thing": replace(parsed.struct, standard=False)})
     if not union:  # (the spec's own types are never unions)
         assert V0Catalog(spec).signature("demo.Thing") == theirs.get_data_type_signature()  # type: ignore[attr-defined]
     assert crc64we(b"123456789") == 0x62EC59E3F1A4F00A  # the CRC-64-WE check value

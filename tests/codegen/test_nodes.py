@@ -8,7 +8,6 @@ rewrites tests/golden/nodes/ (stored as ``<path>.golden`` so that pytest does no
 from __future__ import annotations
 
 import ast
-import copy
 import importlib.util
 import json
 import math
@@ -16,6 +15,7 @@ import os
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 from types import ModuleType
 
@@ -196,18 +196,15 @@ def test_modules_compile_and_are_ruff_clean(which: str, resolved: Resolved, file
 
 
 def _hostile(resolved: Resolved) -> Resolved:
-    hostile = copy.deepcopy(resolved)
-    for node in hostile.spec.nodes.values():
-        node.description = HOSTILE
-    for topic in hostile.spec.topics.values():
-        topic.description = HOSTILE
-    for p in hostile.spec.parameters.values():
-        p.description, p.unit = HOSTILE, HOSTILE
-    for r in hostile.spec.parameter_rules:
-        r.description = HOSTILE
-    for t in hostile.spec.transforms:
-        t.description = HOSTILE
-    return hostile
+    s = resolved.spec  # the model is frozen: the hostile spec is a new one
+    return replace(resolved, spec=replace(
+        s,
+        nodes={k: replace(n, description=HOSTILE) for k, n in s.nodes.items()},
+        topics={k: replace(t, description=HOSTILE) for k, t in s.topics.items()},
+        parameters={k: replace(p, description=HOSTILE, unit=HOSTILE) for k, p in s.parameters.items()},
+        parameter_rules=[replace(r, description=HOSTILE) for r in s.parameter_rules],
+        transforms=[replace(t, description=HOSTILE) for t in s.transforms],
+    ))
 
 
 def test_hostile_text_stays_data(resolved: Resolved, tmp_path: Path) -> None:

@@ -9,7 +9,6 @@ them (convert.py imports ROS and DSDL packages).
 from __future__ import annotations
 
 import ast
-import copy
 import importlib.util
 import json
 import keyword
@@ -17,6 +16,7 @@ import os
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 from types import ModuleType
 
@@ -188,16 +188,14 @@ def test_rover_tables(rover: Resolved, tmp_path: Path) -> None:
 
 def test_hostile_text_stays_inert(sam: Resolved, tmp_path: Path) -> None:
     """Text from the spec reaches the generated modules only as data."""
-    hostile = copy.deepcopy(sam)
-    for topic in hostile.spec.topics.values():
-        topic.description = HOSTILE
-    for device in hostile.spec.devices.values():
-        device.description = HOSTILE * 3
-    for param in hostile.spec.parameters.values():
-        param.description = HOSTILE
-        param.unit = HOSTILE
-    for rule in hostile.spec.parameter_rules:
-        rule.description = HOSTILE
+    s = sam.spec  # the model is frozen: the hostile spec is a new one
+    hostile = replace(sam, spec=replace(
+        s,
+        topics={k: replace(t, description=HOSTILE) for k, t in s.topics.items()},
+        devices={k: replace(d, description=HOSTILE * 3) for k, d in s.devices.items()},
+        parameters={k: replace(p, description=HOSTILE, unit=HOSTILE) for k, p in s.parameters.items()},
+        parameter_rules=[replace(r, description=HOSTILE) for r in s.parameter_rules],
+    ))
     files = emit_python.emit(hostile)
     for path, text in files.items():
         compile(text, path, "exec")

@@ -76,9 +76,8 @@ def used_types(resolved: Resolved) -> list[V0Struct]:
             names |= {p.type for p in [*device.dronecan_publishes, *device.dronecan_subscribes]}
     result = []
     for name in sorted(names):
-        struct = catalog.get(name)
+        struct = catalog.signed(name)
         assert isinstance(struct, V0Struct), name
-        catalog.signature(name)
         result.append(struct)
     return result
 
