@@ -40,6 +40,7 @@ from sam_runtime.cli_support import (
     wait_for_stop,
     write_json_atomic,
 )
+from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
 from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError
 from sam_runtime.recording.reading import read_recording
 from sam_runtime.recording.recorder import METADATA_NAME, Recorder, RecorderConfig
@@ -98,7 +99,9 @@ def record_main(argv: Sequence[str] | None = None) -> int:
         print("DONE recorder " + json.dumps(summary, sort_keys=True), flush=True)
         return EXIT_OK
 
-    return serve("sam-record", run, (GeneratedPackageError, RecordingTargetError, ValueError))
+    # one line, no traceback: what the generated package, the DSDL cache or the bus refuse at start
+    return serve("sam-record", run, (GeneratedPackageError, DsdlCompileError, RecordingTargetError, ValueError,
+                                     OSError))
 
 
 def _replay_parser() -> argparse.ArgumentParser:
@@ -137,6 +140,10 @@ def replay_main(argv: Sequence[str] | None = None) -> int:
             else:
                 gen = generated_package(args)
             rec = read_recording(args.file)
+            if not rec.transfers():
+                print(f"sam-replay: {args.file} holds no UAVCAN transfers (recorded with --no-bus?)",
+                      file=sys.stderr)
+                return EXIT_ERROR
             meta = rec.metadata.get(METADATA_NAME, {})
             layout = args.layout or meta.get("layout") or None
             recorded = [p for p in meta.get("protocols", "cyphal").split(",") if p]
@@ -152,7 +159,7 @@ def replay_main(argv: Sequence[str] | None = None) -> int:
         except SpecError as ex:
             print(f"sam-replay: the spec is invalid:\n{ex}", file=sys.stderr)
             return EXIT_ERROR
-        except (GeneratedPackageError, BridgeConfigError, OSError, ValueError) as ex:
+        except (GeneratedPackageError, BridgeConfigError, DsdlCompileError, OSError, ValueError) as ex:
             print(f"sam-replay: {ex}", file=sys.stderr)
             return EXIT_ERROR
     if not rec.complete:

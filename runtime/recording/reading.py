@@ -2,9 +2,10 @@
 
 Invariants:
 
-- :func:`read_recording` streams the file record by record (mcap's ``StreamReader``: no summary or footer needed)
-  and stops at the first record it cannot read: a cut file yields every message of every complete chunk, in file
-  order, and ``Recording.complete`` says whether the file ended with its footer.
+- :func:`read_recording` refuses a file that does not begin as an MCAP (ValueError), then streams it record by
+  record (mcap's ``StreamReader``: no summary or footer needed) and stops at the first record it cannot read: a cut
+  file yields every message of every complete chunk, in file order, and ``Recording.complete`` says whether the
+  file ended with its footer.
 - :func:`rosbag2_folder` makes a folder that rosbags' rosbag2 ``Reader`` opens (it reads only rosbag2 folders with
   a ``metadata.yaml``, and only MCAP files with a footer): the recording itself (a symbolic link) when complete,
   else a complete copy of everything readable (as ``mcap recover`` does); the metadata lists the ROS topics (CDR)
@@ -22,7 +23,9 @@ from typing import Any
 
 from sam_runtime.recording.schemas import TRANSFER_TYPE, Transfer, decode_transfer
 
-__all__ = ["RecordedMessage", "Recording", "read_recording", "rosbag2_folder"]
+__all__ = ["MCAP_MAGIC", "RecordedMessage", "Recording", "read_recording", "rosbag2_folder"]
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,9 @@ def read_recording(path: Path) -> Recording:
     rec = Recording()
     topic_of: dict[int, str] = {}
     with open(path, "rb") as fh:
+        if fh.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+            raise ValueError(f"{path} is not an MCAP file")
+        fh.seek(0)
         try:
             for r in StreamReader(fh, skip_magic=False, emit_chunks=False).records:
                 if isinstance(r, Schema):

@@ -244,3 +244,10 @@ def test_field_differences_names_paths() -> None:
     assert field_differences(dec, _imu_cdr(1), dec, _imu_cdr(1)) == []
     assert field_differences(dec, _imu_cdr(1), dec, _imu_cdr(1, frame="x")) == ["header.frame_id"]
     assert field_differences(dec, b"junk", dec, _imu_cdr(1)) == ["<undecodable>"]
+
+
+def test_a_file_that_is_no_mcap_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "notes.mcap"
+    path.write_text("not a recording\n")
+    with pytest.raises(ValueError, match="is not an MCAP file"):
+        read_recording(path)
