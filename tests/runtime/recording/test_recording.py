@@ -251,3 +251,16 @@ def test_a_file_that_is_no_mcap_is_refused(tmp_path: Path) -> None:
     path.write_text("not a recording\n")
     with pytest.raises(ValueError, match="is not an MCAP file"):
         read_recording(path)
+
+
+def test_replay_at_the_recorded_pace_takes_the_recorded_time(tmp_path: Path) -> None:
+    path = tmp_path / "paced.mcap"
+    w = RecordingWriter(path)
+    w.add_channel(CYPHAL_TOPIC, TRANSFER_TYPE, "ros2msg", TRANSFER_MSG)
+    for i in range(6):  # 0.1 s apart
+        w.write(CYPHAL_TOPIC, encode_transfer(_transfer(i)), 1_000_000_000 + i * 100_000_000)
+    w.close()
+    paced = replay(path, [_FakeConverter({})], speed="recorded")
+    assert paced.recorded_span_s == pytest.approx(0.5)
+    assert paced.replay_s >= 0.45  # never faster than recorded (a loaded machine may make it slower)
+    assert replay(path, [_FakeConverter({})], speed="max").replay_s < paced.replay_s
