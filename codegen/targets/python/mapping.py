@@ -134,7 +134,8 @@ class MappingEmitter:
 
     # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
     def to_ros(self) -> FunctionDraft:
-        """Values first (every check and drop before anything is built), then one nested constructor call."""
+        """Values first (every check and drop before anything is built), then the result tree, returned as the
+        module's Construction says (a nested constructor call, or CDR bytes)."""
         rm = self.rm
         names = LocalNames(self.module.module_names)
         fn = self.signatures.to_ros(self)
