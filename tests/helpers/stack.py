@@ -97,19 +97,22 @@ class Truth:
 # ============================================================================================ probe
 @dataclass
 class Status:
-    wall_ns: int
+    wall_ns: int  # when the probe received it
     level: int
     message: str
     values: dict[str, str]
+    stamp_ns: int = 0  # the report's own stamp (its node's clock when it published it)
 
 
 @dataclass
 class Records:
     odom: list[tuple[int, tuple[float, float, float], float]] = field(default_factory=list)  # (stamp, xyz, yaw)
     diagnostics: dict[str, list[Status]] = field(default_factory=dict)
-    aborts: list[tuple[int, bool, str]] = field(default_factory=list)  # (wall_ns, active, reason)
+    # (wall_ns received, active, reason, the message's own stamp [ns]: when the monitor decided)
+    aborts: list[tuple[int, bool, str, int]] = field(default_factory=list)
     plans: list[tuple[int, str, list[tuple[float, float, float]]]] = field(default_factory=list)
-    rpms: list[tuple[int, int, int]] = field(default_factory=list)  # (wall_ns, rpm 1, rpm 2)
+    # (wall_ns received, rpm 1, rpm 2, the command's own stamp [ns]: its publisher's clock when it computed it)
+    rpms: list[tuple[int, int, int, int]] = field(default_factory=list)
     buoyancy: list[tuple[int, float]] = field(default_factory=list)
 
 
@@ -178,21 +181,27 @@ class Probe:
                 self.rec.odom.append((stamp, (t.x, t.y, t.z), yaw))
 
     def _on_diag(self, arr: Any) -> None:
-        now = time.time_ns()
+        from sam_runtime.node_support import stamp_to_ns
+
+        now, stamp = time.time_ns(), stamp_to_ns(arr.header.stamp)
         for s in arr.status:
             level = s.level[0] if isinstance(s.level, bytes) else int(s.level)
             self.rec.diagnostics.setdefault(s.name, []).append(
-                Status(now, level, s.message, {kv.key: kv.value for kv in s.values}))
+                Status(now, level, s.message, {kv.key: kv.value for kv in s.values}, stamp))
 
     def _on_abort(self, msg: Any) -> None:
-        self.rec.aborts.append((time.time_ns(), bool(msg.active), msg.reason))
+        from sam_runtime.node_support import stamp_to_ns
+
+        self.rec.aborts.append((time.time_ns(), bool(msg.active), msg.reason, stamp_to_ns(msg.header.stamp)))
 
     def _on_plan(self, msg: Any) -> None:
         poses = [(p.pose.position.x, p.pose.position.y, p.pose.position.z) for p in msg.poses]
         self.rec.plans.append((time.time_ns(), msg.header.frame_id, poses))
 
     def _on_rpms(self, msg: Any) -> None:
-        self.rec.rpms.append((time.time_ns(), msg.thruster_1_rpm, msg.thruster_2_rpm))
+        from sam_runtime.node_support import stamp_to_ns
+
+        self.rec.rpms.append((time.time_ns(), msg.thruster_1_rpm, msg.thruster_2_rpm, stamp_to_ns(msg.header.stamp)))
 
     # ---------------------------------------------------------------------------------- reading
     def status(self, name: str) -> Status | None:
@@ -216,7 +225,10 @@ class Probe:
 
     # ---------------------------------------------------------------------------------- acting
     def wait_subscribed(self, publisher: Any, timeout: float = 20.0) -> None:
-        wait_for(lambda: publisher.get_subscription_count() > 0, timeout, f"a subscriber on {publisher.topic_name}")
+        """Until a subscription of another node matched the publisher (this probe's own subscription to the topic,
+        e.g. /global_plan, matches it too and does not count)."""
+        own = sum(1 for sub in self._subs if sub.topic_name == publisher.topic_name)
+        wait_for(lambda: publisher.get_subscription_count() > own, timeout, f"a subscriber on {publisher.topic_name}")
 
     def send_goal(self, x: float, y: float, z: float, frame: str = "world") -> int:
         from geometry_msgs.msg import PoseStamped
@@ -240,12 +252,10 @@ class Probe:
         self.heading_pub.publish(msg)
         return time.time_ns()
 
-    def send_plan(self, poses: Sequence[tuple[float, float, float]], frame: str = "world") -> int:
-        """A plan stamped now; returns the stamp [ns]."""
+    def _plan(self, poses: Sequence[tuple[float, float, float]], frame: str) -> tuple[Any, int]:
         from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Path as PathMsg
 
-        self.wait_subscribed(self.plan_pub)
         stamp = self.node.get_clock().now()
         path = PathMsg()
         path.header.stamp, path.header.frame_id = stamp.to_msg(), frame
@@ -255,8 +265,47 @@ class Probe:
             p.pose.position.x, p.pose.position.y, p.pose.position.z = x, y, z
             p.pose.orientation.w = 1.0
             path.poses.append(p)
+        return path, stamp.nanoseconds
+
+    def send_plan(self, poses: Sequence[tuple[float, float, float]], frame: str = "world") -> int:
+        """A plan stamped now; returns the stamp [ns]."""
+        self.wait_subscribed(self.plan_pub)
+        path, stamp = self._plan(poses, frame)
         self.plan_pub.publish(path)
-        return stamp.nanoseconds
+        return stamp
+
+    def plans_counted(self, node: str = "controller") -> int:
+        """How many plans ``node`` has counted (its ``plans`` value on /diagnostics; 0 before it reported one)."""
+        return max((int(st.values.get("plans", 0)) for st in self.rec.diagnostics.get(node, [])), default=0)
+
+    def deliver_plan(self, poses: Sequence[tuple[float, float, float]], frame: str = "world", *,
+                     within_s: float, node: str = "controller") -> tuple[int, int]:
+        """A plan stamped now, published until ``node`` counts it on /diagnostics; returns (stamp [ns], copies).
+
+        A publication is delivered only to subscriptions matched both ways: the probe's side matching the node's
+        subscription does not show that the node's side has matched the probe's publisher yet (discovery runs
+        each way on its own; volatile data sent before is not resent). So the same message (same stamp: the plan's
+        age does not change) goes again whenever a report of the node that came after the last copy does not count
+        it yet. The wait is bounded by ``within_s`` after the stamp (a plan's timeout: undelivered by then, it could
+        not be followed anyway), by the node's own clock: its reports' stamps."""
+        wait_for(lambda: self.status(node), 30, f"a first report of {node} on /diagnostics")  # 1 Hz at least
+        before = self.plans_counted(node)
+        self.wait_subscribed(self.plan_pub)
+        path, stamp = self._plan(poses, frame)
+        end_ns = stamp + int(within_s * 1e9)
+        copies = 0
+        while True:
+            self.plan_pub.publish(path)
+            copies += 1
+            published = time.time_ns()
+            report = wait_for(lambda published=published: next(
+                (st for st in reversed(self.rec.diagnostics.get(node, [])) if st.stamp_ns > published), None),
+                30, f"a report of {node} after the plan")  # reported every second (STATUS_PERIOD_S)
+            if self.plans_counted(node) > before:
+                return stamp, copies
+            assert report.stamp_ns <= end_ns, (
+                f"{node} did not count a plan sent {copies} times within {within_s:g} s of its stamp: "
+                f"{report.message} {report.values}")
 
     def set_parameter(self, node: str, name: str, value: Any, timeout: float = 10.0) -> tuple[bool, str]:
         """Through /<node>/set_parameters (rcl_interfaces/SetParameters): (successful, reason)."""

@@ -19,6 +19,7 @@ Each test prints its figures on lines starting with ``FIGURES:`` (run with -s to
 from __future__ import annotations
 
 import asyncio
+import itertools
 import json
 import logging
 import math
@@ -95,6 +96,45 @@ def _closed_fault_media(exc: str) -> bool:
     False
     """
     return "ResourceClosedError: PythonCANMedia('virtual:faults" in exc
+
+
+def _silence_explained(age_s: float, received_t: float, sends: list[float], stalls: list[list[float]],
+                       period: float = 1.0, slack: float = 0.05) -> bool:
+    """Whether "heartbeat lost: none for ``age_s`` s", received by the probe at ``received_t`` (monotonic, the
+    scenario's process), is what a working bridge reports: the device's own heartbeats (``sends``, the times its
+    heartbeat publisher sent them) left a silence that long, or the event loop the device and the bridge share
+    stalled (``stalls``: (when the late timer ran, how late it was), measured) long enough to hold the device's
+    heartbeat or the bridge's handling of it. Generous where the timing is unknown (the report may have waited for
+    the probe up to ``age_s``), never explained without a silence or a stall to show for it.
+
+    >>> _silence_explained(3.2, 100.0, [95.0, 96.0, 97.0, 98.0, 99.0, 99.9], [])  # heartbeats every second
+    False
+    >>> _silence_explained(3.2, 100.0, [95.0, 96.0, 96.8], [])  # the device itself silent since 96.8
+    True
+    >>> _silence_explained(3.9, 100.0, [95.0, 96.0, 97.0, 99.9], [[99.9, 2.8]])  # a stall of 2.8 s held it
+    True
+    >>> _silence_explained(3.9, 100.0, [95.0, 96.0, 97.0, 99.9], [[99.9, 0.5]])  # too short a stall
+    False
+    """
+    lo, hi = received_t - 2 * age_s - period, received_t
+    sent = sorted(t for t in sends if t <= hi)
+    gaps = [b - a for a, b in itertools.pairwise(sent) if b >= lo] + [hi - sent[-1] if sent else math.inf]
+    stalled = sum(lag for t, lag in stalls if t >= lo and t - lag <= hi + age_s)
+    return max(gaps) + stalled >= age_s - slack
+
+
+def _device_ok_or_silence_explained(res: dict[str, Any], dev: str, st: dict[str, Any]) -> None:
+    """A device's report: OK with its heartbeat alive, or ERROR "heartbeat lost" that the device's own heartbeats
+    and the measured loop stalls explain (the simulated devices share the bridge's process and loop: on a loaded
+    machine they may go unheard for 3 s, and the bridge must say so)."""
+    if st["level"] == 0 and st["values"]["alive"] == "True":
+        return
+    age = float(st["values"].get("age_s", "nan"))
+    assert st["level"] == 2 and st["message"].startswith("heartbeat lost") and age >= 3.0, (dev, st)
+    sends, stalls = res["heartbeat_sends"].get(dev, []), res["loop_stalls"]
+    assert _silence_explained(age, st["t"], sends, stalls), (
+        dev, st, "sent around it:", [round(t - st["t"], 3) for t in sends if abs(t - st["t"]) < 3 * age],
+        "stalls around it:", [(round(t - st["t"], 3), lag) for t, lag in stalls if abs(t - st["t"]) < 3 * age])
 
 
 def _no_tracebacks(res: dict[str, Any]) -> None:
@@ -381,21 +421,34 @@ def test_diagnostics_content(can_run: dict[str, Any]) -> None:
         assert sum(int(x) for k, x in v.items() if k.startswith("saturated.")) == int(v["saturated"])
     assert diag[f"{BRIDGE}/mapping/thruster_1_rpm"]["values"]["dropped.publish_error"] == "5"
     assert int(diag[f"{BRIDGE}/mapping/imu"]["values"]["dropped.lost_link_down"]) > 0
+    # Every device at the end, in a report that carries a heartbeat the bridge handled after the phases (the
+    # scenario waited for one in which all are OK, for as long as each device sent 5 heartbeats): OK, or - when
+    # the shared loop let no such report come - a loss that the device's own heartbeats and the stalls explain.
+    final = can_run["final"]
+    _figures("the final /diagnostics report", final | {"loop_stalls_over_1s": [
+        s for s in can_run["loop_stalls"] if s[1] > 1.0]})
     for dev in bridge["devices"]:
         d = diag[f"{BRIDGE}/device/{dev}"]
-        assert d["level"] == 0 and d["values"]["alive"] == "True", (dev, d)
+        assert int(d["values"]["heartbeats"]) > 0, (dev, d)
+        _device_ok_or_silence_explained(can_run, dev, d)
     b = diag[BRIDGE]["values"]
     assert b["link_up"] == "True" and b["link_outages"] == "1" and diag[BRIDGE]["level"] == 0
     # Heartbeat: ERROR when lost, OK again, for every device during the link outage too (it heard nothing).
     # From the baseline on (the scenario waited, with a deadline, until every device was OK on /diagnostics):
-    # OK, then ERROR at least once, and OK at the end.
+    # OK, then ERROR at least once (the link outage or the power-off), and OK again.
     base = can_run["diag_events_baseline"]
-    gps = [e["level"] for e in can_run["diag_events"][base:] if e["name"] == f"{BRIDGE}/device/gps"]
-    assert gps and gps[0] == 2 and gps[-1] == 0, gps
+    gps_events = [e for e in can_run["diag_events"][base:] if e["name"] == f"{BRIDGE}/device/gps"]
+    gps = [e["level"] for e in gps_events]
+    assert gps and gps[0] == 2 and 0 in gps[1:], gps
     # Before it: STALE only while the bridge had not heard the device yet (the probe's first /diagnostics may come
-    # before the first heartbeat), then OK.
-    before = [e["level"] for e in can_run["diag_events"][:base] if e["name"] == f"{BRIDGE}/device/gps"]
-    assert before in ([0], [3, 0]), before
+    # before the first heartbeat), then OK; a loss in between only as the device's heartbeats and the stalls of
+    # the start-up explain it.
+    before_events = [e for e in can_run["diag_events"][:base] if e["name"] == f"{BRIDGE}/device/gps"]
+    for e in before_events:
+        if e["level"] == 2:
+            _device_ok_or_silence_explained(can_run, "gps", e)
+    before = [lvl for lvl, _ in itertools.groupby(e["level"] for e in before_events if e["level"] != 2)]
+    assert before in ([0], [3, 0]), [e["level"] for e in before_events]
     _no_tracebacks(can_run)
 
 
