@@ -105,3 +105,32 @@ def test_the_dronecan_listener_records_every_transfer_checked() -> None:
                               (KIND_REQUEST, 1, "uavcan.protocol.GetNodeInfo", 100, 21, 3, 30)]
     assert got[0].payload == bytes(imu.payload) and got[0].data_type_signature == raw_imu.get_data_type_signature()
     assert dict(taps.crc_failures) == {"uavcan.equipment.ahrs.RawIMU": 1}
+
+
+def test_dronecan_payloads_decode_from_the_attached_definitions_alone(gen: Any, tmp_path: Any) -> None:
+    """The .uavcan files a recording attaches parse on their own (dronecan's parser, nothing else loaded from it)
+    and decode what the listener recorded, down to the signature that seeds the CRC."""
+    import dronecan
+    from dronecan import dsdl, transport
+
+    from sam_runtime.dronecan_io.types import ensure_types
+    from sam_runtime.recording.schemas import dronecan_definition_files
+
+    ensure_types(gen)
+    names = ["uavcan.equipment.ahrs.RawIMU", "uavcan.equipment.esc.Status", "sam.sensor.Altitude"]
+    files = dronecan_definition_files([dronecan.TYPENAMES[n] for n in names])
+    for name, data in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_bytes(data)
+    roots = sorted(str(p) for p in (tmp_path / "dsdl_v0").iterdir())
+    parsed = {t.full_name: t for t in dsdl.parse_namespaces(roots)}
+    assert set(names) <= set(parsed)
+    sent = dronecan.TYPENAMES["uavcan.equipment.ahrs.RawIMU"](rate_gyro_latest=[0.5, -1.0, 2.0],
+                                                               integration_interval=0.01)
+    payload = bytes(transport.Transfer(payload=sent).payload)
+    got = transport.CompoundValue(parsed["uavcan.equipment.ahrs.RawIMU"], None)
+    got._unpack(transport.bits_from_bytes(bytearray(payload)), True)
+    assert list(got.rate_gyro_latest) == [0.5, -1.0, 2.0]
+    assert got.integration_interval == pytest.approx(0.01)
+    for n in names:
+        assert parsed[n].get_data_type_signature() == dronecan.TYPENAMES[n].get_data_type_signature()
