@@ -11,8 +11,8 @@
 
 Layer: beside bridge, sim and nodes, independent of them (tests/test_layers.py). Replay needs the bridge's inbound
 logic (source filter, select routing, counters, codecs): the bridge offers it as
-``sam_runtime.bridge.offline.OfflineBridge`` and the command line hands it to :func:`.replay.replay`, so neither
-package imports the other.
+``sam_runtime.bridge.offline.OfflineBridge`` and the replay command (``sam_runtime.main_job.record_replay``, a layer
+above both) hands it to :func:`.replay.replay`, so neither package imports the other.
 
 Import the submodules (they need the runtime extra: mcap, rclpy, pycyphal); this package imports nothing.
 """
