@@ -52,7 +52,7 @@ def _messages(stream: IO[bytes], topics: list[str] | None, problems: list[str]
         if reader.get_summary() is not None:
             yield from reader.iter_messages(topics=topics, log_time_order=True)
             return
-    except Exception as exc:
+    except Exception as exc:  # a damaged summary or index: stream the records instead
         problems.append(f"its index is unreadable ({type(exc).__name__})")
     stream.seek(0)
     try:
@@ -60,7 +60,7 @@ def _messages(stream: IO[bytes], topics: list[str] | None, problems: list[str]
         for schema, channel, message in NonSeekingReader(stream).iter_messages(topics=topics, log_time_order=False):
             count += 1
             yield schema, channel, message
-    except Exception as exc:
+    except Exception as exc:  # a truncated or corrupt tail: keep what came before it
         problems.append(f"it is cut short or damaged after {count} messages ({type(exc).__name__}): "
                         "what was read before is shown")
 
@@ -72,7 +72,7 @@ def read_recording(path: Path, topics: Iterable[str] | None = None) -> Recording
     path = Path(path)
     wanted = sorted(set(topics)) if topics is not None else None
     try:
-        stream = open(path, "rb")
+        stream = open(path, "rb")  # closed below, once the generator is drained
     except OSError as exc:
         raise RecordingError(f"cannot read {path}: {exc.strerror or exc}") from None
     rec = Recording(path)
@@ -91,7 +91,7 @@ def read_recording(path: Path, topics: Iterable[str] | None = None) -> Recording
             if schema.id not in decoders:
                 try:
                     decoders[schema.id] = factory.decoder_for(channel.message_encoding, schema)
-                except Exception:
+                except Exception:  # an unreadable schema: its topic is counted as undecodable
                     decoders[schema.id] = None
             decode = decoders[schema.id]
             if decode is None:
@@ -99,7 +99,7 @@ def read_recording(path: Path, topics: Iterable[str] | None = None) -> Recording
                 continue
             try:
                 obj = decode(message.data)
-            except Exception:
+            except Exception:  # one bad message is counted, the rest of the topic still plots
                 failed[channel.topic] += 1
                 continue
             rec.types.setdefault(channel.topic, schema.name)
