@@ -119,6 +119,17 @@ class ReplayReport:
         if rt:
             out.append(f"receive-time fields (differ only because the recorder's receive time is not the bridge's): "
                        f"{', '.join(rt)}")
+        for proto, st in sorted(self.bridge.items()):  # the offline bridge's own counters, as the live one reports
+            maps = st.get("mappings", {}).values()
+            drops: Counter[str] = Counter()
+            for m in maps:
+                drops.update(m.get("dropped", {}))
+            saturated = sum(m.get("saturated_total", 0) for m in maps)
+            out.append(f"bridge ({proto}): {sum(m.get('published', 0) for m in maps)} published, "
+                       + (", ".join(f"{k} {n}" for k, n in sorted(drops.items())) or "nothing dropped")
+                       + (f", {saturated} values saturated" if saturated else "")
+                       + "".join(f"; port {p} refused below the bridge: {b}"
+                                 for p, b in sorted(st.get("below_bridge", {}).items())))
         out.append("same as recorded" if self.same else "DIFFERENT from the recording")
         return out
 
