@@ -62,6 +62,7 @@ from sam_runtime.main_job.diag_view import bridge_lines, status_key
 from sam_runtime.main_job.vehicle_view import VehicleView
 from sam_runtime.nodes import implemented, unimplemented
 from sam_runtime.recording.target import RecordingTargetError, check_target
+from sam_runtime.report.plot import limits_from_params, plot_run
 
 if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
@@ -531,4 +532,20 @@ def run(opts: RunOptions) -> int:
                     say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
             if children:
                 say("logs: " + ", ".join(str(c.log) for c in children))
+    if opts.record is not None and opts.record.is_file():  # the recorder has stopped: its file is whole
+        report_picture(opts.record, gen_dir, say)
     return exit_code
+
+
+def report_picture(recording: Path, gen_dir: Path, say: Any) -> Path | None:
+    """The recorded run as one picture beside the recording (<name>.png), with the limits of the generated params
+    file; a failure is said, never raised: the run and its recording are done."""
+    params = sorted((gen_dir / "params").glob("*.params.yaml"))
+    try:
+        limits = limits_from_params(params[0]) if params else None
+        out = plot_run(recording, recording.with_suffix(".png"), limits=limits)
+    except Exception as ex:  # e.g. matplotlib missing, a recording with nothing readable
+        say(f"sam-run: no report picture of {recording}: {type(ex).__name__}: {ex}")
+        return None
+    say(f"report: {out}")
+    return out

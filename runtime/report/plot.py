@@ -186,11 +186,18 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     distinct: dict[tuple[float, float, float], float] = {}
     for t, p in goals:
         distinct.setdefault((round(p.x, 2), round(p.y, 2), round(p.z, 2)), t)
+    labels: dict[tuple[float, float], list[str]] = {}  # goals at one place (down, then up) share a star
     for k, ((x, y, z), t) in enumerate(distinct.items(), 1):
         where = "surface" if z == 0 else f"depth {-z:g} m" if z < 0 else f"altitude {z:g} m"
-        ax_track.plot(x, y, "*", color="#8e44ad", ms=15, label="goal (/nav_goal)" if k == 1 else None)
-        ax_track.annotate(f"goal {k}: {where}, from {t:.0f} s", (x, y), textcoords="offset points",
-                          xytext=(0, -16 if k % 2 else 9), ha="center", fontsize=8, color="#8e44ad")
+        labels.setdefault((x, y), []).append(f"goal {k}: {where}, from {t:.0f} s")
+    xs_all = [x for x, _ in labels] + [p[1] for p in points]
+    middle = (min(xs_all) + max(xs_all)) / 2 if xs_all else 0.0
+    for k, ((x, y), lines) in enumerate(labels.items()):
+        ax_track.plot(x, y, "*", color="#8e44ad", ms=15, label="goal (/nav_goal)" if k == 0 else None)
+        right = x <= middle  # the text toward the middle of the picture, below-beside the star and the end marker
+        ax_track.annotate("\n".join(lines), (x, y), textcoords="offset points", xytext=(12 if right else -12, -10),
+                          ha="left" if right else "right", va="top", fontsize=8, color="#8e44ad",
+                          bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85})
     if points or goals:
         ax_track.set_xlabel(f"x (east) in {frame} [m]")
         ax_track.set_ylabel(f"y (north) in {frame} [m]")

@@ -106,3 +106,18 @@ def test_the_command_writes_beside_the_recording_with_the_projects_limits(dive: 
     assert (tmp_path / "run.png").read_bytes().startswith(PNG_MAGIC)
     assert "limits from" in capsys.readouterr().out
     assert codegen_main(["plot", str(mcap), "-o", str(tmp_path / "run.pdf")]) == 1
+
+
+def test_a_recorded_run_ends_with_its_picture_beside_the_recording(dive: Path, tmp_path: Path) -> None:
+    from sam_runtime.main_job.job import report_picture
+
+    said: list[str] = []
+    mcap = tmp_path / "run.mcap"
+    mcap.write_bytes(dive.read_bytes())
+    out = report_picture(mcap, REPO / "generated", said.append)
+    assert out == tmp_path / "run.png" and out.read_bytes().startswith(PNG_MAGIC) and said == [f"report: {out}"]
+    bad = tmp_path / "bad.mcap"
+    bad.write_text("not a recording")
+    said.clear()
+    assert report_picture(bad, REPO / "generated", said.append) is None  # said, never raised: the run is over
+    assert said and said[0].startswith(f"sam-run: no report picture of {bad}: RecordingError")
