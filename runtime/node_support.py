@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from sam_codegen.model.names import ros_parameter_name
 from sam_runtime.tf_buffer import TfBuffer, TfError
 
 __all__ = [
@@ -117,16 +118,6 @@ class ParameterConfigError(Exception):
 _RULE_OPS: dict[str, Callable[[Any, Any], bool]] = {
     "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
 }
-
-
-def ros_parameter_name(spec_name: str) -> str:
-    """Spec names are written like ROS 1 globals (/safe_depth); ROS 2 parameters are node-local, without the
-    leading slash (nested: dots).
-
-    >>> ros_parameter_name("/safe_depth"), ros_parameter_name("/limits/depth")
-    ('safe_depth', 'limits.depth')
-    """
-    return spec_name.lstrip("/").replace("/", ".")
 
 
 def _coerce(p: ParameterInfoLike, value: Any) -> Any:

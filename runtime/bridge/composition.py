@@ -9,6 +9,7 @@ import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend, BridgeConfigError
 from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
@@ -180,7 +181,7 @@ class Bridge:
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
                                             backend=backend)
         silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in sel.mappings
-                                if m.direction == "uavcan_to_ros"], health.devices,
+                                if m.direction == UAVCAN_TO_ROS], health.devices,
                                alive_since=health.alive_since, last_message=inbound.last_message,
                                listening_since=lambda: link.up_since)
         self.reporter = reporter = Reporter(

@@ -10,6 +10,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.diagnostics import Naming, diagnostic_array
@@ -85,7 +86,7 @@ class Reporter:
             entry = {"direction": m.direction, "topic": m.topic.name, port_key: port_id_of(m),
                      **({"data_type": m.data_type.name} if hasattr(m, "data_type") else {}),
                      **(st.snapshot() if st else empty)}
-            if m.direction == "uavcan_to_ros":
+            if m.direction == UAVCAN_TO_ROS:
                 entry["source_node_ids"] = sorted(m.source_node_ids)
                 group = self.inbound.group_of(m.name)
                 inlet = group.inlet if group is not None else None

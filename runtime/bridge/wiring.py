@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from sam_codegen.model.spec import DIRECTIONS, ROS_TO_UAVCAN, UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import BridgeConfigError
 from sam_runtime.bridge.counters import MappingStats, log
 from sam_runtime.bridge.inbound import InMapping, PortGroup
@@ -40,7 +41,7 @@ def check_destinations(tables: TablesModule, mappings: Sequence[Any] | None = No
     subject, or the DroneCAN data type)."""
     by_id = {d.node_id: d for d in (tables.DEVICES if devices is None else devices)}
     for m in tables.MAPPINGS if mappings is None else mappings:
-        if m.direction != "ros_to_uavcan":
+        if m.direction != ROS_TO_UAVCAN:
             continue
         port, what = (m.data_type.name, "data type") if hasattr(m, "data_type") else (m.port.subject_id, "subject")
         for nid in destinations_of(m):
@@ -95,9 +96,9 @@ def in_groups(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
     wire_matches = getattr(codec, "WIRE_MATCHES", {})
     groups: dict[int, PortGroup] = {}
     for m in mappings:
-        if m.direction not in ("uavcan_to_ros", "ros_to_uavcan"):
+        if m.direction not in DIRECTIONS:
             raise BridgeConfigError(f"mapping {m.name}: unknown direction {m.direction!r}")
-        if m.direction != "uavcan_to_ros":
+        if m.direction != UAVCAN_TO_ROS:
             continue
         dtype = _dtype(gen, m)
         pid = port_id_of(m)
@@ -125,4 +126,4 @@ def out_mappings(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
     path."""
     return [OutMapping(m, codec.CODECS[m.name][1] if codec is not None else find_converter(convert, m, 1),
                        counters[m.name], gen.ros_class(m.topic), _dtype(gen, m), raw=codec is not None)
-            for m in (gen.tables().MAPPINGS if mappings is None else mappings) if m.direction == "ros_to_uavcan"]
+            for m in (gen.tables().MAPPINGS if mappings is None else mappings) if m.direction == ROS_TO_UAVCAN]

@@ -16,6 +16,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+from sam_codegen.model.spec import UAVCAN_TO_ROS
+
 __all__ = ["SUBJECT_ID_MAX", "PortConfigError", "register_environment", "register_node_id", "resolve_subject",
            "subscription_names"]
 
@@ -37,7 +39,7 @@ def subscription_names(mappings: Iterable[Any]) -> dict[int, str]:
     """
     out: dict[int, str] = {}
     for m in mappings:
-        if m.direction == "uavcan_to_ros":
+        if m.direction == UAVCAN_TO_ROS:
             pid = m.data_type.data_type_id if hasattr(m, "data_type") else m.port.subject_id  # DroneCAN: by type
             out.setdefault(int(pid), str(m.name))
     return out

@@ -61,8 +61,6 @@ from sam_runtime.main_job.demo import demo_message
 from sam_runtime.main_job.diag_view import bridge_lines, status_key
 from sam_runtime.main_job.vehicle_view import VehicleView
 from sam_runtime.nodes import implemented, unimplemented
-from sam_runtime.recording.target import RecordingTargetError, check_target
-from sam_runtime.report.plot import limits_from_params, plot_run
 
 if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
@@ -97,7 +95,6 @@ class RunOptions:
     layout: str | None = None  # the spec's layout (which firmware each device runs); a mixed one: two bridges
     dronecan_iface: str = "mcast-lo:"
     wire: str = "codec"  # the bridges' path: the generated wire codecs, or "object" (the object converters)
-    record: Path | None = None  # an MCAP file: the recorder (sam-codegen record) runs as one more child
 
 
 # ============================================================================================ formatting
@@ -404,12 +401,6 @@ def run(opts: RunOptions) -> int:
     def on_signal(signum: int, _frame: Any) -> None:
         stop_reason.append(signal.Signals(signum).name)
 
-    if opts.record is not None:  # an unwritable recording is an error before anything starts
-        try:
-            opts.record = check_target(opts.record)
-        except RecordingTargetError as ex:
-            say(f"sam-run: {ex}")
-            return 1
     old_handlers = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     children: list[_Child] = []
     live: LiveView | None = None
@@ -470,12 +461,6 @@ def run(opts: RunOptions) -> int:
             name = "bridge" if proto is None else f"bridge_{proto}"
             children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire,
                                           *(["--protocol", proto] if proto else [])], env, log_dir / f"{name}.log"))
-        if opts.record is not None:
-            children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
-                                                "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
-                                                *(["--layout", opts.layout] if opts.layout else []),
-                                                *(["--package", opts.package] if opts.package else [])],
-                                   env, log_dir / "recorder.log"))
         if hosted:
             gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
             children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
@@ -532,20 +517,4 @@ def run(opts: RunOptions) -> int:
                     say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
             if children:
                 say("logs: " + ", ".join(str(c.log) for c in children))
-    if opts.record is not None and opts.record.is_file():  # the recorder has stopped: its file is whole
-        report_picture(opts.record, gen_dir, say)
     return exit_code
-
-
-def report_picture(recording: Path, gen_dir: Path, say: Any) -> Path | None:
-    """The recorded run as one picture beside the recording (<name>.png), with the limits of the generated params
-    file; a failure is said, never raised: the run and its recording are done."""
-    params = sorted((gen_dir / "params").glob("*.params.yaml"))
-    try:
-        limits = limits_from_params(params[0]) if params else None
-        out = plot_run(recording, recording.with_suffix(".png"), limits=limits)
-    except Exception as ex:  # e.g. matplotlib missing, a recording with nothing readable
-        say(f"sam-run: no report picture of {recording}: {type(ex).__name__}: {ex}")
-        return None
-    say(f"report: {out}")
-    return out

@@ -31,6 +31,7 @@ import logging
 from dataclasses import dataclass
 from typing import Any
 
+from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS
 from sam_runtime.dronecan_io import Acceptance, FrameGate, HandlerError, NodeLoop, make_driver, parse_iface
 from sam_runtime.dronecan_io.node_loop import close_node
 from sam_runtime.dronecan_io.types import ensure_types, type_problems
@@ -133,7 +134,7 @@ class DroneCanDevices:
         select: dict[str, Any] = {}
         elements: dict[str, Element] = {}
         for m in self.sim.tables.DRONECAN_MAPPINGS:
-            if m.direction == "uavcan_to_ros" and m.data_type.name == type_name and dev.info.node_id in \
+            if m.direction == UAVCAN_TO_ROS and m.data_type.name == type_name and dev.info.node_id in \
                     m.source_node_ids:
                 select.update(m.select)
                 elements.update({e: parse_element(e) for e in m.elements})
@@ -144,7 +145,7 @@ class DroneCanDevices:
         sam = SAM_ACTUATORS_V0.get(name, {})
         out = []
         for m in self.sim.tables.DRONECAN_MAPPINGS:
-            if m.direction != "ros_to_uavcan" or m.data_type.name != type_name or node_id not in \
+            if m.direction != ROS_TO_UAVCAN or m.data_type.name != type_name or node_id not in \
                     m.destination_node_ids:
                 continue
             elements = list(m.elements)
