@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING, Any
 
 from sam_codegen.build import build
 from sam_codegen.model.diagnostics import SpecError
+from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS
 from sam_codegen.project.cyphal_path import CyphalPathError
 from sam_codegen.project.ros_install import RosBuildError, ros_runtime_env
 from sam_codegen.project.workspace import (
@@ -61,6 +62,8 @@ from sam_runtime.main_job.demo import demo_message
 from sam_runtime.main_job.diag_view import bridge_lines, status_key
 from sam_runtime.main_job.vehicle_view import VehicleView
 from sam_runtime.nodes import implemented, unimplemented
+from sam_runtime.recording.target import RecordingTargetError, check_target
+from sam_runtime.report.plot import limits_from_params, plot_run
 
 if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
@@ -95,6 +98,7 @@ class RunOptions:
     layout: str | None = None  # the spec's layout (which firmware each device runs); a mixed one: two bridges
     dronecan_iface: str = "mcast-lo:"
     wire: str = "codec"  # the bridges' path: the generated wire codecs, or "object" (the object converters)
+    record: Path | None = None  # an MCAP file: the recorder (sam-codegen record) runs as one more child
 
 
 # ============================================================================================ formatting
@@ -203,7 +207,7 @@ class LiveView:
         for m in tables.MAPPINGS:
             st = self.topics.get(m.topic.name)
             if st is None:
-                st = _TopicState(m.topic.name, "in" if m.direction == "uavcan_to_ros" else "out", m.rate_hz)
+                st = _TopicState(m.topic.name, "in" if m.direction == UAVCAN_TO_ROS else "out", m.rate_hz)
                 self.topics[m.topic.name] = st
                 self.node.create_subscription(gen.ros_class(m.topic), m.topic.name, st.on_msg, best_effort)
         self.diagnostics: dict[str, Any] = {}
@@ -221,7 +225,7 @@ class LiveView:
                                     hosted=hosted, truth_file=truth_file)
         if demo_commands:
             for m in tables.MAPPINGS:
-                if m.direction == "ros_to_uavcan" and m.topic.name not in seen:
+                if m.direction == ROS_TO_UAVCAN and m.topic.name not in seen:
                     seen.add(m.topic.name)
                     cls = gen.ros_class(m.topic)
                     pub = self.node.create_publisher(cls, m.topic.name, 10)
@@ -401,6 +405,12 @@ def run(opts: RunOptions) -> int:
     def on_signal(signum: int, _frame: Any) -> None:
         stop_reason.append(signal.Signals(signum).name)
 
+    if opts.record is not None:  # an unwritable recording is an error before anything starts
+        try:
+            opts.record = check_target(opts.record)
+        except RecordingTargetError as ex:
+            say(f"sam-run: {ex}")
+            return 1
     old_handlers = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     children: list[_Child] = []
     live: LiveView | None = None
@@ -461,6 +471,12 @@ def run(opts: RunOptions) -> int:
             name = "bridge" if proto is None else f"bridge_{proto}"
             children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire,
                                           *(["--protocol", proto] if proto else [])], env, log_dir / f"{name}.log"))
+        if opts.record is not None:
+            children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
+                                                "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
+                                                *(["--layout", opts.layout] if opts.layout else []),
+                                                *(["--package", opts.package] if opts.package else [])],
+                                   env, log_dir / "recorder.log"))
         if hosted:
             gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
             children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
@@ -517,4 +533,20 @@ def run(opts: RunOptions) -> int:
                     say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
             if children:
                 say("logs: " + ", ".join(str(c.log) for c in children))
+    if opts.record is not None and opts.record.is_file():  # the recorder has stopped: its file is whole
+        report_picture(opts.record, gen_dir, say)
     return exit_code
+
+
+def report_picture(recording: Path, gen_dir: Path, say: Any) -> Path | None:
+    """The recorded run as one picture beside the recording (<name>.png), with the limits of the generated params
+    file; a failure is said, never raised: the run and its recording are done."""
+    params = sorted((gen_dir / "params").glob("*.params.yaml"))
+    try:
+        limits = limits_from_params(params[0]) if params else None
+        out = plot_run(recording, recording.with_suffix(".png"), limits=limits)
+    except Exception as ex:  # e.g. matplotlib missing, a recording with nothing readable
+        say(f"sam-run: no report picture of {recording}: {type(ex).__name__}: {ex}")
+        return None
+    say(f"report: {out}")
+    return out
