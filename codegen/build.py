@@ -19,6 +19,7 @@ from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType, split_composite_name
 from sam_codegen.project.workspace import GENERATED_MARKER, OutDirError, check_out_dir
 from sam_codegen.targets.docs.budget import resolved_budgets
+from sam_codegen.targets.dsdl import dsdl_path
 from sam_codegen.targets.registry import EMITTERS
 from sam_codegen.validate.resolve import Resolved, validate
 
@@ -51,8 +52,6 @@ def verify_dsdl(resolved: Resolved, files: dict[str, str], *, batch: int | None 
     collisions, cannot fail here: batches are used only when every emitted file is a spec type's
     `Name.MAJOR.MINOR.dsdl`, which carries no fixed port id; any other emitted tree is read in one call.
     """
-    from sam_codegen.targets.dsdl import dsdl_path
-
     dsdl_files = {path: text for path, text in files.items() if path.startswith("dsdl/")}
     if not dsdl_files:
         return

@@ -7,7 +7,7 @@ from pathlib import Path
 import pydsdl
 
 from sam_codegen.model.spec import Constant, DsdlStruct, Field, Spec
-from sam_codegen.model.types import DsdlType, split_composite_name
+from sam_codegen.model.types import ArrayKind, DsdlType, split_composite_name
 from sam_codegen.project.cyphal_path import dsdl_lookup_roots
 
 
@@ -30,7 +30,7 @@ def from_pydsdl(data_type: pydsdl.Any) -> DsdlType:
     """Translate a pydsdl field type into the spec's DsdlType."""
     if isinstance(data_type, pydsdl.ArrayType):
         element = from_pydsdl(data_type.element_type)
-        kind = "fixed" if isinstance(data_type, pydsdl.FixedLengthArrayType) else "bounded"
+        kind: ArrayKind = "fixed" if isinstance(data_type, pydsdl.FixedLengthArrayType) else "bounded"
         return DsdlType(element.kind, element.bits, element.composite, kind, data_type.capacity, element.truncated)
     if isinstance(data_type, pydsdl.CompositeType):
         version = data_type.version

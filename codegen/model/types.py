@@ -1,15 +1,23 @@
 """Type expressions of both sides: ROS 2 .msg field types and Cyphal DSDL field types.
 
-Pure data and parsing; the rules that relate the two live in mapping_rules.
+Pure data and parsing; the rules that relate the two live in validate.mapping_rules.
+
+Invariants (checked on construction, as pydsdl's types check theirs): a RosType's base is a primitive or
+`pkg/Name`; an array kind has a capacity exactly when it is bounded or fixed, at least 1; only a string has a bound.
+A DsdlType of kind `composite` names its type and has no bit length, a primitive has its kind's bit length (bool 1,
+byte and utf8 8, float 16/32/64, int 2..64, uint and void 1..64); a cast mode only on a numeric or bool; DSDL has no
+unbounded arrays. The parse functions report a bad type text with their own messages before constructing anything,
+so these checks fire only on a type built wrongly in code.
 """
 
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, TypeGuard
 
 ArrayKind = Literal["", "fixed", "bounded", "dynamic"]
+_ARRAY_KINDS = ("", "fixed", "bounded", "dynamic")
 
 ROS_INT_RANGES: dict[str, tuple[int, int]] = {
     "byte": (0, 255),
@@ -35,6 +43,7 @@ ROS_CONSTANT_NAME = re.compile(r"^[A-Z](?:[A-Z0-9]|_(?!_))*(?<!_)$")
 ROS_PACKAGE_NAME = re.compile(r"^[a-z](?:[a-z0-9]|_(?!_))*(?<!_)$")
 ROS_TOPIC_NAME = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
 
+_ROS_MESSAGE_TYPE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*/[A-Za-z][A-Za-z0-9_]*$")
 _ROS_TYPE = re.compile(
     r"^(?P<base>[A-Za-z][A-Za-z0-9_]*(?:/(?:msg/)?[A-Za-z][A-Za-z0-9_]*)?)"
     r"(?:<=(?P<strbound>[0-9]+))?"
@@ -50,6 +59,33 @@ class RosType:
     array: ArrayKind = ""
     capacity: int | None = None
     string_bound: int | None = None
+
+    def __post_init__(self) -> None:
+        """
+        >>> RosType("x", "fixed", None)
+        Traceback (most recent call last):
+        ...
+        ValueError: RosType('x', 'fixed', None, None): the base is not a primitive nor pkg/Name
+        >>> RosType("float32", "fixed", None)
+        Traceback (most recent call last):
+        ...
+        ValueError: RosType('float32', 'fixed', None, None): a fixed array needs a capacity of at least 1
+        """
+        problem = None
+        if not (self.base in ROS_PRIMITIVES or (isinstance(self.base, str) and _ROS_MESSAGE_TYPE.fullmatch(self.base))):
+            problem = "the base is not a primitive nor pkg/Name"
+        elif self.array not in _ARRAY_KINDS:
+            problem = f"unknown array kind {self.array!r}"
+        elif self.array in ("fixed", "bounded") and not (_is_int(self.capacity) and self.capacity >= 1):
+            problem = f"a {self.array} array needs a capacity of at least 1"
+        elif self.array in ("", "dynamic") and self.capacity is not None:
+            problem = "only a fixed or bounded array has a capacity"
+        elif self.string_bound is not None and (not _is_int(self.string_bound) or self.string_bound < 0
+                                                or self.base not in ("string", "wstring")):
+            problem = "only a string has a bound, a count of characters"
+        if problem is not None:
+            raise ValueError(f"RosType({self.base!r}, {self.array!r}, {self.capacity!r}, {self.string_bound!r}): "
+                             f"{problem}")
 
     @property
     def is_primitive(self) -> bool:
@@ -74,6 +110,10 @@ class RosType:
         elif self.array == "dynamic":
             text += "[]"
         return text
+
+
+def _is_int(value: object) -> TypeGuard[int]:
+    return isinstance(value, int) and not isinstance(value, bool)
 
 
 def parse_ros_type(text: str, package: str | None = None) -> RosType:
@@ -160,6 +200,40 @@ class DsdlType:
     capacity: int | None = None
     truncated: bool = False
 
+    def __post_init__(self) -> None:
+        """
+        >>> DsdlType("float", 8)
+        Traceback (most recent call last):
+        ...
+        ValueError: DsdlType('float', 8, None, '', None): a float has 16, 32 or 64 bits
+        >>> DsdlType("composite", composite="uavcan.Timestamp", array="dynamic")
+        Traceback (most recent call last):
+        ...
+        ValueError: DsdlType('composite', 0, 'uavcan.Timestamp', 'dynamic', None): DSDL arrays are fixed or bounded
+        """
+        problem = None
+        bits = _DSDL_BITS.get(self.kind)
+        if self.kind == "composite":
+            if not isinstance(self.composite, str) or not self.composite or self.bits != 0:
+                problem = "a composite names its type and has no bit length"
+        elif bits is None:
+            problem = f"unknown kind {self.kind!r}"
+        elif self.composite is not None:
+            problem = "only a composite names a type"
+        elif not _is_int(self.bits) or self.bits not in bits:
+            problem = _DSDL_BITS_TEXT[self.kind]
+        if problem is None and self.array not in ("", "fixed", "bounded"):
+            problem = "DSDL arrays are fixed or bounded"
+        elif problem is None and self.array and not (_is_int(self.capacity) and self.capacity >= 1):
+            problem = f"a {self.array} array needs a capacity of at least 1"
+        elif problem is None and not self.array and self.capacity is not None:
+            problem = "only an array has a capacity"
+        elif problem is None and self.truncated and self.kind not in ("bool", "int", "uint", "float"):
+            problem = "only a number or bool has a cast mode"
+        if problem is not None:
+            raise ValueError(f"DsdlType({self.kind!r}, {self.bits!r}, {self.composite!r}, {self.array!r}, "
+                             f"{self.capacity!r}): {problem}")
+
     @property
     def element(self) -> DsdlType:
         return DsdlType(self.kind, self.bits, self.composite, truncated=self.truncated)
@@ -189,6 +263,18 @@ class DsdlType:
         elif self.array == "bounded":
             text += f"[<={self.capacity}]"
         return text
+
+
+# The bit lengths a primitive kind may have (pydsdl's and dronecan's limits together).
+_DSDL_BITS: dict[str, range | tuple[int, ...]] = {
+    "bool": (1,), "byte": (8,), "utf8": (8,), "float": (16, 32, 64), "int": range(2, 65), "uint": range(1, 65),
+    "void": range(1, 65),
+}
+_DSDL_BITS_TEXT = {
+    "bool": "a bool has 1 bit", "byte": "a byte has 8 bits", "utf8": "a utf8 has 8 bits",
+    "float": "a float has 16, 32 or 64 bits", "int": "an int has 2..64 bits", "uint": "a uint has 1..64 bits",
+    "void": "a void has 1..64 bits",
+}
 
 
 def split_composite_name(name: str) -> tuple[str, int, int]:
