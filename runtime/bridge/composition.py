@@ -92,7 +92,13 @@ class Bridge:
         self.tables = tables = gen.tables()
         self.selection = sel = select(tables, layout, protocol)
         self.transport_config = transport or TransportConfig()
-        self.node_id = self.transport_config.node_id(tables.BRIDGE_NODE_ID) if node_id is None else int(node_id)
+        if node_id is not None:
+            self.node_id = int(node_id)
+        elif tables.BRIDGE_NODE_ID is None:
+            raise BridgeConfigError(f"{gen.root}: the spec declares no bridge (bridge.node_id), so there is nothing to "
+                                    f"bridge")
+        else:
+            self.node_id = self.transport_config.node_id(tables.BRIDGE_NODE_ID)
         self.log = RateLimitedLog(log, log_interval)
         self.lifetime = Lifetime(self.name, self.log)
         lock = threading.Lock()

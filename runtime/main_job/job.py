@@ -281,7 +281,7 @@ class LiveView:
 
     # ---------------------------------------------------------------------------------- table
     def table(self, header: str) -> list[str]:
-        bridge = self.tables.BRIDGE_NAME
+        bridge = self.tables.BRIDGE_NAME or ""
         drops_by_topic: dict[str, int] = collections.Counter()
         for name, d in self.diagnostics.items():
             if name.startswith(f"{bridge}/mapping/"):

@@ -56,7 +56,7 @@ class DeadReckoning(DeadReckoningBase):
         t = now_s(self)
         pose = self.estimator.pose(t)
         ages = self.estimator.input_ages(t)
-        silent = [k for k in ("imu", "mag", "pressure") if ages[k] is None or ages[k] > INPUT_TIMEOUT_S]
+        silent = [k for k in ("imu", "mag", "pressure") if (age := ages[k]) is None or age > INPUT_TIMEOUT_S]
         refused = {k: v for k, v in self.estimator.counts.items() if k.startswith("refused.")}
         if pose is None:
             self.status(Level.WARN, "waiting for " + ", ".join(silent or ["the first pose"]), **refused)

@@ -204,7 +204,9 @@ class ClosedLoop:
                         longitudinal_weight_pct=c.longitudinal_weight_pct, buoyancy_pct=c.buoyancy_pct)
             emergency = self.monitor_output
             if emergency is not None and emergency.abort_active:  # the monitor's own commands (same topics)
-                veh.command(rpm_1=emergency.rpm, rpm_2=emergency.rpm, buoyancy_pct=emergency.buoyancy_pct)
+                rpm, buoyancy = emergency.rpm, emergency.buoyancy_pct
+                assert rpm is not None and buoyancy is not None, "an active abort carries its commands"
+                veh.command(rpm_1=rpm, rpm_2=rpm, buoyancy_pct=buoyancy)
         if self.tick % round(self.options.record_period * TICK_HZ) == 0:
             self._record(world)
         self.tick += 1

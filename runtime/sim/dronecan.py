@@ -107,7 +107,7 @@ class DroneCanDevices:
         self.iface = sim.config.dronecan_iface
         self._kind = parse_iface(self.iface).kind  # IfaceError (a ValueError) for a bad or refused URI
         self._restarts: set[asyncio.Task[None]] = set()
-        if not 1 <= sim.bridge_node_id <= 127:
+        if sim.bridge_node_id is not None and not 1 <= sim.bridge_node_id <= 127:
             raise ValueError(f"a DroneCAN node id is 1..127, not the bridge's {sim.bridge_node_id}")
         for dev in sim.devices:
             if dev.protocol == self.protocol and not 1 <= dev.info.node_id <= 125:

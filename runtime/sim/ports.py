@@ -88,7 +88,7 @@ class DeviceHost(Protocol):
     tables: TablesModule
     config: SimConfig
     devices: list[SimDevice]
-    bridge_node_id: int
+    bridge_node_id: int | None
 
     def on_command(self, dev: SimDevice, sp: SubPort, msg: Any, transfer: Any) -> None:
         """A command arrived on ``sp`` (``transfer.source_node_id`` sent it)."""

@@ -96,8 +96,9 @@ class Simulator:
         self.vehicle = VehicleState(time_scale=self.config.time_scale, model=self.config.make_vehicle())
         self._truth_task: asyncio.Task[None] | None = None
         self.truth_written = 0
-        self.bridge_node_id = int(self.config.bridge_node_id if self.config.bridge_node_id is not None
-                                  else self.tables.BRIDGE_NODE_ID)
+        # A spec without a bridge has no node to take commands from: the actuators then accept none.
+        self.bridge_node_id: int | None = (self.config.bridge_node_id if self.config.bridge_node_id is not None
+                                           else self.tables.BRIDGE_NODE_ID)
         protocols = layout_protocols(self.tables, self.config.layout)
         wanted = None if self.config.devices is None else set(self.config.devices)
         if wanted is not None and wanted - set(protocols):
