@@ -27,7 +27,10 @@ import math
 import threading
 from dataclasses import dataclass, field
 
-__all__ = ["TfBuffer", "TfError", "TfExtrapolation", "TfMissingEdge", "TfStale", "Transform"]
+from sam_codegen.model.frames import quat_from_rpy
+
+# quat_from_rpy: the spec's rpy convention, one definition shared with the generator (sam_codegen.model.frames).
+__all__ = ["TfBuffer", "TfError", "TfExtrapolation", "TfMissingEdge", "TfStale", "Transform", "quat_from_rpy"]
 
 Vector = tuple[float, float, float]
 Quaternion = tuple[float, float, float, float]  # x, y, z, w
@@ -95,21 +98,6 @@ def quat_rotate(q: Quaternion, v: Vector) -> Vector:
 
 def quat_conjugate(q: Quaternion) -> Quaternion:
     return (-q[0], -q[1], -q[2], q[3])
-
-
-def quat_from_rpy(roll: float, pitch: float, yaw: float) -> Quaternion:
-    """Roll, pitch, yaw about the fixed x, y, z axes (URDF's rpy, tf2's setRPY).
-
-    >>> [round(c, 12) for c in quat_from_rpy(0.0, 0.0, math.pi)]
-    [0.0, 0.0, 1.0, 0.0]
-    """
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
 
 
 def quat_to_rpy(q: Quaternion) -> Vector:

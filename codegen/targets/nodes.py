@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sam_codegen.model.frames import quat_from_rpy
 from sam_codegen.model.spec import Parameter, Qos, Spec
 from sam_codegen.render.filters import natural_key, one_line, py_str
 from sam_codegen.render.pysource import float_literal
@@ -42,7 +43,7 @@ from sam_codegen.validate.nodes import (
 )
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["emit", "nodes_package", "params_file", "quat_from_rpy"]
+__all__ = ["emit", "nodes_package", "params_file"]
 
 PY_TYPES = {"double": "float", "integer": "int", "bool": "bool", "string": "str"}
 # Names the generated modules define or import themselves; a message class of the same name gets an alias.
@@ -85,19 +86,6 @@ def doc_wrap(text: object, first: str = "", rest: str = "", width: int = DOC_WID
     lines = textwrap.wrap(one_line(str(text)), width, initial_indent=first, subsequent_indent=rest,
                           break_on_hyphens=False) or [first.rstrip()]
     return "\n".join(_escape(line) for line in lines)
-
-
-def quat_from_rpy(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of roll, pitch, yaw about the fixed x, y, z axes (URDF's rpy; as sam_runtime.tf_buffer).
-
-    >>> quat_from_rpy(0.0, 0.0, 0.0)
-    (0.0, 0.0, 0.0, 1.0)
-    """
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
 
 
 def qos_args(qos: Qos) -> str:
