@@ -10,7 +10,6 @@ spec (float32[2], int8[<=3], bool, nested messages in its commands), the rover s
 
 from __future__ import annotations
 
-import doctest
 import json
 import signal
 import subprocess
@@ -34,11 +33,6 @@ from helpers.spec_build import built_spec
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
-
-def test_demo_doctests() -> None:
-    import sam_runtime.main_job.demo
-
-    assert doctest.testmod(sam_runtime.main_job.demo).failed == 0
 
 
 def _spec(name: str) -> tuple[Path, Path]:

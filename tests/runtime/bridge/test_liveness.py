@@ -3,17 +3,11 @@ Pure logic on times passed in: no waiting. The bridge's use of it: tests/test_gl
 
 from __future__ import annotations
 
-import doctest
 import math
 
 import pytest
 
-import sam_runtime.bridge.liveness
 from sam_runtime.bridge.liveness import LivenessCheck, grace_s, silence_of
-
-
-def test_doctests() -> None:
-    assert doctest.testmod(sam_runtime.bridge.liveness).failed == 0
 
 
 @pytest.mark.parametrize(("rate", "grace"), [(100.0, 3.0), (10.0, 3.0), (5 / 3, 3.0), (1.0, 5.0), (0.1, 50.0),

@@ -406,11 +406,3 @@ def test_diagnostics_levels_from_the_backends_health() -> None:
     assert by["br/device/e"].message == "heartbeat lost: none for 3.2 s (the bridge's DroneCAN link is down)"
     assert "level" not in {kv.key for kv in by["br/device/a"].values}
 
-
-def test_doctests() -> None:
-    import doctest
-
-    import sam_runtime.bridge.loss
-
-    res = doctest.testmod(sam_runtime.bridge.loss)
-    assert res.attempted > 0 and res.failed == 0

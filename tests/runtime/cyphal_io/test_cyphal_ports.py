@@ -3,14 +3,12 @@ in-memory registry. Read over the network by a Cyphal tool: tests/test_glider_br
 
 from __future__ import annotations
 
-import doctest
 from typing import Any
 
 import pytest
 
 pytest.importorskip("pycyphal")
 
-import sam_runtime.cyphal_io.ports
 from sam_runtime.cyphal_io.ports import PortConfigError, register_environment, register_node_id, resolve_subject
 
 
@@ -29,9 +27,6 @@ def _registry(env: dict[str, str]) -> Any:
 
     return pycyphal.application.make_registry(None, environment_variables=register_environment(env))
 
-
-def test_doctests() -> None:
-    assert doctest.testmod(sam_runtime.cyphal_io.ports).failed == 0
 
 
 def test_default_is_the_spec_subject_and_the_type_is_exposed(heartbeat_type: type) -> None:

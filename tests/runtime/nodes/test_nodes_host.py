@@ -7,7 +7,6 @@ does); the command-line checks run the host as a child process.
 
 from __future__ import annotations
 
-import doctest
 import signal
 import subprocess
 import sys
@@ -31,13 +30,6 @@ pytestmark = [pytest.mark.ros]
 def _nodes(*args: str, env: dict[str, str] | None = None, timeout: float = 60) -> subprocess.CompletedProcess[str]:
     return subprocess.run(runtime_cmd("nodes", *args), capture_output=True, text=True, timeout=timeout, env=env)
 
-
-def test_doctests() -> None:
-    import sam_runtime.nav.mission
-    import sam_runtime.nodes.common
-
-    for module in (sam_runtime.nodes.common, sam_runtime.nav.mission):
-        assert doctest.testmod(module).failed == 0, module.__name__
 
 
 # ============================================================================================ what runs

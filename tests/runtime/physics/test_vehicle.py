@@ -3,12 +3,10 @@ at the surface and the sea floor, finite actuator rates, determinism for a seed,
 
 from __future__ import annotations
 
-import doctest
 import math
 
 import pytest
 
-import sam_runtime.physics.vehicle as vehicle_module
 from sam_runtime.physics.geo import local_from_latlon
 from sam_runtime.physics.vehicle import (
     SeaFloor,
@@ -18,10 +16,6 @@ from sam_runtime.physics.vehicle import (
     VehicleParams,
     steady_surge_speed,
 )
-
-
-def test_doctests() -> None:
-    assert doctest.testmod(vehicle_module).failed == 0
 
 
 def _run(v: Vehicle, seconds: float, **commands: float) -> Vehicle:
