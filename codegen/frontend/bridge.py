@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.reading import Reader, int_list, map_items, number, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.yaml_source import YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
@@ -220,7 +221,7 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
 
 def parse_layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
     what = f"layout {key!r}"
-    r = Reader(node, what, diag, ("description", "protocol", "devices"))
+    r = Reader(node, what, diag, ("description", "protocol", "devices", "bus"))
     layout_protocol = r.get("protocol", str, None)
     if layout_protocol is not None and layout_protocol not in PROTOCOLS:
         diag.error(r.key_pos("protocol"), f"protocol {layout_protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
@@ -235,4 +236,5 @@ def parse_layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
         elif protocol is not None:
             devices[device] = protocol
             device_pos[device] = key_pos
-    return Layout(key, text_of(r, "description"), layout_protocol, devices, device_pos, pos)
+    return Layout(key, text_of(r, "description"), layout_protocol, devices, device_pos, pos,
+                  parse_bus(r.node("bus"), f"the bus of {what}", diag))

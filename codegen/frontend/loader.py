@@ -12,6 +12,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mapping
+from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
 from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
@@ -42,6 +43,7 @@ __all__ = ["QOS_DEPTH_MAX", "load_spec_file", "parse_qos", "parse_spec", "scalar
 _TOP_KEYS = (
     "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "dronecan_types",
     "frames", "transforms", "topics", "parameters", "parameter_rules", "devices", "layouts", "bridge", "nodes",
+    "bus",
 )
 
 
@@ -145,11 +147,12 @@ def parse_spec(root: YNode, file: str) -> Spec:
         nodes[key] = parse_node(key, pos, node, diag)
     bridged = {m.topic for m in bridge.all_mappings if m.direction == UAVCAN_TO_ROS} if bridge is not None else set()
     topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
+    bus = parse_bus(top.node("bus"), "bus", diag)
     diag.check()
     return Spec(
         file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
         cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
-        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts,
+        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus,
     )
 
 

@@ -277,6 +277,19 @@ class Device:
 
 
 @dataclass(frozen=True)
+class CanBus:
+    """The CAN bus of the vehicle or of one layout (`bus:`), which the build's bus budget judges (validate.bus_budget).
+
+    `bus: none` (present=False): a vehicle without CAN (Cyphal/UDP only), no budget."""
+
+    bitrate: int = 1_000_000  # bit/s: classic CAN, or CAN FD's arbitration phase
+    fd_data_bitrate: int | None = None  # CAN FD's data phase (Cyphal at MTU 64); None: classic CAN
+    load_warning_percent: float = 70.0
+    present: bool = True
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
 class Layout:
     """Which protocol each device speaks: the vehicle as one firmware set (a bus may carry both protocols)."""
 
@@ -286,6 +299,7 @@ class Layout:
     devices: dict[str, str] = field(default_factory=dict)  # per-device overrides
     device_pos: dict[str, Pos] = field(default_factory=dict)
     pos: Pos = NOWHERE
+    bus: CanBus | None = None  # its own bus; None: the spec's
 
 
 @dataclass(frozen=True)
@@ -428,6 +442,7 @@ class Spec:
     nodes: dict[str, Node] = field(default_factory=dict)
     dronecan_types: dict[str, V0Struct] = field(default_factory=dict)  # the spec's own v0 types, by full name
     layouts: dict[str, Layout] = field(default_factory=dict)  # the named layouts beside the implicit default
+    bus: CanBus | None = None  # the vehicle's CAN bus; None: classic CAN at 1 Mbit/s
 
     def devices_by_node_id(self) -> dict[int, Device]:
         return {d.node_id: d for d in self.devices.values()}

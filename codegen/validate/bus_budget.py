@@ -20,7 +20,9 @@ Invariants:
   bits at the nominal bit rate (arbitration, ACK, EOF, intermission) and 32 + 8*DLC (DLC <= 16) or 37 + 8*DLC at the
   data bit rate (control, stuff count, CRC 17/21 with its fixed stuff bits, CRC delimiter).
 - The verdict judges the load with worst-case stuffing (the bound a bus must survive): above the warning threshold
-  (default 70 %) a warning, above 100 % a spec error at the layout (or the `bus` key that sets the bus).
+  (default 70 %, the spec's `load_warning_percent`) a warning, above 100 % a spec error (check_bus_budgets) at the
+  layout's own `bus`, else the named layout, else the spec's `bus`, else the device that loads the bus most.
+- The bus: a layout's own `bus:`, else the spec's, else classic CAN at 1 Mbit/s; `bus: none` has no budget.
 - Pure arithmetic on the resolved spec: no clock, no I/O; the same spec gives the same figures byte for byte.
 """
 
@@ -30,8 +32,8 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from sam_codegen.model.diagnostics import Diagnostic, Pos
-from sam_codegen.model.spec import DsdlStruct, Spec, V0Struct
+from sam_codegen.model.diagnostics import Diagnostic, Pos, SpecError
+from sam_codegen.model.spec import CanBus, DsdlStruct, Spec, V0Struct
 from sam_codegen.model.types import DsdlType
 from sam_codegen.validate.dronecan import ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping
@@ -45,6 +47,7 @@ __all__ = [
     "NodeBudget",
     "Transfer",
     "bus_for",
+    "check_bus_budgets",
     "classic_frame_bits",
     "cyphal_frame_lengths",
     "cyphal_max_bytes",
@@ -364,11 +367,16 @@ class LayoutBudget:
         return None
 
 
-def bus_for(spec: Spec, layout: str) -> Bus:
-    """The bus a layout runs on: its own `bus:`, else the spec's, else classic CAN at 1 Mbit/s."""
+def bus_for(spec: Spec, layout: str) -> Bus | None:
+    """The bus a layout runs on: its own `bus:`, else the spec's, else classic CAN at 1 Mbit/s; None for `bus: none`
+    (no CAN bus, no budget)."""
     named = spec.layouts.get(layout)
-    own = getattr(named, "bus", None) if named is not None else None
-    return own or getattr(spec, "bus", None) or Bus()
+    declared: CanBus | None = (named.bus if named is not None else None) or spec.bus
+    if declared is None:
+        return Bus()
+    if not declared.present:
+        return None
+    return Bus(declared.bitrate, declared.fd_data_bitrate, declared.load_warning_percent, declared.pos)
 
 
 def _liveness(protocol: str) -> Transfer:
@@ -393,7 +401,10 @@ def layout_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str
     classic CAN; None: the bus the spec declares). ``mappings`` holds the resolved mappings by protocol."""
     result = []
     for layout in layouts:
-        bus = bus_for(spec, layout.name)
+        found = bus_for(spec, layout.name)
+        if found is None:
+            continue  # `bus: none`
+        bus = found
         if fd is True and not bus.fd:
             bus = Bus(bus.bitrate, DEFAULT_FD_DATA_BITRATE, bus.warning_percent, bus.pos)
         elif fd is False and bus.fd:
@@ -426,10 +437,24 @@ def layout_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str
                 if layout.devices(protocol):  # a bridge node per protocol its devices speak
                     nodes.append(NodeBudget(spec.bridge.name, spec.bridge.node_id, protocol,
                                             (*commands, _liveness(protocol))))
-        # Where an overload is reported: the `bus` key that sets the bus, else the named layout, else (the implicit
-        # default layout has no place in the file) the device that loads the bus most.
+        # Where an overload is reported: the layout's own `bus`, else the named layout, else the spec's `bus`, else
+        # (the implicit default layout has no place in the file) the device that loads the bus most.
+        named = spec.layouts.get(layout.name)
         heaviest = max((n for n in nodes if n.name in spec.devices), key=lambda n: n.load(bus), default=None)
-        pos = bus.pos or (spec.layouts[layout.name].pos if layout.name in spec.layouts else
-                          spec.devices[heaviest.name].pos if heaviest is not None else Pos(spec.file))
+        if named is not None:
+            pos = named.bus.pos if named.bus is not None else named.pos
+        elif spec.bus is not None:
+            pos = spec.bus.pos
+        else:
+            pos = spec.devices[heaviest.name].pos if heaviest is not None else Pos(spec.file)
         result.append(LayoutBudget(layout.name, bus, tuple(nodes), pos))
     return result
+
+
+def check_bus_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str, list[ResolvedMapping]],
+                      cyphal: Lookup, dronecan: V0Lookup) -> None:
+    """Raise SpecError when a layout's bus cannot carry it (over 100 % with worst-case stuffing)."""
+    errors = [d for d in (b.diagnostic() for b in layout_budgets(spec, layouts, mappings, cyphal, dronecan))
+              if d is not None]
+    if errors:
+        raise SpecError(errors)

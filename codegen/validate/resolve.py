@@ -29,6 +29,7 @@ from sam_codegen.model.types import (
     is_dsdl_identifier,
     split_composite_name,
 )
+from sam_codegen.validate.bus_budget import check_bus_budgets
 from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
@@ -355,6 +356,8 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")
     v.diag.check()
+    # The bus budget judges the resolved spec: a layout its CAN bus cannot carry is an error too.
+    check_bus_budgets(spec, layouts, {"cyphal": mappings, "dronecan": dronecan_mappings}, dsdl.get, v0.get)
     # Every type of the spec passed its checks, so each has its signature (computed in check_types).
     dronecan_types = [v0.signed(t.name) for t in sorted(spec.dronecan_types.values(), key=lambda t: t.name)]
     return Resolved(spec, ros, dsdl, messages, sorted(spec.dsdl_types.values(), key=lambda t: t.name), mappings,

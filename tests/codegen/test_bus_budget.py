@@ -12,7 +12,7 @@ import pydsdl
 import pytest
 
 from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.model.diagnostics import Pos
+from sam_codegen.model.diagnostics import Pos, SpecError
 from sam_codegen.validate.bus_budget import (
     Bus,
     LayoutBudget,
@@ -245,3 +245,93 @@ def test_build_prints_the_budget_and_refuses_a_bus_it_overloads(tmp_path: Path) 
     text = (tmp_path / "over" / "spec" / "interfaces.yaml").read_text().splitlines()
     assert "buoy.Level.0.1, rate_hz: 8000" in "\n".join(text[diagnostic.pos.line - 1: diagnostic.pos.line + 6])
     assert "error: layout 'default' needs" in str(diagnostic) and "most from" in str(diagnostic)
+
+
+# ---- the spec's `bus` key ---------------------------------------------------------------------------------------
+
+def _spec_with(tmp_path: Path, old: str, new: str) -> Path:
+    text = (REPO / "tests" / "specs" / "minimal.yaml").read_text()
+    assert old in text
+    spec = tmp_path / "minimal.yaml"
+    spec.write_text(text.replace(old, new, 1))
+    return spec
+
+
+def _errors(path: Path) -> list[str]:
+    try:
+        validate(load_spec_file(path))
+    except SpecError as exc:
+        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
+    return []
+
+
+LAYOUT = "  all_dronecan: {description: Everything on DroneCAN., protocol: dronecan}"
+BUS_CASES = {
+    "not_a_mapping": ("bus: fast\n", ["minimal.yaml:{line}:6: error: bus must be a mapping or none, found str 'fast' "
+                                       "(expected {{bitrate: ..., fd_data_bitrate: ..., load_warning_percent: ...}} "
+                                       "or none)"]),
+    "unknown_key": ("bus: {speed: 5}\n", ["minimal.yaml:{line}:7: error: unknown field 'speed' in bus (expected one of "
+                                            "bitrate, fd_data_bitrate, load_warning_percent)"]),
+    "bitrate_range": ("bus: {bitrate: 2000000}\n", ["minimal.yaml:{line}:7: error: bitrate 2000000 of bus is out of "
+                                                     "range (expected 10000..1000000 bit/s (classic CAN, or CAN FD's "
+                                                     "arbitration phase))"]),
+    "data_below_nominal": ("bus: {bitrate: 500000, fd_data_bitrate: 250000}\n",
+                           ["minimal.yaml:{line}:24: error: fd_data_bitrate 250000 of bus is out of range (expected "
+                            "500000..12000000 bit/s (at least the bitrate))"]),
+    "warning_range": ("bus: {load_warning_percent: 0}\n", ["minimal.yaml:{line}:7: error: load_warning_percent 0 of "
+                                                           "bus is out of range (expected a percentage above 0, at "
+                                                           "most 100)"]),
+    "bitrate_type": ("bus: {bitrate: 1000000.0}\n", ["minimal.yaml:{line}:16: error: 'bitrate' of bus must be int, "
+                                                     "found float 1000000.0 (expected int)"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BUS_CASES))
+def test_a_wrong_bus_is_a_spec_error_at_its_key(name: str, tmp_path: Path) -> None:
+    text, errors = BUS_CASES[name]
+    base = (REPO / "tests" / "specs" / "minimal.yaml").read_text()
+    line = base[: base.index("devices:")].count("\n") + 1
+    spec = _spec_with(tmp_path, "devices:\n", text + "devices:\n")
+    assert _errors(spec) == [e.format(line=line) for e in errors]
+
+
+def test_the_spec_sets_the_bus_and_a_layout_its_own(tmp_path: Path) -> None:
+    spec = _spec_with(tmp_path, "devices:\n", "bus: {bitrate: 500000, fd_data_bitrate: 2000000, "
+                      "load_warning_percent: 50}\ndevices:\n")
+    resolved = validate(load_spec_file(spec))
+    (budget,) = budgets(resolved).values()
+    assert budget.bus == Bus(500_000, 2_000_000, 50.0, budget.bus.pos) and budget.bus.fd
+    assert budget.bus.describe() == "CAN FD 500 kbit/s, data 2 Mbit/s"
+    v0 = (REPO / "tests" / "specs" / "buoy_v0.yaml").read_text()
+    assert LAYOUT in v0
+    layout_spec = tmp_path / "buoy_v0.yaml"
+    layout_spec.write_text(v0.replace(LAYOUT, LAYOUT[:-1] + ", bus: {bitrate: 125000}}", 1))
+    found = budgets(validate(load_spec_file(layout_spec)))
+    assert found["default"].bus == Bus() and found["all_dronecan"].bus.bitrate == 125_000
+
+
+def test_bus_none_has_no_budget(tmp_path: Path) -> None:
+    from sam_codegen.build import generate
+
+    spec = _spec_with(tmp_path, "type: buoy.Level.0.1, rate_hz: 10}", "type: buoy.Level.0.1, rate_hz: 100000}")
+    assert _errors(spec) and "needs" in _errors(spec)[0]  # 100 kHz on one bus: refused ...
+    text = spec.read_text().replace("devices:\n", "bus: none\ndevices:\n", 1)
+    spec.write_text(text)
+    lines: list[str] = []
+    files = generate(spec, report=lines.append)  # ... unless the vehicle has no CAN bus
+    assert lines == [] and "## CAN bus budget" not in files["docs/interfaces.md"]
+
+
+def test_the_overload_of_a_named_layout_is_reported_at_its_bus(tmp_path: Path) -> None:
+    v0 = (REPO / "tests" / "specs" / "buoy_v0.yaml").read_text()
+    spec = tmp_path / "buoy_v0.yaml"
+    changed = LAYOUT[:-1] + ", bus: {bitrate: 10000}}"
+    assert "{type: buoy.Status, rate_hz: 2}" in v0
+    spec.write_text(v0.replace(LAYOUT, changed, 1).replace("{type: buoy.Status, rate_hz: 2}",
+                                                           "{type: buoy.Status, rate_hz: 200}", 1))
+    errors = _errors(spec)
+    lines = spec.read_text().splitlines()
+    line = lines.index(changed) + 1
+    column = changed.index("bus: {") + len("bus: ") + 1
+    assert len(errors) == 1 and errors[0].startswith(f"buoy_v0.yaml:{line}:{column}: error: layout 'all_dronecan' "
+                                                     "needs ")

@@ -11,7 +11,6 @@ from sam_codegen.validate.bus_budget import (
     DEFAULT_FD_DATA_BITRATE,
     LayoutBudget,
     Transfer,
-    bus_for,
     classic_frame_bits,
     layout_budgets,
 )
@@ -46,6 +45,8 @@ def budget_context(resolved: Resolved) -> dict[str, object]:
     if not resolved.spec.devices:
         return {"bus_budget": None}
     declared = resolved_budgets(resolved)
+    if not declared:  # `bus: none`
+        return {"bus_budget": None}
     other = resolved_budgets(resolved, fd=not any(b.bus.fd for b in declared))
     layouts = []
     for budget, alternative in zip(declared, other, strict=True):
@@ -59,9 +60,8 @@ def budget_context(resolved: Resolved) -> dict[str, object]:
                        "frames": _rate(n.frames_per_s(budget.bus)), "load": _percent(n.load(budget.bus))}
                       for n in budget.nodes],
         })
-    bus = bus_for(resolved.spec, "default")
     return {"bus_budget": {
-        "layouts": layouts, "warning_percent": f"{bus.warning_percent:g}",
+        "layouts": layouts, "warning_percent": f"{declared[0].bus.warning_percent:g}",
         "fd_default": f"{DEFAULT_FD_DATA_BITRATE / 1e6:g} Mbit/s",
         "frame_bits": classic_frame_bits(8), "frame_bits_worst": classic_frame_bits(8, worst_case=True),
         "frames_1m": f"{1e6 / classic_frame_bits(8):,.0f}",
