@@ -320,7 +320,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
                 rows.setdefault(status.name, []).append((t, level))
     names = sorted(rows)
     if rows or rec.get("/abort"):
-        labels = [*names, "abort"]
+        rows_shown = [*names, "abort"]
         for k, name in enumerate(names):
             samples = rows[name]
             for (a, level), (b, _) in zip(samples, [*samples[1:], (end, 0)], strict=True):
@@ -338,8 +338,8 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         if not names:
             ax_state.text(0.5, 0.5, "/diagnostics not recorded", transform=ax_state.transAxes, ha="center",
                           color="#7f8c8d")
-        ax_state.set_yticks(range(len(labels)), labels, fontsize=9)
-        ax_state.set_ylim(-0.7, len(labels) + 0.2)
+        ax_state.set_yticks(range(len(rows_shown)), rows_shown, fontsize=9)
+        ax_state.set_ylim(-0.7, len(rows_shown) + 0.2)
         ax_state.set_xlim(0, end)
         ax_state.legend(handles=[Patch(color=c, label=n) for n, c in LEVELS.values()]
                         + [Patch(color=ABORT_COLOUR, label="abort active")],
