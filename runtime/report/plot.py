@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import textwrap
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -136,43 +137,22 @@ def _limit_lines(ax: Any, limits: Mapping[str, float], names: tuple[str, str], t
         ax.set_title(f"{ax.get_title()}\n(beyond the plotted range: {', '.join(off_scale)})", fontsize=10)
 
 
-def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None, title: str | None = None) -> Path:
-    """Draw the run recorded in ``mcap`` into ``out`` (.png or .svg); returns ``out``. Raises RecordingError for a
-    file that is not a recording, ValueError for an output format other than PNG or SVG."""
-    import matplotlib
+@dataclass(frozen=True)
+class _Run:
+    """What every panel draws from: the recording, its abort spans, its length and the parameter limits; the track
+    (frame, (t, x, y, depth) points) and the goals (t, position) that the track and depth panels share."""
 
-    matplotlib.use("Agg")  # no display: a file is all we write
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Patch
+    rec: Recording
+    spans: list[tuple[float, float, str]]
+    end: float
+    limits: Mapping[str, float]
+    frame: str
+    points: list[tuple[float, float, float, float]]
+    goals: list[tuple[float, Any]]
 
-    out = Path(out)
-    if out.suffix.lower() not in (".png", ".svg"):
-        raise ValueError(f"{out}: the report is a .png or .svg picture")
-    rec = read_recording(Path(mcap), TOPICS)
-    limits = dict(limits or {})
-    spans = _abort_spans(rec)
-    end = max(rec.end_s, 1.0)
 
-    fig = plt.figure(figsize=(15, 19), dpi=100)
-    grid = fig.add_gridspec(5, 2, height_ratios=[1.15, 1.15, 1, 1, 1.05], hspace=0.42, wspace=0.2,
-                            left=0.12, right=0.93, top=0.94, bottom=0.05)
-    ax_track = fig.add_subplot(grid[0:2, 0])
-    ax_depth = fig.add_subplot(grid[0, 1])
-    ax_alt = fig.add_subplot(grid[1, 1], sharex=ax_depth)
-    ax_rpm = fig.add_subplot(grid[2, 0], sharex=ax_depth)
-    ax_ang = fig.add_subplot(grid[2, 1], sharex=ax_depth)
-    ax_pct = fig.add_subplot(grid[3, 0], sharex=ax_depth)
-    ax_bat = fig.add_subplot(grid[3, 1], sharex=ax_depth)
-    ax_state = fig.add_subplot(grid[4, :], sharex=ax_depth)
-    heading = title or f"Run {Path(mcap).name}"
-    fig.suptitle(f"{heading}  ({end:.0f} s recorded)", fontsize=15)
-    if rec.problems:
-        note = textwrap.shorten("Recording: " + "; ".join(rec.problems), 200, placeholder=" ...")
-        fig.text(0.5, 0.955, note, ha="center", fontsize=9, color=ABORT_COLOUR)
-
-    # ---- track and goals
-    frame, points = track(rec)
-    goals = [(t, m.pose.position) for t, m in rec.get("/nav_goal")]
+def _draw_track(ax_track: Any, run: _Run) -> None:
+    frame, points, goals, spans = run.frame, run.points, run.goals, run.spans
     ax_track.set_title(f"Track in {frame} (world -> odom -> base_link from /tf) and goals")
     if points:
         xs, ys = [p[1] for p in points], [p[2] for p in points]
@@ -208,7 +188,9 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     else:
         _not_recorded(ax_track, "/tf (odom -> base_link) and /nav_goal")
 
-    # ---- depth
+
+def _draw_depth(ax_depth: Any, run: _Run) -> None:
+    rec, spans, end, limits, points, goals = run.rec, run.spans, run.end, run.limits, run.points, run.goals
     ax_depth.set_title("Depth")
     depth_top = 0.0
     if points:
@@ -236,7 +218,9 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     else:
         _not_recorded(ax_depth, "/tf and /pressure")
 
-    # ---- altitude
+
+def _draw_altitude(ax_alt: Any, run: _Run) -> None:
+    rec, spans, limits = run.rec, run.spans, run.limits
     ax_alt.set_title("Altitude above the sea floor (/altitude)")
     altitude = rec.get("/altitude")
     if altitude:
@@ -256,7 +240,9 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     else:
         _not_recorded(ax_alt, "/altitude")
 
-    # ---- commands
+
+def _draw_commands(ax_rpm: Any, ax_ang: Any, ax_pct: Any, run: _Run) -> None:
+    rec, spans = run.rec, run.spans
     ax_rpm.set_title("Thruster commands (/thruster_rpms)")
     if _lines(ax_rpm, rec, "/thruster_rpms", [("thruster_1_rpm", "thruster 1"), ("thruster_2_rpm", "thruster 2")]):
         ax_rpm.set_ylabel("speed [rpm]")
@@ -291,7 +277,9 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     else:
         _not_recorded(ax_pct, "/buoyancy_piston_position and /longitudinal_weight_position")
 
-    # ---- battery
+
+def _draw_battery(ax_bat: Any, run: _Run) -> None:
+    rec, spans = run.rec, run.spans
     ax_bat.set_title("Battery (/battery_state)")
     battery = rec.get("/battery_state")
     if battery:
@@ -310,7 +298,11 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
     else:
         _not_recorded(ax_bat, "/battery_state")
 
-    # ---- abort and node states
+
+def _draw_states(ax_state: Any, run: _Run) -> None:
+    from matplotlib.patches import Patch
+
+    rec, spans, end = run.rec, run.spans, run.end
     ax_state.set_title("Abort (/abort) and node states (/diagnostics)")
     rows: dict[str, list[tuple[float, int]]] = {}
     for t, msg in rec.get("/diagnostics"):
@@ -347,6 +339,49 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
         ax_state.grid(axis="x", alpha=0.3)
     else:
         _not_recorded(ax_state, "/abort and /diagnostics")
+
+
+def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None, title: str | None = None) -> Path:
+    """Draw the run recorded in ``mcap`` into ``out`` (.png or .svg); returns ``out``. Raises RecordingError for a
+    file that is not a recording, ValueError for an output format other than PNG or SVG."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # no display: a file is all we write
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    if out.suffix.lower() not in (".png", ".svg"):
+        raise ValueError(f"{out}: the report is a .png or .svg picture")
+    rec = read_recording(Path(mcap), TOPICS)
+    limits = dict(limits or {})
+    spans = _abort_spans(rec)
+    end = max(rec.end_s, 1.0)
+
+    fig = plt.figure(figsize=(15, 19), dpi=100)
+    grid = fig.add_gridspec(5, 2, height_ratios=[1.15, 1.15, 1, 1, 1.05], hspace=0.42, wspace=0.2,
+                            left=0.12, right=0.93, top=0.94, bottom=0.05)
+    ax_track = fig.add_subplot(grid[0:2, 0])
+    ax_depth = fig.add_subplot(grid[0, 1])
+    ax_alt = fig.add_subplot(grid[1, 1], sharex=ax_depth)
+    ax_rpm = fig.add_subplot(grid[2, 0], sharex=ax_depth)
+    ax_ang = fig.add_subplot(grid[2, 1], sharex=ax_depth)
+    ax_pct = fig.add_subplot(grid[3, 0], sharex=ax_depth)
+    ax_bat = fig.add_subplot(grid[3, 1], sharex=ax_depth)
+    ax_state = fig.add_subplot(grid[4, :], sharex=ax_depth)
+    heading = title or f"Run {Path(mcap).name}"
+    fig.suptitle(f"{heading}  ({end:.0f} s recorded)", fontsize=15)
+    if rec.problems:
+        note = textwrap.shorten("Recording: " + "; ".join(rec.problems), 200, placeholder=" ...")
+        fig.text(0.5, 0.955, note, ha="center", fontsize=9, color=ABORT_COLOUR)
+
+    frame, points = track(rec)
+    run = _Run(rec, spans, end, limits, frame, points, [(t, m.pose.position) for t, m in rec.get("/nav_goal")])
+    _draw_track(ax_track, run)
+    _draw_depth(ax_depth, run)
+    _draw_altitude(ax_alt, run)
+    _draw_commands(ax_rpm, ax_ang, ax_pct, run)
+    _draw_battery(ax_bat, run)
+    _draw_states(ax_state, run)
     ax_state.set_xlabel("time since the recording began [s]")
     for ax in (ax_depth, ax_alt, ax_rpm, ax_ang, ax_pct, ax_bat):
         if ax.has_data():
