@@ -19,6 +19,14 @@ class Case:
 
 CASES: tuple[Case, ...] = (
     Case(
+        'message_without_fields_or_constants',
+        'messages:\n',
+        'messages:\n  Empty:\n    description: Nothing.\n',
+        (
+            "minimal.yaml:7:3: error: message 'Empty' has neither fields nor constants (expected a `fields` list, `constants` or `derive_from`)",
+        ),
+    ),
+    Case(
         'yaml_syntax',
         '  /level: {type: buoy_msgs/Level}',
         '  /level: {type: buoy_msgs/Level',
@@ -542,6 +550,18 @@ CASES: tuple[Case, ...] = (
 
 # DroneCAN cases: each breaks tests/specs/minimal_v0.yaml one way (tests/test_v0_bad_specs.py runs them).
 V0_CASES: tuple[Case, ...] = (
+    Case(
+        'v0_bool_constant_not_a_bit',
+        '  skiff.Bilge:\n    id: 20120\n',
+        '  skiff.Bilge:\n    id: 20120\n    constants:\n      - {name: OPEN, type: bool, value: 0}\n'
+        '      - {name: TWO, type: bool, value: 2}\n      - {name: NEG, type: bool, value: -1}\n'
+        '      - {name: HALF, type: bool, value: 0.5}\n',
+        (
+            'minimal_v0.yaml:16:9: error: constant TWO of DroneCAN type skiff.Bilge = 2 is not a bool (expected true, false, 0 or 1)',
+            'minimal_v0.yaml:17:9: error: constant NEG of DroneCAN type skiff.Bilge = -1 is not a bool (expected true, false, 0 or 1)',
+            'minimal_v0.yaml:18:9: error: constant HALF of DroneCAN type skiff.Bilge = 0.5 is not a bool (expected true, false, 0 or 1)',
+        ),
+    ),
     Case(
         'v0_unknown_standard_type',
         '{type: uavcan.equipment.esc.RPMCommand, rate_hz: 10}',

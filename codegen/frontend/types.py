@@ -43,13 +43,20 @@ def _fields(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Di
     return result
 
 
-def _constants(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics) -> list[Constant]:
+def _constants(node: YNode | None, what: str, parse: Callable[[str], Any], diag: Diagnostics,
+               bool_bits: bool = False) -> list[Constant]:
+    """The constants of a message or DSDL type; with `bool_bits` (DSDL v0) a bool constant may be written 0 or 1."""
     result = []
     for item in seq_items(node, f"the constants of {what}", diag):
         r = Reader(item, f"a constant of {what}", diag, _CONST_KEYS)
         name, type_text = r.get("name", str), r.get("type", str)
         value = r.get("value", (bool, int, float, str))
         type_ = parse_type(type_text, r.key_pos("type"), parse, diag)
+        if (bool_bits and isinstance(type_, DsdlType) and type_.kind == "bool" and not type_.array
+                and isinstance(value, int) and not isinstance(value, bool) and value in (0, 1)):
+            # DSDL v0 firmware writes `bool OPEN = 0`, which dronecan's parser reads as 0/1; kept as a bool here so
+            # that every emitter (DSDL true/false, docs, converters) sees one form.
+            value = bool(value)
         if name is not None and type_ is not None and value is not None:
             result.append(Constant(name, type_, value, text_of(r, "comment"), item.pos))
     return result
@@ -68,12 +75,12 @@ def parse_ros_message(key: str, pos: Pos, node: YNode, package: str, external: b
     if derive is not None and r.node("fields") is not None:
         diag.error(r.key_pos("fields"), f"{what} is derived from {derive}: it cannot also list fields")
     fields = _fields(r.node("fields"), what, parse, diag)
-    if derive is None and not fields and r.ok and not external:
-        diag.error(pos, f"{what} has no fields", "a `fields` list or `derive_from`")
-    return RosMessage(
-        pkg, name, fields, _constants(r.node("constants"), what, parse, diag),
-        text_of(r, "description"), derive, external, pos,
-    )
+    constants = _constants(r.node("constants"), what, parse, diag)
+    # A constants-only message (e.g. a vehicle's Topics.msg of topic names) is valid ROS 2: rosidl's C/C++
+    # generators add a placeholder member themselves. Only a message with nothing in it is refused.
+    if derive is None and not fields and not constants and r.ok and not external:
+        diag.error(pos, f"{what} has neither fields nor constants", "a `fields` list, `constants` or `derive_from`")
+    return RosMessage(pkg, name, fields, constants, text_of(r, "description"), derive, external, pos)
 
 
 def parse_dsdl_struct(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> DsdlStruct:
@@ -99,6 +106,7 @@ def parse_dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V
     layout = _fields(r.node("fields"), what, parse_v0_type, diag)
     fields = [f for f in layout if f.name]
     return V0Struct(
-        key, fields, _constants(r.node("constants"), what, parse_v0_type, diag), text_of(r, "description"),
+        key, fields, _constants(r.node("constants"), what, parse_v0_type, diag, bool_bits=True),
+        text_of(r, "description"),
         pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int, None),
     )

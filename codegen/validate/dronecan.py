@@ -158,7 +158,7 @@ class DronecanValidator:
                     bad = True
             for c in struct.constants:
                 assert isinstance(c.type, DsdlType)
-                check_dsdl_value(self.diag, c.type, c.value, c.pos, f"constant {c.name} of {what}")
+                check_dsdl_value(self.diag, c.type, c.value, c.pos, f"constant {c.name} of {what}", v0=True)
             if bad:
                 self.bad_types.add(struct.name)
         self.check_type_cycles()

@@ -43,8 +43,9 @@ def check_ros_value(diag: Diagnostics, t: RosType, value: Scalar, pos: Pos, what
             diag.error(pos, f"{what} is longer than its bound {t.string_bound}")
 
 
-def check_dsdl_value(diag: Diagnostics, t: DsdlType, value: Scalar, pos: Pos, what: str) -> None:
-    """Report `value` unless it is a literal of the primitive scalar DSDL type `t`."""
+def check_dsdl_value(diag: Diagnostics, t: DsdlType, value: Scalar, pos: Pos, what: str, v0: bool = False) -> None:
+    """Report `value` unless it is a literal of the primitive scalar DSDL type `t` (`v0`: a DSDL v0 type, whose
+    bool constants may also be written 0 or 1; the frontend has already turned those into bools)."""
     if t.array or t.kind in ("composite", "void", "utf8"):
         diag.error(pos, f"{what} must have a primitive scalar type, not {t}")
     elif t.kind in ("int", "uint", "byte"):
@@ -55,4 +56,4 @@ def check_dsdl_value(diag: Diagnostics, t: DsdlType, value: Scalar, pos: Pos, wh
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             diag.error(pos, f"{what} = {value!r} is not a finite number", f"a {t}")
     elif t.kind == "bool" and not isinstance(value, bool):
-        diag.error(pos, f"{what} = {value!r} is not a bool", "true or false")
+        diag.error(pos, f"{what} = {value!r} is not a bool", "true, false, 0 or 1" if v0 else "true or false")

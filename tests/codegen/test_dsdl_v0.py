@@ -201,3 +201,29 @@ def test_converters_are_lint_clean_and_deterministic(spec: str, resolved: dict[s
         capture_output=True, text=True, check=False,
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_bool_constants_written_as_bits(tmp_path: Path) -> None:
+    """v0 DSDL as firmware writes it (issue 17): `bool OPEN = 0` is what dronecan's parser reads too, so the spec
+    takes 0/1 for a bool constant beside true/false; the emitted file is read back by dronecan with the same values."""
+    theirs = tmp_path / "theirs" / "demo"
+    theirs.mkdir(parents=True)
+    (theirs / "20190.Valve.uavcan").write_text("bool OPEN = 0\nbool SHUT = 1\nbool state\n", encoding="utf-8")
+    assert [(c.name, c.value) for c in _parse_with_dronecan(theirs)["demo.Valve"].constants] == [  # type: ignore[attr-defined]
+        ("OPEN", 0), ("SHUT", 1)]
+    old = "  skiff.Bilge:\n    id: 20120\n"
+    base = SPECS["minimal_v0"].read_text(encoding="utf-8")
+    spec = tmp_path / "minimal_v0.yaml"
+    spec.write_text(base.replace(old, old + "    constants:\n      - {name: OPEN, type: bool, value: 0}\n"
+                                 "      - {name: SHUT, type: bool, value: 1}\n"
+                                 "      - {name: LOCKED, type: bool, value: true}\n", 1), encoding="utf-8")
+    r = validate(load_spec_file(spec))
+    files = emit_dsdl_v0.emit(r)
+    text = files["dsdl_v0/skiff/20120.Bilge.uavcan"]
+    assert "bool OPEN = false\nbool SHUT = true\nbool LOCKED = true\n" in text
+    out = tmp_path / "ours"
+    for path, body in files.items():
+        (out / path).parent.mkdir(parents=True, exist_ok=True)
+        (out / path).write_text(body, encoding="utf-8")
+    bilge = _parse_with_dronecan(out / "dsdl_v0" / "skiff")["skiff.Bilge"]
+    assert [(c.name, c.value) for c in bilge.constants] == [("OPEN", 0), ("SHUT", 1), ("LOCKED", 1)]  # type: ignore[attr-defined]

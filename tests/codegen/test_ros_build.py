@@ -318,3 +318,50 @@ def test_a_package_without_messages_is_not_built(tmp_path: Path) -> None:
     assert (own / "package.xml").is_file() and not has_interfaces(own)
     assert ros_packages_in_order(tmp_path / "generated" / "ros") == []  # (the ferry needs no other package either)
     assert main(["ros-install", "--out", str(tmp_path / "generated")]) == 0  # says so; no CMake run
+
+
+_CONSTANTS_ONLY_SCRIPT = textwrap.dedent(
+    """\
+    import json
+
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    from buoy_msgs.msg import Topics
+
+    msg = Topics()
+    roundtrip = deserialize_message(serialize_message(msg), Topics) == msg
+    print("RESULT " + json.dumps({"level": Topics.LEVEL, "roundtrip": roundtrip}))
+    """
+)
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+@needs_ros_build
+def test_a_constants_only_message_builds_and_imports(tmp_path: Path) -> None:
+    """A message of constants only (a vehicle's Topics.msg of topic names, issue 19): rosidl builds it (its C/C++
+    generators add a placeholder member), and Python reads the constant and serializes the empty message."""
+    from sam_codegen.build import generate
+
+    base = (Path(__file__).parents[1] / "specs" / "minimal.yaml").read_text(encoding="utf-8")
+    spec = tmp_path / "minimal.yaml"
+    # (catkin_pkg refuses a package.xml without a description, which minimal.yaml does not give)
+    text = base.replace("ros: {package: buoy_msgs}", "ros: {package: buoy_msgs, description: Test buoy.}", 1)
+    spec.write_text(text.replace("messages:\n", "messages:\n  Topics:\n    description: Topic names.\n    constants:\n"
+                                 "      - {name: LEVEL, type: string, value: /level}\n", 1), encoding="utf-8")
+    files = generate(spec)
+    assert files["ros/buoy_msgs/msg/Topics.msg"].endswith('\n\nstring LEVEL="/level"\n')  # (no blank line after it)
+    for rel, text in files.items():
+        if rel.startswith("ros/"):
+            (tmp_path / "generated" / rel).parent.mkdir(parents=True, exist_ok=True)
+            (tmp_path / "generated" / rel).write_text(text, encoding="utf-8")
+    prefix = tmp_path / "install"
+    build_ros_package(tmp_path / "generated" / "ros" / "buoy_msgs", tmp_path / "build", prefix)
+    script = tmp_path / "constants_only.py"
+    script.write_text(_CONSTANTS_ONLY_SCRIPT)
+    proc = subprocess.run([sys.executable, str(script)], env=ros_runtime_env(prefix), capture_output=True, text=True,
+                          timeout=60, check=False)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
+    assert lines, proc.stdout + proc.stderr
+    assert json.loads(lines[-1].removeprefix("RESULT ")) == {"level": "/level", "roundtrip": True}
