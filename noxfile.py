@@ -24,7 +24,9 @@ RUFF_PATHS = ("codegen", "runtime", "tests", "bench", "noxfile.py", "conftest.py
 def _static_checks(session: nox.Session) -> None:
     """ruff, mypy over both packages, and the import layers (tests/test_layers.py)."""
     session.run("ruff", "check", *RUFF_PATHS)
-    links = Path(session.create_tmp()) / "mypy-path"
+    # Not session.create_tmp(): it sets TMPDIR for the session, which would put the tests' tmp_path inside this
+    # project, where the workspace tests would find its spec.
+    links = Path(session.virtualenv.location) / "mypy-path"
     links.mkdir(exist_ok=True)
     for package, folder in PACKAGE_DIRS.items():
         link = links / package
