@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+from sam_codegen.model.frames import quat_from_rpy
+
 __all__ = [
     "EARTH_RADIUS_M",
     "P_ATM",
@@ -60,19 +62,8 @@ def pressure_at_depth(depth_m: float, p_atm: float = P_ATM, rho: float = RHO_SEA
     return p_atm + rho * g * depth_m
 
 
-def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of R = Rz(yaw) Ry(pitch) Rx(roll).
-
-    >>> [round(v, 6) for v in quaternion_from_euler(0.0, 0.0, math.pi / 2)]
-    [0.0, 0.0, 0.707107, 0.707107]
-    """
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
+# R = Rz(yaw) Ry(pitch) Rx(roll), (x, y, z, w): the same rotation as a spec frame's rpy, so one definition.
+quaternion_from_euler = quat_from_rpy
 
 
 def euler_from_quaternion(q: tuple[float, float, float, float]) -> tuple[float, float, float]:
