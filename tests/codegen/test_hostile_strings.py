@@ -82,7 +82,7 @@ def test_hostile_text_is_inert(text: str, tmp_path: Path) -> None:
     # .msg: rosidl reads the same fields and constants as without the hostile text.
     parser = pytest.importorskip("rosidl_adapter.parser")
     parsed = parser.parse_message_string("sam_msgs", "ThrusterRPMs", files["ros/sam_msgs/msg/ThrusterRPMs.msg"])
-    assert [f.name for f in parsed.fields] == ["header", "thruster_1_rpm", "thruster_2_rpm"]
+    assert [f.name for f in parsed.fields] == ["thruster_1_rpm", "thruster_2_rpm", "header"]
     assert "<script>" not in files["ros/sam_msgs/package.xml"]
 
     # DSDL: pydsdl reads the namespace and sees exactly the declared fields (no injected attribute).

@@ -110,18 +110,18 @@ _W38 = _struct.Struct('<4siI16sfffffffHBBBB2xI')
 _W39 = _struct.Struct('<fffffffHBBBB2xII')
 _W40 = _struct.Struct('<eeeeeeeIBI')
 _W41 = _struct.Struct('<HB')
-_W42 = b'\x01\x00\x00\x00\x00\x00\x00\x00'
-_W43 = _struct.Struct('<4siI8si4x')
-_W44 = _struct.Struct('<i4x')
-_W45 = b'\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
-_W46 = _struct.Struct('<4siI12si')
-_W47 = _struct.Struct('<4xi')
+_W42 = b'\x01\x00\x00\x00\x00'
+_W43 = _struct.Struct('<4si4xiI5s')
+_W44 = _struct.Struct('<i12xI')
+_W45 = b'\x00\x01\x00\x00\x00\x00\x00\x00'
+_W46 = _struct.Struct('<8siiI5s')
+_W47 = _struct.Struct('<4xi8xI')
 _W48 = _struct.Struct('<ee')
-_W49 = _struct.Struct('<4siI8sff')
-_W50 = _struct.Struct('<ff')
+_W49 = _struct.Struct('<4sffiI5s')
+_W50 = _struct.Struct('<ff8xI')
 _W51 = _struct.Struct('<e')
-_W52 = _struct.Struct('<4siI8sf')
-_W53 = _struct.Struct('<f')
+_W52 = _struct.Struct('<4sfiI5s')
+_W53 = _struct.Struct('<f8xI')
 _W54 = _struct.Struct('<H')
 _W55 = _struct.Struct('<IHBIH')
 _W56 = _struct.Struct('<4siI16sifB')
@@ -873,7 +873,7 @@ def thruster_1_rpm_wire_to_ros(
     bits, bits_2 = _W41.unpack_from(buf, 0)
     bits_3 = bits | bits_2 << 16
     rpm = (((bits_3 & 262143) ^ 131072) - 131072)
-    return _W43.pack(_W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42, rpm), receive_ns
+    return _W43.pack(_W1, rpm, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
 
 
 def thruster_1_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -884,17 +884,12 @@ def thruster_1_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
-    offset = 12
+    thruster_1_rpm, length = _W44.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    thruster_1_rpm, = _W44.unpack_from(cdr, offset + 4)
     rpm = thruster_1_rpm
     if rpm > 131071:
         stats.saturate('thruster_1_rpm.rpm')
@@ -917,7 +912,7 @@ def thruster_2_rpm_wire_to_ros(
     bits, bits_2 = _W41.unpack_from(buf, 0)
     bits_3 = bits | bits_2 << 16
     rpm = (((bits_3 & 262143) ^ 131072) - 131072)
-    return _W46.pack(_W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W45, rpm), receive_ns
+    return _W46.pack(_W45, rpm, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
 
 
 def thruster_2_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -928,17 +923,12 @@ def thruster_2_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
-    offset = 12
+    thruster_2_rpm, length = _W47.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    thruster_2_rpm, = _W47.unpack_from(cdr, offset + 4)
     rpm = thruster_2_rpm
     if rpm > 131071:
         stats.saturate('thruster_2_rpm.rpm')
@@ -961,8 +951,8 @@ def thrust_vector_wire_to_ros(
     vertical_radians, horizontal_radians = _W48.unpack_from(buf, 0)
     return (
         _W49.pack(
-            _W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42, vertical_radians,
-            horizontal_radians,
+            _W1, vertical_radians, horizontal_radians, receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _W42,
         ),
         receive_ns,
     )
@@ -976,17 +966,12 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
-    offset = 12
+    thruster_vertical_radians, thruster_horizontal_radians, length = _W50.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    thruster_vertical_radians, thruster_horizontal_radians = _W50.unpack_from(cdr, offset + 4)
     vertical_radians = thruster_vertical_radians
     if vertical_radians > 65504.0:
         stats.saturate('thrust_vector.vertical_radians')
@@ -1015,8 +1000,8 @@ def ballast_wire_to_ros(
     weight_1_offset_radians, weight_2_offset_radians = _W48.unpack_from(buf, 0)
     return (
         _W49.pack(
-            _W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42, weight_1_offset_radians,
-            weight_2_offset_radians,
+            _W1, weight_1_offset_radians, weight_2_offset_radians, receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _W42,
         ),
         receive_ns,
     )
@@ -1030,17 +1015,12 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
-    offset = 12
+    weight_1_offset_radians, weight_2_offset_radians, length = _W50.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    weight_1_offset_radians, weight_2_offset_radians = _W50.unpack_from(cdr, offset + 4)
     weight_1_offset_radians_2 = weight_1_offset_radians
     if weight_1_offset_radians_2 > 65504.0:
         stats.saturate('ballast.weight_1_offset_radians')
@@ -1067,7 +1047,7 @@ def longitudinal_weight_wire_to_ros(
     """
     buf = _extend(payload, 10)
     percent, = _W51.unpack_from(buf, 0)
-    return _W52.pack(_W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42, percent), receive_ns
+    return _W52.pack(_W1, percent, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
 
 
 def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1078,17 +1058,12 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 20:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
-    offset = 12
+    percent, length = _W53.unpack_from(cdr, 4)
+    offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 8:
-        raise WireError('CDR: truncated')
-    percent, = _W53.unpack_from(cdr, offset + 4)
     percent_2 = percent
     if percent_2 != percent_2:  # NaN
         stats.reject('longitudinal_weight.percent')
@@ -1111,7 +1086,7 @@ def buoyancy_piston_wire_to_ros(
     """
     buf = _extend(payload, 10)
     percent, = _W51.unpack_from(buf, 0)
-    return _W52.pack(_W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42, percent), receive_ns
+    return _W52.pack(_W1, percent, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
 
 
 def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1122,17 +1097,12 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 20:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
-    offset = 12
+    percent, length = _W53.unpack_from(cdr, 4)
+    offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 8:
-        raise WireError('CDR: truncated')
-    percent, = _W53.unpack_from(cdr, offset + 4)
     percent_2 = percent
     if percent_2 != percent_2:  # NaN
         stats.reject('buoyancy_piston.percent')

@@ -92,15 +92,15 @@ _K43 = b'\x0f\x00\x00\x00altimeter_link\x00\x00\xcd\xcc\xcc=\x9a\x99\x99>\x00\x0
 _K44 = _struct.Struct('<4siI32sff')
 _K45 = _struct.Struct('<12xff')
 _K46 = _struct.Struct('<7sfH')
-_K47 = b'\x01\x00\x00\x00\x00\x00\x00\x00'
-_K48 = _struct.Struct('<4siI8sii')
-_K49 = _struct.Struct('<ii')
+_K47 = b'\x01\x00\x00\x00\x00'
+_K48 = _struct.Struct('<4siiiI5s')
+_K49 = _struct.Struct('<ii8xI')
 _K50 = _struct.Struct('<BBe')
-_K51 = _struct.Struct('<4siI8sff')
-_K52 = _struct.Struct('<ff')
+_K51 = _struct.Struct('<4sffiI5s')
+_K52 = _struct.Struct('<ff8xI')
 _K53 = _struct.Struct('<BBHBBH')
-_K54 = _struct.Struct('<4siI8sf')
-_K55 = _struct.Struct('<f')
+_K54 = _struct.Struct('<4sfiI5s')
+_K55 = _struct.Struct('<f8xI')
 _K56 = _struct.Struct('<BBH')
 _K57 = _struct.Struct('<ee')
 _K58 = _struct.Struct('<4siI16sifB')
@@ -996,7 +996,7 @@ def thruster_rpms_wire_to_ros(
         stats.reject('thruster_rpms.rpm[1]')
         return None
     return (
-        _K48.pack(_K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47, rpm[0], rpm[1]),
+        _K48.pack(_K1, rpm[0], rpm[1], receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47),
         receive_ns,
     )
 
@@ -1009,17 +1009,12 @@ def thruster_rpms_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
-    offset = 12
+    thruster_1_rpm, thruster_2_rpm, length = _K49.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    thruster_1_rpm, thruster_2_rpm = _K49.unpack_from(cdr, offset + 4)
     rpm_0 = thruster_1_rpm
     if rpm_0 > 131071:
         stats.saturate('thruster_rpms.rpm[0]')
@@ -1066,8 +1061,8 @@ def thrust_vector_wire_to_ros(
         return None
     return (
         _K51.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47, commands_actuator_id_0[2],
-            commands_actuator_id_1[2],
+            _K1, commands_actuator_id_0[2], commands_actuator_id_1[2], receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _K47,
         ),
         receive_ns,
     )
@@ -1081,17 +1076,12 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
-    offset = 12
+    thruster_vertical_radians, thruster_horizontal_radians, length = _K52.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    thruster_vertical_radians, thruster_horizontal_radians = _K52.unpack_from(cdr, offset + 4)
     commands_actuator_id_0_command_value = thruster_vertical_radians
     if commands_actuator_id_0_command_value > 65504.0:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
@@ -1135,8 +1125,8 @@ def ballast_wire_to_ros(
         return None
     return (
         _K51.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47, commands_actuator_id_2[2],
-            commands_actuator_id_3[2],
+            _K1, commands_actuator_id_2[2], commands_actuator_id_3[2], receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _K47,
         ),
         receive_ns,
     )
@@ -1150,17 +1140,12 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 24:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
-    offset = 12
+    weight_1_offset_radians, weight_2_offset_radians, length = _K52.unpack_from(cdr, 4)
+    offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 12:
-        raise WireError('CDR: truncated')
-    weight_1_offset_radians, weight_2_offset_radians = _K52.unpack_from(cdr, offset + 4)
     commands_actuator_id_2_command_value = weight_1_offset_radians
     if commands_actuator_id_2_command_value > 65504.0:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
@@ -1200,8 +1185,8 @@ def longitudinal_weight_wire_to_ros(
         return None
     return (
         _K54.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47,
-            commands_actuator_id_4[2] * 100.0,
+            _K1, commands_actuator_id_4[2] * 100.0, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000,
+            _K47,
         ),
         receive_ns,
     )
@@ -1215,17 +1200,12 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 20:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
-    offset = 12
+    percent, length = _K55.unpack_from(cdr, 4)
+    offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 8:
-        raise WireError('CDR: truncated')
-    percent, = _K55.unpack_from(cdr, offset + 4)
     commands_actuator_id_4_command_value = percent
     if commands_actuator_id_4_command_value != commands_actuator_id_4_command_value:  # NaN
         stats.reject('longitudinal_weight.commands[actuator_id=4].command_value')
@@ -1266,8 +1246,8 @@ def buoyancy_piston_wire_to_ros(
         return None
     return (
         _K54.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47,
-            commands_actuator_id_5[2] * 100.0,
+            _K1, commands_actuator_id_5[2] * 100.0, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000,
+            _K47,
         ),
         receive_ns,
     )
@@ -1281,17 +1261,12 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
     size = len(cdr)
     if size < 4 or cdr[0] != 0 or cdr[1] != 1:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
-    if size < 16:
+    if size < 20:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
-    offset = 12
+    percent, length = _K55.unpack_from(cdr, 4)
+    offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
-    offset += length
-    offset += -offset & 3
-    if size < offset + 8:
-        raise WireError('CDR: truncated')
-    percent, = _K55.unpack_from(cdr, offset + 4)
     commands_actuator_id_5_command_value = percent
     if commands_actuator_id_5_command_value != commands_actuator_id_5_command_value:  # NaN
         stats.reject('buoyancy_piston.commands[actuator_id=5].command_value')

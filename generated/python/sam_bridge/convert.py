@@ -112,15 +112,15 @@ def _new_Vector3(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> Vector3:
 
 
 def _new_BallastAngles(
-    header: Header | None = None,
     weight_1_offset_radians: float = 0.0,
     weight_2_offset_radians: float = 0.0,
+    header: Header | None = None,
 ) -> BallastAngles:
     _m = _NEW(BallastAngles)
     _m._check_fields = False
-    _m._header = _new_Header() if header is None else header
     _m._weight_1_offset_radians = weight_1_offset_radians
     _m._weight_2_offset_radians = weight_2_offset_radians
+    _m._header = _new_Header() if header is None else header
     return _m
 
 
@@ -164,11 +164,11 @@ def _new_BatteryInfo(
     return _m
 
 
-def _new_PercentStamped(header: Header | None = None, percent: float = 0.0) -> PercentStamped:
+def _new_PercentStamped(percent: float = 0.0, header: Header | None = None) -> PercentStamped:
     _m = _NEW(PercentStamped)
     _m._check_fields = False
-    _m._header = _new_Header() if header is None else header
     _m._percent = percent
+    _m._header = _new_Header() if header is None else header
     return _m
 
 
@@ -199,15 +199,15 @@ def _new_ThrustVectorFeedback(
 
 
 def _new_ThrusterAngles(
-    header: Header | None = None,
     thruster_vertical_radians: float = 0.0,
     thruster_horizontal_radians: float = 0.0,
+    header: Header | None = None,
 ) -> ThrusterAngles:
     _m = _NEW(ThrusterAngles)
     _m._check_fields = False
-    _m._header = _new_Header() if header is None else header
     _m._thruster_vertical_radians = thruster_vertical_radians
     _m._thruster_horizontal_radians = thruster_horizontal_radians
+    _m._header = _new_Header() if header is None else header
     return _m
 
 
@@ -227,15 +227,15 @@ def _new_ThrusterFeedback(
 
 
 def _new_ThrusterRPMs(
-    header: Header | None = None,
     thruster_1_rpm: int = 0,
     thruster_2_rpm: int = 0,
+    header: Header | None = None,
 ) -> ThrusterRPMs:
     _m = _NEW(ThrusterRPMs)
     _m._check_fields = False
-    _m._header = _new_Header() if header is None else header
     _m._thruster_1_rpm = thruster_1_rpm
     _m._thruster_2_rpm = thruster_2_rpm
+    _m._header = _new_Header() if header is None else header
     return _m
 
 
@@ -1305,10 +1305,10 @@ def thruster_1_rpm_to_ros(
     sam.actuator.ThrusterRPM.0.1 -> sam_msgs/ThrusterRPMs
     """
     return _new_ThrusterRPMs(
+        thruster_1_rpm=src.rpm,
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        thruster_1_rpm=src.rpm,
     )
 
 
@@ -1337,10 +1337,10 @@ def thruster_2_rpm_to_ros(
     sam.actuator.ThrusterRPM.0.1 -> sam_msgs/ThrusterRPMs
     """
     return _new_ThrusterRPMs(
+        thruster_2_rpm=src.rpm,
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        thruster_2_rpm=src.rpm,
     )
 
 
@@ -1369,11 +1369,11 @@ def thrust_vector_to_ros(
     sam.actuator.ThrustVector.0.1 -> sam_msgs/ThrusterAngles
     """
     return _new_ThrusterAngles(
+        thruster_vertical_radians=src.vertical_radians,
+        thruster_horizontal_radians=src.horizontal_radians,
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        thruster_vertical_radians=src.vertical_radians,
-        thruster_horizontal_radians=src.horizontal_radians,
     )
 
 
@@ -1412,11 +1412,11 @@ def ballast_to_ros(
     sam.actuator.BallastAngles.0.1 -> sam_msgs/BallastAngles
     """
     return _new_BallastAngles(
+        weight_1_offset_radians=src.weight_1_offset_radians,
+        weight_2_offset_radians=src.weight_2_offset_radians,
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        weight_1_offset_radians=src.weight_1_offset_radians,
-        weight_2_offset_radians=src.weight_2_offset_radians,
     )
 
 
@@ -1453,10 +1453,10 @@ def longitudinal_weight_to_ros(
     sam.actuator.PercentCommand.0.1 -> sam_msgs/PercentStamped
     """
     return _new_PercentStamped(
+        percent=src.percent,
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        percent=src.percent,
     )
 
 
@@ -1488,10 +1488,10 @@ def buoyancy_piston_to_ros(
     sam.actuator.PercentCommand.0.1 -> sam_msgs/PercentStamped
     """
     return _new_PercentStamped(
+        percent=src.percent,
         header=_new_Header(
             stamp=_new_Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        percent=src.percent,
     )
 
 

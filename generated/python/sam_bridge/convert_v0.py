@@ -642,11 +642,11 @@ def thruster_rpms_to_ros(src: Any, receive_ns: int, stats: ConversionStats) -> T
         stats.reject('thruster_rpms.rpm[1]')
         return None
     return ThrusterRPMs(
+        thruster_1_rpm=rpm[0],
+        thruster_2_rpm=rpm[1],
         header=Header(
             stamp=Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        thruster_1_rpm=rpm[0],
-        thruster_2_rpm=rpm[1],
     )
 
 
@@ -686,11 +686,11 @@ def thrust_vector_to_ros(src: Any, receive_ns: int, stats: ConversionStats) -> T
         stats.reject('thrust_vector.commands[actuator_id=1]')
         return None
     return ThrusterAngles(
+        thruster_vertical_radians=commands_actuator_id_0.command_value,
+        thruster_horizontal_radians=commands_actuator_id_1.command_value,
         header=Header(
             stamp=Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        thruster_vertical_radians=commands_actuator_id_0.command_value,
-        thruster_horizontal_radians=commands_actuator_id_1.command_value,
     )
 
 
@@ -743,11 +743,11 @@ def ballast_to_ros(src: Any, receive_ns: int, stats: ConversionStats) -> Ballast
         stats.reject('ballast.commands[actuator_id=3]')
         return None
     return BallastAngles(
+        weight_1_offset_radians=commands_actuator_id_2.command_value,
+        weight_2_offset_radians=commands_actuator_id_3.command_value,
         header=Header(
             stamp=Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        weight_1_offset_radians=commands_actuator_id_2.command_value,
-        weight_2_offset_radians=commands_actuator_id_3.command_value,
     )
 
 
@@ -796,10 +796,10 @@ def longitudinal_weight_to_ros(src: Any, receive_ns: int, stats: ConversionStats
         stats.reject('longitudinal_weight.commands[actuator_id=4]')
         return None
     return PercentStamped(
+        percent=commands_actuator_id_4.command_value * 100.0,
         header=Header(
             stamp=Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        percent=commands_actuator_id_4.command_value * 100.0,
     )
 
 
@@ -846,10 +846,10 @@ def buoyancy_piston_to_ros(src: Any, receive_ns: int, stats: ConversionStats) ->
         stats.reject('buoyancy_piston.commands[actuator_id=5]')
         return None
     return PercentStamped(
+        percent=commands_actuator_id_5.command_value * 100.0,
         header=Header(
             stamp=Time(sec=receive_ns // 1_000_000_000, nanosec=receive_ns % 1_000_000_000),
         ),
-        percent=commands_actuator_id_5.command_value * 100.0,
     )
 
 
