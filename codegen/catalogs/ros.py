@@ -13,6 +13,7 @@ import sys
 from collections.abc import Mapping
 from pathlib import Path
 
+from sam_codegen.catalogs.ros_known import known_message
 from sam_codegen.model.diagnostics import Pos
 from sam_codegen.model.spec import Constant, Field, RosMessage, Scalar, Spec
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, parse_ros_type
@@ -103,6 +104,9 @@ class RosCatalog:
             return self._spec.messages[full_name]
         if full_name in self._spec.external_messages:
             return self._spec.external_messages[full_name]
+        known = known_message(full_name)  # the standard messages the tool knows (tf2_msgs/TFMessage)
+        if known is not None:
+            return known
         if full_name not in self._cache:
             self._cache[full_name] = self.read_installed(full_name)
         return self._cache[full_name]
