@@ -245,4 +245,12 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:29:3: error: topics /a/b and /A/B both give constant A_B of ros.topics_message Topics (expected topic names that stay distinct in upper case with `_` for every other character, or no ros.topics_message)",
         ),
     ),
+    Case(
+        "external_publisher_cannot_serve_a_latched_subscription",
+        ((TOPICS_END, TOPICS_END + "  /mode: {type: std_msgs/UInt8, published_by: {external: the operator GUI}}\n"),
+         ("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [/level, {topic: /mode, qos: latched}]\n    parameters: [/warn_level]")),
+        (
+            "minimal.yaml:64:26: error: node logger subscribes to /mode with latched (reliable, transient_local, keep last 1), but an external publisher (the operator GUI) publishes it with reliable (reliable, volatile, keep last 10): a volatile publisher cannot serve a transient_local subscription (expected a QoS the publishers can serve)",
+        ),
+    ),
 )
