@@ -14,6 +14,9 @@ LOGGER = "  logger:\n    subscribes: [/level]\n    parameters: [/warn_level]\n"
 VALVE_CONTROL = "  valve_control:\n    subscribes: [/level]\n    publishes: [/valve]\n    parameters: [/alarm_level]\n"
 TOPICS_END = "  /valve: {type: std_msgs/UInt8}\n"
 FRAMES = "frames:\n  base_link: {}\n"
+BRIDGE_MAPPINGS = (  # the minimal spec's two mappings, to cut out whole
+    '    level:\n      direction: uavcan_to_ros\n      subject_id: 100\n      topic: /level\n      source_node_ids: [10]\n      frame_id: base_link\n      fields:\n        header.stamp: timestamp.microsecond\n        level: level_mm\n    valve:\n      direction: ros_to_uavcan\n      subject_id: 101\n      topic: /valve\n      destination_node_id: 11\n      fields:\n        data: open_pct\n'
+)
 TF_TOPICS = "  /tf: {type: tf2_msgs/TFMessage}\n  /tf_static: {type: tf2_msgs/TFMessage}\n"
 TF2_MSGS = ("external_messages:\n  tf2_msgs/TFMessage:\n    fields:\n"
             "      - {name: transforms, type: \"geometry_msgs/TransformStamped[]\"}\nmessages:\n")
@@ -251,6 +254,18 @@ CASES: tuple[Case, ...] = (
          ("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [/level, {topic: /mode, qos: latched}]\n    parameters: [/warn_level]")),
         (
             "minimal.yaml:64:26: error: node logger subscribes to /mode with latched (reliable, transient_local, keep last 1), but an external publisher (the operator GUI) publishes it with reliable (reliable, volatile, keep last 10): a volatile publisher cannot serve a transient_local subscription (expected a QoS the publishers can serve)",
+        ),
+    ),
+    Case(
+        "topics_message_without_topics",
+        (("ros: {package: buoy_msgs}", "ros: {package: buoy_msgs, topics_message: Topics}"),
+         ("topics:\n  /level: {type: buoy_msgs/Level}\n  /valve: {type: std_msgs/UInt8}\n", "topics: {}\n"),
+         ("    subscribes: [/level]\n    parameters: [/warn_level]\n", "    parameters: [/warn_level]\n"),
+         ("  valve_control:\n    subscribes: [/level]\n    publishes: [/valve]\n", "  valve_control:\n"),
+         ("bridge:\n  name: bridge\n  node_id: 100\n  mappings:\n", "bridge:\n  name: bridge\n  node_id: 100\n  mappings: {}\nunused_mappings:\n"),
+         ("unused_mappings:\n" + BRIDGE_MAPPINGS, "")),
+        (
+            "minimal.yaml:4:27: error: ros.topics_message Topics would have no constant: the spec has no topics (expected topics, or no ros.topics_message)",
         ),
     ),
 )

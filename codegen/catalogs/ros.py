@@ -1,5 +1,5 @@
-"""ROS message definitions: the ones validation derived, the spec's own, the spec's external ones and the installed
-packages' .msg files.
+"""ROS message definitions: the ones validation derived, the spec's own, the spec's external ones, the standard ones
+the tool knows (catalogs.ros_known: tf2_msgs/TFMessage) and the installed packages' .msg files, in that order.
 
 Invariant: a catalog never changes the spec nor a message it returns; what it reads from disk it caches, so one
 name gives one message object for the catalog's life.

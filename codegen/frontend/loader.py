@@ -3,7 +3,7 @@
 The top level is read here; its sections in frontend.types, frontend.bridge and frontend.nodes, all with
 frontend.reading's helpers. Every model object is built whole from what was read, and the Spec last: nothing is
 changed after it is built (the model is frozen). Each topic's effective QoS is chosen here, once the bridge's
-mappings are known.
+mappings are known; the TF topics the nodes' transforms imply join the declared ones first (frontend.topic_sources).
 """
 
 from __future__ import annotations

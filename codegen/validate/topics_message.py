@@ -52,6 +52,10 @@ def topics_message(spec: Spec, diag: Diagnostics) -> RosMessage | None:
                    f"{spec.messages[full_name].pos.line}): the generated message would replace it",
                    "another name for the topics message")
         return None
+    if not spec.topics:
+        diag.error(pos, f"ros.topics_message {name} would have no constant: the spec has no topics",
+                   "topics, or no ros.topics_message")
+        return None
     constants: list[Constant] = []
     first: dict[str, str] = {}  # constant -> the topic that gave it
     for topic in spec.topics.values():
