@@ -4,7 +4,7 @@ Layout (written by ``sam-codegen build``)::
 
     <generated>/dsdl/<root namespace>/...       Cyphal DSDL of the vehicle's own types
     <generated>/ros/<ros package>/              the ament package of the custom ROS messages
-    <generated>/ros/<external package>/         one per package of the spec's external_messages (tf2_msgs)
+    <generated>/ros/<external package>/         one per package of the external_messages and known ones (tf2_msgs)
     <generated>/python/<vehicle>_bridge/        tables.py (stdlib only) and convert.py (converters)
 
 Nothing here is SAM-specific: the Python package is found by scanning ``<generated>/python`` for a

@@ -265,8 +265,8 @@ CASES: tuple[Case, ...] = (
         '      topic: /levels\n',
         (
             "minimal.yaml:45:5: error: mapping 'level' uses undeclared topic '/levels' (expected a topic of `topics`)",
-            "minimal.yaml:63:18: error: node logger subscribes to /level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
-            "minimal.yaml:66:18: error: node valve_control subscribes to /level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
+            "minimal.yaml:63:18: error: node logger subscribes to /level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN, or `published_by: external` on the topic)",
+            "minimal.yaml:66:18: error: node valve_control subscribes to /level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN, or `published_by: external` on the topic)",
         ),
     ),
     Case(

@@ -14,6 +14,9 @@ LOGGER = "  logger:\n    subscribes: [/level]\n    parameters: [/warn_level]\n"
 VALVE_CONTROL = "  valve_control:\n    subscribes: [/level]\n    publishes: [/valve]\n    parameters: [/alarm_level]\n"
 TOPICS_END = "  /valve: {type: std_msgs/UInt8}\n"
 FRAMES = "frames:\n  base_link: {}\n"
+BRIDGE_MAPPINGS = (  # the minimal spec's two mappings, to cut out whole
+    '    level:\n      direction: uavcan_to_ros\n      subject_id: 100\n      topic: /level\n      source_node_ids: [10]\n      frame_id: base_link\n      fields:\n        header.stamp: timestamp.microsecond\n        level: level_mm\n    valve:\n      direction: ros_to_uavcan\n      subject_id: 101\n      topic: /valve\n      destination_node_id: 11\n      fields:\n        data: open_pct\n'
+)
 TF_TOPICS = "  /tf: {type: tf2_msgs/TFMessage}\n  /tf_static: {type: tf2_msgs/TFMessage}\n"
 TF2_MSGS = ("external_messages:\n  tf2_msgs/TFMessage:\n    fields:\n"
             "      - {name: transforms, type: \"geometry_msgs/TransformStamped[]\"}\nmessages:\n")
@@ -32,14 +35,14 @@ CASES: tuple[Case, ...] = (
         ((TOPICS_END, TOPICS_END + "  /alarm: {type: std_msgs/Bool}\n"),
          ("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [/level, /alarm]\n    parameters: [/warn_level]")),
         (
-            "minimal.yaml:64:26: error: node logger subscribes to /alarm, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
+            "minimal.yaml:64:26: error: node logger subscribes to /alarm, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN, or `published_by: external` on the topic)",
         ),
     ),
     Case(
         "bridge_command_nobody_publishes",
         (("    publishes: [/valve]\n", "    publishes: []\n"),),
         (
-            "minimal.yaml:54:5: error: the bridge subscribes to /valve (mapping valve), which nobody publishes (expected a node that publishes the commands)",
+            "minimal.yaml:54:5: error: the bridge subscribes to /valve (mapping valve), which nobody publishes (expected a node that publishes the commands, or `published_by: external` on the topic)",
         ),
     ),
     Case(
@@ -111,14 +114,6 @@ CASES: tuple[Case, ...] = (
         ),
     ),
     Case(
-        "transforms_need_the_tf_topic",
-        ((FRAMES, FRAMES + "  odom: {}\ntransforms:\n  - {parent: odom, child: base_link, publisher: logger}\n"),
-         (LOGGER, LOGGER + "    transforms: [odom->base_link]\n")),
-        (
-            "minimal.yaml:68:18: error: node logger uses transforms, but topic /tf is not declared (expected /tf: {type: tf2_msgs/TFMessage} under topics)",
-        ),
-    ),
-    Case(
         "transform_claims_and_gifts_disagree",
         (("messages:\n", TF2_MSGS), (TOPICS_END, TOPICS_END + TF_TOPICS),
          (FRAMES, FRAMES + "  odom: {}\n  map: {}\ntransforms:\n  - {parent: odom, child: base_link, publisher: valve_control}\n"),
@@ -145,7 +140,6 @@ CASES: tuple[Case, ...] = (
          (LOGGER, LOGGER + "    reads_transforms: [map->base_link, base_link->sensor, sensor->sensor, base_link->nowhere]\n")),
         (
             "minimal.yaml:72:24: error: node logger reads transform map->base_link, but no chain of declared transforms and static frames connects them (expected frames linked by `transforms` entries or `parent`s)",
-            "minimal.yaml:72:40: error: node logger reads transform base_link->sensor through static frames, but topic /tf_static is not declared (expected /tf_static: {type: tf2_msgs/TFMessage} under topics)",
             "minimal.yaml:72:59: error: node logger reads transform sensor->sensor: a frame relative to itself (expected two different frames)",
             "minimal.yaml:72:75: error: node logger reads transform base_link->nowhere, but frame 'nowhere' is not declared (expected a frame of `frames`)",
         ),
@@ -200,6 +194,78 @@ CASES: tuple[Case, ...] = (
         (("    subscribes: [/level]\n    publishes", "    subscribes: [/level, /level]\n    publishes"),),
         (
             "minimal.yaml:66:26: error: node valve_control subscribes to /level twice",
+        ),
+    ),
+    # Issue 19: topics published from outside the spec, tf2_msgs known to the tool, the generated topics message.
+    Case(
+        "published_by_something_else_than_external",
+        ((TOPICS_END, "  /valve: {type: std_msgs/UInt8, published_by: operator}\n  /a: {type: std_msgs/Bool, published_by: [external]}\n"
+                      "  /b: {type: std_msgs/Bool, published_by: {external: \" \"}}\n  /c: {type: std_msgs/Bool, published_by: {who: gui}}\n"),),
+        (
+            "minimal.yaml:26:48: error: published_by of topic '/valve' is str 'operator': only `external` is a publisher the spec does not declare (nodes say what they publish under `nodes`) (expected external, or {external: who publishes it})",
+            "minimal.yaml:27:43: error: published_by of topic '/a' must be `external` or a mapping, found a list (expected external, or {external: who publishes it})",
+            "minimal.yaml:28:44: error: published_by of topic '/b': the text of `external` is empty (expected who publishes it (e.g. \"the operator GUI\"), or plain `published_by: external`)",
+            "minimal.yaml:29:43: error: missing field 'external' in published_by of topic '/c'",
+            "minimal.yaml:29:44: error: unknown field 'who' in published_by of topic '/c' (expected one of external)",
+        ),
+    ),
+    Case(
+        "external_publisher_on_a_topic_the_bridge_publishes",
+        (("  /level: {type: buoy_msgs/Level}\n", "  /level: {type: buoy_msgs/Level, published_by: {external: a rosbag}}\n"),),
+        (
+            "minimal.yaml:25:49: error: topic /level is published_by external, but the bridge publishes it from UAVCAN (mapping level): a second source would pass for the device's data (expected published_by on a topic the bridge does not publish, or another topic for the outside source)",
+        ),
+    ),
+    Case(
+        "restated_tf2_message_differs_from_the_known_one",
+        (("messages:\n", "external_messages:\n  tf2_msgs/TFMessage:\n    fields:\n      - {name: transforms, type: \"geometry_msgs/Transform[]\"}\nmessages:\n"),
+         (FRAMES, FRAMES + "  odom: {}\ntransforms:\n  - {parent: odom, child: base_link, publisher: logger}\n"),
+         (LOGGER, LOGGER + "    transforms: [odom->base_link]\n")),
+        (
+            "minimal.yaml:7:3: error: external message tf2_msgs/TFMessage differs from ROS 2's definition, which the tool knows (geometry_msgs/TransformStamped[] transforms) (expected the known fields, or no declaration: the tool knows tf2_msgs/TFMessage)",
+        ),
+    ),
+    Case(
+        "topics_message_name_not_camel_case",
+        (("ros: {package: buoy_msgs}", "ros: {package: buoy_msgs, topics_message: topic_names}"),),
+        (
+            "minimal.yaml:4:27: error: ros.topics_message 'topic_names' is not a valid ROS message name (expected CamelCase, e.g. Topics)",
+        ),
+    ),
+    Case(
+        "topics_message_is_a_declared_message",
+        (("ros: {package: buoy_msgs}", "ros: {package: buoy_msgs, topics_message: Level}"),),
+        (
+            "minimal.yaml:4:27: error: ros.topics_message Level is also declared under messages (line 7): the generated message would replace it (expected another name for the topics message)",
+        ),
+    ),
+    Case(
+        "topic_names_that_give_one_constant",
+        (("ros: {package: buoy_msgs}", "ros: {package: buoy_msgs, topics_message: Topics}"),
+         (TOPICS_END, TOPICS_END + "  /a/b: {type: std_msgs/Bool, published_by: external}\n  /a_b: {type: std_msgs/Bool, published_by: external}\n  /A/B: {type: std_msgs/Bool, published_by: external}\n")),
+        (
+            "minimal.yaml:28:3: error: topics /a/b and /a_b both give constant A_B of ros.topics_message Topics (expected topic names that stay distinct in upper case with `_` for every other character, or no ros.topics_message)",
+            "minimal.yaml:29:3: error: topics /a/b and /A/B both give constant A_B of ros.topics_message Topics (expected topic names that stay distinct in upper case with `_` for every other character, or no ros.topics_message)",
+        ),
+    ),
+    Case(
+        "external_publisher_cannot_serve_a_latched_subscription",
+        ((TOPICS_END, TOPICS_END + "  /mode: {type: std_msgs/UInt8, published_by: {external: the operator GUI}}\n"),
+         ("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [/level, {topic: /mode, qos: latched}]\n    parameters: [/warn_level]")),
+        (
+            "minimal.yaml:64:26: error: node logger subscribes to /mode with latched (reliable, transient_local, keep last 1), but an external publisher (the operator GUI) publishes it with reliable (reliable, volatile, keep last 10): a volatile publisher cannot serve a transient_local subscription (expected a QoS the publishers can serve)",
+        ),
+    ),
+    Case(
+        "topics_message_without_topics",
+        (("ros: {package: buoy_msgs}", "ros: {package: buoy_msgs, topics_message: Topics}"),
+         ("topics:\n  /level: {type: buoy_msgs/Level}\n  /valve: {type: std_msgs/UInt8}\n", "topics: {}\n"),
+         ("    subscribes: [/level]\n    parameters: [/warn_level]\n", "    parameters: [/warn_level]\n"),
+         ("  valve_control:\n    subscribes: [/level]\n    publishes: [/valve]\n", "  valve_control:\n"),
+         ("bridge:\n  name: bridge\n  node_id: 100\n  mappings:\n", "bridge:\n  name: bridge\n  node_id: 100\n  mappings: {}\nunused_mappings:\n"),
+         ("unused_mappings:\n" + BRIDGE_MAPPINGS, "")),
+        (
+            "minimal.yaml:4:27: error: ros.topics_message Topics would have no constant: the spec has no topics (expected topics, or no ros.topics_message)",
         ),
     ),
 )

@@ -1,5 +1,5 @@
-"""ROS message definitions: the ones validation derived, the spec's own, the spec's external ones and the installed
-packages' .msg files.
+"""ROS message definitions: the ones validation derived, the spec's own, the spec's external ones, the standard ones
+the tool knows (catalogs.ros_known: tf2_msgs/TFMessage) and the installed packages' .msg files, in that order.
 
 Invariant: a catalog never changes the spec nor a message it returns; what it reads from disk it caches, so one
 name gives one message object for the catalog's life.
@@ -13,6 +13,7 @@ import sys
 from collections.abc import Mapping
 from pathlib import Path
 
+from sam_codegen.catalogs.ros_known import known_message
 from sam_codegen.model.diagnostics import Pos
 from sam_codegen.model.spec import Constant, Field, RosMessage, Scalar, Spec
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, parse_ros_type
@@ -103,6 +104,9 @@ class RosCatalog:
             return self._spec.messages[full_name]
         if full_name in self._spec.external_messages:
             return self._spec.external_messages[full_name]
+        known = known_message(full_name)  # the standard messages the tool knows (tf2_msgs/TFMessage)
+        if known is not None:
+            return known
         if full_name not in self._cache:
             self._cache[full_name] = self.read_installed(full_name)
         return self._cache[full_name]

@@ -3,7 +3,7 @@
 The top level is read here; its sections in frontend.types, frontend.bridge and frontend.nodes, all with
 frontend.reading's helpers. Every model object is built whole from what was read, and the Spec last: nothing is
 changed after it is built (the model is frozen). Each topic's effective QoS is chosen here, once the bridge's
-mappings are known.
+mappings are known; the TF topics the nodes' transforms imply join the declared ones first (frontend.topic_sources).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mappin
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
+from sam_codegen.frontend.topic_sources import implied_tf_topics, parse_published_by
 from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
@@ -58,12 +59,14 @@ def parse_spec(root: YNode, file: str) -> Spec:
         diag.error(top.key_pos("spec_version"), f"spec_version {version} is not supported", "1")
     vehicle = Reader(top.node("vehicle") or YMap(top.pos), "vehicle", diag, ("name", "description"))
     ros = Reader(top.node("ros") or YMap(top.pos), "ros", diag,
-                  ("package", "version", "description", "maintainer", "maintainer_email", "license"))
+                  ("package", "version", "description", "maintainer", "maintainer_email", "license",
+                   "topics_message"))
     cyphal = Reader(top.node("cyphal") or YMap(top.pos), "cyphal", diag, ("root_namespace",))
     package = ros.get("package", str) or ""
     info = RosPackageInfo(package, ros.get("version", str, "0.1.0"), text_of(ros, "description"),
                           ros.get("maintainer", str, "maintainer"),
-                          ros.get("maintainer_email", str, "maintainer@example.org"), ros.get("license", str, "MIT"))
+                          ros.get("maintainer_email", str, "maintainer@example.org"), ros.get("license", str, "MIT"),
+                          ros.get("topics_message", str, None), ros.key_pos("topics_message"))
     external_messages: dict[str, RosMessage] = {}
     for key, pos, node in map_items(top.node("external_messages"), "external_messages", diag):
         if "/" not in key:
@@ -101,14 +104,16 @@ def parse_spec(root: YNode, file: str) -> Spec:
                        + "): two types on one topic", "one type per topic; give the second its own topic")
     declared_topics: list[Topic] = []  # their effective QoS comes once the bridge is read
     for key, pos, node in map_items(topics_node, "topics", diag, duplicates=False):
-        r = Reader(node, f"topic {key!r}", diag, ("type", "description", "section", "qos"))
+        r = Reader(node, f"topic {key!r}", diag, ("type", "description", "section", "qos", "published_by"))
         type_ = r.get("type", str)
         qos_node = r.node("qos")
         qos = parse_qos(qos_node, f"the QoS of topic {key!r}", diag) if qos_node is not None else None
+        external, external_pos = parse_published_by(r.node("published_by"), key, diag)
         if type_ is not None:
             declared_topics.append(Topic(key, type_.replace("/msg/", "/"), text_of(r, "description"),
                                          str(r.get("section", (str, float, int), "")), pos, qos,
-                                         qos_node.pos if qos_node is not None else pos))
+                                         qos_node.pos if qos_node is not None else pos,
+                                         external_publisher=external, external_pos=external_pos))
     parameters: dict[str, Parameter] = {}
     for key, pos, node in map_items(top.node("parameters"), "parameters", diag):
         parameter = parse_parameter(key, pos, node, diag)
@@ -146,6 +151,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
         nodes[key] = parse_node(key, pos, node, diag)
     bridged = {m.topic for m in bridge.all_mappings if m.direction == UAVCAN_TO_ROS} if bridge is not None else set()
+    declared_topics += implied_tf_topics({t.name: t for t in declared_topics}, nodes, frames)
     topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
     bus = parse_bus(top.node("bus"), "bus", diag)
     diag.check()

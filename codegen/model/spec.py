@@ -176,6 +176,11 @@ class Topic:
     # frontend, which knows the bridge's mappings when it builds the topic. None only for a hand-built Topic.
     qos: Qos | None = None
     qos_origin: str = ""  # why: "declared", or the default rule that chose it
+    # `published_by: external`: published (also) from outside the spec (an operator GUI, a mission executive);
+    # the text says who ("" when the spec does not say). None: only the spec's nodes and bridge publish it.
+    external_publisher: str | None = None
+    external_pos: Pos = NOWHERE
+    implied: bool = False  # not declared: /tf or /tf_static, which the nodes' transforms imply (frontend.tf_topics)
 
 
 def default_qos(topic: Topic, bridged: set[str]) -> tuple[Qos, str]:
@@ -420,6 +425,8 @@ class RosPackageInfo:
     maintainer: str = "maintainer"
     maintainer_email: str = "maintainer@example.org"
     license: str = "MIT"
+    topics_message: str | None = None  # `ros.topics_message`: a generated message of topic-name constants
+    topics_message_pos: Pos = NOWHERE
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from sam_codegen.catalogs.ros import RosCatalog
+from sam_codegen.catalogs.ros_known import known_message
 from sam_codegen.model.diagnostics import Diagnostics, Pos
 
 # `X as X`: re-exported, importable from here since before they moved down to the model (where the frontend and
@@ -28,6 +29,7 @@ from sam_codegen.model.spec import TF_STATIC_TOPIC as TF_STATIC_TOPIC
 from sam_codegen.model.spec import TF_TOPIC as TF_TOPIC
 from sam_codegen.model.spec import default_qos as default_qos
 from sam_codegen.model.types import ROS_PACKAGE_NAME
+from sam_codegen.validate.external_publishers import check_external_publishers
 
 _NODE_NAME = re.compile(r"[a-z][a-z0-9_]*")
 
@@ -137,8 +139,13 @@ class Endpoint:
 
 def publishers(spec: Spec) -> dict[str, list[Endpoint]]:
     """topic -> its publishers: nodes (their `publishes`, /tf for their transforms), the bridge's uavcan_to_ros
-    mappings, and the node host for /tf_static when the spec has static frames."""
+    mappings, the node host for /tf_static when the spec has static frames, and the tools outside the spec of a
+    topic `published_by: external` (which use the topic's QoS, as every publisher does)."""
     result: dict[str, list[Endpoint]] = {}
+    for topic in spec.topics.values():
+        if topic.external_publisher is not None:
+            result.setdefault(topic.name, []).append(Endpoint(external_endpoint(topic.external_publisher),
+                                                              topic.external_pos))
     for node in spec.nodes.values():
         for item in node.publish_items:
             result.setdefault(item.topic, []).append(Endpoint(f"node {node.name}", item.pos))
@@ -152,6 +159,15 @@ def publishers(spec: Spec) -> dict[str, list[Endpoint]]:
     if static:
         result.setdefault(TF_STATIC_TOPIC, []).append(Endpoint("the node host (static frames)", static[0].pos))
     return result
+
+
+def external_endpoint(who: str) -> str:
+    """How messages name an external publisher.
+
+    >>> external_endpoint(""), external_endpoint("the operator GUI")
+    ('an external publisher', 'an external publisher (the operator GUI)')
+    """
+    return f"an external publisher ({who})" if who else "an external publisher"
 
 
 def static_edges(spec: Spec) -> set[tuple[str, str]]:
@@ -296,7 +312,8 @@ class _NodeChecks:
         ends = self.publishers.get(item.topic, [])
         if not ends:
             self.error(item.pos, f"node {node.name} subscribes to {item.topic}, which nobody publishes",
-                       "a topic some node publishes, or one the bridge publishes from UAVCAN")
+                       "a topic some node publishes, or one the bridge publishes from UAVCAN, or "
+                       "`published_by: external` on the topic")
             return
         if item.qos is None or topic.qos is None:
             return
@@ -309,10 +326,6 @@ class _NodeChecks:
 
     def check_transforms(self, node: Node, member) -> None:
         s, what = self.spec, f"node {node.name}"
-        if (node.transform_items or node.read_transform_items) and TF_TOPIC not in s.topics:
-            item = (node.transform_items or node.read_transform_items)[0]
-            self.error(item.pos, f"{what} uses transforms, but topic {TF_TOPIC} is not declared",
-                       f"{TF_TOPIC}: {{type: {TF_MESSAGE}}} under topics")
         seen: set[tuple[str, str]] = set()
         for item in node.transform_items:
             edge = (item.parent, item.child)
@@ -333,10 +346,6 @@ class _NodeChecks:
                     self.error(item.pos, f"{what} reads transform {item.parent}->{item.child}, but no chain of "
                                "declared transforms and static frames connects them",
                                "frames linked by `transforms` entries or `parent`s")
-                elif static_edges(s) & set(chain) and TF_STATIC_TOPIC not in s.topics:
-                    self.error(item.pos, f"{what} reads transform {item.parent}->{item.child} through static "
-                               f"frames, but topic {TF_STATIC_TOPIC} is not declared",
-                               f"{TF_STATIC_TOPIC}: {{type: {TF_MESSAGE}}} under topics")
                 member(f"lookup_{transform_identifier(*edge)}", f"reading {item.parent}->{item.child}", item.pos)
             seen.add(edge)
 
@@ -365,7 +374,7 @@ class _NodeChecks:
             seen.add(m.topic)
             if not self.publishers.get(m.topic):
                 self.error(m.pos, f"the bridge subscribes to {m.topic} (mapping {m.name}), which nobody publishes",
-                           "a node that publishes the commands")
+                           "a node that publishes the commands, or `published_by: external` on the topic")
 
 
 def check_external_packages(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> None:
@@ -379,6 +388,13 @@ def check_external_packages(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> N
         if not ROS_PACKAGE_NAME.fullmatch(message.package):
             diag.error(message.pos, f"package {message.package!r} of external message {message.name} is not valid",
                        "lower case letters, digits and single underscores, starting with a letter")
+            continue
+        known = known_message(message.full_name)  # a standard message the tool knows: the spec may restate it
+        if known is not None:
+            if [(f.name, str(f.type)) for f in known.fields] != [(f.name, str(f.type)) for f in message.fields]:
+                diag.error(message.pos, f"external message {message.full_name} differs from ROS 2's definition, "
+                           f"which the tool knows ({', '.join(f'{f.type} {f.name}' for f in known.fields)})",
+                           f"the known fields, or no declaration: the tool knows {message.full_name}")
             continue
         installed = ros.read_installed(message.full_name)  # not the spec's override
         if installed is None:
@@ -394,6 +410,7 @@ def check_external_packages(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> N
 def check_nodes(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> None:
     """Every check of this module; errors go to diag."""
     check_external_packages(spec, ros, diag)
+    check_external_publishers(spec, diag)
     _NodeChecks(spec, ros, diag).check()
 
 

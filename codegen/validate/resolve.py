@@ -34,6 +34,7 @@ from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.nodes import check_nodes
+from sam_codegen.validate.topics_message import topics_message
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -343,6 +344,8 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     for struct in spec.dsdl_types.values():
         v.check_dsdl_struct(struct)
     messages = v.check_messages()
+    topics_msg = topics_message(spec, v.diag)  # ros.topics_message (validate.topics_message)
+    messages = sorted([*messages, topics_msg], key=lambda m: m.name) if topics_msg is not None else messages
     v.check_frames_and_parameters()
     v.check_topics_and_nodes()
     check_nodes(spec, ros, v.diag)  # nodes, QoS, TF topics, external packages (validate.nodes)

@@ -22,6 +22,7 @@ from types import ModuleType
 import pytest
 import yaml
 
+from sam_codegen.catalogs.ros_known import external_messages_to_generate
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.targets import nodes as emit_nodes
 from sam_codegen.targets.python import convert as emit_python
@@ -251,7 +252,7 @@ def test_tables_carry_qos_frames_and_nodes(resolved: Resolved, tmp_path: Path) -
         assert s.rotation == pytest.approx(quat_from_rpy(*f.rpy), abs=1e-15)  # the runtime's own conversion
     assert [n.name for n in tables.NODES] == list(spec.nodes)
     assert tables.ROS_PACKAGES[-1] in (spec.ros.name, "tf2_msgs") and set(tables.ROS_PACKAGES) == {
-        spec.ros.name, *(m.package for m in spec.external_messages.values())}
+        spec.ros.name, *(m.package for m in external_messages_to_generate(spec).values())}
     assert tables.PARAMS_FILE == f"params/{spec.vehicle}.params.yaml"
     for n in tables.NODES:
         node = spec.nodes[n.name]

@@ -45,8 +45,9 @@ def _sample(cls):  # type: ignore[no-untyped-def]
             setattr(msg, name, True)
         elif type_name.startswith("sequence<uint8"):
             setattr(msg, name, [1, 2, 3])
-    msg.header.frame_id = "base_link"
-    msg.header.stamp.sec = 12
+    if hasattr(msg, "header"):  # (not the constants-only Topics)
+        msg.header.frame_id = "base_link"
+        msg.header.stamp.sec = 12
     return msg
 
 

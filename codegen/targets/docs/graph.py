@@ -43,6 +43,20 @@ LEGEND = [
     (PUBLISH, "a node publishes a topic"),
 ]
 TEENSY_COLOUR = "#f39c12"
+# Topics `published_by: external`: one box per distinct "who" in the nodes' column, its edges in their own colour.
+# Drawn (and in the legend) only for a spec that has them, so the pictures of other specs stay as they were.
+EXTERNAL = "external"
+EXTERNAL_COLOUR = "#7f8c8d"
+EXTERNAL_LEGEND = (EXTERNAL, "published from outside the spec (published_by: external)")
+
+
+def external_box(who: str) -> str:
+    """The name of the box of an external publisher: never a node's name (those are identifiers).
+
+    >>> external_box(""), external_box("the operator GUI")
+    ('(external)', '(external) the operator GUI')
+    """
+    return f"(external) {who}" if who else "(external)"
 
 
 # ---- the graph (shared by the Mermaid block and the SVG) -----------------------------------------------
@@ -51,7 +65,7 @@ TEENSY_COLOUR = "#f39c12"
 class Edge:
     """One arrow: a box (kind, name) to another, with the subject id as label on the device side of the bridge."""
 
-    kind: str  # UAVCAN_TO_ROS | ROS_TO_UAVCAN | SUBSCRIBE | PUBLISH
+    kind: str  # UAVCAN_TO_ROS | ROS_TO_UAVCAN | SUBSCRIBE | PUBLISH | EXTERNAL
     src: tuple[str, str]  # (box kind, name)
     dst: tuple[str, str]
     label: str = ""
@@ -59,8 +73,8 @@ class Edge:
 
 @dataclass
 class Graph:
-    """The boxes of the four columns (devices, the bridge, topics, nodes), the edges between them, and how each
-    bridge mapping runs through the bridge."""
+    """The boxes of the four columns (devices, the bridge, topics, nodes and external publishers), the edges between
+    them, and how each bridge mapping runs through the bridge."""
 
     devices: list[str]
     bridge: str | None
@@ -69,6 +83,16 @@ class Graph:
     edges: list[Edge] = field(default_factory=list)
     # per mapping: (direction, its device-side edges, its topic-side edge), joined inside the bridge
     links: list[tuple[str, list[int], int]] = field(default_factory=list)
+    externals: dict[str, str] = field(default_factory=dict)  # box name -> who (external_box), in topic order
+
+    @property
+    def colours(self) -> dict[str, str]:
+        """The edge kinds this graph draws, with their colours."""
+        return {**EDGE_COLOURS, EXTERNAL: EXTERNAL_COLOUR} if self.externals else dict(EDGE_COLOURS)
+
+    @property
+    def legend(self) -> list[tuple[str, str]]:
+        return [*LEGEND, EXTERNAL_LEGEND] if self.externals else list(LEGEND)
 
 
 class PortIndex:
@@ -157,6 +181,12 @@ def build_graph(resolved: Resolved) -> Graph:
         for topic in node_published_topics(spec, node):
             if topic in spec.topics:
                 add(Edge(PUBLISH, ("node", node.name), ("topic", topic)))
+    for name in topics:
+        who = spec.topics[name].external_publisher
+        if who is not None:
+            box = external_box(who)
+            graph.externals.setdefault(box, who)
+            add(Edge(EXTERNAL, (EXTERNAL, box), ("topic", name)))
     return graph
 
 
@@ -198,7 +228,7 @@ def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     def node_id(kind: str, name: str) -> str:
         key = (kind, name)
         if key not in ids:
-            prefix = {"device": "dev", "bridge": "bridge", "topic": "topic", "node": "node"}[kind]
+            prefix = {"device": "dev", "bridge": "bridge", "topic": "topic", "node": "node", EXTERNAL: "ext"}[kind]
             base = prefix + "_" + (re.sub(r"[^A-Za-z0-9]+", "_", name).strip("_") or "x")
             candidate, n = base, 2
             while candidate in used:
@@ -221,23 +251,43 @@ def mermaid_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         vertex("topic", name, ('(["', '"])'), "topic", [name, spec.topics[name].type])
     for name in graph.nodes:
         vertex("node", name, ('("', '")'), "rosnode", [name])
+    for name, who in graph.externals.items():
+        vertex(EXTERNAL, name, ('[/"', '"/]'), EXTERNAL, [EXTERNAL, *([who] if who else [])])
     edges = []
     for e in graph.edges:
         edges.append({"src": node_id(*e.src), "dst": node_id(*e.dst),
                       "label": mermaid_label(e.label) if e.label else "", "kind": e.kind})
     styles = []
-    for kind, colour in EDGE_COLOURS.items():
+    for kind, colour in graph.colours.items():
         indexes = [str(i) for i, e in enumerate(edges) if e["kind"] == kind]
         if indexes:
             styles.append({"indexes": ",".join(indexes), "colour": colour})
     classes = []
-    for cls in ("device", "bridge", "topic", "rosnode"):
+    for cls in ("device", "bridge", "topic", "rosnode", EXTERNAL):
         members = [v["id"] for v in vertices if v["cls"] == cls]
         if members:
             classes.append({"name": cls, "members": ",".join(members)})
-    return {"vertices": vertices, "edges": edges, "link_styles": styles, "classes": classes}
+    return {"vertices": vertices, "edges": edges, "link_styles": styles, "classes": classes,
+            "has_external": bool(graph.externals)}
 
 
-__all__ = ["EDGE_COLOURS", "LEGEND", "PUBLISH", "ROS_TO_UAVCAN", "SUBSCRIBE", "SVG_NAME", "TEENSY_COLOUR",
-           "UAVCAN_TO_ROS", "Edge", "Graph", "PortIndex", "build_graph", "mapping_devices", "mermaid_context",
-           "mermaid_label"]
+__all__ = [
+    "EDGE_COLOURS",
+    "EXTERNAL",
+    "EXTERNAL_COLOUR",
+    "LEGEND",
+    "PUBLISH",
+    "ROS_TO_UAVCAN",
+    "SUBSCRIBE",
+    "SVG_NAME",
+    "TEENSY_COLOUR",
+    "UAVCAN_TO_ROS",
+    "Edge",
+    "Graph",
+    "PortIndex",
+    "build_graph",
+    "external_box",
+    "mapping_devices",
+    "mermaid_context",
+    "mermaid_label",
+]

@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections.abc import Hashable, Iterable
 from pathlib import Path
 
+from sam_codegen.catalogs.ros_known import external_messages_to_generate
 from sam_codegen.model.spec import QOS_PROFILES, Mapping, Node, Port, Qos, Spec
 from sam_codegen.targets.docs.graph import ROS_TO_UAVCAN, SVG_NAME, UAVCAN_TO_ROS, Graph, PortIndex, mermaid_context
 from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
@@ -60,7 +61,7 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         "params_file": params_file(spec),
         "qos_profiles": [{"name": name, "text": Qos(q.reliability, q.durability, q.depth).describe()}
                          for name, q in QOS_PROFILES.items()],
-        "external_packages": sorted({m.package for m in spec.external_messages.values()}),
+        "external_packages": sorted({m.package for m in external_messages_to_generate(spec).values()}),
         **_message_rows(resolved),
         "parameters": _parameter_rows(spec),
         "rules": _rule_rows(spec),
@@ -118,7 +119,7 @@ def _range(minimum: float | None, maximum: float | None) -> str:
 
 def _topic_users(spec: Spec) -> TopicUsers:
     """{topic: (its publishers, its subscribers)} in spec order: nodes, then the bridge, then the node host for the
-    static frames on /tf_static."""
+    static frames on /tf_static, then the tools outside the spec (`published_by: external`)."""
     bridge = spec.bridge
     node_publishers = _users((n.name, node_published_topics(spec, n)) for n in spec.nodes.values())  # topic -> nodes
     node_subscribers = _users((n.name, node_subscribed_topics(spec, n)) for n in spec.nodes.values())
@@ -135,6 +136,9 @@ def _topic_users(spec: Spec) -> TopicUsers:
                 subscribers.append(bridge.name)
         if name == TF_STATIC_TOPIC and static_frames:
             publishers.append("node host (static frames)")
+        who = spec.topics[name].external_publisher
+        if who is not None:
+            publishers.append(f"external ({who})" if who else "external")
         users[name] = (publishers, subscribers)
     return users
 
@@ -188,7 +192,8 @@ def _message_rows(resolved: Resolved) -> dict[str, list[Row]]:
     externals: list[Row] = [{
         "name": msg.full_name, "description": msg.description, "topics": list(topics_of_type.get(msg.full_name, [])),
         "fields": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in msg.fields],
-    } for msg in spec.external_messages.values()]
+        "known": msg.full_name not in spec.external_messages,
+    } for msg in external_messages_to_generate(spec).values()]
     return {"messages": messages, "externals": externals}
 
 

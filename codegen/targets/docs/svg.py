@@ -2,9 +2,10 @@
 comes out byte for byte the same.
 
 svg_context lays out the Graph (graph.py) in steps, one function each: the boxes and their text (_boxes), their sizes
-(_size_boxes), the columns devices -> bridge -> topics -> nodes (_place_columns), the rows (_place_rows: topics stacked
-in graph order, devices and nodes at the barycentre of the topics they reach), the ports where edges meet boxes
-(_side_ports, _bridge_ports), the paths (_edge_paths, _inner_paths) and the legend.
+(_size_boxes), the columns devices -> bridge -> topics -> nodes and external publishers (_place_columns), the rows
+(_place_rows: topics stacked in graph order, devices, nodes and external publishers at the barycentre of the topics
+they reach), the ports where edges meet boxes (_side_ports, _bridge_ports), the paths (_edge_paths, _inner_paths)
+and the legend.
 
 Invariants:
 
@@ -26,8 +27,7 @@ from pathlib import Path
 from sam_codegen.model.spec import Spec
 from sam_codegen.render.filters import one_line
 from sam_codegen.targets.docs.graph import (
-    EDGE_COLOURS,
-    LEGEND,
+    EXTERNAL,
     PUBLISH,
     SUBSCRIBE,
     TEENSY_COLOUR,
@@ -50,7 +50,7 @@ GAP_BRIDGE_TOPIC = 60
 GAP_TOPIC_NODE = 160
 TOP = 52  # below the title: column headings
 CONTENT_TOP = 76
-PORT_GAP = {"device": 16, "bridge": 0, "topic": 7, "node": 10}  # least distance between the ports of a box
+PORT_GAP = {"device": 16, "bridge": 0, "topic": 7, "node": 10, EXTERNAL: 10}  # least distance between a box's ports
 COLUMNS = ("device", "bridge", "topic", "node")  # box kinds, left to right
 BRIDGE_TITLE = "The UAVCAN <-> ROS bridge (document section IV.B)."
 
@@ -75,6 +75,11 @@ class Box:
     y: int = 0
     w: int = 0
     h: int = 0
+
+    @property
+    def column(self) -> str:
+        """The column it stands in: an external publisher's box stands with the nodes."""
+        return "node" if self.kind == EXTERNAL else self.kind
 
     @property
     def cy(self) -> float:
@@ -147,9 +152,9 @@ def svg_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
     if bridge_box is not None:
         _bridge_ports(bridge_box, graph, ports)
     content_bottom = max([topics_bottom, *(b.y + b.h for b in boxes.values())])
-    legend, teensy_y = _legend(content_bottom)
+    legend, teensy_y = _legend(content_bottom, graph.legend)
     width = x["node"] + widths["node"] + MARGIN
-    width = max(width, MARGIN + 50 + max(text_width(t, SMALL_SIZE + 1) for _, t in LEGEND) + MARGIN)
+    width = max(width, MARGIN + 50 + max(text_width(t, SMALL_SIZE + 1) for _, t in graph.legend) + MARGIN)
     return {
         "width": width,
         "height": teensy_y + 24,
@@ -158,7 +163,8 @@ def svg_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         "heading_y": TOP + 10,
         "title_y": 26,
         "margin": MARGIN,
-        "colours": EDGE_COLOURS,
+        "colours": graph.colours,
+        "has_external": bool(graph.externals),
         "teensy_colour": TEENSY_COLOUR,
         "boxes": [
             {"kind": b.kind, "x": b.x, "y": b.y, "w": b.w, "h": b.h, "title": b.title, "rows": b.text_rows()}
@@ -192,6 +198,9 @@ def _boxes(spec: Spec, graph: Graph) -> dict[BoxKey, Box]:
         lines += [("small", f"tf {parent} -> {child}") for parent, child in n.transforms]
         lines += [("small", f"param {p}") for p in n.parameters]
         boxes[("node", name)] = Box("node", name, lines, n.description)
+    for name, who in graph.externals.items():
+        lines = [("name", "external"), *([("small", _clip(who, 40))] if who else [])]
+        boxes[(EXTERNAL, name)] = Box(EXTERNAL, name, lines, f"Published from outside the spec: {who or 'external'}")
     if graph.bridge is not None and spec.bridge is not None:
         lines = [("name", graph.bridge), ("small", f"node id {spec.bridge.node_id}"),
                  ("small", f"{len(spec.bridge.mappings)} mappings")]
@@ -200,7 +209,7 @@ def _boxes(spec: Spec, graph: Graph) -> dict[BoxKey, Box]:
 
 
 def _column(boxes: dict[BoxKey, Box], kind: str) -> list[Box]:
-    return [b for b in boxes.values() if b.kind == kind]
+    return [b for b in boxes.values() if b.column == kind]
 
 
 def _size_boxes(boxes: dict[BoxKey, Box], graph: Graph) -> dict[str, int]:
@@ -215,7 +224,7 @@ def _size_boxes(boxes: dict[BoxKey, Box], graph: Graph) -> dict[str, int]:
         members = _column(boxes, kind)
         widths[kind] = max([140, *(_content_width(b.lines) for b in members)])
         for b in members:
-            b.w, b.h = widths[kind], max(_content_height(b.lines), (degree[(kind, b.name)] + 1) * PORT_GAP[kind])
+            b.w, b.h = widths[kind], max(_content_height(b.lines), (degree[(b.kind, b.name)] + 1) * PORT_GAP[b.kind])
     return widths
 
 
@@ -266,7 +275,7 @@ def _place_rows(boxes: dict[BoxKey, Box], graph: Graph, bridge_box: Box | None) 
         members = _column(boxes, kind)
         desired = {}
         for i, b in enumerate(members):
-            ys = linked_ys.get((kind, b.name), [])
+            ys = linked_ys.get((b.kind, b.name), [])
             desired[b.name] = sum(ys) / len(ys) if ys else 1e9 + i  # unconnected: at the bottom, in spec order
         _stack(members, desired, top, max(topics_bottom, top))
     return topics_bottom, topic_of_edge
@@ -284,7 +293,7 @@ def _linked_heights(boxes: dict[BoxKey, Box], graph: Graph) -> tuple[dict[BoxKey
         for i in dev_edges:
             topic_of_edge.setdefault(i, topic_edge)
     for e in graph.edges:
-        if e.kind in (SUBSCRIBE, PUBLISH):
+        if e.kind in (SUBSCRIBE, PUBLISH, EXTERNAL):
             ty = _topic_y(boxes, e)
             for key in dict.fromkeys((e.src, e.dst)):
                 linked_ys.setdefault(key, []).append(ty)
@@ -323,7 +332,7 @@ def _side_ports(boxes: dict[BoxKey, Box], graph: Graph, topic_of_edge: dict[int,
         for i, end in ends_of.get(key, []):
             e = graph.edges[i]
             other = e.dst if end == "src" else e.src
-            faces_left = (box.kind == "topic" and other[0] == "bridge") or box.kind == "node"
+            faces_left = (box.kind == "topic" and other[0] == "bridge") or box.column == "node"
             (left if faces_left else right).append((i, end))
         attach(box, "left", left)
         attach(box, "right", right)
@@ -374,15 +383,15 @@ def _inner_paths(graph: Graph, ports: dict[EdgeEnd, Point]) -> list[dict[str, ob
     return inner
 
 
-def _legend(content_bottom: int) -> tuple[list[dict[str, object]], int]:
+def _legend(content_bottom: int, rows: list[tuple[str, str]]) -> tuple[list[dict[str, object]], int]:
     """The legend rows below the content, and the height of the Teensy note below them."""
     legend_top = content_bottom + 28
     legend: list[dict[str, object]] = []
-    for k, (kind, text) in enumerate(LEGEND):
+    for k, (kind, text) in enumerate(rows):
         y = legend_top + k * 18
         legend.append({"kind": kind, "y": y, "d": f"M{MARGIN},{y} L{MARGIN + 40},{y}", "tx": MARGIN + 50,
                        "ty": y + 4, "text": text})
-    return legend, legend_top + len(LEGEND) * 18
+    return legend, legend_top + len(rows) * 18
 
 
 __all__ = ["svg_context", "text_width"]
