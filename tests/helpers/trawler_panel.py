@@ -6,8 +6,8 @@ python trawler_panel.py --generated DIR --iface mcast-lo:<bus>:<port> --start-fi
 
 Prints ``READY {...}`` with what dronecan decodes data type id 20100 as; once F exists, broadcasts Switch
 (switch_id 1, level 100 k + 7, flags k) for k = 0..4, one Switch of switch_id 3 (no mapping selects it) and one Panic
-("LEAK"), printing ``PUBLISHED``; records every Switch and Panic it receives (source, type name, values). On SIGTERM or
-when ``--max-life`` runs out: ``SUMMARY {...}``, exit 0.
+("LEAK"), printing ``PUBLISHED``; records every Switch and Panic it receives (source, type name, values), each
+also as a line ``GOT <type> <source> <values>``. On SIGTERM or when ``--max-life`` runs out: ``SUMMARY {...}``, exit 0.
 """
 
 from __future__ import annotations
@@ -59,6 +59,7 @@ def main() -> int:
             return
         received.append({"source": e.transfer.source_node_id, "type": t.full_name, "data_type_id": t.default_dtid,
                          "values": values})
+        print(f"GOT {t.full_name} {e.transfer.source_node_id} {json.dumps(values)}", flush=True)
 
     node.add_handler(None, on_message)
     decoded_as = dronecan.DATATYPES.get((20100, switch.kind))

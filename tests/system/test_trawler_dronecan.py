@@ -10,7 +10,10 @@ com.hobbywing.esc.RawCommand; Panic mapped onto /panic_in and /panic_out with ``
   type (and the panel too);
 - Panic both ways as ordinary mappings: the panel's Panic on /panic_in; /panic_out broadcast once as Panic, its text
   cut to reason_text's 7 bytes and counted (``saturated``); the built-in duty is off (no /trawler_bridge/panic_received
-  publisher, no triple broadcast).
+  publisher, no triple broadcast);
+- the same spec with ``panic_duty: both`` (wire path: the mapping's tap shares Panic with the duty): the mappings as
+  above and the built-in duty beside them (the panel's Panic also on /trawler_bridge/panic_received,
+  /trawler_bridge/panic broadcast three times).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from helpers.spec_build import generated_spec
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
+SPECS = Path(__file__).parents[1] / "specs"
 BRIDGE_ID, PANEL_ID, RELAY_ID = 100, 30, 31
 BRIDGE = "trawler_bridge"
 LEVELS = [7, 107, 207, 307, 407]
@@ -65,7 +69,17 @@ class Probe(ThreadedProbe):
     node_name = "test_trawler_probe"
 
     def setup(self) -> None:
+        from std_msgs.msg import String
+
         self.messages: dict[str, list[Any]] = {}
+        self.builtin: list[str] = []
+        self.string = String
+
+    def watch_builtin(self) -> None:
+        """The built-in Panic duty's topics (used by the `both` run; never published in the others)."""
+        self.node.create_subscription(self.string, f"/{BRIDGE}/panic_received",
+                                      lambda m: self.builtin.append(m.data), 10)
+        self.builtin_pub = self.node.create_publisher(self.string, f"/{BRIDGE}/panic", 10)
 
     def on_message(self, topic: str, msg: Any) -> None:
         self.messages.setdefault(topic, []).append(msg.data)
@@ -78,13 +92,32 @@ def _summary(proc: Proc) -> dict[str, Any]:
 
 @pytest.fixture(scope="module", params=["codec", "object"])
 def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    wire = request.param
+    d = tmp_path_factory.mktemp(f"trawler_{wire}")
+    return _scenario(d, generated_spec("trawler_v0"), wire, domain_id(47 if wire == "codec" else 48), both=False)
+
+
+@pytest.fixture(scope="module")
+def run_both(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """The trawler with `panic_duty: both`, generated here, on the wire path."""
+    from sam_codegen.build import build
+
+    d = tmp_path_factory.mktemp("trawler_both")
+    spec = d / "spec" / "trawler_v0.yaml"
+    spec.parent.mkdir()
+    text = (SPECS / "trawler_v0.yaml").read_text(encoding="utf-8")
+    assert text.count("  panic_duty: mappings\n") == 1
+    spec.write_text(text.replace("  panic_duty: mappings\n", "  panic_duty: both\n"), encoding="utf-8")
+    build(spec, d / "generated")
+    return _scenario(d, d / "generated", "codec", domain_id(49), both=True)
+
+
+def _scenario(d: Path, generated: Path, wire: str, domain: str, both: bool) -> dict[str, Any]:
     from sam_runtime.genpkg import GeneratedPackage
 
-    wire = request.param
-    generated = generated_spec("trawler_v0")
-    gen = GeneratedPackage(generated)
-    d = tmp_path_factory.mktemp(f"trawler_{wire}")
-    domain = domain_id(47 if wire == "codec" else 48)
+    # The probe's topics and QoS, from the spec's package as tests/specs has it (the `both` variant has the same ones;
+    # one process imports one copy of a generated package).
+    gen = GeneratedPackage(generated_spec("trawler_v0"))
     env = child_env(Path(sys.prefix).absolute(), domain)
     iface = private_iface()
     common = ["--generated", str(generated), "--dronecan-iface", iface]
@@ -101,6 +134,7 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
             mp.setenv("ROS_DOMAIN_ID", domain)
             mp.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
             probe = Probe(_DroneCanTopics(gen), ["/panel_level", "/panic_in"], ["/relay_level", "/panic_out"])
+            probe.watch_builtin()
         out["panel_ready"] = json.loads(panel.wait_line("READY ", 60).split(" ", 1)[1])
         bridge.wait_line("READY", 90)
         sim.wait_line("READY", 90)
@@ -112,11 +146,23 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
                 and all(p.get_subscription_count() > 0 for p in probe.pubs.values())
 
         poll_until(ready, 30, "the bridge hearing both devices and matching the probe")
-        out["builtin_publishers"] = probe.node.count_publishers(f"/{BRIDGE}/panic_received")
-        out["builtin_subscribers"] = probe.node.count_subscribers(f"/{BRIDGE}/panic")
+        duties = f"{BRIDGE}_dronecan_duties"  # the duties' own ROS node: its services say it is discovered
+
+        def duty_endpoints() -> tuple[list[str], list[str]] | None:
+            services = [n for n, _ in probe.node.get_service_names_and_types_by_node(duties, "/")] \
+                if duties in probe.node.get_node_names() else []
+            if f"/{BRIDGE}/panel/get_node_info" not in services:
+                return None
+            return ([n for n, _ in probe.node.get_publisher_names_and_types_by_node(duties, "/")],
+                    [n for n, _ in probe.node.get_subscriber_names_and_types_by_node(duties, "/")])
+
+        out["duty_publishes"], out["duty_subscribes"] = poll_until(duty_endpoints, 20, "the duties' ROS node")
 
         probe.publish("/relay_level", {"data": 1234})
         probe.publish("/panic_out", {"data": "WATER-INGRESS"})
+        if both:
+            poll_until(lambda: probe.builtin_pub.get_subscription_count() > 0, 20, "the built-in duty's /panic")
+            probe.builtin_pub.publish(probe.string(data="ROS-ABORT"))
         (d / "go").touch()
         panel.wait_line("PUBLISHED", 20)
 
@@ -124,7 +170,11 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
             return [r for r in load_records(d / "sim.jsonl") if r["dir"] == "rx" and r["data_type"] == kind]
 
         poll_until(lambda: len(probe.messages.get("/panel_level", [])) >= len(LEVELS)
-                   and probe.messages.get("/panic_in"), 20, "the panel's Switch and Panic on ROS")
+                   and probe.messages.get("/panic_in") and (probe.builtin or not both), 20,
+                   "the panel's Switch and Panic on ROS")
+        panics = 4 if both else 1  # the mapping's, and the built-in duty's three
+        poll_until(lambda: sum(line.startswith(f"GOT uavcan.protocol.Panic {BRIDGE_ID} ") for line in panel.lines)
+                   >= panics, 20, f"{panics} Panic from the bridge at the panel")
         poll_until(lambda: rx("trawler.io.Switch") and rx("uavcan.protocol.Panic"), 20,
                    "the relay board receiving the bridge's Switch and Panic")
         poll_until(lambda: (read_json(d / "bridge.json") or {}).get("mappings", {}).get("panel_level", {})
@@ -135,6 +185,7 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
         out["panel"] = _summary(panel)
         assert bridge.stop(signal.SIGTERM) == 0, bridge.stderr_tail()
         out["messages"] = {t: list(v) for t, v in probe.messages.items()}
+        out["builtin"] = list(probe.builtin)
         out["stats"] = read_json(d / "bridge.json")
         out["sim"] = read_json(d / "sim.json")
     finally:
@@ -183,4 +234,19 @@ def test_panic_mapped_both_ways_with_the_cut_counted(run: dict[str, Any]) -> Non
 
 
 def test_the_builtin_panic_duty_is_off(run: dict[str, Any]) -> None:
-    assert run["builtin_publishers"] == 0 and run["builtin_subscribers"] == 0
+    assert f"/{BRIDGE}/panic_received" not in run["duty_publishes"]
+    assert f"/{BRIDGE}/panic" not in run["duty_subscribes"]
+    assert run["builtin"] == []
+
+
+def test_with_both_the_builtin_duty_runs_beside_the_mappings(run_both: dict[str, Any]) -> None:
+    r = run_both
+    assert f"/{BRIDGE}/panic_received" in r["duty_publishes"] and f"/{BRIDGE}/panic" in r["duty_subscribes"]
+    assert r["messages"]["/panic_in"] == ["LEAK"]  # the mapping, on the wire path: its tap shares Panic ...
+    assert r["builtin"] == [f"node {PANEL_ID}: LEAK"]  # ... with the built-in duty
+    panics = [p["values"]["reason_text"] for p in r["panel"]["received"]
+              if p["type"] == "uavcan.protocol.Panic" and p["source"] == BRIDGE_ID]
+    assert sorted(panics) == ["ROS-ABO"] * 3 + ["WATER-I"]
+    m = r["stats"]["mappings"]
+    assert m["panic_out"]["saturated"] == {"panic_out.reason_text": 1} and m["panic_in"]["published"] == 1
+    assert r["messages"]["/panel_level"] == LEVELS
