@@ -189,3 +189,15 @@ def test_panic_codec_cuts_reason_text_at_7_bytes_on_a_character_boundary_and_cou
     assert codec.panic_in_wire_to_ros(b"LEAK", 0, stats) == (_cdr_string("LEAK"), -1)
     for name in [m for m in sys.modules if m.split(".")[0] == "trawler_bridge"]:
         monkeypatch.delitem(sys.modules, name)
+
+
+def test_the_reference_says_the_namespaces_and_who_handles_panic() -> None:
+    from sam_codegen.targets.docs import emit
+
+    text = emit(validate(load_spec_file(TRAWLER)))["docs/interfaces.md"]
+    assert "- Standard definitions used: `uavcan`, `ardupilot` (`dronecan_namespaces`: the data type ids of the " \
+           "other namespaces are free for the spec's own types).\n" in text
+    assert "- `uavcan.protocol.Panic` is handled by the spec's DroneCAN mappings of `uavcan.protocol.Panic` " \
+           "(`panic_duty: mappings`; the built-in duty is off).\n" in text
+    assert "| `data` | → | `reason_text` | string → uint8\\[&lt;=7\\] (longer than 7 bytes cut) |" in text
+    assert "- Data type id 20100, signature" in text
