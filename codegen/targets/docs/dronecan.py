@@ -63,9 +63,9 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
     duty = panic_duty(spec)
     bridge = spec.bridge.name if spec.bridge is not None else "bridge"
     builtin = f"the bridge's built-in duty (`/{bridge}/panic` broadcast three times, `/{bridge}/panic_received`)"
-    panic = {"builtin": builtin, "mappings": "the spec's DroneCAN mappings of `uavcan.protocol.Panic` "
-             "(`panic_duty: mappings`; the built-in duty is off)",
-             "both": f"the spec's DroneCAN mappings of `uavcan.protocol.Panic` and {builtin} (`panic_duty: both`)"}[duty]
+    own = "the spec's DroneCAN mappings of `uavcan.protocol.Panic`"
+    panic = {"builtin": builtin, "mappings": f"{own} (`panic_duty: mappings`; the built-in duty is off)",
+             "both": f"{own} and {builtin} (`panic_duty: both`)"}[duty]
     return {"dronecan": {"layouts": layouts, "devices": devices, "types": types, "mappings": mappings,
                          "namespaces": namespaces, "panic": panic}
             if devices or types or mappings or len(layouts) > 1 else None}
