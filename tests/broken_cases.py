@@ -79,7 +79,7 @@ CASES: tuple[Case, ...] = (
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
         (
-            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes, bus)",
+            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes, bus, dronecan_namespaces)",
         ),
     ),
     Case(
@@ -611,7 +611,7 @@ V0_CASES: tuple[Case, ...] = (
         'id: 20120',
         'id: 20100',
         (
-            'minimal_v0.yaml:12:3: error: data type id 20100 of DroneCAN type skiff.Bilge is taken by the standard type com.hobbywing.esc.RawCommand (expected a free vendor-specific id, e.g. in 20101..20199)',
+            'minimal_v0.yaml:12:3: error: data type id 20100 of DroneCAN type skiff.Bilge is taken by the standard type com.hobbywing.esc.RawCommand of namespace com, loaded by default (no dronecan_namespaces: every namespace) (expected a free vendor-specific id, e.g. in 20101..20199, or dronecan_namespaces without com if the vehicle never uses it)',
         ),
     ),
     Case(
@@ -881,6 +881,109 @@ V0_CASES: tuple[Case, ...] = (
         (
             "minimal_v0.yaml:31:11: error: DroneCAN type 'skiff.Bilge' of device gauge has no data type id: it can only be nested in other types (expected a message type with a data type id)",
             "minimal_v0.yaml:56:5: error: DroneCAN type 'skiff.Bilge' of DroneCAN mapping 'bilge' has no data type id: it can only be nested in other types (expected a message type with a data type id)",
+        ),
+    ),
+    Case(
+        'v0_namespaces_clash_inside',
+        'dronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        'dronecan_namespaces: [com.hobbywing]\ndronecan_types:\n  skiff.Bilge:\n    id: 20100',
+        (
+            'minimal_v0.yaml:13:3: error: data type id 20100 of DroneCAN type skiff.Bilge is taken by the standard type com.hobbywing.esc.RawCommand of namespace com.hobbywing, which dronecan_namespaces loads (expected a free vendor-specific id, e.g. in 20101..20199, or dronecan_namespaces without com.hobbywing if the vehicle never uses it)',
+        ),
+    ),
+    Case(
+        'v0_namespaces_unknown',
+        'dronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        'dronecan_namespaces: [uavcan, hobbywing, com.nobody]\ndronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        (
+            "minimal_v0.yaml:11:31: error: unknown DroneCAN namespace 'hobbywing' in dronecan_namespaces (expected a namespace of the standard definitions: ardupilot, com, cuav, dronecan, uavcan, or one inside them, e.g. com.hobbywing)",
+            "minimal_v0.yaml:11:42: error: unknown DroneCAN namespace 'com.nobody' in dronecan_namespaces (expected a namespace of the standard definitions: ardupilot, com, cuav, dronecan, uavcan, or one inside them, e.g. com.hobbywing; inside com: com.hex, com.himark, com.hobbywing, com.tmotor, com.volz, com.xacti)",
+        ),
+    ),
+    Case(
+        'v0_namespaces_twice',
+        'dronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        'dronecan_namespaces: [ardupilot, ardupilot]\ndronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        (
+            "minimal_v0.yaml:11:34: error: DroneCAN namespace 'ardupilot' appears twice in dronecan_namespaces (first at line 11) (expected each namespace once)",
+        ),
+    ),
+    Case(
+        'v0_namespaces_not_a_list',
+        'dronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        'dronecan_namespaces: ardupilot\ndronecan_types:\n  skiff.Bilge:\n    id: 20120',
+        (
+            "minimal_v0.yaml:11:22: error: dronecan_namespaces must be a list, found str 'ardupilot' (expected a list)",
+        ),
+    ),
+    Case(
+        'v0_type_outside_namespaces',
+        'dronecan_types:\n  skiff.Bilge:\n    id: 20120\n    fields:\n      - {name: timestamp, type: uavcan.Timestamp}',
+        'dronecan_namespaces: [dronecan]\ndronecan_types:\n  skiff.Bilge:\n    id: 20120\n    fields:\n      - {name: timestamp, type: ardupilot.gnss.Heading}',
+        (
+            'minimal_v0.yaml:16:9: error: DroneCAN type ardupilot.gnss.Heading of DroneCAN type skiff.Bilge is in namespace ardupilot, which dronecan_namespaces does not load (expected ardupilot or ardupilot.gnss in dronecan_namespaces)',
+        ),
+    ),
+)
+
+# Broken variants of tests/specs/trawler_v0.yaml (vendor data type ids, Panic mapped onto the spec's topics):
+# tests/codegen/test_vendor_panic.py runs them.
+TRAWLER_CASES: tuple[Case, ...] = (
+    Case(
+        'panic_duty_unset',
+        '  panic_duty: mappings\n',
+        '',
+        (
+            "trawler_v0.yaml:57:5: error: DroneCAN mapping 'panic_in' maps uavcan.protocol.Panic, which the bridge's built-in Panic duty (/trawler_bridge/panic, /trawler_bridge/panic_received) handles too: the spec must say which handles it (expected `panic_duty: mappings` in bridge (the mappings instead of the built-in duty) or `panic_duty: both`)",
+        ),
+    ),
+    Case(
+        'panic_duty_builtin_with_mapping',
+        '  panic_duty: mappings\n',
+        '  panic_duty: builtin\n',
+        (
+            "trawler_v0.yaml:39:3: error: panic_duty builtin leaves uavcan.protocol.Panic to the bridge's built-in duty, but DroneCAN mapping 'panic_in' maps it (expected `panic_duty: mappings` or `panic_duty: both`)",
+        ),
+    ),
+    Case(
+        'panic_duty_unknown',
+        '  panic_duty: mappings\n',
+        '  panic_duty: none\n',
+        (
+            "trawler_v0.yaml:39:3: error: panic_duty 'none' of the bridge is unknown (expected builtin (the bridge's built-in Panic duty), mappings (the spec's mappings of uavcan.protocol.Panic instead) or both)",
+        ),
+    ),
+    Case(
+        'panic_duty_yaml_off',
+        '  panic_duty: mappings\n',
+        '  panic_duty: off\n',
+        (
+            "trawler_v0.yaml:39:15: error: 'panic_duty' of bridge must be str, found bool False (expected str)",
+        ),
+    ),
+    Case(
+        'panic_duty_mappings_without_mapping',
+        '    panic_in:\n      direction: uavcan_to_ros\n      data_type: uavcan.protocol.Panic\n      topic: /panic_in\n      source_node_ids: [30]\n      fields:\n        data: reason_text\n    panic_out:\n      direction: ros_to_uavcan\n      data_type: uavcan.protocol.Panic\n      topic: /panic_out\n      destination_node_ids: [31]\n      fields:\n        data: reason_text\n',
+        '',
+        (
+            "trawler_v0.yaml:39:3: error: panic_duty mappings turns the bridge's built-in Panic duty off, but no DroneCAN mapping maps uavcan.protocol.Panic: nothing would send or receive Panic (expected a dronecan_mappings entry with `data_type: uavcan.protocol.Panic`, or `panic_duty: builtin`)",
+            'trawler_v0.yaml:61:32: error: node deck subscribes to /panic_in, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN, or `published_by: external` on the topic)',
+        ),
+    ),
+    Case(
+        'v0_text_into_number',
+        '  /relay_level: {type: std_msgs/UInt16}',
+        '  /relay_level: {type: std_msgs/String}',
+        (
+            "trawler_v0.yaml:56:9: error: DroneCAN mapping 'relay_level', field 'data': a DroneCAN uint8[<=N] maps to a ROS string, not uint16 to string",
+        ),
+    ),
+    Case(
+        'v0_text_namespace_outside',
+        'dronecan_namespaces: [uavcan, ardupilot]',
+        'dronecan_namespaces: [uavcan, com]',
+        (
+            'trawler_v0.yaml:12:3: error: data type id 20100 of DroneCAN type trawler.io.Switch is taken by the standard type com.hobbywing.esc.RawCommand of namespace com, which dronecan_namespaces loads (expected a free vendor-specific id, e.g. in 20101..20199, or dronecan_namespaces without com if the vehicle never uses it)',
         ),
     ),
 )

@@ -7,6 +7,11 @@ DRONECAN_DSDL_PATH, folders holding such root namespaces separated by `:`, repla
 checkout). Files are read on demand; the signature is computed here as dronecan's parser computes it (the tests
 compare the two over every standard type).
 
+Which standard namespaces a spec uses is its choice (`dronecan_namespaces`: root namespaces such as `ardupilot`, or
+namespaces inside one such as `com.hobbywing`; `uavcan` always): the catalog knows only the definitions inside them
+(`files`, `get`, `standard_ids`), so a type of another namespace is unknown and its data type id free for the spec's
+own types. Without the key it knows every definition (`all_files`), as dronecan.load_dsdl() loads them.
+
 Invariant: the catalog changes no struct. `get` gives a type as declared (its `signature` 0); `signed` gives it with
 the data type signature, computed on demand: what an emitter of ids and signatures reads.
 """
@@ -208,12 +213,25 @@ def _file_name_parts(name: str) -> tuple[int | None, str] | None:
     return None, items[0]
 
 
+def in_namespaces(name: str, namespaces: tuple[str, ...]) -> bool:
+    """Whether the full name `name` lies in one of `namespaces` (a namespace holds what its name prefixes).
+
+    >>> in_namespaces("com.hobbywing.esc.RawCommand", ("uavcan", "com.hobbywing"))
+    True
+    >>> in_namespaces("com.hobbywingx.Thing", ("com.hobbywing",)), in_namespaces("uavcan.Timestamp", ("uavcan",))
+    (False, True)
+    """
+    return any(name.startswith(ns + ".") for ns in namespaces)
+
+
 class V0Catalog:
-    """Looks v0 types up by full name: the spec's own `dronecan_types` first, then the standard definitions."""
+    """Looks v0 types up by full name: the spec's own `dronecan_types` first, then the standard definitions of the
+    namespaces the spec uses."""
 
     def __init__(self, spec: Spec, roots: list[Path] | None = None) -> None:
         self._spec = spec
         self._roots = roots
+        self._all_files: dict[str, tuple[Path, int | None]] | None = None
         self._files: dict[str, tuple[Path, int | None]] | None = None
         self._definitions: dict[str, _Definition | None] = {}
         self._signatures: dict[str, int] = {}
@@ -226,17 +244,41 @@ class V0Catalog:
             self._roots = standard_roots()
         return self._roots
 
-    def files(self) -> dict[str, tuple[Path, int | None]]:
-        """Every standard type: full name -> (file, data type id)."""
-        if self._files is None:
-            self._files = {}
+    def all_files(self) -> dict[str, tuple[Path, int | None]]:
+        """Every standard type, whatever the spec uses: full name -> (file, data type id)."""
+        if self._all_files is None:
+            self._all_files = {}
             for root in self.roots:
                 for path in sorted(root.rglob("*.uavcan")):
                     parts = _file_name_parts(path.name)
                     if parts is None:
                         continue
                     namespace = ".".join([root.name, *path.relative_to(root).parent.parts])
-                    self._files.setdefault(f"{namespace}.{parts[1]}", (path, parts[0]))
+                    self._all_files.setdefault(f"{namespace}.{parts[1]}", (path, parts[0]))
+        return self._all_files
+
+    @property
+    def namespaces(self) -> tuple[str, ...]:
+        """The namespaces of the standard definitions the spec uses: `uavcan` and its `dronecan_namespaces`, or
+        every root namespace when it has none (the default)."""
+        chosen = self._spec.dronecan_namespaces
+        if chosen is None:
+            return tuple(dict.fromkeys(["uavcan", *(r.name for r in self.roots)]))
+        return tuple(dict.fromkeys(["uavcan", *chosen]))
+
+    def known_namespaces(self) -> set[str]:
+        """Every namespace of the standard definitions, the root ones and those inside them."""
+        result: set[str] = set()
+        for name in self.all_files():
+            parts = name.split(".")[:-1]
+            result.update(".".join(parts[:k]) for k in range(1, len(parts) + 1))
+        return result
+
+    def files(self) -> dict[str, tuple[Path, int | None]]:
+        """Every standard type of the namespaces the spec uses: full name -> (file, data type id)."""
+        if self._files is None:
+            namespaces = self.namespaces
+            self._files = {name: entry for name, entry in self.all_files().items() if in_namespaces(name, namespaces)}
         return self._files
 
     def standard_ids(self) -> dict[tuple[bool, int], str]:

@@ -14,7 +14,7 @@ from pathlib import Path
 from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mapping
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
-from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
+from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.topic_sources import implied_tf_topics, parse_published_by
 from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
@@ -44,7 +44,7 @@ __all__ = ["QOS_DEPTH_MAX", "load_spec_file", "parse_qos", "parse_spec", "scalar
 _TOP_KEYS = (
     "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "dronecan_types",
     "frames", "transforms", "topics", "parameters", "parameter_rules", "devices", "layouts", "bridge", "nodes",
-    "bus",
+    "bus", "dronecan_namespaces",
 )
 
 
@@ -137,7 +137,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     bridge_node = top.node("bridge")
     bridge = None
     if bridge_node is not None:
-        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings"))
+        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty"))
         name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
         mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
         for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
@@ -146,7 +146,8 @@ def parse_spec(root: YNode, file: str) -> Spec:
                 mapping = parse_mapping(key, pos, node, diag, protocol)
                 if mapping is not None:
                     mappings[protocol].append(mapping)
-        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"])
+        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
+                        panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"))
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
         nodes[key] = parse_node(key, pos, node, diag)
@@ -154,11 +155,15 @@ def parse_spec(root: YNode, file: str) -> Spec:
     declared_topics += implied_tf_topics({t.name: t for t in declared_topics}, nodes, frames)
     topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
     bus = parse_bus(top.node("bus"), "bus", diag)
+    namespaces = str_list(top.node("dronecan_namespaces"), "dronecan_namespaces", diag) \
+        if top.node("dronecan_namespaces") is not None else None
     diag.check()
     return Spec(
         file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
         cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
         parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus,
+        dronecan_namespaces=tuple(n for n, _ in namespaces) if namespaces is not None else None,
+        dronecan_namespaces_pos=tuple(p for _, p in namespaces) if namespaces is not None else (),
     )
 
 

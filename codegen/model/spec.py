@@ -354,6 +354,10 @@ class Bridge:
     mappings: list[Mapping] = field(default_factory=list)  # Cyphal
     pos: Pos = NOWHERE
     dronecan_mappings: list[Mapping] = field(default_factory=list)
+    # Who handles uavcan.protocol.Panic: "builtin" (the bridge's duty), "mappings" (only dronecan_mappings of
+    # Panic) or "both"; None: not said (the built-in duty, and no mapping of Panic allowed)
+    panic_duty: str | None = None
+    panic_duty_pos: Pos = NOWHERE
 
     @property
     def all_mappings(self) -> list[Mapping]:
@@ -450,6 +454,9 @@ class Spec:
     dronecan_types: dict[str, V0Struct] = field(default_factory=dict)  # the spec's own v0 types, by full name
     layouts: dict[str, Layout] = field(default_factory=dict)  # the named layouts beside the implicit default
     bus: CanBus | None = None  # the vehicle's CAN bus; None: classic CAN at 1 Mbit/s
+    # The namespaces of the standard v0 definitions the spec uses (uavcan always); None: every one (the default)
+    dronecan_namespaces: tuple[str, ...] | None = None
+    dronecan_namespaces_pos: tuple[Pos, ...] = ()  # each entry's position
 
     def devices_by_node_id(self) -> dict[int, Device]:
         return {d.node_id: d for d in self.devices.values()}

@@ -27,6 +27,7 @@ from sam_codegen.model.spec import (
     V0Struct,
 )
 from sam_codegen.model.types import V0_MAX_FULL_NAME, V0_NAMESPACE_COMPONENT, V0_SHORT_NAME, DsdlType
+from sam_codegen.validate.dronecan_namespaces import check_namespaces, clash_message, outside_message
 from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, format_path
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.values import check_dsdl_value, python_safe
@@ -84,6 +85,10 @@ class DronecanValidator:
                                "be looked up", "the `dronecan` package installed (pip install "
                                "'sam-codegen[runtime]') or DRONECAN_DSDL_PATH naming folders that hold uavcan/")
                 return None
+            outside = outside_message(self.catalog, name, what)
+            if outside is not None:
+                self.error(pos, *outside)
+                return None
             self.error(pos, f"unknown DroneCAN type {name!r} of {what}",
                        "a type of dronecan_types or a standard one, e.g. uavcan.equipment.ahrs.RawIMU")
             return None
@@ -100,6 +105,7 @@ class DronecanValidator:
 
     # ---- the spec's own types ------------------------------------------------------------------------------
     def check_types(self) -> None:
+        check_namespaces(self.spec, self.catalog, self.diag)
         ids: dict[int, str] = {}
         standard = self.catalog.standard_ids() if self.catalog.roots else {}
         reserved_roots = set(DRONECAN_ROOTS) | {r.name for r in self.catalog.roots}
@@ -125,8 +131,8 @@ class DronecanValidator:
                     self.error(struct.pos, f"data type id {dtid} of {what} is outside the vendor-specific range",
                                f"{VENDOR_MESSAGE_IDS.start}..{VENDOR_MESSAGE_IDS.stop - 1}")
                 elif (False, dtid) in standard:
-                    self.error(struct.pos, f"data type id {dtid} of {what} is taken by the standard type "
-                               f"{standard[(False, dtid)]}", "a free vendor-specific id, e.g. in 20101..20199")
+                    self.error(struct.pos, *clash_message(self.spec, self.catalog, dtid, what,
+                                                          standard[(False, dtid)]))
                 elif dtid in ids:
                     self.error(struct.pos, f"data type id {dtid} of {what} is taken by {ids[dtid]}",
                                "a unique data type id")
@@ -149,7 +155,11 @@ class DronecanValidator:
                 if t.kind != "composite" or not t.composite:
                     continue
                 nested = self.catalog.get(t.composite)
-                if nested is None:
+                outside = outside_message(self.catalog, t.composite, what) if nested is None else None
+                if outside is not None:
+                    self.error(f.pos, *outside)
+                    bad = True
+                elif nested is None:
                     self.error(f.pos, f"unknown DroneCAN type {t.composite!r} in {what}",
                                "a type of dronecan_types or a standard one, by its full name (e.g. uavcan.Timestamp)")
                     bad = True

@@ -297,10 +297,13 @@ def missing_table_keys(uav: DsdlType, keys: set[int], shown: int = 5) -> tuple[i
     return count, first
 
 
-def check_string(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:
-    """Check a UAVCAN utf8[<=N] / ROS string pair (step kind `string`); returns whether the round trip is exact."""
-    if uav.kind != "utf8" or uav.array != "bounded" or ros.base != "string" or ros.array:
-        raise RuleError(f"a UAVCAN utf8[<=N] maps to a ROS string, not {uav} to {ros}")
+def check_string(ros: RosType, uav: DsdlType, link: FieldLink, v0: bool = False) -> bool:
+    """Check a UAVCAN utf8[<=N] / ROS string pair (step kind `string`); returns whether the round trip is exact.
+    `v0`: a DroneCAN mapping, whose text is uint8[<=N] (v0 DSDL has no utf8), e.g. Panic's reason_text."""
+    text = v0 and uav.kind == "uint" and uav.bits == 8  # the same bytes as utf8: what v0 firmware sends as text
+    if not (uav.kind == "utf8" or text) or uav.array != "bounded" or ros.base != "string" or ros.array:
+        what = "a DroneCAN uint8[<=N]" if v0 else "a UAVCAN utf8[<=N]"
+        raise RuleError(f"{what} maps to a ROS string, not {uav} to {ros}")
     if link.scale is not None or link.offset is not None or link.table is not None or link.limits is not None:
         raise RuleError("scale, offset, table and limits do not apply to strings")
     if ros.string_bound is not None and ros.string_bound < (uav.capacity or 0):

@@ -336,7 +336,7 @@ class MappingValidator:
                 raise RuleError("limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping "
                                 "passes on what the device measured")
             if uav_type.kind == "utf8" or ros_type.base == "string":
-                exact = check_string(ros_type, uav_type, link)
+                exact = check_string(ros_type, uav_type, link, mapping.protocol == "dronecan")
                 kind = "string"
             elif uav_type.array or ros_type.array:
                 exact = check_arrays(ros_type, uav_type, link)

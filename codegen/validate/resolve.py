@@ -34,6 +34,7 @@ from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.nodes import check_nodes
+from sam_codegen.validate.panic_duty import check_panic_duty
 from sam_codegen.validate.topics_message import topics_message
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
@@ -355,6 +356,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     dronecan.check_devices()
     mappings = dronecan.mappings.resolve_mappings()
     dronecan_mappings = dronecan.resolve_mappings()
+    check_panic_duty(spec, v.diag)
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")

@@ -205,7 +205,10 @@ class Bridge:
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
         if sel.protocol == "dronecan":
-            self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **self._dronecan_options)
+            # the spec's `panic_duty: mappings` turns the built-in Panic duty off (tables of older builds: on)
+            options = {"panic": getattr(tables, "DRONECAN_PANIC_DUTY", "builtin") != "mappings",
+                       **self._dronecan_options}
+            self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **options)
             self.duties.attach()
         link.attach()
         reporter.attach()

@@ -5,7 +5,9 @@ message the same way; a generated codec does both straight from and to the bytes
 the data types it is given, the completed message transfers that :class:`~.frame_gate.FrameGate` assembled, checks
 them as dronecan's ``Transfer.from_frames`` does (toggle bits, transfer ids, and the CRC of a multi-frame transfer,
 seeded with the data type's signature) and hands the payload to a handler instead of to the node. What fails a check
-is counted under the same :class:`~.drops.DropReason` the NodeLoop gives dronecan's own errors.
+is counted under the same :class:`~.drops.DropReason` the NodeLoop gives dronecan's own errors. A data type marked
+:meth:`TransferTaps.share` goes to the node as well once its handler had it (a part that handles it with dronecan's
+own handlers beside a tapped mapping: the bridge's built-in Panic duty beside a mapping of Panic).
 :func:`broadcast_payload` sends payload bytes as dronecan's ``Node.broadcast`` sends a message: same framing (tail
 bytes, CRC, transfer ids from the node's own counter, classic CAN with tail array optimisation), no encoding.
 """
@@ -65,6 +67,11 @@ class TransferTaps:
     def __init__(self, drops: DropCounter) -> None:
         self.drops = drops
         self._taps: dict[int, _Tap] = {}
+        self._shared: set[int] = set()  # data type ids the node gets too
+
+    def share(self, data_type_id: int) -> None:
+        """Transfers of this data type that pass the checks go to the node too, after the tap's handler."""
+        self._shared.add(data_type_id)
 
     def add(self, data_type_id: int, crc_base: int, handler: PayloadHandler) -> None:
         self._taps[data_type_id] = _Tap(crc_base, handler)
@@ -83,6 +90,7 @@ class TransferTaps:
         payload = self._payload(frames, tap.crc_base, dtid, src)
         if payload is not None:
             tap.handler(payload, src, frames[0].data[-1] & 0x1F, frames[0].ts_monotonic)
+            return dtid not in self._shared  # a failed check is counted once, here: the node never sees it
         return True
 
     def _payload(self, frames: list[CANFrame], crc_base: int, dtid: int, src: int) -> bytes | None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
 from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
 from sam_codegen.validate.mapping_rules import format_path
+from sam_codegen.validate.panic_duty import panic_duty
 from sam_codegen.validate.resolve import Resolved
 
 
@@ -54,7 +55,19 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
             "frame_id": m.frame_id, "rate": fmt_rate(rm.rate_hz), "auto": m.auto,
             "on_out_of_range": m.on_out_of_range, "rows": rows,
         })
-    return {"dronecan": {"layouts": layouts, "devices": devices, "types": types, "mappings": mappings}
+    chosen = spec.dronecan_namespaces
+    namespaces = (f"{', '.join(f'`{n}`' for n in resolved.dronecan.namespaces)} (`dronecan_namespaces`: the data "
+                  "type ids of the other namespaces are free for the spec's own types)"
+                  if chosen is not None and resolved.dronecan is not None
+                  else "every namespace the `dronecan` package bundles (the default: their data type ids stay taken)")
+    duty = panic_duty(spec)
+    bridge = spec.bridge.name if spec.bridge is not None else "bridge"
+    builtin = f"the bridge's built-in duty (`/{bridge}/panic` broadcast three times, `/{bridge}/panic_received`)"
+    own = "the spec's DroneCAN mappings of `uavcan.protocol.Panic`"
+    panic = {"builtin": builtin, "mappings": f"{own} (`panic_duty: mappings`; the built-in duty is off)",
+             "both": f"{own} and {builtin} (`panic_duty: both`)"}[duty]
+    return {"dronecan": {"layouts": layouts, "devices": devices, "types": types, "mappings": mappings,
+                         "namespaces": namespaces, "panic": panic}
             if devices or types or mappings or len(layouts) > 1 else None}
 
 

@@ -184,8 +184,9 @@ class MappingEmitter:
             default = None if first.default is None else py_literal(first.default)
             statements.append(TableLookup(var, table, read, key, default))
             return [(s.ros_path, var)]
-        if isinstance(first, DecodeUtf8):
-            return [(s.ros_path, f"{read}.tobytes().decode(errors='replace')")]
+        if isinstance(first, DecodeUtf8):  # utf8[<=N]; a DroneCAN uint8[<=N] (v0 has no utf8) as a list of bytes
+            raw = f"{read}.tobytes()" if s.uavcan_type.kind == "utf8" else f"bytes({self.uavcan.as_list(read)})"
+            return [(s.ros_path, f"{raw}.decode(errors='replace')")]
         ros_base = s.ros_type.base
         if s.kind == "number":
             expr = pys.to_ros_expr(read, ops, ros_base)

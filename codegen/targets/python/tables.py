@@ -23,6 +23,7 @@ from sam_codegen.targets.python.names import py_class_name, py_module
 from sam_codegen.targets.ros import build_order
 from sam_codegen.validate.mapping_rules import format_path
 from sam_codegen.validate.nodes import class_name, node_topic_qos
+from sam_codegen.validate.panic_duty import panic_duty
 from sam_codegen.validate.resolve import Resolved
 
 __all__ = ["cyphal_context", "dronecan_context", "nodes_context", "table_types_source", "tables_context"]
@@ -105,6 +106,14 @@ def _type_info(struct: V0Struct) -> str:
             f"{not struct.standard})")
 
 
+def _tuple_literal(names: tuple[str, ...]) -> str:
+    """
+    >>> _tuple_literal(("uavcan",)), _tuple_literal(("uavcan", "ardupilot"))
+    ("('uavcan',)", "('uavcan', 'ardupilot')")
+    """
+    return "(" + ", ".join(py_str(n) for n in names) + ("," if len(names) == 1 else "") + ")"
+
+
 def _type_ref(struct: V0Struct) -> str:
     return f"_DRONECAN_TYPE[{py_str(struct.name)}]"
 
@@ -150,8 +159,11 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
         "cyphal_mappings": [py_str(n) for n in layout.cyphal_mappings],
         "dronecan_mappings": [py_str(n) for n in layout.dronecan_mappings],
     } for layout in resolved.layouts]
+    chosen = spec.dronecan_namespaces
     return {
         "dronecan_dirs": [py_str(d) for d in dsdl_v0.load_dirs(resolved)],
+        "dronecan_namespaces": "None" if chosen is None or catalog is None else _tuple_literal(catalog.namespaces),
+        "panic_duty": py_str(panic_duty(spec)),
         "dronecan_types": [_type_info(t) for t in types.values()],
         "dronecan_devices": devices,
         "dronecan_mappings": mappings,

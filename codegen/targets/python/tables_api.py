@@ -55,3 +55,5 @@ class TablesModule(Protocol):
     STATIC_TRANSFORMS: tuple[StaticTransformInfo, ...]
     TRANSFORMS: tuple[TransformInfo, ...]
     NODES: tuple[NodeInfo, ...]
+    DRONECAN_NAMESPACES: tuple[str, ...] | None  # None: every namespace dronecan loads
+    DRONECAN_PANIC_DUTY: str  # "builtin" | "mappings" | "both"

@@ -922,6 +922,13 @@ MAPPINGS: tuple[MappingInfo, ...] = (
 # Under the generated folder: the spec's own DroneCAN types, for dronecan.load_dsdl() (convert_v0.load_types).
 DRONECAN_DSDL_DIRS: tuple[str, ...] = ('dsdl_v0/sam',)
 
+# The namespaces of dronecan's own definitions the spec uses (uavcan always; None: every one dronecan
+# loads): the data type ids of the others are free (sam_runtime.dronecan_io.types leaves their types out).
+DRONECAN_NAMESPACES: tuple[str, ...] | None = None
+
+# Who handles uavcan.protocol.Panic: "builtin" (the bridge's duty), "mappings" (the spec's) or "both".
+DRONECAN_PANIC_DUTY: str = 'builtin'
+
 # The DroneCAN message types of the devices and mappings, by name.
 DRONECAN_TYPES: tuple[DroneCanTypeInfo, ...] = (
     DroneCanTypeInfo('sam.actuator.PositionFeedback', 20102, 0x4F9415770AF42BD6, True),

@@ -6,7 +6,10 @@ lifetime beside the DroneCAN backend:
   ``/<bridge>/<device>/restart``;
 - ``uavcan.protocol.Panic`` both ways (std_msgs/String): a Panic on the bus is published on ``/<bridge>/panic_received``
   as ``node <id>: <reason>``; a message on ``/<bridge>/panic`` is broadcast as Panic (reason: its first 7 bytes)
-  MIN_MESSAGES (3) times 0.1 s apart, as receivers wait for 3 within MAX_INTERVAL_MS (500) before they act;
+  MIN_MESSAGES (3) times 0.1 s apart, as receivers wait for 3 within MAX_INTERVAL_MS (500) before they act.
+  ``panic=False`` (the spec's ``panic_duty: mappings``: its own mappings of Panic instead) leaves Panic alone; beside
+  a mapping of Panic on the wire path (``panic_duty: both``) the tapped Panic transfers are shared with the node, so
+  both see every Panic;
 - optional: the bus's ``uavcan.protocol.GlobalTimeSync`` master (1 Hz, with the previous transmission's time) and a
   dynamic node id allocation server (dronecan's CentralizedServer with its NodeMonitor, in memory).
 
@@ -66,9 +69,10 @@ class DroneCanDuties:
     :param devices: node id -> device name."""
 
     def __init__(self, lifetime: Lifetime, backend: Any, ros: Any, devices: Mapping[int, str], *,
-                 time_sync: bool = False, dna_server: bool = False, timeout: float = 1.0) -> None:
+                 time_sync: bool = False, dna_server: bool = False, timeout: float = 1.0, panic: bool = True) -> None:
         self.lifetime, self.backend, self.ros = lifetime, backend, ros
         self.devices = dict(devices)
+        self.panic = bool(panic)  # the built-in Panic duty (off: the spec's mappings of Panic handle it)
         self.time_sync, self.dna_server, self.timeout = bool(time_sync), bool(dna_server), float(timeout)
         self.counts: dict[str, int] = {"panic_in": 0, "panic_out": 0, "time_sync_sent": 0, "requests": 0,
                                        "request_timeouts": 0}
@@ -100,8 +104,9 @@ class DroneCanDuties:
         for nid, name in sorted(self.devices.items()):
             node.create_service(Trigger, f"/{base}/{name}/get_node_info", _service(self._get_node_info, nid))
             node.create_service(Trigger, f"/{base}/{name}/restart", _service(self._restart, nid))
-        self._panic_pub = node.create_publisher(String, f"/{base}/panic_received", 10)
-        node.create_subscription(String, f"/{base}/panic", self._on_ros_panic, 10)
+        if self.panic:
+            self._panic_pub = node.create_publisher(String, f"/{base}/panic_received", 10)
+            node.create_subscription(String, f"/{base}/panic", self._on_ros_panic, 10)
         self._executor = SingleThreadedExecutor(context=self.ros.context)
         self._executor.add_node(node)
         self._thread = threading.Thread(target=self._spin, name=f"{base}-dronecan-duties", daemon=True)
@@ -233,7 +238,12 @@ class DroneCanDuties:
     def _on_open(self, node: Any, node_loop: Any) -> None:
         import dronecan
 
-        node_loop.add_handler(dronecan.uavcan.protocol.Panic, self._on_bus_panic)
+        if self.panic:
+            panic = dronecan.uavcan.protocol.Panic
+            node_loop.add_handler(panic, self._on_bus_panic)
+            taps = getattr(getattr(node_loop, "gate", None), "taps", None)
+            if taps is not None:  # a mapping of Panic on the wire path takes its transfers: share them with us
+                taps.share(panic.default_dtid)
         if self.dna_server:
             from dronecan.app.dynamic_node_id import CentralizedServer
             from dronecan.app.node_monitor import NodeMonitor

@@ -195,3 +195,31 @@ def test_taps_give_back_the_payload_and_count_what_dronecan_refuses(dronecan_mod
     other = _CaptureDriver()  # another data type, and a service: dronecan's, untouched
     _node(dronecan_mod, other, 11).broadcast(_messages(dronecan_mod)[2])
     assert not taps.take(_frames(other.sent))
+
+
+def test_a_shared_tap_hands_the_transfer_to_the_node_too(dronecan_mod: Any) -> None:
+    """The bridge's built-in Panic duty beside a mapping of Panic on the wire path (`panic_duty: both`): the tap's
+    handler has the transfer, then the node too; one that fails its checks is counted once, by the tap."""
+    from sam_runtime.dronecan_io import DropCounter
+    from sam_runtime.dronecan_io.wire import TransferTaps
+
+    drops = DropCounter()
+    taps = TransferTaps(drops)
+    panic = dronecan_mod.TYPENAMES["uavcan.protocol.Panic"]
+    got: list[bytes] = []
+    taps.add(panic.default_dtid, panic.base_crc, lambda payload, src, tid, ts: got.append(payload))
+    driver = _CaptureDriver()
+    _node(dronecan_mod, driver, 12).broadcast(panic(reason_text=b"LEAK"))
+    assert taps.take(_frames(driver.sent)) and got == [b"LEAK"]  # not shared: the tap's alone
+    taps.share(panic.default_dtid)
+    assert not taps.take(_frames(driver.sent)) and got == [b"LEAK", b"LEAK"]  # shared: the node's as well
+    long = _CaptureDriver()
+    imu = _messages(dronecan_mod)[0]
+    imu_type = dronecan_mod.get_dronecan_data_type(imu)
+    taps.add(imu_type.default_dtid, imu_type.base_crc, lambda payload, src, tid, ts: got.append(payload))
+    taps.share(imu_type.default_dtid)
+    _node(dronecan_mod, long, 12).broadcast(imu)
+    bad = _frames(long.sent)
+    bad[0].data[0] ^= 0xFF
+    assert taps.take(bad) and len(got) == 2  # a bad CRC: counted here, never handed on
+    assert sum(drops.detailed().values()) == 1
