@@ -15,7 +15,8 @@ from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mappin
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
-from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
+from sam_codegen.frontend.services import parse_service_mapping
+from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message, parse_ros_service
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
 from sam_codegen.model.spec import (
@@ -43,7 +44,7 @@ __all__ = ["QOS_DEPTH_MAX", "load_spec_file", "parse_qos", "parse_spec", "scalar
 _TOP_KEYS = (
     "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "dronecan_types",
     "frames", "transforms", "topics", "parameters", "parameter_rules", "devices", "layouts", "bridge", "nodes",
-    "bus",
+    "bus", "services",
 )
 
 
@@ -132,7 +133,8 @@ def parse_spec(root: YNode, file: str) -> Spec:
     bridge_node = top.node("bridge")
     bridge = None
     if bridge_node is not None:
-        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings"))
+        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings",
+                                                 "service_mappings"))
         name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
         mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
         for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
@@ -141,18 +143,28 @@ def parse_spec(root: YNode, file: str) -> Spec:
                 mapping = parse_mapping(key, pos, node, diag, protocol)
                 if mapping is not None:
                     mappings[protocol].append(mapping)
-        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"])
+        service_mappings = [m for key, pos, node in map_items(r.node("service_mappings"), "bridge service_mappings",
+                                                              diag)
+                            for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]
+        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"], service_mappings)
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
         nodes[key] = parse_node(key, pos, node, diag)
     bridged = {m.topic for m in bridge.all_mappings if m.direction == UAVCAN_TO_ROS} if bridge is not None else set()
     topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
     bus = parse_bus(top.node("bus"), "bus", diag)
+    services = {}
+    for key, pos, node in map_items(top.node("services"), "services", diag):
+        if "/" in key:
+            diag.error(pos, f"service type {key!r} is declared in package {package}: give its bare name", "Name")
+            continue
+        srv = parse_ros_service(key, pos, node, package, diag)
+        services[srv.full_name] = srv
     diag.check()
     return Spec(
         file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
         cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
-        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus,
+        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus, services,
     )
 
 

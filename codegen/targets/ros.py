@@ -105,8 +105,13 @@ def emit(resolved: Resolved) -> dict[str, str]:
         files[f"{root}/msg/{message.name}.msg"] = render(
             "ros/message.msg.j2", message=message, spec_name=spec_name
         )
+    for srv in resolved.services:
+        files[f"{root}/srv/{srv.name}.srv"] = render("ros/service.srv.j2", srv=srv, spec_name=spec_name)
+    # A .srv's fields are a message's for the dependencies (its two halves become Request and Response messages).
+    srv_parts = [RosMessage(s.package, s.name, [*s.request, *s.response]) for s in resolved.services]
     context = {"package": spec.ros, "messages": [m.name for m in resolved.messages],
-               "dependencies": _dependencies(resolved.messages, package)}
+               "services": [s.name for s in resolved.services],
+               "dependencies": _dependencies([*resolved.messages, *srv_parts], package)}
     files[f"{root}/package.xml"] = render("ros/package.xml.j2", **context)
     files[f"{root}/CMakeLists.txt"] = render("ros/CMakeLists.txt.j2", **context)
     for name, messages in external_packages(resolved).items():

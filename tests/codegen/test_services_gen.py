@@ -1,0 +1,88 @@
+"""Service types (issue 19): the spec's DroneCAN service types come out as v0 DSDL that dronecan's own parser reads
+with the same id, kind, fields and signature as the generator computed; the spec's `services` come out as .srv
+files listed in the package's CMakeLists, which rosidl builds and rclpy imports and serializes."""
+
+from __future__ import annotations
+
+import json
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from sam_codegen.build import generate
+from sam_codegen.frontend.loader import load_spec_file
+from sam_codegen.validate.resolve import validate
+
+SPEC = Path(__file__).parents[1] / "specs" / "auv_services.yaml"
+
+
+def test_v0_service_type_as_dronecan_parses_it(tmp_path: Path) -> None:
+    dsdl = pytest.importorskip("dronecan.dsdl")
+    files = generate(SPEC)
+    text = files["dsdl_v0/lolo/power/201.UpdateBattery.uavcan"]
+    assert "\n---\n" in text and "service, data type id 201" in text
+    folder = tmp_path / "lolo" / "power"
+    folder.mkdir(parents=True)
+    (folder / "201.UpdateBattery.uavcan").write_text(text)
+    (parsed,) = dsdl.parse_namespaces([str(tmp_path / "lolo")])
+    resolved = validate(load_spec_file(SPEC))
+    (ours,) = resolved.dronecan_types
+    assert parsed.kind == parsed.KIND_SERVICE and parsed.default_dtid == 201 == ours.data_type_id
+    assert parsed.get_data_type_signature() == ours.signature != 0
+    assert [f.name for f in parsed.request_fields] == ["command", "charge"]
+    assert [f.name for f in parsed.response_fields] == ["success"]
+    assert [c.name for c in parsed.request_constants] == ["COMMAND_RECALIBRATE"]
+
+
+def test_standard_service_types_have_their_response() -> None:
+    """The catalog reads a standard service's response too (what a service mapping links)."""
+    pytest.importorskip("dronecan")
+    resolved = validate(load_spec_file(SPEC))
+    assert resolved.dronecan is not None
+    info = resolved.dronecan.get("uavcan.protocol.GetNodeInfo")
+    assert info is not None and info.service and info.fields == []
+    assert [f.name for f in info.response] == ["status", "software_version", "hardware_version", "name"]
+
+
+def test_srv_file_and_cmake_list() -> None:
+    files = generate(SPEC)
+    srv = files["ros/lolo_msgs/srv/UpdateBattery.srv"]
+    body = [line for line in srv.splitlines() if line and not line.startswith("#")]
+    assert body == ["uint8 command", "float32 charge_percent", "---", "bool success", "uint8 status"]
+    assert '"srv/UpdateBattery.srv"' in files["ros/lolo_msgs/CMakeLists.txt"]
+    assert files == generate(SPEC)  # deterministic
+
+
+_SRV_SCRIPT = textwrap.dedent(
+    """\
+    import json
+
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    from lolo_msgs.srv import UpdateBattery
+
+    request = UpdateBattery.Request(command=1, charge_percent=42.5)
+    back = deserialize_message(serialize_message(request), UpdateBattery.Request)
+    response = UpdateBattery.Response()
+    print("RESULT " + json.dumps({"command": back.command, "charge": back.charge_percent,
+                                  "success": response.success, "status": response.status}))
+    """
+)
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+def test_srv_builds_with_rosidl_and_imports(tmp_path: Path) -> None:
+    from helpers.ros_packages import run_child
+    from helpers.spec_build import built_spec
+
+    built = built_spec("auv_services")
+    script = tmp_path / "srv_check.py"
+    script.write_text(_SRV_SCRIPT)
+    proc = run_child([str(script)], built.prefix, "0", timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
+    assert lines, proc.stdout + proc.stderr
+    assert json.loads(lines[-1].removeprefix("RESULT ")) == {"command": 1, "charge": 42.5, "success": False,
+                                                            "status": 0}
