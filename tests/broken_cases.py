@@ -886,6 +886,7 @@ V0_CASES: tuple[Case, ...] = (
 )
 
 
+
 # Service cases: each breaks tests/specs/auv_services.yaml one way (tests/codegen/test_bad_specs_services.py runs them).
 SERVICE_CASES: tuple[Case, ...] = (
     Case(
@@ -942,7 +943,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '  update_battery:\n    description: Update',
         (
             "auv_services.yaml:19:3: error: 'update_battery' is not a valid ROS service name (expected CamelCase, e.g. UpdateBattery)",
-            "auv_services.yaml:52:5: error: unknown service type 'lolo_msgs/UpdateBattery' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
+            "auv_services.yaml:80:5: error: unknown service type 'lolo_msgs/UpdateBattery' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
         ),
     ),
     Case(
@@ -982,7 +983,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      type: lolo_msgs/UpdateBattery',
         '      type: lolo_msgs/UpdateBatt',
         (
-            "auv_services.yaml:52:5: error: unknown service type 'lolo_msgs/UpdateBatt' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
+            "auv_services.yaml:80:5: error: unknown service type 'lolo_msgs/UpdateBatt' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
         ),
     ),
     Case(
@@ -990,7 +991,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      data_type: lolo.power.UpdateBattery',
         '      data_type: uavcan.equipment.power.BatteryInfo',
         (
-            "auv_services.yaml:52:5: error: DroneCAN type 'uavcan.equipment.power.BatteryInfo' of service mapping 'update_battery' is a message type (expected a service type)",
+            "auv_services.yaml:80:5: error: DroneCAN type 'uavcan.equipment.power.BatteryInfo' of service mapping 'update_battery' is a message type (expected a service type)",
         ),
     ),
     Case(
@@ -998,7 +999,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      data_type: lolo.power.UpdateBattery',
         '      data_type: lolo.power.Update',
         (
-            "auv_services.yaml:52:5: error: unknown DroneCAN type 'lolo.power.Update' of service mapping 'update_battery' (expected a service type of dronecan_types or a standard one, e.g. uavcan.protocol.GetNodeInfo)",
+            "auv_services.yaml:80:5: error: unknown DroneCAN type 'lolo.power.Update' of service mapping 'update_battery' (expected a service type of dronecan_types or a standard one, e.g. uavcan.protocol.GetNodeInfo)",
         ),
     ),
     Case(
@@ -1006,7 +1007,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      destination_node_id: 30',
         '      destination_node_id: 31',
         (
-            "auv_services.yaml:52:5: error: destination node id 31 of service mapping 'update_battery' is not a DroneCAN device (expected the node id of a device with DroneCAN ports)",
+            "auv_services.yaml:80:5: error: destination node id 31 of service mapping 'update_battery' is not a DroneCAN device (expected the node id of a device with DroneCAN ports)",
         ),
     ),
     Case(
@@ -1014,7 +1015,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        charge_percent: charge\n',
         '',
         (
-            "auv_services.yaml:52:5: error: service mapping 'update_battery' leaves request fields of lolo.power.UpdateBattery without a value: charge (expected a `request` line or a `uavcan_values` entry for each)",
+            "auv_services.yaml:80:5: error: service mapping 'update_battery' leaves request fields of lolo.power.UpdateBattery without a value: charge (expected a `request` line or a `uavcan_values` entry for each)",
         ),
     ),
     Case(
@@ -1022,7 +1023,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        charge_percent: charge\n',
         '        charge_pct: charge\n',
         (
-            "auv_services.yaml:60:9: error: 'charge_pct' of service mapping 'update_battery' is not a field of the srv request (expected command, charge_percent)",
+            "auv_services.yaml:88:9: error: 'charge_pct' of service mapping 'update_battery' is not a field of the srv request (expected command, charge_percent)",
         ),
     ),
     Case(
@@ -1030,7 +1031,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        charge_percent: charge\n',
         '        charge_percent: charge_pct\n',
         (
-            "auv_services.yaml:60:9: error: 'charge_pct' of service mapping 'update_battery' is not a field of the UAVCAN request (expected command, charge)",
+            "auv_services.yaml:88:9: error: 'charge_pct' of service mapping 'update_battery' is not a field of the UAVCAN request (expected command, charge)",
         ),
     ),
     Case(
@@ -1038,7 +1039,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        charge_percent: charge\n',
         '        charge_percent: command\n',
         (
-            "auv_services.yaml:60:9: error: service mapping 'update_battery' writes UAVCAN request field 'command' twice",
+            "auv_services.yaml:88:9: error: service mapping 'update_battery' writes UAVCAN request field 'command' twice",
         ),
     ),
     Case(
@@ -1046,7 +1047,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        charge_percent: charge\n',
         '        charge_percent: charge\n      uavcan_values: {charge: 50}\n',
         (
-            "auv_services.yaml:52:5: error: service mapping 'update_battery' writes UAVCAN request field 'charge' twice",
+            "auv_services.yaml:80:5: error: service mapping 'update_battery' writes UAVCAN request field 'charge' twice",
         ),
     ),
     Case(
@@ -1054,7 +1055,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        charge_percent: charge\n',
         '        charge_percent: charge\n      uavcan_values: {mode: 1}\n',
         (
-            "auv_services.yaml:52:5: error: uavcan_values of service mapping 'update_battery' name 'mode', not a field of the request of lolo.power.UpdateBattery (expected command, charge)",
+            "auv_services.yaml:80:5: error: uavcan_values of service mapping 'update_battery' name 'mode', not a field of the request of lolo.power.UpdateBattery (expected command, charge)",
         ),
     ),
     Case(
@@ -1062,7 +1063,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      request:\n        command: command\n',
         '      uavcan_values: {command: 300}\n      request:\n',
         (
-            "auv_services.yaml:52:5: error: uavcan value 'command' of service mapping 'update_battery' = 300 does not fit uint8 (expected an integer in [0, 255])",
+            "auv_services.yaml:80:5: error: uavcan value 'command' of service mapping 'update_battery' = 300 does not fit uint8 (expected an integer in [0, 255])",
         ),
     ),
     Case(
@@ -1070,7 +1071,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      timeout: 0.5',
         '      timeout: 0',
         (
-            "auv_services.yaml:57:7: error: 'timeout' of service mapping 'update_battery' is 0 s (expected 0 < timeout <= 60 (seconds))",
+            "auv_services.yaml:85:7: error: 'timeout' of service mapping 'update_battery' is 0 s (expected 0 < timeout <= 60 (seconds))",
         ),
     ),
     Case(
@@ -1078,7 +1079,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      service: /bms/update_battery',
         '      service: bms update',
         (
-            "auv_services.yaml:52:5: error: service name 'bms update' of service mapping 'update_battery' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
+            "auv_services.yaml:80:5: error: service name 'bms update' of service mapping 'update_battery' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
         ),
     ),
     Case(
@@ -1086,7 +1087,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        status: success\n',
         '        status: {from: success, table: {0: 1}}\n',
         (
-            "auv_services.yaml:63:9: error: response field 'status' of service mapping 'update_battery': a service line takes `from`, `scale`, `offset` or `value` (expected no table, limits or round in a service mapping)",
+            "auv_services.yaml:91:9: error: response field 'status' of service mapping 'update_battery': a service line takes `from`, `scale`, `offset` or `value` (expected no table, limits or round in a service mapping)",
         ),
     ),
     Case(
@@ -1094,7 +1095,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      timeout: 0.5',
         '      timeout: 0.5\n      protocol: cyphal',
         (
-            "auv_services.yaml:58:7: error: service mapping 'update_battery': service mappings run on DroneCAN only so far (expected dronecan)",
+            "auv_services.yaml:86:7: error: service mapping 'update_battery': service mappings run on DroneCAN only so far (expected dronecan)",
         ),
     ),
     Case(
@@ -1102,7 +1103,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '        success: success\n',
         '        success: {from: success, scale: 2}\n',
         (
-            "auv_services.yaml:62:9: error: response field 'success' (bool) of service mapping 'update_battery' cannot take success (uint8) (expected numbers or bools (scale/offset on numbers), or a string with a uint8 array)",
+            "auv_services.yaml:90:9: error: response field 'success' (bool) of service mapping 'update_battery' cannot take success (uint8) (expected numbers or bools (scale/offset on numbers), or a string with a uint8 array)",
         ),
     ),
     Case(
@@ -1110,7 +1111,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      timeout: 0.5',
         '      timeout: 0.5\n      retries: 3',
         (
-            "auv_services.yaml:58:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values)",
+            "auv_services.yaml:86:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values)",
         ),
     ),
     Case(
@@ -1118,7 +1119,47 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      service: /bms/update_battery\n',
         '',
         (
-            "auv_services.yaml:53:7: error: missing field 'service' in service mapping 'update_battery'",
+            "auv_services.yaml:81:7: error: missing field 'service' in service mapping 'update_battery'",
+        ),
+    ),
+    Case(
+        'svc_map_destination_field_unknown',
+        '      data_type: uavcan.protocol.RestartNode\n      destination_node_id: node_id',
+        '      data_type: uavcan.protocol.RestartNode\n      destination_node_id: node',
+        (
+            "auv_services.yaml:105:5: error: destination_node_id 'node' of service mapping 'restart_node' is not an integer field of the srv request (expected a node id, or the name of an integer field of the request)",
+        ),
+    ),
+    Case(
+        'svc_map_nested_unknown',
+        '        uptime_sec: status.uptime_sec',
+        '        uptime_sec: status.uptime',
+        (
+            "auv_services.yaml:100:9: error: 'status.uptime' of service mapping 'get_node_info' is not a field of the UAVCAN response (expected status, software_version, hardware_version, name (a field of a nested type as a.b))",
+        ),
+    ),
+    Case(
+        'svc_map_nested_request',
+        '      uavcan_values: {magic_number: 742196058910}\n',
+        '      uavcan_values: {magic_number: 742196058910}\n      request:\n        node_id: magic_number.x\n',
+        (
+            "auv_services.yaml:112:9: error: 'magic_number.x' of service mapping 'restart_node' is not a field of the UAVCAN request (expected magic_number)",
+        ),
+    ),
+    Case(
+        'svc_map_magic_missing',
+        '      uavcan_values: {magic_number: 742196058910}\n',
+        '',
+        (
+            "auv_services.yaml:105:5: error: service mapping 'restart_node' leaves request fields of uavcan.protocol.RestartNode without a value: magic_number (expected a `request` line or a `uavcan_values` entry for each)",
+        ),
+    ),
+    Case(
+        'svc_map_duplicate_service',
+        '      service: /bridge/restart_node',
+        '      service: /bridge/get_node_info',
+        (
+            "auv_services.yaml:105:5: error: service /bridge/get_node_info of service mapping 'restart_node' is already served by service mapping 'get_node_info' (expected one mapping per ROS service)",
         ),
     ),
 )

@@ -48,8 +48,11 @@ def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -
         if value is not None:
             uavcan_values[path] = value
     service, type_, data_type = r.get("service", str), r.get("type", str), r.get("data_type", str)
-    node_id = r.get("destination_node_id", int)
-    if service is None or type_ is None or data_type is None or node_id is None:
+    # a node id, or the ROS request field that gives it at each call
+    destination = r.get("destination_node_id", (int, str))
+    if service is None or type_ is None or data_type is None or destination is None:
         return None
-    return ServiceMapping(name, service, type_.replace("/srv/", "/"), data_type, node_id, timeout,
-                          links["request"], links["response"], uavcan_values, protocol, pos)
+    field = destination if isinstance(destination, str) else None
+    return ServiceMapping(name, service, type_.replace("/srv/", "/"), data_type,
+                          0 if field is not None else int(destination), timeout, links["request"], links["response"],
+                          uavcan_values, protocol, pos, field)

@@ -384,6 +384,9 @@ class ServiceMapping:
     uavcan_values: dict[str, Scalar] = field(default_factory=dict)  # request fields set to constants
     protocol: str = "dronecan"
     pos: Pos = NOWHERE
+    # The ROS request field that names the node to ask (`destination_node_id: node_id`, e.g. GetNodeInfo of any
+    # node); None: always destination_node_id.
+    destination_field: str | None = None
 
 
 @dataclass(frozen=True)

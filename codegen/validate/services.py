@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from sam_codegen.catalogs.dronecan import SERVICE_ID_MAX, VENDOR_SERVICE_IDS, V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
+from sam_codegen.model.spec import Field, FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import (
     ROS_FIELD_NAME,
     ROS_FLOAT_BITS,
@@ -32,6 +32,7 @@ from sam_codegen.validate.values import check_dsdl_value, python_safe
 
 __all__ = ["ResolvedServiceMapping", "ServiceLink", "ServiceValidator"]
 
+_F32_MAX = 3.4028234663852886e38
 _V0_FIELD_NAME = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
 
 
@@ -203,7 +204,14 @@ class ServiceValidator:
             self.error(m.pos, f"DroneCAN type {m.data_type!r} of {what} is a message type", "a service type")
             struct = None
         device = s.devices_by_node_id().get(m.destination_node_id)
-        if device is None or "dronecan" not in device.protocols:
+        if m.destination_field is not None:
+            dest = next((f for f in srv.request if f.name == m.destination_field), None) if srv is not None else None
+            if srv is not None and (dest is None or not isinstance(dest.type, RosType)
+                                    or _ros_kind(dest.type) != "int"):
+                self.error(m.pos, f"destination_node_id {m.destination_field!r} of {what} is not an integer field of "
+                           f"the srv request", "a node id, or the name of an integer field of the request")
+                return None
+        elif device is None or "dronecan" not in device.protocols:
             self.error(m.pos, f"destination node id {m.destination_node_id} of {what} is not a DroneCAN device",
                        "the node id of a device with DroneCAN ports")
         if srv is None or struct is None or srv.full_name in self.bad or struct.name in self.bad:
@@ -285,12 +293,15 @@ class ServiceValidator:
                            "a number, bool or string field")
                 return None
             return ServiceLink(link.ros_path, None, kind, link.value)
-        uav_field = uavcan.get(link.uavcan_path or "")
+        uav_field = self.uavcan_field(link.uavcan_path or "", uavcan, nested=not to_uavcan)
         if uav_field is None:
             self.error(link.pos, f"{link.uavcan_path!r} of {what} is not a field of the UAVCAN {part}",
-                       ", ".join(uavcan) or "none: the UAVCAN " + part + " is empty")
+                       (", ".join(uavcan) or "none: the UAVCAN " + part + " is empty")
+                       + ("" if to_uavcan else " (a field of a nested type as a.b)"))
             return None
-        ros_kind, uav_kind = _ros_kind(ros_field.type), _v0_kind(uav_field.type)
+        ros_t, uav_t = ros_field.type, uav_field.type
+        assert isinstance(ros_t, RosType) and isinstance(uav_t, DsdlType)
+        ros_kind, uav_kind = _ros_kind(ros_t), _v0_kind(uav_t)
         scaled = link.scale is not None or link.offset is not None
         if ros_kind is None or uav_kind is None or (ros_kind == "text") != (uav_kind == "text") \
                 or (scaled and "bool" in (ros_kind, uav_kind)):
@@ -298,20 +309,36 @@ class ServiceValidator:
                        f"{link.uavcan_path} ({uav_field.type})", "numbers or bools (scale/offset on numbers), or "
                        "a string with a uint8 array")
             return None
-        target_type, target_kind = (uav_field.type, uav_kind) if to_uavcan else (ros_field.type, ros_kind)
+        target_kind = uav_kind if to_uavcan else ros_kind
         lo, hi = -math.inf, math.inf
         if target_kind == "int":
-            lo, hi = target_type.range if to_uavcan else ROS_INT_RANGES[target_type.base]
+            lo, hi = uav_t.range if to_uavcan else ROS_INT_RANGES[ros_t.base]
         elif target_kind == "text" and to_uavcan:
-            hi = float(target_type.capacity or 0)
-        elif target_kind == "text" and target_type.string_bound is not None:
-            hi = float(target_type.string_bound)
-        elif target_kind == "float" and not to_uavcan and target_type.base == "float32":
-            lo, hi = -3.4028234663852886e38, 3.4028234663852886e38
-        elif target_kind == "float" and to_uavcan and target_type.bits == 16:
+            hi = float(uav_t.capacity or 0)
+        elif target_kind == "text" and ros_t.string_bound is not None:
+            hi = float(ros_t.string_bound)
+        elif target_kind == "float" and not to_uavcan and ros_t.base == "float32":
+            lo, hi = -_F32_MAX, _F32_MAX
+        elif target_kind == "float" and to_uavcan and uav_t.bits == 16:
             lo, hi = -65504.0, 65504.0
-        elif target_kind == "float" and to_uavcan and target_type.bits == 32:
-            lo, hi = -3.4028234663852886e38, 3.4028234663852886e38
+        elif target_kind == "float" and to_uavcan and uav_t.bits == 32:
+            lo, hi = -_F32_MAX, _F32_MAX
+        assert target_kind is not None
         if to_uavcan:
             return ServiceLink(uav_field.name, ros_field.name, target_kind, None, link.scale, link.offset, lo, hi)
-        return ServiceLink(ros_field.name, uav_field.name, target_kind, None, link.scale, link.offset, lo, hi)
+        return ServiceLink(ros_field.name, link.uavcan_path, target_kind, None, link.scale, link.offset, lo, hi)
+
+    def uavcan_field(self, path: str, fields: dict, nested: bool) -> Field | None:
+        """The field a UAVCAN path names: a field of the request or response, or with `nested` (responses) a
+        field of a composite field's type (`status.uptime_sec`), never an element of an array."""
+        names = path.split(".")
+        if len(names) > 1 and not nested:
+            return None
+        found: Field | None = fields.get(names[0])
+        for name in names[1:]:
+            t = found.type if found is not None else None
+            if not isinstance(t, DsdlType) or t.kind != "composite" or t.array or not t.composite:
+                return None
+            inner = self.catalog.get(t.composite)
+            found = inner.field(name) if inner is not None else None
+        return found

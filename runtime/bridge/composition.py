@@ -211,7 +211,7 @@ class Bridge:
             self.duties.attach()
             services = self.gen.services()
             served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
-                      if m.destination_node_id in sel.devices]
+                      if m.destination_node_id in sel.devices or m.destination_field is not None]
             if served:
                 self.services = DroneCanServices(lifetime, backend, self.ros, served,
                                                  diagnostics_period=self._diagnostics_period)

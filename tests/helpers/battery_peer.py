@@ -6,7 +6,10 @@ and answers each request by its ``command``:
 - 2: never (the caller's timeout);
 - 3: twice (a duplicate response);
 - 4: ``--late`` seconds later (after the bridge's timeout: a late response);
-- 5: a malformed response (a single frame with an empty payload, which dronecan cannot decode).
+- 5: a malformed response (a single frame with an empty payload, which dronecan cannot decode);
+
+and the node duties: GetNodeInfo (dronecan's own answer, name ``org.lolo.bms``), RestartNode (``ok`` when the
+magic number is right; prints ``RESTART``) and GetTransportStats (11 sent, 22 received, 3 errors).
 
 python battery_peer.py --iface mcast-lo:<bus>:<port> --node-id 30 --generated <generated> [--late 1.5]
 
@@ -89,12 +92,30 @@ def main() -> int:
         else:
             respond(event, min(command, 255))
 
+    protocol = dronecan.uavcan.protocol
+
+    def on_duty(transfer: Any) -> None:
+        """RestartNode (ok when the magic number is right; the node does not really restart) and
+        GetTransportStats (fixed figures); dronecan answers GetNodeInfo itself."""
+        if transfer.data_type_id == protocol.RestartNode.default_dtid:
+            ok = int(transfer.payload.magic_number) == protocol.RestartNode.Request().MAGIC_NUMBER
+            say("RESTART", ok=ok)
+            response: Any = protocol.RestartNode.Response(ok=ok)
+        else:
+            response = protocol.GetTransportStats.Response(transfers_tx=11, transfers_rx=22, transfer_errors=3)
+        node.respond(response, transfer.source_node_id, transfer.transfer_id, transfer.transfer_priority)
+
+    duties = {protocol.RestartNode.default_dtid, protocol.GetTransportStats.default_dtid}
+
     def hook(transfer: Any) -> None:
         # Requests are taken here, not by a dronecan handler, which must answer each request at once.
-        if (getattr(transfer, "direction", "") == "rx" and transfer.service_not_message
-                and transfer.request_not_response and transfer.dest_node_id == args.node_id
-                and transfer.data_type_id == dtype.default_dtid):
+        if not (getattr(transfer, "direction", "") == "rx" and transfer.service_not_message
+                and transfer.request_not_response and transfer.dest_node_id == args.node_id):
+            return
+        if transfer.data_type_id == dtype.default_dtid:
             on_request(SimpleNamespace(request=transfer.payload, transfer=transfer))
+        elif transfer.data_type_id in duties:
+            on_duty(transfer)
 
     node.add_transfer_hook(hook)
     stop = threading.Event()

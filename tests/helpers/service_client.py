@@ -27,6 +27,8 @@ def main() -> int:
     p.add_argument("--status", required=True)
     p.add_argument("--out", required=True)
     p.add_argument("--deadline", type=float, default=60.0)
+    p.add_argument("--duties", action="store_true", help="then GetNodeInfo, GetTransportStats, RestartNode")
+    p.add_argument("--device", type=int, default=30)
     args = p.parse_args()
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
@@ -83,6 +85,8 @@ def main() -> int:
         futures = [call(2, 1.0), call(1, 2.0)]
         wait(futures, order)
         result["concurrent"] = [{"command": (2, 1)[i], "success": bool(futures[i].result().success)} for i in order]
+        if args.duties:
+            result["duties"] = duties(node, executor, wait, args.device)
         # The counters: every call (7), the duplicate and the late answer (which comes after its call ended).
         while True:
             with lock:
@@ -101,6 +105,24 @@ def main() -> int:
         node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+def duties(node: Any, executor: Any, wait: Any, device: int) -> dict[str, Any]:
+    """The typed node duties of the device and of a node that does not exist (99)."""
+    from lolo_msgs.srv import GetNodeInfo, GetTransportStats, RestartNode
+
+    out: dict[str, Any] = {}
+    services = {GetNodeInfo: "get_node_info", RestartNode: "restart_node", GetTransportStats: "get_transport_stats"}
+    for name, srv, nid in (("info", GetNodeInfo, device), ("info_missing", GetNodeInfo, 99),
+                           ("stats", GetTransportStats, device), ("restart", RestartNode, device)):
+        client = node.create_client(srv, f"/bridge/{services[srv]}")
+        while not client.wait_for_service(timeout_sec=0.2):
+            executor.spin_once(timeout_sec=0.05)
+        future = client.call_async(srv.Request(node_id=nid))
+        wait([future], [])
+        r = future.result()
+        out[name] = {f: getattr(r, f) for f in r.get_fields_and_field_types()}
+    return out
 
 
 if __name__ == "__main__":

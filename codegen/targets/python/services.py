@@ -54,7 +54,9 @@ def emit(resolved: Resolved) -> dict[str, str]:
             "ros_class": py_str(srv.name), "ros_type": py_str(f"{srv.package}/srv/{srv.name}"),
             "data_type": py_str(rm.struct.name), "data_type_id": rm.struct.data_type_id,
             "signature": f"0x{rm.struct.signature:016X}", "destination_node_id": m.destination_node_id,
-            "device": py_str(by_id[m.destination_node_id].name), "timeout_s": py_number(m.timeout_s),
+            "device": py_str(by_id[m.destination_node_id].name if m.destination_field is None else ""),
+            "destination_field": py_str(m.destination_field) if m.destination_field is not None else "None",
+            "timeout_s": py_number(m.timeout_s),
             "request": [_link(link) for link in rm.request], "response": [_link(link) for link in rm.response],
             "success_field": py_str(success.name) if success is not None and str(success.type) == "bool" else "None",
             "message_field": py_str(message.name) if message is not None and str(message.type) == "string"

@@ -12,8 +12,9 @@ by the response: the srv's default values, with its bool ``success`` False and i
 when the srv has those fields (std_srvs' convention; the ROS client never waits forever). Every call is counted per
 mapping: ``calls``, ``answered``, ``timeouts``, ``failed.<reason>``, ``saturated.<field>``, and responses that reach
 no waiting call are counted and dropped, never raised: ``late_responses`` (after its call timed out),
-``duplicate_responses`` (a second answer), ``unexpected_responses`` (to no request of ours), ``malformed_responses``
-(a payload dronecan could not decode: the call then times out). The counters are published once a second, and at
+``duplicate_responses`` (a second answer), ``malformed_responses`` (a payload dronecan could not decode: the call
+then times out); a response to no request of the mappings is left to dronecan, which drops it (another part of the
+bridge, the node duties, may be its asker). The counters are published once a second, and at
 once after a failure, on /diagnostics as ``<bridge>/service/<name>`` (WARN for 10 s after a failure or a bad
 response), and are in the bridge's ``stats()["services"]``.
 """
@@ -67,7 +68,11 @@ def _number(link: Any, value: float, towards_uavcan: bool, saturated: list[str])
 def _convert(links: Sequence[Any], source: Any, towards_uavcan: bool, saturated: list[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for link in links:
-        raw = link.value if link.source is None else getattr(source, link.source)
+        raw = link.value
+        if link.source is not None:  # a response's source may be nested: "status.uptime_sec"
+            raw = source
+            for name in link.source.split("."):
+                raw = getattr(raw, name)
         if link.kind == "text":
             if towards_uavcan:
                 data = str(raw).encode()
@@ -144,7 +149,11 @@ class DroneCanServices:
         self.diagnostics_period = float(diagnostics_period)
         self._lock = threading.Lock()
         self.stats = {m.name: _Stats(m) for m in self.mappings}
-        self._by_key = {(m.data_type_id, m.destination_node_id): m for m in self.mappings}
+        # who gets a response from (data type id, node): a mapping with a fixed device, else one of that data type
+        # whose request names the node
+        self._by_key = {(m.data_type_id, m.destination_node_id): m for m in self.mappings
+                        if m.destination_field is None}
+        self._by_type = {m.data_type_id: m for m in self.mappings if m.destination_field is not None}
         self._pending: dict[tuple[int, int, int], _Call] = {}  # in the loop's thread only
         self._finished: collections.OrderedDict[tuple[int, int, int], str] = collections.OrderedDict()
         self._sending: _Call | None = None  # the call node.request is sending (its transfer id comes by the hook)
@@ -213,12 +222,17 @@ class DroneCanServices:
             values = to_uavcan(m, request, saturated)
         except Exception as ex:  # a value the conversion cannot take (a bug: the spec's types are checked)
             return self._fail(m, response, "convert_error", f"the request cannot be converted: {ex}")
+        nid = m.destination_node_id
+        if m.destination_field is not None:
+            nid = int(getattr(request, m.destination_field))
+            if not 1 <= nid <= 127:
+                return self._fail(m, response, "bad_node_id", f"{nid} is not a DroneCAN node id (1..127)")
         call = _Call()
         loop = self._loop
         if loop is None or loop.is_closed() or self.lifetime.closed:
             return self._fail(m, response, "not_running", "the bridge is not running")
         started = time.monotonic()
-        loop.call_soon_threadsafe(self._send, m, values, call)
+        loop.call_soon_threadsafe(self._send, m, nid, values, call)
         # dronecan's own timeout ends the call; the margin only guards against a stalled loop.
         if not call.done.wait(m.timeout_s + 2.0):
             call.failure, call.reason = f"the bridge's loop did not answer within {m.timeout_s + 2.0:.1f} s", "stalled"
@@ -226,7 +240,7 @@ class DroneCanServices:
             for name in saturated:
                 st.counts[f"saturated.{name}"] += 1
         if call.failure is not None or call.values is None:
-            return self._fail(m, response, call.reason or "failed", call.failure or "no answer")
+            return self._fail(m, response, call.reason or "failed", call.failure or "no answer", nid)
         for name, value in call.values.items():
             setattr(response, name, value)
         with self._lock:
@@ -235,12 +249,12 @@ class DroneCanServices:
             st.latency_ms_max = max(st.latency_ms_max, st.latency_ms_last)
         return response
 
-    def _fail(self, m: Any, response: Any, reason: str, text: str) -> Any:
+    def _fail(self, m: Any, response: Any, reason: str, text: str, nid: int | None = None) -> Any:
         st = self.stats[m.name]
         with self._lock:
             st.problem("timeouts" if reason == "timeout" else f"failed.{reason}")
         self.lifetime.rlog.note((f"service {m.name}", reason), logging.WARNING, "service %s (%s, node %d): %s",
-                                m.service, m.data_type, m.destination_node_id, text)
+                                m.service, m.data_type, m.destination_node_id if nid is None else nid, text)
         if m.success_field is not None:
             setattr(response, m.success_field, False)
         if m.message_field is not None:
@@ -249,7 +263,7 @@ class DroneCanServices:
         return response
 
     # ------------------------------------------------------------------------------------------------ UAVCAN side
-    def _send(self, m: Any, values: dict[str, Any], call: _Call) -> None:
+    def _send(self, m: Any, nid: int, values: dict[str, Any], call: _Call) -> None:
         """In the loop's thread: the request to the device; its response or timeout ends ``call``."""
         import dronecan
 
@@ -264,8 +278,7 @@ class DroneCanServices:
                 setattr(request, name, value)
             self._sending = call
             try:
-                node.request(request, m.destination_node_id, lambda event: self._on_response(m, call, event),
-                             timeout=m.timeout_s)
+                node.request(request, nid, lambda event: self._on_response(m, nid, call, event), timeout=m.timeout_s)
             finally:
                 self._sending = None
         except Exception as ex:
@@ -275,7 +288,7 @@ class DroneCanServices:
         if call.key is not None:
             self._pending[call.key] = call
 
-    def _on_response(self, m: Any, call: _Call, event: Any) -> None:
+    def _on_response(self, m: Any, nid: int, call: _Call, event: Any) -> None:
         """dronecan's request callback (the loop's thread): the response, or None at the timeout."""
         key = call.key
         if key is not None:
@@ -284,8 +297,8 @@ class DroneCanServices:
             while len(self._finished) > _FINISHED_KEPT:
                 self._finished.popitem(last=False)
         if event is None:
-            call.failure, call.reason = (f"node {m.destination_node_id} ({m.device}) did not answer within "
-                                         f"{m.timeout_s:g} s", "timeout")
+            who = f"node {nid}" + (f" ({m.device})" if m.device else "")
+            call.failure, call.reason = f"{who} did not answer within {m.timeout_s:g} s", "timeout"
         else:
             saturated: list[str] = []
             try:
@@ -313,15 +326,16 @@ class DroneCanServices:
             return
         if transfer.request_not_response or transfer.dest_node_id != self.backend.node_id:
             return
-        m = self._by_key.get((transfer.data_type_id, transfer.source_node_id))
-        if m is None:
-            return
         key = (transfer.data_type_id, transfer.source_node_id, transfer.transfer_id)
         if key in self._pending:
             return  # the answer its call waits for: dronecan hands it over next
         state = self._finished.get(key)
-        reason = {"timed_out": "late_responses", "answered": "duplicate_responses"}.get(state or "",
-                                                                                       "unexpected_responses")
+        if state is None:
+            return  # a response to no request of ours (another part of the bridge asked): dronecan's business
+        m = self._by_key.get(key[:2]) or self._by_type.get(key[0])
+        if m is None:
+            return
+        reason = "late_responses" if state == "timed_out" else "duplicate_responses"
         with self._lock:
             self.stats[m.name].problem(reason)
         self.lifetime.rlog.note((f"service {m.name}", reason), logging.WARNING,
@@ -330,7 +344,7 @@ class DroneCanServices:
 
     def _on_drop(self, key: Any, detail: str) -> None:
         """A transfer dronecan could not decode (the NodeLoop counted it): a malformed response of a mapping."""
-        m = self._by_key.get((key.data_type_id, key.source_node_id))
+        m = self._by_key.get((key.data_type_id, key.source_node_id)) or self._by_type.get(key.data_type_id)
         if m is None or "malformed" not in str(getattr(key.reason, "value", key.reason)):
             return
         with self._lock:
@@ -346,10 +360,9 @@ class DroneCanServices:
                 out[name] = {
                     "service": m.service, "ros_type": m.ros_type, "data_type": m.data_type,
                     "data_type_id": m.data_type_id, "destination_node_id": m.destination_node_id,
-                    "device": m.device, "timeout_s": m.timeout_s,
+                    "device": m.device, "destination_field": m.destination_field, "timeout_s": m.timeout_s,
                     **{k: st.counts.get(k, 0) for k in ("calls", "answered", "timeouts", "late_responses",
-                                                         "duplicate_responses", "unexpected_responses",
-                                                         "malformed_responses")},
+                                                         "duplicate_responses", "malformed_responses")},
                     **{k: v for k, v in sorted(st.counts.items()) if "." in k},
                     "latency_ms_last": st.latency_ms_last, "latency_ms_max": st.latency_ms_max,
                     "warn": st.last_problem is not None and now - st.last_problem < WARN_AFTER_PROBLEM_S,
@@ -364,7 +377,8 @@ class DroneCanServices:
         for name, entry in self.snapshot().items():
             status = DiagnosticStatus()
             status.name = f"{self.ros.name}/service/{name}"
-            status.hardware_id = f"node {entry['destination_node_id']} ({entry['device']})"
+            status.hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
+                                  else f"the node of the request's {entry['destination_field']}")
             status.level = DiagnosticStatus.WARN if entry["warn"] else DiagnosticStatus.OK
             status.message = (f"{entry['answered']}/{entry['calls']} answered, {entry['timeouts']} timed out"
                               + (" (a recent failure or bad response)" if entry["warn"] else ""))
