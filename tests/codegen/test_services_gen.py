@@ -86,3 +86,22 @@ def test_srv_builds_with_rosidl_and_imports(tmp_path: Path) -> None:
     assert lines, proc.stdout + proc.stderr
     assert json.loads(lines[-1].removeprefix("RESULT ")) == {"command": 1, "charge": 42.5, "success": False,
                                                             "status": 0}
+
+
+def test_docs_list_the_services() -> None:
+    """The interface reference has the srv types, the DroneCAN service type with its response, and each service
+    mapping with its target, timeout, failure fields and field rows."""
+    md = generate(SPEC)["docs/interfaces.md"]
+    section = md[md.index("\n## Services\n"):]
+    assert "#### `lolo_msgs/srv/UpdateBattery`" in section and "| response | `status` | `uint8` |" in section
+    assert "Service data type id 201, signature `0x45BD5887DCE2B78B`." in section
+    assert ("- Service: `/bms/update_battery` (`lolo_msgs/srv/UpdateBattery`) → `lolo.power.UpdateBattery` (id 201) "
+            "to node 30 (bms), timeout 0.5 s") in section
+    assert "| `uptime_sec` | ← | `status.uptime_sec` | rounded, saturated to \\[0, 4294967295\\] |" in section
+    assert "- Failure shown in: `success`, `message`" in section
+
+
+def test_specs_without_services_have_no_services_output() -> None:
+    files = generate(Path(__file__).parents[1] / "specs" / "minimal_v0.yaml")
+    assert "\n## Services\n" not in files["docs/interfaces.md"]
+    assert not any(p.endswith("/services.py") or "/srv/" in p for p in files)
