@@ -16,12 +16,19 @@ from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
 from sam_codegen.frontend.services import parse_service_mapping
-from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message, parse_ros_service
+from sam_codegen.frontend.types import (
+    parse_dronecan_type,
+    parse_dsdl_service,
+    parse_dsdl_struct,
+    parse_ros_message,
+    parse_ros_service,
+)
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
 from sam_codegen.model.spec import (
     UAVCAN_TO_ROS,
     Bridge,
+    DsdlService,
     DsdlStruct,
     Frame,
     Mapping,
@@ -80,7 +87,11 @@ def parse_spec(root: YNode, file: str) -> Spec:
         message = parse_ros_message(key, pos, node, package, False, diag)
         messages[message.full_name] = message
     dsdl_types: dict[str, DsdlStruct] = {}
+    dsdl_services: dict[str, DsdlService] = {}
     for key, pos, node in map_items(top.node("dsdl_types"), "dsdl_types", diag):
+        if isinstance(node, YMap) and ("request" in node.entries or "response" in node.entries):
+            dsdl_services[key] = parse_dsdl_service(key, pos, node, diag)  # a service type
+            continue
         dsdl_types[key] = parse_dsdl_struct(key, pos, node, diag)
     frames: dict[str, Frame] = {}
     for key, pos, node in map_items(top.node("frames"), "frames", diag):
@@ -164,7 +175,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     return Spec(
         file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
         cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
-        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus, services,
+        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus, services, dsdl_services,
     )
 
 

@@ -352,6 +352,18 @@ class Mapping:
 
 
 @dataclass(frozen=True)
+class DsdlService:
+    """A Cyphal service type of the spec (`dsdl_types` with `request` and `response`): its two halves as structs
+    of its name, each emitted with the same `sealed`/`extent`, `---` between them."""
+
+    name: str  # full name with version: lolo.power.SetLimits.1.0
+    request: DsdlStruct
+    response: DsdlStruct
+    description: str = ""
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
 class RosService:
     """A ROS 2 service type of the spec's package (`services:`): a .srv with a request and a response."""
 
@@ -492,6 +504,7 @@ class Spec:
     layouts: dict[str, Layout] = field(default_factory=dict)  # the named layouts beside the implicit default
     bus: CanBus | None = None  # the vehicle's CAN bus; None: classic CAN at 1 Mbit/s
     services: dict[str, RosService] = field(default_factory=dict)  # the package's own .srv types, by pkg/Name
+    dsdl_services: dict[str, DsdlService] = field(default_factory=dict)  # the spec's Cyphal service types
 
     def devices_by_node_id(self) -> dict[int, Device]:
         return {d.node_id: d for d in self.devices.values()}

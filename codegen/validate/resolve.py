@@ -15,7 +15,7 @@ from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import Constant, DsdlStruct, Field, RosMessage, RosService, Spec, V0Struct
+from sam_codegen.model.spec import Constant, DsdlService, DsdlStruct, Field, RosMessage, RosService, Spec, V0Struct
 from sam_codegen.model.types import (
     DSDL_NAMESPACE_COMPONENT,
     DSDL_SHORT_NAME,
@@ -61,6 +61,7 @@ class Resolved:
     layouts: list[ResolvedLayout]  # the implicit "default" first
     services: list[RosService] = field(default_factory=list)  # the package's .srv types, sorted by name
     service_mappings: list[ResolvedServiceMapping] = field(default_factory=list)
+    dsdl_services: list[DsdlService] = field(default_factory=list)  # the spec's Cyphal service types, by name
 
 
 def derive_messages(spec: Spec, dsdl: DsdlCatalog, diag: Diagnostics) -> tuple[dict[str, RosMessage], set[str]]:
@@ -345,6 +346,9 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     v.check_header()
     for struct in spec.dsdl_types.values():
         v.check_dsdl_struct(struct)
+    for service in spec.dsdl_services.values():  # each half as a struct (an error of the name is reported once)
+        v.check_dsdl_struct(service.request)
+        v.check_dsdl_struct(service.response)
     messages = v.check_messages()
     v.check_frames_and_parameters()
     v.check_topics_and_nodes()
@@ -369,7 +373,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     dronecan_types = [v0.signed(t.name) for t in sorted(spec.dronecan_types.values(), key=lambda t: t.name)]
     return Resolved(spec, ros, dsdl, messages, sorted(spec.dsdl_types.values(), key=lambda t: t.name), mappings,
                     v0, [t for t in dronecan_types if t is not None], dronecan_mappings, layouts, srv_types,
-                    service_mappings)
+                    service_mappings, sorted(spec.dsdl_services.values(), key=lambda t: t.name))
 
 
 __all__ = ["CAN_NODE_IDS", "SUBJECT_IDS", "Constant", "Field", "Resolved", "validate"]

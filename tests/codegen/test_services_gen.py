@@ -99,9 +99,29 @@ def test_docs_list_the_services() -> None:
             "to node 30 (bms), timeout 0.5 s") in section
     assert "| `uptime_sec` | ← | `status.uptime_sec` | rounded, saturated to \\[0, 4294967295\\] |" in section
     assert "- Failure shown in: `success`, `message`" in section
+    assert "#### `lolo.power.SetChargeLimits.1.0`\n\nEach half extent 64 bytes." in section
+    assert "| response | — | `void7` | — |" in section
 
 
 def test_specs_without_services_have_no_services_output() -> None:
     files = generate(Path(__file__).parents[1] / "specs" / "minimal_v0.yaml")
     assert "\n## Services\n" not in files["docs/interfaces.md"]
     assert not any(p.endswith("/services.py") or "/srv/" in p for p in files)
+
+
+def test_cyphal_service_type_as_pydsdl_reads_it(tmp_path: Path) -> None:
+    """A `dsdl_types` entry with request and response is a Cyphal service type: emitted with `---` between its
+    halves (each with the extent), read by pydsdl as a service with those fields."""
+    pydsdl = pytest.importorskip("pydsdl")
+    from sam_codegen.project.cyphal_path import dsdl_lookup_roots
+
+    files = generate(SPEC)
+    rel = "dsdl/lolo/power/SetChargeLimits.1.0.dsdl"
+    (tmp_path / rel).parent.mkdir(parents=True)
+    (tmp_path / rel).write_text(files[rel])
+    (service,) = pydsdl.read_namespace(tmp_path / "dsdl" / "lolo", [str(r) for r in dsdl_lookup_roots()])
+    assert isinstance(service, pydsdl.ServiceType) and service.full_name == "lolo.power.SetChargeLimits"
+    assert [f.name for f in service.request_type.fields_except_padding] == ["low_percent", "high_percent"]
+    assert [f.name for f in service.response_type.fields_except_padding] == ["accepted", "reason"]
+    assert service.request_type.extent == service.response_type.extent == 64 * 8
+    assert [c.name for c in service.request_type.constants] == ["MAX_PERCENT"]

@@ -44,6 +44,12 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
         "request": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in t.declared_fields],
         "response": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in t.declared_response],
     } for t in resolved.dronecan_types if t.service]
+    cyphal = [{
+        "name": t.name, "description": t.description,
+        "size": "sealed" if t.request.sealed else f"extent {t.request.extent} bytes",
+        "request": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in t.request.declared_fields],
+        "response": [{"name": f.name, "type": str(f.type), "comment": f.comment} for f in t.response.declared_fields],
+    } for t in resolved.dsdl_services]
     by_id = spec.devices_by_node_id()
     mappings = []
     for rm in resolved.service_mappings:
@@ -64,5 +70,5 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
             "data_type": rm.struct.name, "data_type_id": rm.struct.data_type_id, "destination": destination,
             "timeout": f"{m.timeout_s:g} s", "failure": failure, "rows": rows,
         })
-    return {"services": {"srvs": srvs, "v0": v0, "mappings": mappings}
-            if srvs or v0 or mappings else None}
+    return {"services": {"srvs": srvs, "v0": v0, "cyphal": cyphal, "mappings": mappings}
+            if srvs or v0 or cyphal or mappings else None}
