@@ -125,3 +125,18 @@ def test_cyphal_service_type_as_pydsdl_reads_it(tmp_path: Path) -> None:
     assert [f.name for f in service.response_type.fields_except_padding] == ["accepted", "reason"]
     assert service.request_type.extent == service.response_type.extent == 64 * 8
     assert [c.name for c in service.request_type.constants] == ["MAX_PERCENT"]
+
+
+def test_pydsdl_rejects_a_service_type_at_its_position(tmp_path: Path) -> None:
+    """A Cyphal service type pydsdl refuses (its response outgrows the extent) is an error at the type's line."""
+    pytest.importorskip("pydsdl")
+    from sam_codegen.model.diagnostics import SpecError
+
+    path = tmp_path / "auv_services.yaml"
+    path.write_text(SPEC.read_text().replace('{name: reason, type: "uint8[<=32]"}', '{name: reason, type: '
+                                             '"uint8[<=80]"}', 1))
+    with pytest.raises(SpecError) as info:
+        generate(path)
+    (diagnostic,) = info.value.diagnostics
+    assert str(diagnostic).startswith(f"{path}:8:3: error: DSDL type lolo.power.SetChargeLimits.1.0 is rejected by "
+                                      "pydsdl: The specified extent of 512 bits is too small")
