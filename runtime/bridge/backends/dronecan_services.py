@@ -2,10 +2,10 @@
 spec's ``bridge.service_mappings``) answered by a v0 request to its device.
 
 Threads: the ROS services live on a ROS node of their own, served by a MultiThreadedExecutor with a reentrant
-callback group, so one slow device holds one executor thread for at most its mapping's timeout and never another
-call, the bridge's topics (another executor) or its UAVCAN loop. A call converts the ROS request (in that thread),
-hands it to the asyncio loop's thread, which owns the dronecan node (``call_soon_threadsafe``), and waits for the
-response or the timeout; dronecan's request callback (in the loop's thread) converts the response and wakes it.
+callback group (max(4, 2 per mapping) threads: more calls at once wait for a free one), so one slow device holds
+one executor thread for at most its mapping's timeout and never another call, the bridge's topics (another
+executor) or its UAVCAN loop. A call converts the ROS request (in that thread), hands it to the asyncio loop's
+thread, which owns the dronecan node (``call_soon_threadsafe``), and waits for the response or the timeout; dronecan's request callback (in the loop's thread) converts the response and wakes it.
 
 The caller learns of a failure (no answer within ``timeout_s``, the link down, a request that could not be sent)
 by the response: the srv's default values, with its bool ``success`` False and its string ``message`` the reason
@@ -185,7 +185,8 @@ class DroneCanServices:
 
             self._diag_pub = node.create_publisher(DiagnosticArray, "/diagnostics", 10)
             node.create_timer(self.diagnostics_period, self.publish_diagnostics, callback_group=group)
-        self._executor = MultiThreadedExecutor(num_threads=_EXECUTOR_THREADS, context=self.ros.context)
+        threads = max(_EXECUTOR_THREADS, 2 * len(self.mappings))  # two calls in flight per mapping at least
+        self._executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
         self._executor.add_node(node)
         self._thread = threading.Thread(target=self._spin, name=f"{base}-services", daemon=True)
         self._thread.start()
