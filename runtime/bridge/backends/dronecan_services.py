@@ -5,7 +5,8 @@ Threads: the ROS services live on a ROS node of their own, served by a MultiThre
 callback group (max(4, 2 per mapping) threads: more calls at once wait for a free one), so one slow device holds
 one executor thread for at most its mapping's timeout and never another call, the bridge's topics (another
 executor) or its UAVCAN loop. A call converts the ROS request (in that thread), hands it to the asyncio loop's
-thread, which owns the dronecan node (``call_soon_threadsafe``), and waits for the response or the timeout; dronecan's request callback (in the loop's thread) converts the response and wakes it.
+thread, which owns the dronecan node (``call_soon_threadsafe``), and waits for the response or the timeout;
+dronecan's request callback (in the loop's thread) converts the response and wakes it.
 
 The caller learns of a failure (no answer within ``timeout_s``, the link down, a request that could not be sent)
 by the response: the srv's default values, with its bool ``success`` False and its string ``message`` the reason
