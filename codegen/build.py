@@ -125,7 +125,7 @@ def _pydsdl_diagnostic(resolved: Resolved, exc: pydsdl.FrontendError, dsdl_dir: 
             relative = None
         if relative is not None:
             name = ".".join([*relative.parent.parts, relative.name.removesuffix(".dsdl")])
-    struct = resolved.spec.dsdl_types.get(name)
+    struct = resolved.spec.dsdl_types.get(name) or resolved.spec.dsdl_services.get(name)  # (a service type too)
     pos = struct.pos if struct else Pos(resolved.spec.file)
     return Diagnostic(pos, f"DSDL type {name or '?'} is rejected by pydsdl: {exc.text}")
 

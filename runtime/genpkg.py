@@ -177,6 +177,16 @@ class GeneratedPackage:
             self._convert_v0 = mod
         return self._convert_v0
 
+    def services(self) -> ModuleType | None:
+        """``<pkg>.services`` (the bridge's service mappings as data, standard library only); None when the spec
+        has none."""
+        try:
+            return self._import("services")
+        except ModuleNotFoundError as ex:
+            if ex.name and ex.name.split(".")[-1] == "services":
+                return None
+            raise
+
     def codec(self, protocol: str = "cyphal") -> ModuleType | None:
         """The generated wire codecs of ``protocol``: ``<pkg>.codec`` (Cyphal) or ``<pkg>.codec_v0`` (DroneCAN),
         standard library only; None when the package has none (built by an older sam-codegen)."""

@@ -79,7 +79,7 @@ CASES: tuple[Case, ...] = (
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
         (
-            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes, bus, dronecan_namespaces)",
+            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes, bus, dronecan_namespaces, services)",
         ),
     ),
     Case(
@@ -984,6 +984,326 @@ TRAWLER_CASES: tuple[Case, ...] = (
         'dronecan_namespaces: [uavcan, com]',
         (
             'trawler_v0.yaml:12:3: error: data type id 20100 of DroneCAN type trawler.io.Switch is taken by the standard type com.hobbywing.esc.RawCommand of namespace com, which dronecan_namespaces loads (expected a free vendor-specific id, e.g. in 20101..20199, or dronecan_namespaces without com if the vehicle never uses it)',
+        ),
+    ),
+)
+
+
+
+
+# Service cases: each breaks tests/specs/auv_services.yaml one way (tests/codegen/test_bad_specs_services.py runs them).
+SERVICE_CASES: tuple[Case, ...] = (
+    Case(
+        'service_id_out_of_range',
+        '    id: 201\n',
+        '    id: 20201\n',
+        (
+            'auv_services.yaml:21:3: error: data type id 20201 of DroneCAN service type lolo.power.UpdateBattery is outside the vendor-specific service range (expected 200..255)',
+        ),
+    ),
+    Case(
+        'service_id_standard_range',
+        '    id: 201\n',
+        '    id: 1\n',
+        (
+            'auv_services.yaml:21:3: error: data type id 1 of DroneCAN service type lolo.power.UpdateBattery is outside the vendor-specific service range (expected 200..255)',
+        ),
+    ),
+    Case(
+        'service_without_id',
+        '    id: 201\n',
+        '',
+        (
+            'auv_services.yaml:21:3: error: DroneCAN service type lolo.power.UpdateBattery needs its data type id (`id`) (expected a vendor-specific service id, 200..255)',
+        ),
+    ),
+    Case(
+        'service_without_response',
+        '    response:\n      - {name: success, type: uint8, comment: 1 when done}\n',
+        '',
+        (
+            "auv_services.yaml:21:3: error: service type 'lolo.power.UpdateBattery' needs `response` (expected both `request` and `response` (an empty list for an empty half))",
+        ),
+    ),
+    Case(
+        'service_with_fields',
+        '    request:\n      - {name: command, type: uint8, comment: what to do}\n',
+        '    fields:\n      - {name: x, type: uint8}\n    request:\n      - {name: command, type: uint8, comment: what to do}\n',
+        (
+            "auv_services.yaml:26:5: error: DroneCAN type 'lolo.power.UpdateBattery' has `request`/`response` (a service type): it cannot also list fields (expected `fields` for a message type, or `request` and `response` for a service type)",
+        ),
+    ),
+    Case(
+        'service_response_bad_field',
+        '      - {name: success, type: uint8, comment: 1 when done}',
+        '      - {name: 2success, type: uint8}',
+        (
+            "auv_services.yaml:30:9: error: '2success' is not a valid DroneCAN field name in the response of DroneCAN service type lolo.power.UpdateBattery (expected a letter, then letters, digits and underscores; not a Python keyword)",
+        ),
+    ),
+    Case(
+        'srv_bad_name',
+        '  UpdateBattery:\n    description: Update',
+        '  update_battery:\n    description: Update',
+        (
+            "auv_services.yaml:32:3: error: 'update_battery' is not a valid ROS service name (expected CamelCase, e.g. UpdateBattery)",
+            "auv_services.yaml:93:5: error: unknown service type 'lolo_msgs/UpdateBattery' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
+        ),
+    ),
+    Case(
+        'srv_bad_field_type',
+        '      - {name: charge_percent, type: float32}',
+        '      - {name: charge_percent, type: std_msgs/Floaty}',
+        (
+            "auv_services.yaml:36:9: error: unknown ROS type 'std_msgs/Floaty' in the request of service type lolo_msgs/UpdateBattery (expected a primitive, a message of this spec or an installed ROS message)",
+        ),
+    ),
+    Case(
+        'srv_missing_response',
+        "    response:\n      - {name: success, type: bool, comment: true when the device did it}\n      - {name: status, type: uint8, comment: the device's answer}\n",
+        '',
+        (
+            "auv_services.yaml:32:3: error: missing field 'response' in service type 'UpdateBattery' (expected a list of fields (an empty list for none))",
+        ),
+    ),
+    Case(
+        'srv_duplicate_field',
+        "      - {name: status, type: uint8, comment: the device's answer}",
+        '      - {name: success, type: uint8}',
+        (
+            "auv_services.yaml:39:9: error: field 'success' appears twice in the response of service type lolo_msgs/UpdateBattery",
+        ),
+    ),
+    Case(
+        'srv_with_package',
+        'services:\n  UpdateBattery:',
+        'services:\n  lolo_msgs/UpdateBattery:',
+        (
+            "auv_services.yaml:32:3: error: service type 'lolo_msgs/UpdateBattery' is declared in package lolo_msgs: give its bare name (expected Name)",
+        ),
+    ),
+    Case(
+        'svc_map_unknown_srv',
+        '      type: lolo_msgs/UpdateBattery',
+        '      type: lolo_msgs/UpdateBatt',
+        (
+            "auv_services.yaml:93:5: error: unknown service type 'lolo_msgs/UpdateBatt' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
+        ),
+    ),
+    Case(
+        'svc_map_message_type',
+        '      data_type: lolo.power.UpdateBattery',
+        '      data_type: uavcan.equipment.power.BatteryInfo',
+        (
+            "auv_services.yaml:93:5: error: DroneCAN type 'uavcan.equipment.power.BatteryInfo' of service mapping 'update_battery' is a message type (expected a service type)",
+        ),
+    ),
+    Case(
+        'svc_map_unknown_type',
+        '      data_type: lolo.power.UpdateBattery',
+        '      data_type: lolo.power.Update',
+        (
+            "auv_services.yaml:93:5: error: unknown DroneCAN type 'lolo.power.Update' of service mapping 'update_battery' (expected a service type of dronecan_types or a standard one, e.g. uavcan.protocol.GetNodeInfo)",
+        ),
+    ),
+    Case(
+        'svc_map_not_a_device',
+        '      destination_node_id: 30',
+        '      destination_node_id: 31',
+        (
+            "auv_services.yaml:93:5: error: destination node id 31 of service mapping 'update_battery' is not a DroneCAN device (expected the node id of a device with DroneCAN ports)",
+        ),
+    ),
+    Case(
+        'svc_map_request_field_missing',
+        '        charge_percent: charge\n',
+        '',
+        (
+            "auv_services.yaml:93:5: error: service mapping 'update_battery' leaves request fields of lolo.power.UpdateBattery without a value: charge (expected a `request` line or a `uavcan_values` entry for each)",
+        ),
+    ),
+    Case(
+        'svc_map_unknown_ros_field',
+        '        charge_percent: charge\n',
+        '        charge_pct: charge\n',
+        (
+            "auv_services.yaml:101:9: error: 'charge_pct' of service mapping 'update_battery' is not a field of the srv request (expected command, charge_percent)",
+        ),
+    ),
+    Case(
+        'svc_map_unknown_uavcan_field',
+        '        charge_percent: charge\n',
+        '        charge_percent: charge_pct\n',
+        (
+            "auv_services.yaml:101:9: error: 'charge_pct' of service mapping 'update_battery' is not a field of the UAVCAN request (expected command, charge)",
+        ),
+    ),
+    Case(
+        'svc_map_request_twice',
+        '        charge_percent: charge\n',
+        '        charge_percent: command\n',
+        (
+            "auv_services.yaml:101:9: error: service mapping 'update_battery' writes UAVCAN request field 'command' twice",
+        ),
+    ),
+    Case(
+        'svc_map_request_value',
+        '        charge_percent: charge\n',
+        '        charge_percent: charge\n      uavcan_values: {charge: 50}\n',
+        (
+            "auv_services.yaml:93:5: error: service mapping 'update_battery' writes UAVCAN request field 'charge' twice",
+        ),
+    ),
+    Case(
+        'svc_map_uavcan_value_unknown',
+        '        charge_percent: charge\n',
+        '        charge_percent: charge\n      uavcan_values: {mode: 1}\n',
+        (
+            "auv_services.yaml:93:5: error: uavcan_values of service mapping 'update_battery' name 'mode', not a field of the request of lolo.power.UpdateBattery (expected command, charge)",
+        ),
+    ),
+    Case(
+        'svc_map_uavcan_value_range',
+        '      request:\n        command: command\n',
+        '      uavcan_values: {command: 300}\n      request:\n',
+        (
+            "auv_services.yaml:93:5: error: uavcan value 'command' of service mapping 'update_battery' = 300 does not fit uint8 (expected an integer in [0, 255])",
+        ),
+    ),
+    Case(
+        'svc_map_timeout',
+        '      timeout: 0.5',
+        '      timeout: 0',
+        (
+            "auv_services.yaml:98:7: error: 'timeout' of service mapping 'update_battery' is 0 s (expected 0 < timeout <= 60 (seconds))",
+        ),
+    ),
+    Case(
+        'svc_map_bad_service_name',
+        '      service: /bms/update_battery',
+        '      service: bms update',
+        (
+            "auv_services.yaml:93:5: error: service name 'bms update' of service mapping 'update_battery' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
+        ),
+    ),
+    Case(
+        'svc_map_table',
+        '        status: success\n',
+        '        status: {from: success, table: {0: 1}}\n',
+        (
+            "auv_services.yaml:104:9: error: response field 'status' of service mapping 'update_battery': a service line takes `from`, `scale`, `offset` or `value` (expected no table, limits or round in a service mapping)",
+        ),
+    ),
+    Case(
+        'svc_map_protocol',
+        '      timeout: 0.5',
+        '      timeout: 0.5\n      protocol: cyphal',
+        (
+            "auv_services.yaml:99:7: error: service mapping 'update_battery': service mappings run on DroneCAN only so far (expected dronecan)",
+        ),
+    ),
+    Case(
+        'svc_map_bool_scaled',
+        '        success: success\n',
+        '        success: {from: success, scale: 2}\n',
+        (
+            "auv_services.yaml:103:9: error: response field 'success' (bool) of service mapping 'update_battery' cannot take success (uint8) (expected numbers or bools (scale/offset on numbers), or a string with a uint8 array)",
+        ),
+    ),
+    Case(
+        'svc_map_unknown_key',
+        '      timeout: 0.5',
+        '      timeout: 0.5\n      retries: 3',
+        (
+            "auv_services.yaml:99:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values)",
+        ),
+    ),
+    Case(
+        'svc_map_missing_service',
+        '      service: /bms/update_battery\n',
+        '',
+        (
+            "auv_services.yaml:94:7: error: missing field 'service' in service mapping 'update_battery'",
+        ),
+    ),
+    Case(
+        'svc_map_destination_field_unknown',
+        '      data_type: uavcan.protocol.RestartNode\n      destination_node_id: node_id',
+        '      data_type: uavcan.protocol.RestartNode\n      destination_node_id: node',
+        (
+            "auv_services.yaml:118:5: error: destination_node_id 'node' of service mapping 'restart_node' is not an integer field of the srv request (expected a node id, or the name of an integer field of the request)",
+        ),
+    ),
+    Case(
+        'svc_map_nested_unknown',
+        '        uptime_sec: status.uptime_sec',
+        '        uptime_sec: status.uptime',
+        (
+            "auv_services.yaml:113:9: error: 'status.uptime' of service mapping 'get_node_info' is not a field of the UAVCAN response (expected status, software_version, hardware_version, name (a field of a nested type as a.b))",
+        ),
+    ),
+    Case(
+        'svc_map_nested_request',
+        '      uavcan_values: {magic_number: 742196058910}\n',
+        '      uavcan_values: {magic_number: 742196058910}\n      request:\n        node_id: magic_number.x\n',
+        (
+            "auv_services.yaml:125:9: error: 'magic_number.x' of service mapping 'restart_node' is not a field of the UAVCAN request (expected magic_number)",
+        ),
+    ),
+    Case(
+        'svc_map_magic_missing',
+        '      uavcan_values: {magic_number: 742196058910}\n',
+        '',
+        (
+            "auv_services.yaml:118:5: error: service mapping 'restart_node' leaves request fields of uavcan.protocol.RestartNode without a value: magic_number (expected a `request` line or a `uavcan_values` entry for each)",
+        ),
+    ),
+    Case(
+        'dsdl_service_without_response',
+        '      - {name: accepted, type: bool}\n      - {type: void7}\n      - {name: reason, type: "uint8[<=32]"}\n',
+        '',
+        (
+            "auv_services.yaml:16:14: error: the fields of the response of DSDL service type 'lolo.power.SetChargeLimits.1.0' must be a list, found null (expected a list)",
+        ),
+    ),
+    Case(
+        'dsdl_service_without_extent',
+        '    extent: 64\n    constants:',
+        '    constants:',
+        (
+            "auv_services.yaml:8:3: error: DSDL service type 'lolo.power.SetChargeLimits.1.0' needs `sealed: true` or `extent: <bytes>` (expected sealed or extent (DSDL requires one))",
+        ),
+    ),
+    Case(
+        'dsdl_service_bad_field',
+        '      - {name: high_percent, type: uint8}',
+        '      - {name: uint8, type: uint8}',
+        (
+            "auv_services.yaml:15:9: error: 'uint8' is not a valid DSDL identifier in DSDL type lolo.power.SetChargeLimits.1.0 (expected letters, digits and underscores, not reserved (e.g. uint8, bool, saturated) nor a Python keyword)",
+        ),
+    ),
+    Case(
+        'dsdl_service_unknown_type',
+        '      - {name: accepted, type: bool}',
+        '      - {name: accepted, type: lolo.Missing.1.0}',
+        (
+            "auv_services.yaml:17:9: error: unknown DSDL type 'lolo.Missing.1.0' in DSDL type lolo.power.SetChargeLimits.1.0 (expected a type of this spec or of CYPHAL_PATH (uavcan.*, reg.*))",
+        ),
+    ),
+    Case(
+        'dsdl_service_outside_root',
+        '  lolo.power.SetChargeLimits.1.0:',
+        '  other.power.SetChargeLimits.1.0:',
+        (
+            "auv_services.yaml:8:3: error: DSDL type other.power.SetChargeLimits.1.0 is outside the spec's root namespace 'lolo' (expected lolo.<namespace>.Name.MAJOR.MINOR)",
+        ),
+    ),
+    Case(
+        'svc_map_duplicate_service',
+        '      service: /bridge/restart_node',
+        '      service: /bridge/get_node_info',
+        (
+            "auv_services.yaml:118:5: error: service /bridge/get_node_info of service mapping 'restart_node' is already served by service mapping 'get_node_info' (expected one mapping per ROS service)",
         ),
     ),
 )

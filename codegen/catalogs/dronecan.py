@@ -36,6 +36,7 @@ TIMESTAMP = "uavcan.Timestamp"  # truncated uint56 usec; 0 = unknown
 MESSAGE_ID_MAX = 65535
 SERVICE_ID_MAX = 255
 VENDOR_MESSAGE_IDS = range(20000, 21000)  # DroneCAN's vendor-specific message range
+VENDOR_SERVICE_IDS = range(200, 256)  # DroneCAN's vendor-specific service range
 
 _MASK64 = 0xFFFFFFFFFFFFFFFF
 _POLY64 = 0x42F0E1EBA9EA3693
@@ -168,6 +169,8 @@ def parse_definition(text: str, full_name: str, data_type_id: int | None, source
         full_name, [f for f in layout if f.name], constants, standard=True, union=union,
         layout=layout if any(not f.name for f in layout) else [], data_type_id=data_type_id,
         service=len(parts) > 1, source=source,
+        response=[f for f in parts[1][0] if f.name] if len(parts) > 1 else [],
+        response_layout=parts[1][0] if len(parts) > 1 and any(not f.name for f in parts[1][0]) else [],
     )
     response = (parts[1][0], parts[1][2]) if len(parts) > 1 else None
     return _Definition(struct_, layout, response, override)
@@ -328,6 +331,8 @@ class V0Catalog:
         declared = self._spec.dronecan_types.get(name)
         if declared is not None:
             layout, response, override, union = declared.declared_fields, None, None, declared.union
+            if declared.service:
+                response = (declared.declared_response, False)
         else:
             definition = self._definition(name)
             if definition is None:

@@ -20,7 +20,7 @@ from sam_codegen.model.spec import (
     V0Port,
 )
 
-__all__ = ["parse_device", "parse_layout", "parse_mapping"]
+__all__ = ["parse_device", "parse_layout", "parse_link", "parse_mapping"]
 
 
 def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics) -> FieldLink | None:
@@ -238,3 +238,7 @@ def parse_layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
             device_pos[device] = key_pos
     return Layout(key, text_of(r, "description"), layout_protocol, devices, device_pos, pos,
                   parse_bus(r.node("bus"), f"the bus of {what}", diag))
+
+
+# A service mapping's request and response lines are a mapping's lines (frontend.services reads them with this).
+parse_link = _link

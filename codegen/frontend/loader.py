@@ -15,13 +15,21 @@ from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mappin
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, str_list, text_of
+from sam_codegen.frontend.services import parse_service_mapping
 from sam_codegen.frontend.topic_sources import implied_tf_topics, parse_published_by
-from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
+from sam_codegen.frontend.types import (
+    parse_dronecan_type,
+    parse_dsdl_service,
+    parse_dsdl_struct,
+    parse_ros_message,
+    parse_ros_service,
+)
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
 from sam_codegen.model.spec import (
     UAVCAN_TO_ROS,
     Bridge,
+    DsdlService,
     DsdlStruct,
     Frame,
     Mapping,
@@ -44,7 +52,7 @@ __all__ = ["QOS_DEPTH_MAX", "load_spec_file", "parse_qos", "parse_spec", "scalar
 _TOP_KEYS = (
     "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "dronecan_types",
     "frames", "transforms", "topics", "parameters", "parameter_rules", "devices", "layouts", "bridge", "nodes",
-    "bus", "dronecan_namespaces",
+    "bus", "dronecan_namespaces", "services",
 )
 
 
@@ -82,7 +90,11 @@ def parse_spec(root: YNode, file: str) -> Spec:
         message = parse_ros_message(key, pos, node, package, False, diag)
         messages[message.full_name] = message
     dsdl_types: dict[str, DsdlStruct] = {}
+    dsdl_services: dict[str, DsdlService] = {}
     for key, pos, node in map_items(top.node("dsdl_types"), "dsdl_types", diag):
+        if isinstance(node, YMap) and ("request" in node.entries or "response" in node.entries):
+            dsdl_services[key] = parse_dsdl_service(key, pos, node, diag)  # a service type
+            continue
         dsdl_types[key] = parse_dsdl_struct(key, pos, node, diag)
     frames: dict[str, Frame] = {}
     for key, pos, node in map_items(top.node("frames"), "frames", diag):
@@ -137,7 +149,8 @@ def parse_spec(root: YNode, file: str) -> Spec:
     bridge_node = top.node("bridge")
     bridge = None
     if bridge_node is not None:
-        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty"))
+        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty",
+                                                 "service_mappings"))
         name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
         mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
         for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
@@ -146,7 +159,11 @@ def parse_spec(root: YNode, file: str) -> Spec:
                 mapping = parse_mapping(key, pos, node, diag, protocol)
                 if mapping is not None:
                     mappings[protocol].append(mapping)
+        service_mappings = [m for key, pos, node in map_items(r.node("service_mappings"), "bridge service_mappings",
+                                                              diag)
+                            for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]
         bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
+                        service_mappings=service_mappings,
                         panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"))
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
@@ -157,6 +174,13 @@ def parse_spec(root: YNode, file: str) -> Spec:
     bus = parse_bus(top.node("bus"), "bus", diag)
     namespaces = str_list(top.node("dronecan_namespaces"), "dronecan_namespaces", diag) \
         if top.node("dronecan_namespaces") is not None else None
+    services = {}
+    for key, pos, node in map_items(top.node("services"), "services", diag):
+        if "/" in key:
+            diag.error(pos, f"service type {key!r} is declared in package {package}: give its bare name", "Name")
+            continue
+        srv = parse_ros_service(key, pos, node, package, diag)
+        services[srv.full_name] = srv
     diag.check()
     return Spec(
         file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
@@ -164,6 +188,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
         parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus,
         dronecan_namespaces=tuple(n for n, _ in namespaces) if namespaces is not None else None,
         dronecan_namespaces_pos=tuple(p for _, p in namespaces) if namespaces is not None else (),
+        services=services, dsdl_services=dsdl_services,
     )
 
 

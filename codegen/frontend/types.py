@@ -8,10 +8,11 @@ from typing import Any
 from sam_codegen.frontend.reading import Reader, parse_type, seq_items, text_of
 from sam_codegen.frontend.yaml_source import YNode
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import Constant, DsdlStruct, Field, RosMessage, V0Struct
+from sam_codegen.model.spec import Constant, DsdlService, DsdlStruct, Field, RosMessage, RosService, V0Struct
 from sam_codegen.model.types import DsdlType, parse_dsdl_type, parse_ros_type, parse_v0_type
 
-__all__ = ["parse_dronecan_type", "parse_dsdl_struct", "parse_ros_message"]
+__all__ = ["parse_dronecan_type", "parse_dsdl_service", "parse_dsdl_struct", "parse_ros_message",
+           "parse_ros_service"]
 
 
 _FIELD_KEYS = ("name", "type", "comment", "default")
@@ -102,11 +103,63 @@ def parse_dsdl_struct(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Dsd
 
 def parse_dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V0Struct:
     what = f"DroneCAN type {key!r}"
-    r = Reader(node, what, diag, ("id", "description", "fields", "constants"))
-    layout = _fields(r.node("fields"), what, parse_v0_type, diag)
+    r = Reader(node, what, diag, ("id", "description", "fields", "constants", "request", "response"))
+    # A service type has `request` and `response` (its two halves, `---` between them in DSDL), not `fields`.
+    service = r.node("request") is not None or r.node("response") is not None
+    if service and r.node("fields") is not None:
+        diag.error(r.key_pos("fields"), f"{what} has `request`/`response` (a service type): it cannot also list "
+                   "fields", "`fields` for a message type, or `request` and `response` for a service type")
+    if service:
+        for part in ("request", "response"):
+            if r.node(part) is None:
+                diag.error(pos, f"service type {key!r} needs `{part}`", "both `request` and `response` (an empty "
+                           "list for an empty half)")
+    layout = _fields(r.node("request" if service else "fields"), what, parse_v0_type, diag)
     fields = [f for f in layout if f.name]
+    response_layout = _fields(r.node("response"), f"the response of {what}", parse_v0_type, diag) if service else []
+    response = [f for f in response_layout if f.name]
     return V0Struct(
         key, fields, _constants(r.node("constants"), what, parse_v0_type, diag, bool_bits=True),
         text_of(r, "description"),
         pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int, None),
+        service=service, response=response,
+        response_layout=response_layout if len(response) < len(response_layout) else [],
     )
+
+
+def parse_dsdl_service(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> DsdlService:
+    """A `dsdl_types` entry with `request` and `response` (field lists): a Cyphal service type."""
+    what = f"DSDL service type {key!r}"
+    r = Reader(node, what, diag, ("description", "request", "response", "constants", "sealed", "extent"))
+    sealed = r.get("sealed", bool, False)
+    extent = r.get("extent", int, None)
+    if r.ok and not sealed and extent is None:
+        diag.error(pos, f"{what} needs `sealed: true` or `extent: <bytes>`", "sealed or extent (DSDL requires one)")
+    if sealed and extent is not None:
+        diag.error(r.key_pos("extent"), f"{what} cannot be both sealed and have an extent")
+    halves = []
+    for part in ("request", "response"):
+        if r.ok and r.node(part) is None:
+            diag.error(pos, f"{what} needs `{part}`", "both `request` and `response` (an empty list for an empty half)")
+        layout = _fields(r.node(part), f"the {part} of {what}", parse_dsdl_type, diag)
+        fields = [f for f in layout if f.name]
+        constants = _constants(r.node("constants"), what, parse_dsdl_type, diag) if part == "request" else []
+        halves.append(DsdlStruct(key, fields, constants, "", bool(sealed), extent, pos=pos,
+                                 layout=layout if len(fields) < len(layout) else []))
+    return DsdlService(key, halves[0], halves[1], text_of(r, "description"), pos)
+
+
+def parse_ros_service(key: str, pos: Pos, node: YNode, package: str, diag: Diagnostics) -> RosService:
+    """A `services:` entry: a .srv of the spec's package (bare name) with `request` and `response` field lists."""
+    what = f"service type {key!r}"
+    r = Reader(node, what, diag, ("description", "request", "response"))
+
+    def parse(text: str) -> Any:
+        return parse_ros_type(text, package)
+
+    for part in ("request", "response"):
+        if r.ok and r.node(part) is None:
+            diag.error(pos, f"missing field {part!r} in {what}", "a list of fields (an empty list for none)")
+    return RosService(package, key, _fields(r.node("request"), f"the request of {what}", parse, diag),
+                      _fields(r.node("response"), f"the response of {what}", parse, diag),
+                      text_of(r, "description"), pos)

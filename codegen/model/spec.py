@@ -113,6 +113,15 @@ class V0Struct(DsdlStruct):
     signature: int = 0  # the data type signature (CRC-64-WE), which seeds a transfer's CRC
     service: bool = False
     source: str = ""  # the definition file of a standard type
+    # A service type (service=True): `fields`/`layout` are its request, these its response (padding included in
+    # response_layout, empty when it has none), as the part after `---` of its definition.
+    response: list[Field] = field(default_factory=list)
+    response_layout: list[Field] = field(default_factory=list)
+
+    @property
+    def declared_response(self) -> list[Field]:
+        """The response fields in declaration order with their padding."""
+        return self.response_layout or self.response
 
     @property
     def full_name(self) -> str:
@@ -348,6 +357,56 @@ class Mapping:
 
 
 @dataclass(frozen=True)
+class DsdlService:
+    """A Cyphal service type of the spec (`dsdl_types` with `request` and `response`): its two halves as structs
+    of its name, each emitted with the same `sealed`/`extent`, `---` between them."""
+
+    name: str  # full name with version: lolo.power.SetLimits.1.0
+    request: DsdlStruct
+    response: DsdlStruct
+    description: str = ""
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
+class RosService:
+    """A ROS 2 service type of the spec's package (`services:`): a .srv with a request and a response."""
+
+    package: str
+    name: str
+    request: list[Field]
+    response: list[Field]
+    description: str = ""
+    pos: Pos = NOWHERE
+
+    @property
+    def full_name(self) -> str:
+        return f"{self.package}/{self.name}"
+
+
+@dataclass(frozen=True)
+class ServiceMapping:
+    """A ROS service the bridge serves by a UAVCAN request to one device (`bridge.service_mappings`). Both link
+    lists are `ros_field: uavcan_field` lines as in a mapping: `request` goes ROS->UAVCAN (with `uavcan_values` for
+    request fields set to constants), `response` UAVCAN->ROS."""
+
+    name: str
+    service: str  # the ROS service name
+    type: str  # the srv type, pkg/Name
+    data_type: str  # the UAVCAN service type (v0 full name)
+    destination_node_id: int
+    timeout_s: float = 1.0
+    request: list[FieldLink] = field(default_factory=list)
+    response: list[FieldLink] = field(default_factory=list)
+    uavcan_values: dict[str, Scalar] = field(default_factory=dict)  # request fields set to constants
+    protocol: str = "dronecan"
+    pos: Pos = NOWHERE
+    # The ROS request field that names the node to ask (`destination_node_id: node_id`, e.g. GetNodeInfo of any
+    # node); None: always destination_node_id.
+    destination_field: str | None = None
+
+
+@dataclass(frozen=True)
 class Bridge:
     name: str
     node_id: int
@@ -358,6 +417,7 @@ class Bridge:
     # Panic) or "both"; None: not said (the built-in duty, and no mapping of Panic allowed)
     panic_duty: str | None = None
     panic_duty_pos: Pos = NOWHERE
+    service_mappings: list[ServiceMapping] = field(default_factory=list)
 
     @property
     def all_mappings(self) -> list[Mapping]:
@@ -457,6 +517,8 @@ class Spec:
     # The namespaces of the standard v0 definitions the spec uses (uavcan always); None: every one (the default)
     dronecan_namespaces: tuple[str, ...] | None = None
     dronecan_namespaces_pos: tuple[Pos, ...] = ()  # each entry's position
+    services: dict[str, RosService] = field(default_factory=dict)  # the package's own .srv types, by pkg/Name
+    dsdl_services: dict[str, DsdlService] = field(default_factory=dict)  # the spec's Cyphal service types
 
     def devices_by_node_id(self) -> dict[int, Device]:
         return {d.node_id: d for d in self.devices.values()}

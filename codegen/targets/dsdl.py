@@ -34,7 +34,11 @@ def dsdl_path(name: str) -> str:
 def emit(resolved: Resolved) -> dict[str, str]:
     environment().filters.setdefault("dsdl_literal", dsdl_literal)
     spec_name = Path(resolved.spec.file).name
-    return {
+    files = {
         f"dsdl/{dsdl_path(struct.name)}": render("dsdl/type.dsdl.j2", struct=struct, spec_name=spec_name)
         for struct in resolved.dsdl_types
     }
+    for service in resolved.dsdl_services:  # request, `---`, response: each half sealed or with the extent
+        files[f"dsdl/{dsdl_path(service.name)}"] = render("dsdl/service.dsdl.j2", service=service,
+                                                          spec_name=spec_name)
+    return files

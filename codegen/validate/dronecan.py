@@ -72,7 +72,7 @@ class DronecanValidator:
     def uses_dronecan(self) -> bool:
         s = self.spec
         return bool(s.dronecan_types or any("dronecan" in d.protocols for d in s.devices.values())
-                    or (s.bridge is not None and s.bridge.dronecan_mappings))
+                    or (s.bridge is not None and (s.bridge.dronecan_mappings or s.bridge.service_mappings)))
 
     def message_type(self, name: str, pos: Pos, what: str) -> V0Struct | None:
         """The v0 message type `name` for a port or mapping; reported (once per kind of problem) when unusable."""
@@ -126,7 +126,7 @@ class DronecanValidator:
                 self.error(struct.pos, f"{what} has a name longer than {V0_MAX_FULL_NAME} characters")
                 bad = True
             dtid = struct.data_type_id
-            if dtid is not None:
+            if dtid is not None and not struct.service:  # a service's id: validate.services
                 if not 0 <= dtid <= MESSAGE_ID_MAX or dtid not in VENDOR_MESSAGE_IDS:
                     self.error(struct.pos, f"data type id {dtid} of {what} is outside the vendor-specific range",
                                f"{VENDOR_MESSAGE_IDS.start}..{VENDOR_MESSAGE_IDS.stop - 1}")

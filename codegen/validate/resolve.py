@@ -8,14 +8,14 @@ messages are derived before any check looks a ROS type up, so every check sees t
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import Constant, DsdlStruct, Field, RosMessage, Spec, V0Struct
+from sam_codegen.model.spec import Constant, DsdlService, DsdlStruct, Field, RosMessage, RosService, Spec, V0Struct
 from sam_codegen.model.types import (
     DSDL_NAMESPACE_COMPONENT,
     DSDL_SHORT_NAME,
@@ -35,6 +35,7 @@ from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, deriv
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.nodes import check_nodes
 from sam_codegen.validate.panic_duty import check_panic_duty
+from sam_codegen.validate.services import ResolvedServiceMapping, ServiceValidator
 from sam_codegen.validate.topics_message import topics_message
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
@@ -60,6 +61,9 @@ class Resolved:
     dronecan_types: list[V0Struct]  # the spec's own, sorted by name
     dronecan_mappings: list[ResolvedMapping]
     layouts: list[ResolvedLayout]  # the implicit "default" first
+    services: list[RosService] = field(default_factory=list)  # the package's .srv types, sorted by name
+    service_mappings: list[ResolvedServiceMapping] = field(default_factory=list)
+    dsdl_services: list[DsdlService] = field(default_factory=list)  # the spec's Cyphal service types, by name
 
 
 def derive_messages(spec: Spec, dsdl: DsdlCatalog, diag: Diagnostics) -> tuple[dict[str, RosMessage], set[str]]:
@@ -344,6 +348,9 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     v.check_header()
     for struct in spec.dsdl_types.values():
         v.check_dsdl_struct(struct)
+    for service in spec.dsdl_services.values():  # each half as a struct (an error of the name is reported once)
+        v.check_dsdl_struct(service.request)
+        v.check_dsdl_struct(service.response)
     messages = v.check_messages()
     topics_msg = topics_message(spec, v.diag)  # ros.topics_message (validate.topics_message)
     messages = sorted([*messages, topics_msg], key=lambda m: m.name) if topics_msg is not None else messages
@@ -353,11 +360,15 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     publishers = v.check_devices()
     dronecan = DronecanValidator(spec, v0, v.diag, v.mapping_validator(v0, publishers))
     dronecan.check_types()
+    services = ServiceValidator(spec, ros, v0, v.diag)
+    srv_types = services.check_srv_types()
+    services.check_v0_service_types()
     dronecan.check_devices()
     mappings = dronecan.mappings.resolve_mappings()
     dronecan_mappings = dronecan.resolve_mappings()
     check_panic_duty(spec, v.diag)
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
+    service_mappings = services.resolve_mappings()
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")
     v.diag.check()
@@ -366,7 +377,8 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     # Every type of the spec passed its checks, so each has its signature (computed in check_types).
     dronecan_types = [v0.signed(t.name) for t in sorted(spec.dronecan_types.values(), key=lambda t: t.name)]
     return Resolved(spec, ros, dsdl, messages, sorted(spec.dsdl_types.values(), key=lambda t: t.name), mappings,
-                    v0, [t for t in dronecan_types if t is not None], dronecan_mappings, layouts)
+                    v0, [t for t in dronecan_types if t is not None], dronecan_mappings, layouts, srv_types,
+                    service_mappings, sorted(spec.dsdl_services.values(), key=lambda t: t.name))
 
 
 __all__ = ["CAN_NODE_IDS", "SUBJECT_IDS", "Constant", "Field", "Resolved", "validate"]

@@ -13,6 +13,7 @@ from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend, BridgeConfigError
 from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
+from sam_runtime.bridge.backends.dronecan_services import DroneCanServices
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
@@ -126,6 +127,7 @@ class Bridge:
         self.outbound: Outbound | None = None
         self.reporter: Reporter | None = None
         self.duties: Any = None  # DroneCAN: sam_runtime.bridge.backends.dronecan_duties
+        self.services: DroneCanServices | None = None  # DroneCAN: the spec's service mappings
 
     @property
     def name(self) -> str:
@@ -210,6 +212,13 @@ class Bridge:
                        **self._dronecan_options}
             self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **options)
             self.duties.attach()
+            services = self.gen.services()
+            served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
+                      if m.destination_node_id in sel.devices or m.destination_field is not None]
+            if served:
+                self.services = DroneCanServices(lifetime, backend, self.ros, served,
+                                                 diagnostics_period=self._diagnostics_period)
+                self.services.attach()
         link.attach()
         reporter.attach()
         self.ros.attach_spinner()
@@ -229,7 +238,10 @@ class Bridge:
         """A JSON-serialisable snapshot of every counter, the devices' heartbeats and the bridge itself."""
         if self.reporter is None:
             raise RuntimeError("start() the bridge first")
-        return self.reporter.snapshot()
+        snapshot = self.reporter.snapshot()
+        if self.services is not None:
+            snapshot["services"] = self.services.snapshot()
+        return snapshot
 
     def diagnostics_message(self) -> Any:
         """The /diagnostics message now (diagnostic_msgs/DiagnosticArray)."""

@@ -10,9 +10,10 @@ dataflow picture), from one resolved spec.
   (columns, barycentric rows) so that it needs no graphviz and comes out byte for byte the same (svg.py).
 
 The modules import one way: this package (emit) -> markdown | svg | dronecan -> wording -> graph. Only this module
-imports markdown, svg and dronecan; none of them imports this package. The target imports targets.nodes only for the
-names of generated files. Everything that comes from the spec reaches the output through md_cell / md_code / xml_text
-in the templates (templates/docs/); the modules compute structure, numbers and the conversion wording.
+imports markdown, svg, dronecan and services (the service types and mappings); none of them imports this package.
+The target imports targets.nodes only for the names of generated files. Everything that comes from the spec reaches
+the output through md_cell / md_code / xml_text in the templates (templates/docs/); the modules compute structure,
+numbers and the conversion wording.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from sam_codegen.targets.docs.budget import budget_context
 from sam_codegen.targets.docs.dronecan import dronecan_context
 from sam_codegen.targets.docs.graph import SVG_NAME, build_graph
 from sam_codegen.targets.docs.markdown import markdown_context
+from sam_codegen.targets.docs.services import services_context
 from sam_codegen.targets.docs.svg import svg_context
 from sam_codegen.validate.resolve import Resolved
 
@@ -34,7 +36,8 @@ def emit(resolved: Resolved) -> dict[str, str]:
     graph = build_graph(resolved)
     return {
         MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph),
-                        **dronecan_context(resolved), **budget_context(resolved)).rstrip("\n") + "\n",
+                        **dronecan_context(resolved), **budget_context(resolved),
+                        **services_context(resolved)).rstrip("\n") + "\n",
         SVG_PATH: render("docs/dataflow.svg.j2", **svg_context(resolved, graph)),
     }
 
