@@ -34,6 +34,7 @@ from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.nodes import check_nodes
+from sam_codegen.validate.routing import check_routing
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -353,6 +354,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     mappings = dronecan.mappings.resolve_mappings()
     dronecan_mappings = dronecan.resolve_mappings()
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
+    check_routing(spec, v.diag)  # `any` node ids, `shares_data_type` (validate.routing)
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")
     v.diag.check()
