@@ -179,6 +179,10 @@ class DroneCanDevices:
             if any(e in sam for e in elements):  # SAM's firmware: its own elements of a shared broadcast
                 elements = [e for e in elements if e in sam]
             elif len(destinations) > 1 and len(elements) == len(destinations):
+                # one element per destination: the i-th lowest position for the i-th lowest node id (a spec may
+                # name them in any order, e.g. a constant rpm[0] after rpm[1] from the topic)
+                if all(parse_element(e).index is not None for e in elements):
+                    elements.sort(key=lambda e: parse_element(e).index or 0)
                 elements = [elements[destinations.index(node_id)]]
             out.append(Addressing(tuple(m.select), tuple(parse_element(e) for e in elements)))
         if not out and sam:  # no mapping sends it: the firmware's own elements, where the type has them
