@@ -102,7 +102,8 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
                    "saturate or reject")
     source_node_ids, any_node, any_pos = node_ids_or_any(r, "source_node_ids", what, diag)
     destination_node_id = None if dronecan else r.get("destination_node_id", int, None)
-    data_type, destination_node_ids, select_pos = "", [], NOWHERE
+    data_type, select_pos = "", NOWHERE
+    destination_node_ids: list[int] = []
     select: dict[str, Scalar] = {}
     if dronecan:
         data_type = r.get("data_type", str) or ""

@@ -279,7 +279,7 @@ class DroneCanDevices:
         selections: Selections = pp.extra
         for path, value in selections.next_select():
             _put(obj, path, value)
-        claimed = {el.value for el in selections.elements if el.key is not None}
+        claimed = {el.value for el in selections.elements if el.key is not None and el.value is not None}
         for el in selections.elements:
             ensure_element(obj, el, claimed, t, now_us)
 

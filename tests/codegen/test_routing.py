@@ -75,7 +75,8 @@ def test_any_node_reaches_every_device_with_the_port(resolved: Resolved) -> None
 
 def test_shared_data_type_keeps_each_mappings_elements(resolved: Resolved) -> None:
     """[r1, r2], [r] and [c, r] of one RPMCommand: each mapping builds its own message."""
-    elements = {rm.mapping.name: [u for uses in rm.elements.values() for u in uses] for rm in resolved.dronecan_mappings}
+    elements = {rm.mapping.name: [u for uses in rm.elements.values() for u in uses]
+                for rm in resolved.dronecan_mappings}
     assert elements["thrusters"] == [0, 1]
     assert elements["legacy_rpm"] == [0]
     assert elements["legacy_stbd_rpm"] == [1, 0]  # rpm[1] from the topic, rpm[0] a constant
@@ -122,9 +123,10 @@ def test_generated_tables_say_any_node(generated: Path) -> None:
 
 def test_docs_show_any_node_and_sharing(generated: Path) -> None:
     md = (generated / "docs" / "interfaces.md").read_text(encoding="utf-8")
-    assert "| `winch` | UAVCAN → ROS | `trawler.Winch.0.1` | 700 | `/winch/tension` | `std_msgs/Float32` | from any node |" \
-        in md
-    assert md.count("the bridge does not protect this topic against a spoofing or stray node") == 4  # winch, 3 v0
+    assert ("| `winch` | UAVCAN → ROS | `trawler.Winch.0.1` | 700 | `/winch/tension` | `std_msgs/Float32` | "
+            "from any node |") in md
+    # the winch (Cyphal) and the three DroneCAN status mappings
+    assert md.count("the bridge does not protect this topic against a spoofing or stray node") == 4
     assert ("- Shares `uavcan.equipment.esc.RPMCommand` with `legacy_rpm`, `legacy_stbd_rpm` (`shares_data_type`): "
             "each mapping broadcasts its own messages") in md
     assert ("- Any node (`destination_node_ids: any`): the broadcast is for every device that receives "
