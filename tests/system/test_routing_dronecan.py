@@ -66,7 +66,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                env, d)
     probe = Proc("probe", helper_cmd("ros_probe.py", "listen", "--generated", str(gen), "--topics",
                                      ",".join(IN_TOPICS), "--out", str(d / "probe.json"), "--record",
-                                     str(d / "probe.jsonl")), env, d)
+                                     str(d / "probe.jsonl"), "--diagnostics"), env, d)
     (d / "plan.json").write_text(json.dumps({"rate_hz": 20, "topics": COMMANDS}))
     procs = [probe, bridge, sim]
     try:
@@ -177,6 +177,11 @@ def test_an_esc_the_spec_never_names_is_bridged_by_its_index(run: dict[str, Any]
     peer = [r for r in run["records"] if r["topic"] == "/esc1/status" and r["msg"]["x"] == 4321.0]
     assert len(peer) == PEER_SELECTED and {r["msg"]["y"] for r in peer} == {1.0}
     assert run["probe"]["counts"]["/esc1/status"] == after["esc1_status"]["published"]
+    diagnostics = run["probe"]["diagnostics"]
+    status = next(v for k, v in diagnostics.items() if k.endswith("/mapping/esc1_status"))
+    assert status["values"]["source_node_ids"] == "any"  # the choice is visible on /diagnostics
+    static = next(v for k, v in diagnostics.items() if k.endswith("/mapping/legacy_rpm"))
+    assert "destination_node_ids" not in static["values"]
 
 
 def test_topics_sharing_a_broadcast_type_each_send_their_own(run: dict[str, Any]) -> None:
