@@ -158,7 +158,8 @@ class DroneCanDevices:
                     dev.info.node_id in m.source_node_ids or getattr(m, "any_node", False)):
                 selects[tuple(m.select)] = None
                 elements.update({e: parse_element(e) for e in m.elements})
-        return Selections(tuple(selects), list(elements.values()))
+        # a mapping without `select` takes every message, those of the other selections too: no turn of its own
+        return Selections(tuple(s for s in selects if s or len(selects) == 1), list(elements.values()))
 
     def _destinations(self, m: Any) -> list[int]:
         """A command mapping's destination node ids; with ``any`` the devices that subscribe to its type."""

@@ -51,3 +51,29 @@ def test_each_esc_takes_its_own_element_of_every_shared_command(adapter: DroneCa
 
     assert taken(30, "esc_port") == [["rpm[0]"], ["rpm[0]"], ["rpm[0]"]]
     assert taken(31, "esc_stbd") == [["rpm[1]"], ["rpm[1]"]]
+
+
+def _spec_tables(spec: str) -> Any:
+    if spec == "sam":
+        from helpers.runtime_support import generated_or_skip
+
+        return generated_or_skip().tables()
+    return GeneratedPackage(generated_spec(spec)).tables()
+
+
+@pytest.mark.parametrize("spec", ["sam", "minimal_v0", "buoy_v0", "ferry", "trawler"])
+def test_every_select_routed_mapping_has_a_device_sending_its_values(spec: str) -> None:
+    """Class 11 for every spec with DroneCAN: each UAVCAN->ROS mapping with `select` is fed by some simulated device
+    that sends its values (in turn with the other selections that accept the device), so its topic publishes."""
+    tables = _spec_tables(spec)
+    sim: Any = SimpleNamespace(config=SimpleNamespace(dronecan_iface="mcast-lo:"), bridge_node_id=100, devices=[],
+                               tables=tables)
+    devices = DroneCanDevices(sim)
+    routed = [m for m in tables.DRONECAN_MAPPINGS if m.direction == "uavcan_to_ros" and m.select]
+    for m in routed:
+        senders = [d.name for d in tables.DRONECAN_DEVICES
+                   if any(p.data_type.name == m.data_type.name for p in d.publishes)
+                   and tuple(m.select) in devices._fixed_values(_dev(d.node_id, d.name), m.data_type.name).selects]
+        assert senders, f"{spec}: no simulated device sends the select values of {m.name}"
+    if spec in ("sam", "trawler"):
+        assert len(routed) >= 2
