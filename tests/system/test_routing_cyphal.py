@@ -37,7 +37,7 @@ UDP = ["--transport", "udp", "--iface", "127.0.0.1"]
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     gen = generated_spec("trawler")
     d = tmp_path_factory.mktemp("routing_cyphal")
-    env = child_env(Path(sys.prefix).absolute(), domain_id(58), {"SAM_GENERATED_DIR": str(gen)})
+    env = child_env(Path(sys.prefix).absolute(), domain_id(94), {"SAM_GENERATED_DIR": str(gen)})
     with cyphal_udp_lock():
         bridge = Proc("bridge", runtime_cmd("bridge", "--protocol", "cyphal", *UDP, "--stats-file",
                                             str(d / "bridge.json")), env, d)

@@ -57,7 +57,7 @@ COMMANDS = {
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     gen = generated_spec("trawler")
     d = tmp_path_factory.mktemp("routing_dronecan")
-    env = child_env(Path(sys.prefix).absolute(), domain_id(57), {"SAM_GENERATED_DIR": str(gen)})
+    env = child_env(Path(sys.prefix).absolute(), domain_id(93), {"SAM_GENERATED_DIR": str(gen)})
     iface = private_iface()
     bridge = Proc("bridge", runtime_cmd("bridge", "--protocol", "dronecan", "--dronecan-iface", iface,
                                         "--stats-file", str(d / "bridge.json")), env, d)
