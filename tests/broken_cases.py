@@ -669,7 +669,7 @@ V0_CASES: tuple[Case, ...] = (
         '      data_type: skiff.Bilge\n',
         '      data_type: skiff.Bilge\n      subject_id: 7\n',
         (
-            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, shares_data_type)",
         ),
     ),
     Case(
@@ -736,14 +736,6 @@ V0_CASES: tuple[Case, ...] = (
         '      source_node_ids: [10]\n      select: {level_mm: 1}\n      fields:\n        data: level_mm\n  dronecan',
         (
             "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
-        ),
-    ),
-    Case(
-        'v0_select_also_mapped',
-        '        data: level_mm\n      ignore: [timestamp]',
-        '        data: pump_id\n      ignore: [timestamp, level_mm]',
-        (
-            "minimal_v0.yaml:57:5: error: UAVCAN field 'pump_id' is set by `select` in DroneCAN mapping 'bilge'; it cannot also be mapped (expected the field in select only)",
         ),
     ),
     Case(
@@ -815,7 +807,7 @@ V0_CASES: tuple[Case, ...] = (
         'nodes:\n',
         '    rudder_2:\n      direction: ros_to_uavcan\n      data_type: uavcan.equipment.actuator.ArrayCommand\n      topic: /rudder\n      destination_node_ids: [21]\n      fields:\n        data: "commands[actuator_id=2].command_value"\n      uavcan_values: {"commands[actuator_id=2].command_type": 0}\nnodes:\n',
         (
-            "minimal_v0.yaml:82:5: error: DroneCAN mappings 'rudder' and 'rudder_2' both command uavcan.equipment.actuator.ArrayCommand (commands[actuator_id=2]) (expected distinct `select` values or distinct items chosen by key, or one mapping that writes every element)",
+            "minimal_v0.yaml:82:5: error: DroneCAN mappings 'rudder' and 'rudder_2' both command uavcan.equipment.actuator.ArrayCommand (commands[actuator_id=2]) (expected distinct `select` values or distinct items chosen by key, or one mapping that writes every element, or `shares_data_type: true` in 'rudder' and 'rudder_2': each then sends its own messages)",
         ),
     ),
     Case(
@@ -1304,6 +1296,110 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      service: /bridge/get_node_info',
         (
             "auv_services.yaml:118:5: error: service /bridge/get_node_info of service mapping 'restart_node' is already served by service mapping 'get_node_info' (expected one mapping per ROS service)",
+        ),
+    ),
+)
+
+
+# Routing (issue 17 classes 5-7): each breaks tests/specs/seiner.yaml one way (tests/codegen/test_routing.py).
+ROUTING_CASES: tuple[Case, ...] = (
+    Case(
+        'routing_select_also_commanded',
+        '        data: command\n',
+        '        data: hardpoint_id\n      uavcan_values: {command: 0}\n',
+        (
+            "seiner.yaml:159:5: error: UAVCAN field 'hardpoint_id' is set by `select` in DroneCAN mapping 'hook'; it cannot also be mapped (expected the field in select only)",
+        ),
+    ),
+    Case(
+        'routing_share_not_opted_in',
+        '      destination_node_ids: [30]\n      shares_data_type: true\n',
+        '      destination_node_ids: [30]\n',
+        (
+            "seiner.yaml:124:5: error: DroneCAN mappings 'thrusters' and 'legacy_rpm' both command uavcan.equipment.esc.RPMCommand (expected distinct `select` values or distinct items chosen by key, or one mapping that writes every element, or `shares_data_type: true` in 'legacy_rpm': each then sends its own messages)",
+            "seiner.yaml:131:5: error: DroneCAN mappings 'legacy_rpm' and 'legacy_stbd_rpm' both command uavcan.equipment.esc.RPMCommand (expected distinct `select` values or distinct items chosen by key, or one mapping that writes every element, or `shares_data_type: true` in 'legacy_rpm': each then sends its own messages)",
+        ),
+    ),
+    Case(
+        'routing_share_stale',
+        '      destination_node_ids: [33]\n',
+        '      destination_node_ids: [33]\n      shares_data_type: true\n',
+        (
+            "seiner.yaml:159:5: error: DroneCAN mapping 'hook' says `shares_data_type: true`, but no other mapping commands what it commands of uavcan.equipment.hardpoint.Command (expected no `shares_data_type`: it shares nothing)",
+        ),
+    ),
+    Case(
+        'routing_share_on_uavcan_to_ros',
+        '      select: {actuator_id: 3}\n',
+        '      select: {actuator_id: 3}\n      shares_data_type: true\n',
+        (
+            "seiner.yaml:106:5: error: DroneCAN mapping 'rudder_position' goes UAVCAN->ROS: `shares_data_type` is for ROS->UAVCAN mappings (UAVCAN->ROS mappings of one data type are told apart by source node and select) (expected no `shares_data_type`)",
+        ),
+    ),
+    Case(
+        'routing_share_in_cyphal',
+        '      subject_id: 700\n',
+        '      subject_id: 700\n      shares_data_type: true\n',
+        (
+            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+        ),
+    ),
+    Case(
+        'routing_share_not_bool',
+        '      destination_node_ids: [30]\n      shares_data_type: true\n',
+        '      destination_node_ids: [30]\n      shares_data_type: yes please\n',
+        (
+            "seiner.yaml:129:25: error: 'shares_data_type' of DroneCAN mapping 'legacy_rpm' must be bool, found str 'yes please' (expected bool)",
+        ),
+    ),
+    Case(
+        'routing_any_misspelt',
+        '      select: {actuator_id: 3}\n      topic: /rudder/position\n      source_node_ids: any\n',
+        '      select: {actuator_id: 3}\n      topic: /rudder/position\n      source_node_ids: all\n',
+        (
+            "seiner.yaml:111:24: error: source_node_ids of DroneCAN mapping 'rudder_position' must be a list of node ids or `any`, found 'all' (expected a list of node ids, or `any` for every node)",
+        ),
+    ),
+    Case(
+        'routing_any_no_publisher',
+        '      - {type: uavcan.equipment.actuator.Status, rate_hz: 10}\n',
+        '      - {type: uavcan.equipment.esc.Status, rate_hz: 10}\n',
+        (
+            "seiner.yaml:111:7: error: DroneCAN mapping 'rudder_position' says `source_node_ids: any`, but no device publishes uavcan.equipment.actuator.Status on DroneCAN (expected a device with `uavcan.equipment.actuator.Status` in its DroneCAN publishes)",
+        ),
+    ),
+    Case(
+        'routing_any_no_subscriber',
+        'data_type: uavcan.equipment.esc.RPMCommand\n      topic: /legacy/stbd_rpm\n      destination_node_ids: any\n      shares_data_type: true\n      fields:\n        data: rpm[1]\n      uavcan_values: {"rpm[0]": 0}',
+        'data_type: uavcan.equipment.esc.RawCommand\n      topic: /legacy/stbd_rpm\n      destination_node_ids: any\n      shares_data_type: true\n      fields:\n        data: cmd[1]\n      uavcan_values: {"cmd[0]": 0}',
+        (
+            "seiner.yaml:132:5: error: DroneCAN mapping 'legacy_stbd_rpm' says `shares_data_type: true`, but no other mapping commands what it commands of uavcan.equipment.esc.RawCommand (expected no `shares_data_type`: it shares nothing)",
+            "seiner.yaml:136:7: error: DroneCAN mapping 'legacy_stbd_rpm' says `destination_node_ids: any`, but no device subscribes to uavcan.equipment.esc.RawCommand on DroneCAN (expected a device with `uavcan.equipment.esc.RawCommand` in its DroneCAN subscribes)",
+        ),
+    ),
+    Case(
+        'routing_any_source_on_command',
+        '      topic: /legacy/rudder\n      destination_node_ids: any\n',
+        '      topic: /legacy/rudder\n      source_node_ids: any\n',
+        (
+            "seiner.yaml:154:7: error: DroneCAN mapping 'legacy_rudder' goes ROS->UAVCAN: it has a destination, not sources (expected destination_node_ids)",
+        ),
+    ),
+    Case(
+        'routing_any_cyphal_destination',
+        '      source_node_ids: any\n      fields:\n        data: tension\n      ignore: [winch_id]\n',
+        '      source_node_ids: any\n      fields:\n        data: tension\n      ignore: [winch_id]\n    winch_cmd:\n      direction: ros_to_uavcan\n      subject_id: 701\n      topic: /hook\n      destination_node_id: any\n      fields:\n        data: winch_id\n',
+        (
+            "seiner.yaml:83:5: error: mapping 'winch_cmd' needs destination_node_id: the node its commands are meant for",
+            "seiner.yaml:87:28: error: 'destination_node_id' of mapping 'winch_cmd' must be int, found str 'any' (expected int)",
+        ),
+    ),
+    Case(
+        'routing_any_cyphal_no_publisher',
+        '    publishes:\n      - {subject_id: 700, type: seiner.Winch.0.1, rate_hz: 5}\n',
+        '    subscribes:\n      - {subject_id: 700, type: seiner.Winch.0.1, rate_hz: 5}\n',
+        (
+            "seiner.yaml:79:7: error: mapping 'winch' says `source_node_ids: any`, but no device publishes subject 700 (expected a device with subject 700 in its publishes)",
         ),
     ),
 )

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from sam_codegen.frontend.bus import parse_bus
-from sam_codegen.frontend.reading import Reader, int_list, map_items, number, scalar, seq_items, str_list, text_of
+from sam_codegen.frontend.reading import Reader, map_items, number, scalar, seq_items, str_list, text_of
+from sam_codegen.frontend.routing import node_ids_or_any
 from sam_codegen.frontend.yaml_source import YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
 from sam_codegen.model.spec import (
@@ -80,6 +81,7 @@ _MAPPING_KEYS = (
 _DRONECAN_MAPPING_KEYS = (
     "direction", "topic", "data_type", "select", "source_node_ids", "destination_node_ids", "frame_id",
     "fields", "ignore", "uavcan_values", "on_out_of_range",
+    "shares_data_type",
 )
 
 
@@ -98,13 +100,15 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
     if policy not in ("saturate", "reject"):
         diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range {policy!r} of {what} is unknown",
                    "saturate or reject")
-    source_node_ids = int_list(r.node("source_node_ids"), "source_node_ids", what, diag)
+    source_node_ids, any_node, any_pos = node_ids_or_any(r, "source_node_ids", what, diag)
     destination_node_id = None if dronecan else r.get("destination_node_id", int, None)
-    data_type, destination_node_ids, select_pos = "", [], NOWHERE
+    data_type, select_pos = "", NOWHERE
+    destination_node_ids: list[int] = []
     select: dict[str, Scalar] = {}
     if dronecan:
         data_type = r.get("data_type", str) or ""
-        destination_node_ids = int_list(r.node("destination_node_ids"), "destination_node_ids", what, diag)
+        destination_node_ids, any_dest, dest_pos = node_ids_or_any(r, "destination_node_ids", what, diag)
+        any_node, any_pos = any_node or any_dest, any_pos if any_node else dest_pos
         select_pos = r.key_pos("select")
         for path, _, value_node in map_items(r.node("select"), f"select of {what}", diag):
             value = scalar(value_node, (bool, int), f"select value {path!r} of {what}", diag)
@@ -130,7 +134,7 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
         name, direction or UAVCAN_TO_ROS, r.get("topic", str) or "", 0 if dronecan else r.get("subject_id", int) or 0,
         source_node_ids, destination_node_id, r.get("frame_id", str, None), links, ignore, uavcan_values, auto,
         policy if policy in ("saturate", "reject") else "saturate", pos, protocol, data_type, destination_node_ids,
-        select, select_pos,
+        select, select_pos, any_node, any_pos, bool(dronecan and r.get("shares_data_type", bool, False)),
     )
     destination = "destination_node_ids" if dronecan else "destination_node_id"
     if direction == UAVCAN_TO_ROS and r.node(destination) is not None:
@@ -139,11 +143,11 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
     if direction == ROS_TO_UAVCAN and r.node("source_node_ids") is not None:
         diag.error(r.key_pos("source_node_ids"), f"{what} goes ROS->UAVCAN: it has a destination, not sources",
                    destination)
-    if direction == UAVCAN_TO_ROS and not mapping.source_node_ids:
+    if direction == UAVCAN_TO_ROS and not mapping.source_node_ids and not any_node:
         diag.error(pos, f"{what} needs source_node_ids: the node ids whose messages it accepts")
     if direction == ROS_TO_UAVCAN and not dronecan and mapping.destination_node_id is None:
         diag.error(pos, f"{what} needs destination_node_id: the node its commands are meant for")
-    if direction == ROS_TO_UAVCAN and dronecan and not mapping.destination_node_ids:
+    if direction == ROS_TO_UAVCAN and dronecan and not mapping.destination_node_ids and not any_node:
         diag.error(pos, f"{what} needs destination_node_ids: the nodes its broadcast commands are meant for")
     return mapping
 

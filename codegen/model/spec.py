@@ -354,6 +354,12 @@ class Mapping:
     destination_node_ids: list[int] = field(default_factory=list)
     select: dict[str, Scalar] = field(default_factory=dict)
     select_pos: Pos = NOWHERE
+    # Routing (codegen/validate/routing.py): `source_node_ids: any` (or DroneCAN's `destination_node_ids: any`)
+    # accepts every node instead of the static ids; `shares_data_type` lets several ROS->UAVCAN mappings broadcast
+    # the same DroneCAN data type (each sends its own messages).
+    any_node: bool = False
+    any_node_pos: Pos = NOWHERE
+    shares_data_type: bool = False
 
 
 @dataclass(frozen=True)

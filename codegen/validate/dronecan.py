@@ -15,7 +15,6 @@ from sam_codegen.catalogs.dronecan import (
 from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.spec import (
     PROTOCOLS,
-    ROS_TO_UAVCAN,
     UAVCAN_TO_ROS,
     Constant,
     Device,
@@ -28,8 +27,9 @@ from sam_codegen.model.spec import (
 )
 from sam_codegen.model.types import V0_MAX_FULL_NAME, V0_NAMESPACE_COMPONENT, V0_SHORT_NAME, DsdlType
 from sam_codegen.validate.dronecan_namespaces import check_namespaces, clash_message, outside_message
-from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, format_path
+from sam_codegen.validate.mapping_rules import ResolvedMapping
 from sam_codegen.validate.mappings import MappingValidator
+from sam_codegen.validate.routing import check_shared_broadcasts, routed_node_ids
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
 V0_NODE_IDS = range(1, 126)  # 0 is anonymous, 126 and 127 are kept for maintenance tools
@@ -240,7 +240,7 @@ class DronecanValidator:
         struct = self.message_type(mapping.data_type, mapping.pos, what) if mapping.data_type else None
         rate = 0.0
         publishing = mapping.direction == UAVCAN_TO_ROS
-        nodes = mapping.source_node_ids if publishing else mapping.destination_node_ids
+        nodes = routed_node_ids(s, mapping)  # static ids, or with `any` every device with the port
         role = "source" if publishing else "destination"
         users: dict[int, V0Port] = {}
         for device in s.devices.values():
@@ -269,25 +269,9 @@ class DronecanValidator:
 
     def check_broadcasts(self, resolved: list[ResolvedMapping]) -> None:
         """Two ROS->UAVCAN mappings that broadcast one data type must not command the same thing: they need
-        different `select` values, or distinct items chosen by key (ArrayCommand's actuator ids)."""
-        claims: dict[str, list[tuple[ResolvedMapping, dict[str, object], set[str] | None]]] = {}
-        for rm in resolved:
-            if rm.mapping.direction != ROS_TO_UAVCAN:
-                continue
-            select: dict[str, object] = {format_path(list(p)): v for p, _, v in rm.select}
-            items: set[str] | None = None
-            if rm.elements and all(isinstance(e, Key) for es in rm.elements.values() for e in es):
-                items = {f"{format_path(list(path))}[{e}]" for path, es in rm.elements.items() for e in es}
-            for other, other_select, other_items in claims.get(rm.mapping.data_type, []):
-                if any(k in other_select and other_select[k] != v for k, v in select.items()):
-                    continue  # different selections: different recipients
-                overlap = items & other_items if items is not None and other_items is not None else None
-                if overlap is None or overlap:
-                    shared = f" ({', '.join(sorted(overlap))})" if overlap else ""
-                    self.error(rm.mapping.pos, f"DroneCAN mappings {other.mapping.name!r} and {rm.mapping.name!r} "
-                               f"both command {rm.mapping.data_type}{shared}", "distinct `select` values or distinct "
-                               "items chosen by key, or one mapping that writes every element")
-            claims.setdefault(rm.mapping.data_type, []).append((rm, select, items))
+        different `select` values, or distinct items chosen by key (ArrayCommand's actuator ids), or both opt in
+        with `shares_data_type` (validate.routing)."""
+        check_shared_broadcasts(resolved, self.diag)
 
     # ---- layouts -------------------------------------------------------------------------------------------
     def resolve_layouts(self, cyphal: list[ResolvedMapping], dronecan: list[ResolvedMapping]) -> list[ResolvedLayout]:
@@ -332,8 +316,7 @@ class DronecanValidator:
             active = active_mappings[protocol]
             for rm in rms:
                 m = rm.mapping
-                nodes = m.source_node_ids if m.direction == UAVCAN_TO_ROS else (
-                    m.destination_node_ids if protocol == "dronecan" else [m.destination_node_id])
+                nodes = routed_node_ids(s, m)
                 devices = [by_id[n].name for n in nodes if n in by_id]
                 speaking = [d for d in devices if protocols[d] == protocol]
                 if speaking and len(speaking) < len(devices):

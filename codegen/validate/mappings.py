@@ -425,7 +425,8 @@ class MappingValidator:
         linked = {s.uavcan for s in resolved.steps if s.uavcan_path} | self.failed_paths
         valued = {format_path(list(p)) for p, _, _ in resolved.uavcan_values}
         selected = {format_path(list(p)) for p, _, _ in resolved.select}
-        for path in sorted(selected & (linked | valued)):
+        # UAVCAN->ROS may also publish a select field (esc_index routed on and reported); ROS->UAVCAN sets it once
+        for path in sorted(selected & (linked | valued) if mapping.direction == ROS_TO_UAVCAN else selected & valued):
             self.error(mapping.pos, f"UAVCAN field {path!r} is set by `select` in {what}; it cannot also be mapped",
                        "the field in select only")
         linked |= selected

@@ -35,6 +35,7 @@ from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, deriv
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.nodes import check_nodes
 from sam_codegen.validate.panic_duty import check_panic_duty
+from sam_codegen.validate.routing import check_routing
 from sam_codegen.validate.services import ResolvedServiceMapping, ServiceValidator
 from sam_codegen.validate.topics_message import topics_message
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
@@ -369,6 +370,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     check_panic_duty(spec, v.diag)
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
     service_mappings = services.resolve_mappings()
+    check_routing(spec, v.diag)  # `any` node ids, `shares_data_type` (validate.routing)
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")
     v.diag.check()

@@ -123,7 +123,8 @@ message is still published), rejected ones under ``rejected.<...>``.
 - ROS QoS: each topic's from the spec (``qos``: sensor data best effort, commands and states reliable, ...).
   A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last, so DDS drops that
   subscriber's oldest samples (reliable topics) or never waits for it (best effort) instead of blocking the bridge.
-- Security: a mapping accepts transfers only from its spec's source node ids (``unknown_source`` otherwise);
+- Security: a mapping accepts transfers only from its spec's source node ids (``unknown_source`` otherwise), or
+  from every node when the spec says ``source_node_ids: any`` for it (``any_node``: routed by its ``select`` alone);
   actuators (the simulated ones too) accept commands only from the bridge's node id. Cyphal/UDP binds
   127.0.0.1 and ROS discovery stays on localhost (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) unless the user
   configures an interface (``--iface``, UAVCAN__UDP__IFACE, or that variable) explicitly.

@@ -63,6 +63,9 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
             "direction": m["direction"], "topic": m["topic"], **_port(m), "port": m["port"],
             "received": m["received"], "published": m["published"], "dropped": m["dropped_total"],
         }
+        for key in ("source_node_ids", "destination_node_ids"):
+            if m.get(key) == "any":  # the spec's explicit choice, visible: no node id filter (no spoofing check)
+                values[key] = "any"
         values.update({f"dropped.{k}": v for k, v in sorted(m["dropped"].items())})
         values["saturated"] = m["saturated_total"]
         values.update({f"saturated.{k}": v for k, v in sorted(m["saturated"].items())})

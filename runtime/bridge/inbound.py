@@ -10,6 +10,10 @@ backend's receive loop), ``unselected`` (DroneCAN: a broadcast from an accepted 
 selects, e.g. an esc.Status with an ESC index no mapping reads; counted on the first mapping accepting the device).
 A transfer from a device that another mapping of the shared port accepts is that mapping's alone.
 
+A mapping with ``any_node`` (the spec's ``source_node_ids: any``) accepts every source node id: it is routed only
+by what the message says (DroneCAN's ``select`` and the items it reads), so it gives up the source filter's
+protection against spoofing; its port then never counts ``unknown_source``.
+
 Stamps: a device stamp of 0 (unknown) becomes the receive time; an empty frame id the mapping's; a stamp older than
 the previous one of the same source on the same mapping is published anyway, in arrival order, and counted as
 ``out_of_order``. A source that restarted (:meth:`Inbound.forget_stamps`) may have restarted its clock: its next
@@ -34,7 +38,12 @@ from sam_runtime.bridge.counters import MappingStats, count_handler_error
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
 
-__all__ = ["InMapping", "Inbound", "PortGroup"]
+__all__ = ["InMapping", "Inbound", "PortGroup", "accepts"]
+
+
+def accepts(info: Any, src: int | None) -> bool:
+    """Whether the mapping ``info`` takes a transfer from node ``src`` (its source node ids, or any node)."""
+    return src in info.source_node_ids or (src is not None and getattr(info, "any_node", False))
 
 
 @dataclass
@@ -66,6 +75,7 @@ class PortGroup:
     loss: TransferLoss
     accepted_sources: frozenset[int] = frozenset()
     inlet: Inlet | None = None
+    any_source: bool = False  # a mapping of the port accepts every node id (``any_node``)
 
     @property
     def raw(self) -> bool:
@@ -84,6 +94,7 @@ class Inbound:
         self.groups = {g.port_id: g for g in groups}
         for g in groups:
             g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
+            g.any_source = any(getattr(im.info, "any_node", False) for im in g.mappings)
         self._receive_ns: Callable[[], int] = ros.receive_ns
         self._group_of = {im.info.name: g for g in groups for im in g.mappings}
 
@@ -129,7 +140,7 @@ class Inbound:
         counted below the bridge)."""
         try:
             return [im for im in group.mappings
-                    if src in im.info.source_node_ids and (im.matches is None or im.matches(msg))]
+                    if accepts(im.info, src) and (im.matches is None or im.matches(msg))]
         except ValueError as ex:  # only the wire path's matches parse bytes
             if not group.raw:
                 raise
@@ -142,7 +153,7 @@ class Inbound:
 
     def _bridge_transfer(self, group: PortGroup, msg: Any, src: int | None, tid: int, now: float) -> None:
         rlog = self.lifetime.rlog
-        known = src in group.accepted_sources
+        known = src in group.accepted_sources or (group.any_source and src is not None)
         if not known:
             for im in group.mappings:  # no mapping's device: each mapping of the port counts it
                 im.stats.receive()
@@ -171,7 +182,7 @@ class Inbound:
         for im, out, error in results:
             self._account(im, src, tid, lost, lost_est, receive_ns, out, error)
         if not takers:  # from an accepted device, but what no mapping selects: never a silent loss
-            im = next(im for im in group.mappings if src in im.info.source_node_ids)
+            im = next(im for im in group.mappings if accepts(im.info, src))
             im.stats.receive()
             im.stats.drop("unselected")
             rlog.note((im.info.name, "unselected"), logging.WARNING, "node %s sent a message no mapping of port %d "

@@ -87,7 +87,7 @@ class Reporter:
                      **({"data_type": m.data_type.name} if hasattr(m, "data_type") else {}),
                      **(st.snapshot() if st else empty)}
             if m.direction == UAVCAN_TO_ROS:
-                entry["source_node_ids"] = sorted(m.source_node_ids)
+                entry["source_node_ids"] = "any" if getattr(m, "any_node", False) else sorted(m.source_node_ids)
                 group = self.inbound.group_of(m.name)
                 inlet = group.inlet if group is not None else None
                 entry["port"] = inlet.port_name if inlet is not None else (
@@ -107,7 +107,8 @@ class Reporter:
                 entry["ros_subscribers"] = self.ros.matched(m.topic.name)
             else:
                 if hasattr(m, "destination_node_ids"):
-                    entry["destination_node_ids"] = list(destinations_of(m))
+                    entry["destination_node_ids"] = "any" if getattr(m, "any_node", False) else list(
+                        destinations_of(m))
                 else:
                     entry["destination_node_id"] = m.destination_node_id
                 om = self.outbound.mappings.get(m.name)

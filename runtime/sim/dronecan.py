@@ -11,7 +11,10 @@ that its layout puts on DroneCAN.
   addressed to it and the broadcasts it subscribes to), so a sensor is not woken by every frame of the bus.
 - Broadcasts: each v0 port on the simulator's publish loop (same schedule as the Cyphal ports), its values from
   :mod:`sam_runtime.sim.devices_dronecan` (the same physics of the shared vehicle), then the values the spec's
-  DroneCAN mappings from this device select on (``esc_index``, ``device_id``) and the items they read.
+  DroneCAN mappings from this device select on (``esc_index``, ``device_id``) and the items they read. Every
+  mapping that accepts the device (its ``source_node_ids``, or ``any``) gets its ``select`` values in turn: the
+  device's broadcasts of a type go round the distinct selections of the mappings that accept it, one a tick (the
+  nominal rate is kept; each select-routed topic gets its share), so every such topic publishes in simulation.
 - Commands: a v0 command is a broadcast; a device takes its element of it (``rpm[1]``, ``commands[actuator_id=4]``):
   the elements of the DroneCAN mappings whose ``destination_node_ids`` hold the device (for SAM's devices the ones
   :data:`~sam_runtime.sim.devices_dronecan.SAM_ACTUATORS_V0` gives them; else by position when a mapping has one
@@ -53,6 +56,23 @@ __all__ = ["DroneCanDevices", "ensure_types", "type_problems"]
 _log = logging.getLogger("sam_runtime.sim.simulator")
 NODE_STATUS_INTERVAL_S = 1.0
 RESTART_NODE = "uavcan.protocol.RestartNode"
+
+
+@dataclass
+class Selections:
+    """What a device's broadcasts of one type carry for the bridge: the distinct ``select`` values of the mappings
+    that accept the device, sent in turn (``turn`` counts the broadcasts), and the items they read (all of them)."""
+
+    selects: tuple[tuple[tuple[str, Any], ...], ...]
+    elements: list[Element]
+    turn: int = 0
+
+    def next_select(self) -> tuple[tuple[str, Any], ...]:
+        if not self.selects:
+            return ()
+        select = self.selects[self.turn % len(self.selects)]
+        self.turn += 1
+        return select
 
 
 @dataclass(frozen=True)
@@ -129,30 +149,42 @@ class DroneCanDevices:
             sp.extra = self._addressing(dev, t.name)
             dev.subs.append(sp)
 
-    def _fixed_values(self, dev: SimDevice, type_name: str) -> tuple[list[tuple[str, Any]], list[Element]]:
+    def _fixed_values(self, dev: SimDevice, type_name: str) -> Selections:
         """What the bridge's mappings from this device look for in its broadcasts of ``type_name``."""
-        select: dict[str, Any] = {}
+        selects: dict[tuple[tuple[str, Any], ...], None] = {}
         elements: dict[str, Element] = {}
         for m in self.sim.tables.DRONECAN_MAPPINGS:
-            if m.direction == UAVCAN_TO_ROS and m.data_type.name == type_name and dev.info.node_id in \
-                    m.source_node_ids:
-                select.update(m.select)
+            if m.direction == UAVCAN_TO_ROS and m.data_type.name == type_name and (
+                    dev.info.node_id in m.source_node_ids or getattr(m, "any_node", False)):
+                selects[tuple(m.select)] = None
                 elements.update({e: parse_element(e) for e in m.elements})
-        return list(select.items()), list(elements.values())
+        # a mapping without `select` takes every message, those of the other selections too: no turn of its own
+        return Selections(tuple(s for s in selects if s or len(selects) == 1), list(elements.values()))
+
+    def _destinations(self, m: Any) -> list[int]:
+        """A command mapping's destination node ids; with ``any`` the devices that subscribe to its type."""
+        if not getattr(m, "any_node", False):
+            return sorted(m.destination_node_ids)
+        return sorted(d.node_id for d in self.sim.tables.DRONECAN_DEVICES
+                      if any(p.data_type.name == m.data_type.name for p in d.subscribes))
 
     def _addressing(self, dev: SimDevice, type_name: str) -> list[Addressing]:
         name, node_id = dev.info.name, dev.info.node_id
         sam = SAM_ACTUATORS_V0.get(name, {})
         out = []
         for m in self.sim.tables.DRONECAN_MAPPINGS:
-            if m.direction != ROS_TO_UAVCAN or m.data_type.name != type_name or node_id not in \
-                    m.destination_node_ids:
+            destinations = self._destinations(m) if m.direction == ROS_TO_UAVCAN else []
+            if m.direction != ROS_TO_UAVCAN or m.data_type.name != type_name or node_id not in destinations:
                 continue
             elements = list(m.elements)
             if any(e in sam for e in elements):  # SAM's firmware: its own elements of a shared broadcast
                 elements = [e for e in elements if e in sam]
-            elif len(m.destination_node_ids) > 1 and len(elements) == len(m.destination_node_ids):
-                elements = [elements[sorted(m.destination_node_ids).index(node_id)]]
+            elif len(destinations) > 1 and len(elements) == len(destinations):
+                # one element per destination: the i-th lowest position for the i-th lowest node id (a spec may
+                # name them in any order, e.g. a constant rpm[0] after rpm[1] from the topic)
+                if all(parse_element(e).index is not None for e in elements):
+                    elements.sort(key=lambda e: parse_element(e).index or 0)
+                elements = [elements[destinations.index(node_id)]]
             out.append(Addressing(tuple(m.select), tuple(parse_element(e) for e in elements)))
         if not out and sam:  # no mapping sends it: the firmware's own elements, where the type has them
             fields = _field_names(type_name)
@@ -245,11 +277,11 @@ class DroneCanDevices:
         return generic_fill_v0(dronecan.TYPENAMES[pp.dtype](), t, now_us, seed=pp.ident)
 
     def finish(self, dev: SimDevice, pp: PubPort, obj: Any, t: float, now_us: int) -> None:
-        select, elements = pp.extra
-        for path, value in select:
+        selections: Selections = pp.extra
+        for path, value in selections.next_select():
             _put(obj, path, value)
-        claimed = {el.value for el in elements if el.key is not None}
-        for el in elements:
+        claimed = {el.value for el in selections.elements if el.key is not None and el.value is not None}
+        for el in selections.elements:
             ensure_element(obj, el, claimed, t, now_us)
 
     def command_values(self, dev: SimDevice, sp: SubPort, msg: Any) -> dict[str, Any] | None:

@@ -11,7 +11,7 @@ In this process (no ROS needed):
 
 In a child process with SAM's ROS package (as tests/test_v0_converters.py does it; the spec's own v0 types added by
 sam_runtime.dronecan_io.types.ensure_types, never dronecan.load_dsdl), hypothesis property tests for every DroneCAN
-mapping of SAM's spec and of tests/specs/{ferry,minimal_v0,buoy_v0,trawler_v0}.yaml:
+mapping of SAM's spec and of tests/specs/{ferry,minimal_v0,buoy_v0,trawler_v0,seiner}.yaml:
 
 (a) random dronecan messages -> dronecan's bytes (``Transfer(payload=obj).payload``) -> ``<m>_wire_to_ros`` gives
     the CDR of ``<m>_to_ros`` (NaN-aware), its stamp, the same counts, and ``WIRE_MATCHES`` agrees with ``MATCHES``;
@@ -42,7 +42,8 @@ from hypothesis import strategies as st
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml",
          "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",
-         "trawler": ROOT / "tests" / "specs" / "trawler_v0.yaml"}
+         "trawler_v0": ROOT / "tests" / "specs" / "trawler_v0.yaml",
+         "seiner": ROOT / "tests" / "specs" / "seiner.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)

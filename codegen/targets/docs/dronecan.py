@@ -41,6 +41,10 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
         return [f"{n} ({devices_by_id[n].name})" if n in devices_by_id else str(n) for n in ids]
 
     mappings = []
+    commanding: dict[str, list[str]] = {}  # data type -> the ROS->UAVCAN mappings that opted in to share it
+    for rm in resolved.dronecan_mappings:
+        if rm.mapping.shares_data_type and rm.mapping.direction != UAVCAN_TO_ROS:
+            commanding.setdefault(rm.mapping.data_type, []).append(rm.mapping.name)
     for rm in resolved.dronecan_mappings:
         m = rm.mapping
         to_ros = m.direction == UAVCAN_TO_ROS
@@ -49,7 +53,9 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
             "name": m.name, "to_ros": to_ros, "direction": "UAVCAN → ROS" if to_ros else "ROS → UAVCAN",
             "data_type": m.data_type, "topic": m.topic, "ros_type": rm.ros_message.full_name,
             "data_type_id": getattr(rm.dsdl_struct, "data_type_id", None),
-            "nodes": nodes(m.source_node_ids if to_ros else m.destination_node_ids),
+            "nodes": ["any node"] if m.any_node else nodes(m.source_node_ids if to_ros else m.destination_node_ids),
+            "any_node": m.any_node,
+            "shares_with": [n for n in commanding.get(m.data_type, []) if n != m.name] if m.shares_data_type else [],
             "select": ", ".join(f"{format_path(list(p))} = {v}" for p, _, v in rm.select),
             "elements": [f"{format_path(list(path))}[{u}]" for path, uses in rm.elements.items() for u in uses],
             "frame_id": m.frame_id, "rate": fmt_rate(rm.rate_hz), "auto": m.auto,

@@ -318,7 +318,7 @@ def _mapping_rows(resolved: Resolved, subject_types: dict[int, str]) -> list[Row
         topic = spec.topics.get(m.topic)
         if m.direction == UAVCAN_TO_ROS:
             nodes = [node_ref(n) for n in m.source_node_ids]
-            nodes_note = "" if nodes else "any publisher"
+            nodes_note = "any node" if m.any_node else "" if nodes else "any publisher"
         else:
             nodes = [node_ref(m.destination_node_id)] if m.destination_node_id is not None else []
             nodes_note = "" if nodes else "broadcast"
@@ -332,6 +332,7 @@ def _mapping_rows(resolved: Resolved, subject_types: dict[int, str]) -> list[Row
             "ros_type": topic.type if topic is not None else "",
             "nodes": nodes,
             "nodes_note": nodes_note,
+            "any_node": m.any_node,
             "frame_id": m.frame_id,
             "rate": fmt_rate(rm.rate_hz) if rm is not None else "",
             "auto": m.auto,

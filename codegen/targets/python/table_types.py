@@ -78,6 +78,8 @@ class MappingInfo:
     # back as the receive time; and text only when it is UTF-8 without NUL characters)
     exact_uavcan_fields: tuple[str, ...]
     linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
+    # `source_node_ids: any`: UAVCAN->ROS accepts every node (no source filter, so no spoofing protection)
+    any_node: bool = False
 
 
 @dataclass(frozen=True)
@@ -130,6 +132,9 @@ class DroneCanMappingInfo:
     to_uavcan: str
     exact_uavcan_fields: tuple[str, ...]  # as MappingInfo's
     linked_uavcan_fields: tuple[str, ...]
+    # `source_node_ids: any` / `destination_node_ids: any`: every node (the node id sets are empty);
+    # UAVCAN->ROS then routes only on `select` and the items read
+    any_node: bool = False
 
 
 @dataclass(frozen=True)

@@ -74,7 +74,7 @@ def cyphal_context(resolved: Resolved) -> dict[str, Any]:
             "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
             "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
-            "exact_uavcan_fields": exact, "linked_uavcan_fields": linked,
+            "exact_uavcan_fields": exact, "linked_uavcan_fields": linked, "any_node": m.any_node,
         })
     parameters = []
     for param in spec.parameters.values():
@@ -152,6 +152,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
             "exact_uavcan_fields": [py_str(s.uavcan) for s in rm.steps if s.uavcan_path and s.exact],
             "linked_uavcan_fields": [py_str(s.uavcan) for s in rm.steps if s.uavcan_path],
+            "any_node": m.any_node,
         })
     layouts = [{
         "name": py_str(layout.name), "description": layout.description,
