@@ -15,6 +15,7 @@ from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mappin
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
+from sam_codegen.frontend.traffic import check_enable_services
 from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
@@ -141,6 +142,8 @@ def parse_spec(root: YNode, file: str) -> Spec:
                 mapping = parse_mapping(key, pos, node, diag, protocol)
                 if mapping is not None:
                     mappings[protocol].append(mapping)
+        for protocol, protocol_mappings in mappings.items():
+            check_enable_services(protocol_mappings, protocol, diag)
         bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"])
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):

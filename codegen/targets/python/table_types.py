@@ -78,6 +78,13 @@ class MappingInfo:
     # back as the receive time; and text only when it is UTF-8 without NUL characters)
     exact_uavcan_fields: tuple[str, ...]
     linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
+    # run-time traffic control (sam_runtime.bridge.rate_limit, .switches): the latest message at most max_rate_hz a
+    # second (None: every one); ROS->UAVCAN: a command older than deadline_s since the bridge received it is not
+    # sent; the mapping's initial state and its std_srvs/SetBool service (a ROS name the bridge's node resolves)
+    max_rate_hz: float | None = None
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)
@@ -130,6 +137,10 @@ class DroneCanMappingInfo:
     to_uavcan: str
     exact_uavcan_fields: tuple[str, ...]  # as MappingInfo's
     linked_uavcan_fields: tuple[str, ...]
+    max_rate_hz: float | None = None  # these four as MappingInfo's
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)

@@ -74,6 +74,13 @@ class MappingInfo:
     # back as the receive time; and text only when it is UTF-8 without NUL characters)
     exact_uavcan_fields: tuple[str, ...]
     linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
+    # run-time traffic control (sam_runtime.bridge.rate_limit, .switches): the latest message at most max_rate_hz a
+    # second (None: every one); ROS->UAVCAN: a command older than deadline_s since the bridge received it is not
+    # sent; the mapping's initial state and its std_srvs/SetBool service (a ROS name the bridge's node resolves)
+    max_rate_hz: float | None = None
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)
@@ -126,6 +133,10 @@ class DroneCanMappingInfo:
     to_uavcan: str
     exact_uavcan_fields: tuple[str, ...]  # as MappingInfo's
     linked_uavcan_fields: tuple[str, ...]
+    max_rate_hz: float | None = None  # these four as MappingInfo's
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)
@@ -572,6 +583,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'accelerometer_latest[1]',
             'accelerometer_latest[2]',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_imu',
     ),
     MappingInfo(
         name='magnetic_field',
@@ -598,6 +613,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'magnetic_field_ga[2]',
             'magnetic_field_covariance',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_magnetic_field',
     ),
     MappingInfo(
         name='gps_fix',
@@ -625,6 +644,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'status',
             'position_covariance',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_gps_fix',
     ),
     MappingInfo(
         name='pressure',
@@ -640,6 +663,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='pressure_to_uavcan',
         exact_uavcan_fields=('static_pressure', 'static_pressure_variance'),
         linked_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_pressure',
     ),
     MappingInfo(
         name='battery_state',
@@ -661,6 +688,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'state_of_charge_pct',
             'state_of_health_pct',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_state',
     ),
     MappingInfo(
         name='altitude',
@@ -676,6 +707,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='altitude_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'altitude', 'altitude_variance'),
         linked_uavcan_fields=('timestamp.microsecond', 'altitude', 'altitude_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_altitude',
     ),
     MappingInfo(
         name='battery_info',
@@ -721,6 +756,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'model_instance_id',
             'model_name',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_info',
     ),
     MappingInfo(
         name='thruster_1_rpm',
@@ -736,6 +775,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_1_rpm_to_uavcan',
         exact_uavcan_fields=('rpm',),
         linked_uavcan_fields=('rpm',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_1_rpm',
     ),
     MappingInfo(
         name='thruster_2_rpm',
@@ -751,6 +794,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_2_rpm_to_uavcan',
         exact_uavcan_fields=('rpm',),
         linked_uavcan_fields=('rpm',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_2_rpm',
     ),
     MappingInfo(
         name='thrust_vector',
@@ -766,6 +813,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thrust_vector_to_uavcan',
         exact_uavcan_fields=('vertical_radians', 'horizontal_radians'),
         linked_uavcan_fields=('vertical_radians', 'horizontal_radians'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector',
     ),
     MappingInfo(
         name='ballast',
@@ -781,6 +832,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='ballast_to_uavcan',
         exact_uavcan_fields=('weight_1_offset_radians', 'weight_2_offset_radians'),
         linked_uavcan_fields=('weight_1_offset_radians', 'weight_2_offset_radians'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_ballast',
     ),
     MappingInfo(
         name='longitudinal_weight',
@@ -796,6 +851,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='longitudinal_weight_to_uavcan',
         exact_uavcan_fields=('percent',),
         linked_uavcan_fields=('percent',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight',
     ),
     MappingInfo(
         name='buoyancy_piston',
@@ -811,6 +870,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='buoyancy_piston_to_uavcan',
         exact_uavcan_fields=('percent',),
         linked_uavcan_fields=('percent',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston',
     ),
     MappingInfo(
         name='thruster_1_feedback',
@@ -832,6 +895,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_1_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
         linked_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_1_feedback',
     ),
     MappingInfo(
         name='thruster_2_feedback',
@@ -853,6 +920,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_2_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
         linked_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_2_feedback',
     ),
     MappingInfo(
         name='thrust_vector_feedback',
@@ -874,6 +945,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thrust_vector_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'vertical_mrad', 'horizontal_mrad'),
         linked_uavcan_fields=('timestamp.microsecond', 'vertical_mrad', 'horizontal_mrad'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector_feedback',
     ),
     MappingInfo(
         name='longitudinal_weight_feedback',
@@ -895,6 +970,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='longitudinal_weight_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight_feedback',
     ),
     MappingInfo(
         name='buoyancy_piston_feedback',
@@ -916,6 +995,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='buoyancy_piston_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston_feedback',
     ),
 )
 
@@ -1094,6 +1177,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'accelerometer_latest[1]',
             'accelerometer_latest[2]',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_imu',
     ),
     DroneCanMappingInfo(
         name='magnetic_field',
@@ -1116,6 +1203,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'magnetic_field_ga[2]',
             'magnetic_field_covariance',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_magnetic_field',
     ),
     DroneCanMappingInfo(
         name='gps_fix',
@@ -1144,6 +1235,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'height_ellipsoid_mm',
             'status',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_gps_fix',
     ),
     DroneCanMappingInfo(
         name='pressure',
@@ -1161,6 +1256,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='pressure_to_uavcan',
         exact_uavcan_fields=('static_pressure', 'static_pressure_variance'),
         linked_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_pressure',
     ),
     DroneCanMappingInfo(
         name='battery_state',
@@ -1178,6 +1277,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='battery_state_to_uavcan',
         exact_uavcan_fields=('voltage', 'current', 'state_of_charge_pct'),
         linked_uavcan_fields=('voltage', 'current', 'temperature', 'state_of_charge_pct'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_state',
     ),
     DroneCanMappingInfo(
         name='battery_info',
@@ -1225,6 +1328,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'model_instance_id',
             'model_name',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_info',
     ),
     DroneCanMappingInfo(
         name='altitude',
@@ -1242,6 +1349,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='altitude_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'altitude', 'altitude_variance'),
         linked_uavcan_fields=('timestamp.usec', 'altitude', 'altitude_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_altitude',
     ),
     DroneCanMappingInfo(
         name='thruster_rpms',
@@ -1259,6 +1370,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thruster_rpms_to_uavcan',
         exact_uavcan_fields=('rpm[0]', 'rpm[1]'),
         linked_uavcan_fields=('rpm[0]', 'rpm[1]'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_rpms',
     ),
     DroneCanMappingInfo(
         name='thrust_vector',
@@ -1282,6 +1397,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'commands[actuator_id=0].command_value',
             'commands[actuator_id=1].command_value',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector',
     ),
     DroneCanMappingInfo(
         name='ballast',
@@ -1305,6 +1424,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'commands[actuator_id=2].command_value',
             'commands[actuator_id=3].command_value',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_ballast',
     ),
     DroneCanMappingInfo(
         name='longitudinal_weight',
@@ -1322,6 +1445,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='longitudinal_weight_to_uavcan',
         exact_uavcan_fields=('commands[actuator_id=4].command_value',),
         linked_uavcan_fields=('commands[actuator_id=4].command_value',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight',
     ),
     DroneCanMappingInfo(
         name='buoyancy_piston',
@@ -1339,6 +1466,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='buoyancy_piston_to_uavcan',
         exact_uavcan_fields=('commands[actuator_id=5].command_value',),
         linked_uavcan_fields=('commands[actuator_id=5].command_value',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston',
     ),
     DroneCanMappingInfo(
         name='thruster_1_feedback',
@@ -1356,6 +1487,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thruster_1_feedback_to_uavcan',
         exact_uavcan_fields=('rpm', 'current'),
         linked_uavcan_fields=('rpm', 'current', 'temperature'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_1_feedback',
     ),
     DroneCanMappingInfo(
         name='thruster_2_feedback',
@@ -1373,6 +1508,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thruster_2_feedback_to_uavcan',
         exact_uavcan_fields=('rpm', 'current'),
         linked_uavcan_fields=('rpm', 'current', 'temperature'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_2_feedback',
     ),
     DroneCanMappingInfo(
         name='thrust_vector_feedback',
@@ -1390,6 +1529,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thrust_vector_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'vertical_mrad', 'horizontal_mrad'),
         linked_uavcan_fields=('timestamp.usec', 'vertical_mrad', 'horizontal_mrad'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector_feedback',
     ),
     DroneCanMappingInfo(
         name='longitudinal_weight_feedback',
@@ -1407,6 +1550,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='longitudinal_weight_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight_feedback',
     ),
     DroneCanMappingInfo(
         name='buoyancy_piston_feedback',
@@ -1424,6 +1571,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='buoyancy_piston_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston_feedback',
     ),
 )
 
