@@ -78,9 +78,10 @@ class MappingInfo:
     # back as the receive time; and text only when it is UTF-8 without NUL characters)
     exact_uavcan_fields: tuple[str, ...]
     linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
-    # run-time traffic control (sam_runtime.bridge.rate_limit, .switches): the latest message at most max_rate_hz a
-    # second (None: every one); ROS->UAVCAN: a command older than deadline_s since the bridge received it is not
-    # sent; the mapping's initial state and its std_srvs/SetBool service (a ROS name the bridge's node resolves)
+    # run-time traffic control (sam_runtime.bridge.rate_limit, .switches): the latest message at most
+    # max_rate_hz a second (None: every one); ROS->UAVCAN: a command older than deadline_s since the
+    # bridge received it is not sent; the mapping's initial state and its std_srvs/SetBool service
+    # (a ROS name the bridge's node resolves)
     max_rate_hz: float | None = None
     deadline_s: float | None = None
     enabled: bool = True
