@@ -602,6 +602,14 @@ CASES: tuple[Case, ...] = (
         ),
     ),
     Case(
+        'mapping_deadline_within_the_rate_interval',
+        '      topic: /valve\n',
+        '      topic: /valve\n      max_rate_hz: 2\n      deadline: 0.5\n',
+        (
+            "minimal.yaml:59:7: error: deadline of mapping 'valve' (0.5 s) is not longer than the interval of its max_rate_hz (0.5 s): a command held for its slot could expire every time (expected a deadline above 0.5 s)",
+        ),
+    ),
+    Case(
         'mapping_enabled_not_bool',
         '      topic: /level\n',
         '      topic: /level\n      enabled: 1\n',

@@ -7,7 +7,8 @@
 - `deadline` (seconds > 0, ros_to_uavcan only): a command older than this when it would be sent is not sent; its age
   counts from when the bridge's ROS subscription took it (the bridge's monotonic clock), not from its header stamp
   (the stamp is the publisher's clock, maybe sim time or another machine's, and many command types have none). A
-  UAVCAN->ROS message has no "too late" for the bridge to judge, so the key is an error there.
+  UAVCAN->ROS message has no "too late" for the bridge to judge, so the key is an error there. With `max_rate_hz`
+  the deadline must be longer than the interval 1 / max_rate_hz: the command held for its slot waits up to that.
 - `enabled` (bool, default true): the initial state of the mapping's switch; `enable_service` (a ROS name, default
   `~/enable_<mapping>`, under the bridge node's name) is the std_srvs/SetBool service that flips it at run time.
   SAM's current bridge calls its switches `start_stop_<topic>`: set `enable_service: start_stop_thruster1_cmd` to
@@ -56,6 +57,11 @@ def parse_traffic(r: Reader, what: str, direction: str | None, diag: Diagnostics
     if r.node("deadline") is not None and direction == UAVCAN_TO_ROS:
         diag.error(r.key_pos("deadline"), f"{what} goes UAVCAN->ROS: a deadline applies to commands (ros_to_uavcan) "
                    "only", "max_rate_hz to thin a stream, or no deadline")
+        deadline = None
+    if rate is not None and deadline is not None and deadline <= 1.0 / rate:
+        diag.error(r.key_pos("deadline"), f"deadline of {what} ({deadline:g} s) is not longer than the interval of its "
+                   f"max_rate_hz ({1.0 / rate:g} s): a command held for its slot could expire every time",
+                   f"a deadline above {1.0 / rate:g} s")
         deadline = None
     enabled = r.get("enabled", bool, True)
     service = r.get("enable_service", str, "")
