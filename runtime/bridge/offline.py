@@ -12,6 +12,9 @@ generated package would have published for that transfer had it received it at `
 the same conversion at a receive time one second and a bit later, so a caller can tell the fields that depend on
 the receive time (a device stamp of 0 becomes the receive time) from the others. Never raises for any payload
 (a payload the codec refuses is counted as ``deserialization_failures`` below the bridge, as live).
+Traffic control (issue 19): a mapping the spec starts disabled drops and counts (``disabled``) as live; a mapping's
+``max_rate_hz`` is a policy of the live bridge's clock and is not applied here: every conversion comes out, so a
+recording of a rate-limited topic replays with more messages than were recorded (reported as extra).
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from sam_runtime.bridge.inbound import Inbound, InMapping
 from sam_runtime.bridge.layout import select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.switches import switches_of
 from sam_runtime.bridge.wiring import in_groups, missing_codecs, nominal_rates
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.genpkg import GeneratedPackage
@@ -163,6 +167,8 @@ class OfflineBridge:
         for group in self.inbound.groups.values():
             for im in group.mappings:
                 im.ros_publisher = _Collector(self, im)
+                # traffic control offline: the initial switch as live; no rate limit (see the docstring)
+                im.switch, im.pacer = switches_of([im.info])[im.info.name], None
         self._out: list[tuple[InMapping, bytes]] = []
 
     @property
