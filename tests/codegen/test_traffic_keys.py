@@ -21,11 +21,12 @@ def _tables(generated: Path, package: str) -> Any:
 def test_traffic_keys_in_tables_and_docs(tmp_path: Path) -> None:
     out = tmp_path / "generated"
     build(SPECS / "weir.yaml", out)
-    maps = {m.name: m for m in _tables(out, "weir_bridge").MAPPINGS}
-    got = {name: (m.max_rate_hz, m.deadline_s, m.enabled, m.enable_service) for name, m in maps.items()}
-    assert got == {"level": (4.0, None, True, "~/enable_level"),
-                   "level_raw": (None, None, False, "~/enable_level_raw"),
-                   "gate": (2.0, 1.5, True, "start_stop_gate")}
+    tables = _tables(out, "weir_bridge")
+    for mappings in (tables.MAPPINGS, tables.DRONECAN_MAPPINGS):
+        got = {m.name: (m.max_rate_hz, m.deadline_s, m.enabled, m.enable_service) for m in mappings}
+        assert got == {"level": (4.0, None, True, "~/enable_level"),
+                       "level_raw": (None, None, False, "~/enable_level_raw"),
+                       "gate": (2.0, 1.5, True, "start_stop_gate")}
     docs = (out / "docs" / "interfaces.md").read_text()
     assert "- Rate: at most 4 Hz, the latest message published to ROS" in docs
     assert ("- Switch: `std_srvs/SetBool` service `~/enable_level_raw` (under the bridge node's name), initially "

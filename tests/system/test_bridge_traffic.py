@@ -1,7 +1,7 @@
 """The bridge's run-time traffic control across processes (issue 19), on tests/specs/weir.yaml: the simulated gauge
-publishes its level at 50 Hz (sam-sim) to the bridge (sam-bridge) over Cyphal/UDP 127.0.0.1, and this test's own
-rclpy node (its own context and ROS domain: an independent client) listens, calls the services and publishes
-commands.
+publishes its level at 50 Hz (sam-sim) to the bridge (sam-bridge), over Cyphal/UDP 127.0.0.1 and (layout dronecan)
+over DroneCAN on a private ``mcast-lo:`` bus, and this test's own rclpy node (its own context and ROS domain: an
+independent client) listens, calls the services and publishes commands.
 
 - ``level`` (max_rate_hz: 4): what reaches ROS is at most what 4 Hz allows over the interval its messages span,
   judged from the DDS source timestamps the bridge's publisher put on them (the system's clock at publish time, not
@@ -22,6 +22,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -142,17 +143,26 @@ def _count(values: dict[str, str] | None, key: str) -> int:
     return int((values or {}).get(key, "0"))
 
 
-def test_rate_limit_disabled_mapping_and_setbool_across_processes(tmp_path: Path) -> None:
+@pytest.mark.parametrize("protocol", ["cyphal", "dronecan"])
+def test_rate_limit_disabled_mapping_and_setbool_across_processes(protocol: str, tmp_path: Path) -> None:
     generated = generated_spec("weir")  # its topics are std_msgs: no ROS package of its own to build
-    domain = domain_id(61)
+    domain = domain_id(61 if protocol == "cyphal" else 62)
     env = child_env(Path(sys.prefix).absolute(), domain)
-    udp = ["--transport", "udp", "--iface", "127.0.0.1"]
-    with cyphal_udp_lock():
-        bridge = Proc("bridge", runtime_cmd("bridge", "--generated", str(generated), *udp), env, tmp_path)
-        sim = Proc("sim", runtime_cmd("sim", "--generated", str(generated), *udp), env, tmp_path)
+    with ExitStack() as stack:
+        if protocol == "cyphal":
+            stack.enter_context(cyphal_udp_lock())
+            bus = ["--transport", "udp", "--iface", "127.0.0.1"]
+        else:
+            pytest.importorskip("dronecan")
+            from helpers.dronecan_support import private_iface
+
+            bus = ["--layout", "dronecan", "--dronecan-iface", private_iface()]
+        bridge = Proc("bridge", runtime_cmd("bridge", "--generated", str(generated), *bus), env, tmp_path)
+        sim = Proc("sim", runtime_cmd("sim", "--generated", str(generated), *bus), env, tmp_path)
         probe = TrafficProbe(int(domain))
         try:
-            bridge.wait_line("READY", START_TIMEOUT_S)
+            ready = bridge.wait_line("READY", START_TIMEOUT_S)
+            assert ("mcast-lo" in ready) == (protocol == "dronecan"), ready
             sim.wait_line("READY", START_TIMEOUT_S)
             _check_rate_limit(probe)
             _check_disabled_then_enabled(probe)
