@@ -16,7 +16,8 @@ from typing import Any
 
 from sam_runtime.common.rate_log import DEFAULT_INTERVAL_S, RateLimitedLog
 
-__all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "INTENDED_DROPS", "MappingStats", "count_handler_error", "log"]
+__all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "INTENDED_DROPS", "MappingStats", "count_handler_error",
+           "count_superseded", "log"]
 
 log = logging.getLogger("sam_runtime.bridge")
 
@@ -97,6 +98,11 @@ class MappingStats:
                 "last_drop_age_s": None if self.last_drop_monotonic is None
                 else round(time.monotonic() - self.last_drop_monotonic, 3),
             }
+
+
+def count_superseded(stats: MappingStats, reason: str, _item: Any) -> None:
+    """A held message or command a newer one replaced (a Pacer's ``supersede``: functools.partial of this)."""
+    stats.drop(reason)
 
 
 def count_handler_error(stats: Iterable[MappingStats], where: str, ex: Exception,

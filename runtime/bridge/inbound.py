@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend, Inlet
-from sam_runtime.bridge.counters import MappingStats, count_handler_error
+from sam_runtime.bridge.counters import MappingStats, count_handler_error, count_superseded
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
 from sam_runtime.bridge.rate_limit import Pacer
@@ -45,10 +45,6 @@ from sam_runtime.bridge.switches import MappingSwitch
 __all__ = ["InMapping", "Inbound", "PortGroup"]
 
 _DISABLED = object()  # a conversion result: the mapping was disabled, nothing converted
-
-
-def _count_superseded(stats: MappingStats, reason: str, _item: Any) -> None:
-    stats.drop(reason)
 
 
 @dataclass
@@ -107,7 +103,7 @@ class Inbound:
                 rate = getattr(im.info, "max_rate_hz", None)
                 if rate is not None and im.pacer is None:
                     im.pacer = Pacer(rate, functools.partial(self._deliver, im),
-                                     functools.partial(_count_superseded, im.stats, "rate_limited"))
+                                     functools.partial(count_superseded, im.stats, "rate_limited"))
 
     def attach(self) -> None:
         """The ROS publishers and the backend's subscriptions when the bridge starts (before the backend opens)."""

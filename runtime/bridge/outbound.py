@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend, LinkDownError, Outlet
-from sam_runtime.bridge.counters import MappingStats, count_handler_error, log
+from sam_runtime.bridge.counters import MappingStats, count_handler_error, count_superseded, log
 from sam_runtime.bridge.handoff import Handoff
 from sam_runtime.bridge.layout import port_id_of
 from sam_runtime.bridge.lifetime import Lifetime
@@ -39,10 +39,6 @@ from sam_runtime.common.tasks import cancel_and_wait
 __all__ = ["DEFAULT_QUEUE_SIZE", "OutMapping", "Outbound"]
 
 DEFAULT_QUEUE_SIZE = 256
-
-
-def _count_superseded(stats: MappingStats, reason: str, _item: Any) -> None:
-    stats.drop(reason)
 
 
 @dataclass
@@ -88,7 +84,7 @@ class Outbound:
             rate = getattr(om.info, "max_rate_hz", None)
             if rate is not None and om.pacer is None:
                 om.pacer = Pacer(rate, functools.partial(self._put, om),
-                                 functools.partial(_count_superseded, om.stats, "coalesced"))
+                                 functools.partial(count_superseded, om.stats, "coalesced"))
         self._timed = {topic: any(om.deadline_s is not None for om in oms) for topic, oms in self.by_topic.items()}
         self.clock: Callable[[], float] = time.monotonic  # of the deadline check (tests may set their own)
 
