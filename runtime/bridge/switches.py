@@ -6,8 +6,8 @@ ROS node, named by the tables' ``enable_service`` (default ``~/enable_<mapping>`
 A disabled mapping drops every message it gets and counts it as ``disabled`` (UAVCAN->ROS before conversion;
 ROS->UAVCAN before conversion, and also a command that was queued or held for its rate slot when the mapping was
 disabled: nothing goes out after the service answered). Its transfer-loss and liveness bookkeeping go on, so a
-re-enabled mapping reports as before. /diagnostics shows ``enabled`` and the service of every mapping, and a
-change is published at once.
+re-enabled mapping reports as before. /diagnostics shows ``enabled`` and the service of every mapping (its full name,
+as the node resolved it), and a change is published at once.
 
 Threads: the services run on the rclpy executor thread, the paths read :attr:`MappingSwitch.enabled` on either
 thread (one attribute, assigned atomically).
@@ -35,6 +35,7 @@ class MappingSwitch:
     enabled: bool = True
     changes: int = 0
     requests: int = 0
+    resolved: str = ""  # the service's full name once the node created it (namespace, ~ expanded)
 
     def set(self, value: bool) -> str:
         """Set the state; the answer for the caller."""
@@ -47,7 +48,8 @@ class MappingSwitch:
         return f"mapping {self.name}: {state}"
 
     def snapshot(self) -> dict[str, Any]:
-        return {"enabled": self.enabled, "enable_service": self.service, "enable_changes": self.changes}
+        return {"enabled": self.enabled, "enable_service": self.resolved or self.service,
+                "enable_changes": self.changes}
 
 
 def switches_of(mappings: Any) -> dict[str, MappingSwitch]:
@@ -77,14 +79,18 @@ class EnableServices:
 
         for sw in self.switches.values():
             self.services[sw.name] = self.ros.node.create_service(SetBool, sw.service, self._callback(sw))
+            sw.resolved = self.resolved(sw.name)
             if not sw.enabled:
                 log.info("mapping %s starts disabled (enable it with std_srvs/SetBool %s)", sw.name,
                          self.resolved(sw.name))
 
     def resolved(self, mapping: str) -> str:
-        """The service's full name as ROS resolved it."""
-        srv = self.services.get(mapping)
-        return str(getattr(srv, "srv_name", "")) if srv is not None else self.switches[mapping].service
+        """The service's full name as the node resolves it (its namespace, its name for ``~``, remappings)."""
+        name = self.switches[mapping].service
+        try:
+            return str(self.ros.node.resolve_service_name(name))
+        except Exception:  # no node (yet): the name as the spec gave it
+            return name
 
     def _callback(self, sw: MappingSwitch) -> Callable[[Any, Any], Any]:
         def on_request(request: Any, response: Any) -> Any:

@@ -197,7 +197,7 @@ def _check_rate_limit(probe: TrafficProbe) -> None:
     assert limited > 0  # the gauge sends 50 Hz: the rest is thinned out, and counted
     values = last[1]
     assert values["max_rate_hz"] == "4.0" and values["enabled"] == "True"
-    assert values["enable_service"] == "~/enable_level"
+    assert values["enable_service"] == f"/{BRIDGE}/enable_level"  # ~/enable_level, resolved by the bridge's node
     held = _count(values, "received") - _count(values, "published") - _count(values, "dropped")
     assert held in (0, 1), values  # every message published or counted, but the one waiting for its slot
     assert last[2] == 0, last  # intended drops do not make the mapping WARN
@@ -211,7 +211,7 @@ def _check_disabled_then_enabled(probe: TrafficProbe) -> None:
     values = wait_for(disabled_and_dropping, 30, "level_raw dropping as disabled")
     assert values["enabled"] == "False" and _count(values, "published") == 0
     assert probe.received("/level_raw") == []  # and nothing reached ROS meanwhile
-    assert probe.history("level_raw")[-1][3].startswith("disabled (std_srvs/SetBool ~/enable_level_raw)")
+    assert probe.history("level_raw")[-1][3].startswith(f"disabled (std_srvs/SetBool /{BRIDGE}/enable_level_raw)")
 
     answer = probe.set_bool(f"/{BRIDGE}/enable_level_raw", True)
     assert answer.success and answer.message == "mapping level_raw: enabled"
@@ -256,4 +256,4 @@ def _check_commands(probe: TrafficProbe) -> None:
     late = sum(_count(values, k) - _count(base, k) for k in ("dropped.expired", "dropped.disabled"))
     # (disabled: one of the first ten the bridge took after `base` was reported, before the switch)
     assert published >= 2 and coalesced >= 1 and published + coalesced + late == got, values
-    assert values["deadline_s"] == "1.5" and values["enable_service"] == "start_stop_gate"
+    assert values["deadline_s"] == "1.5" and values["enable_service"] == "/start_stop_gate"

@@ -316,3 +316,41 @@ def test_diagnostics_show_the_traffic_control() -> None:
     assert values["max_rate_hz"] == "2.0" and values["deadline_s"] == "0.25"
     assert values["dropped.coalesced"] == "5" and values["dropped.disabled"] == "2"
     assert status.level == b"\x00" and status.message.startswith("disabled (std_srvs/SetBool ~/enable_valve)")
+
+
+# ============================================================================================ SetBool services
+def test_enable_services_names_resolve_under_the_node_and_its_namespace() -> None:
+    """`~/enable_<mapping>` lands under the bridge node's name, a relative name in its namespace; a call flips the
+    switch, answers, and asks for /diagnostics at once."""
+    rclpy = pytest.importorskip("rclpy")
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.signals import SignalHandlerOptions
+    from std_srvs.srv import SetBool
+
+    from sam_runtime.bridge.switches import EnableServices
+
+    ctx = rclpy.Context()
+    rclpy.init(args=[], context=ctx, domain_id=97, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        node = Node("weir_bridge", namespace="/v1", context=ctx)
+        switches = switches_of([NS(name="level", enabled=True, enable_service="~/enable_level"),
+                                NS(name="gate", enabled=False, enable_service="start_stop_gate")])
+        changed: list[int] = []
+        services = EnableServices(_lifetime(), NS(node=node), switches, on_change=lambda: changed.append(1))
+        services._start()
+        assert services.resolved("level") == "/v1/weir_bridge/enable_level"
+        assert services.resolved("gate") == "/v1/start_stop_gate"
+        assert switches["level"].snapshot()["enable_service"] == "/v1/weir_bridge/enable_level"  # /diagnostics
+        client = node.create_client(SetBool, "/v1/start_stop_gate")
+        executor = SingleThreadedExecutor(context=ctx)
+        executor.add_node(node)
+        future = client.call_async(SetBool.Request(data=True))
+        executor.spin_until_future_complete(future, timeout_sec=10.0)
+        answer = future.result()
+        assert answer is not None and answer.success and answer.message == "mapping gate: enabled"
+        assert switches["gate"].enabled and changed == [1]
+        executor.shutdown(timeout_sec=1.0)
+        node.destroy_node()
+    finally:
+        ctx.shutdown()
