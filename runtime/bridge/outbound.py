@@ -128,8 +128,8 @@ class Outbound:
 
     def _convert_and_hand_off(self, oms: Sequence[OutMapping], msg: Any) -> None:
         rlog = self.lifetime.rlog
-        # the command's age counts from here (asyncio's loop.time() is this clock: time.monotonic)
-        received = time.monotonic() if oms and self._timed.get(oms[0].info.topic.name) else 0.0
+        # the command's age counts from here, on the worker's clock (time.monotonic: thread-safe)
+        received = self.clock() if oms and self._timed.get(oms[0].info.topic.name) else 0.0
         for om in oms:
             st = om.stats
             st.receive()

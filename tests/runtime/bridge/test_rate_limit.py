@@ -271,9 +271,8 @@ def test_outbound_worker_drops_expired_and_disabled_commands() -> None:
     outlet = om.outlet = FakeOutlet()
     now = [50.0]
     out.clock = lambda: now[0]
-    out.on_ros([om], "fresh-ish")  # carries time.monotonic(): the test's clock decides below
-    (obj, received) = _queued(om)[0]
-    assert obj == "fresh-ish" and isinstance(received, float)
+    out.on_ros([om], "taken")  # stamped with the clock when the rclpy callback takes it
+    assert _queued(om) == [("taken", 50.0)]
 
     async def main() -> None:
         assert om.queue is not None
