@@ -87,7 +87,7 @@ CASES: tuple[Case, ...] = (
         '      subject_id: 100\n',
         '      subject_id: 100\n      subjectid: 100\n',
         (
-            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(
@@ -545,6 +545,102 @@ CASES: tuple[Case, ...] = (
             'minimal.yaml:23:5: error: a mapping key must be a plain scalar',
         ),
     ),
+    Case(
+        'mapping_rate_zero',
+        '      topic: /level\n',
+        '      topic: /level\n      max_rate_hz: 0\n',
+        (
+            "minimal.yaml:49:7: error: max_rate_hz of mapping 'level' must be positive, found 0 (expected a rate in Hz above 0)",
+        ),
+    ),
+    Case(
+        'mapping_rate_negative',
+        '      topic: /valve\n',
+        '      topic: /valve\n      max_rate_hz: -5\n',
+        (
+            "minimal.yaml:58:7: error: max_rate_hz of mapping 'valve' must be positive, found -5 (expected a rate in Hz above 0)",
+        ),
+    ),
+    Case(
+        'mapping_rate_not_a_number',
+        '      topic: /level\n',
+        '      topic: /level\n      max_rate_hz: fast\n',
+        (
+            "minimal.yaml:49:20: error: 'max_rate_hz' of mapping 'level' must be int or number, found str 'fast' (expected int or number)",
+        ),
+    ),
+    Case(
+        'mapping_rate_infinite',
+        '      topic: /level\n',
+        '      topic: /level\n      max_rate_hz: .inf\n',
+        (
+            "minimal.yaml:49:20: error: 'max_rate_hz' of mapping 'level' must be finite",
+        ),
+    ),
+    Case(
+        'mapping_deadline_on_uavcan_to_ros',
+        '      topic: /level\n',
+        '      topic: /level\n      deadline: 0.5\n',
+        (
+            "minimal.yaml:49:7: error: mapping 'level' goes UAVCAN->ROS: a deadline applies to commands (ros_to_uavcan) only (expected max_rate_hz to thin a stream, or no deadline)",
+        ),
+    ),
+    Case(
+        'mapping_deadline_zero',
+        '      topic: /valve\n',
+        '      topic: /valve\n      deadline: 0\n',
+        (
+            "minimal.yaml:58:7: error: deadline of mapping 'valve' must be positive, found 0 (expected seconds above 0)",
+        ),
+    ),
+    Case(
+        'mapping_deadline_not_a_number',
+        '      topic: /valve\n',
+        '      topic: /valve\n      deadline: [1]\n',
+        (
+            "minimal.yaml:58:17: error: 'deadline' of mapping 'valve' must be int or number, found a list (expected int or number)",
+        ),
+    ),
+    Case(
+        'mapping_deadline_within_the_rate_interval',
+        '      topic: /valve\n',
+        '      topic: /valve\n      max_rate_hz: 2\n      deadline: 0.5\n',
+        (
+            "minimal.yaml:59:7: error: deadline of mapping 'valve' (0.5 s) is not longer than the interval of its max_rate_hz (0.5 s): a command held for its slot could expire every time (expected a deadline above 0.5 s)",
+        ),
+    ),
+    Case(
+        'mapping_enabled_not_bool',
+        '      topic: /level\n',
+        '      topic: /level\n      enabled: 1\n',
+        (
+            "minimal.yaml:49:16: error: 'enabled' of mapping 'level' must be bool, found int 1 (expected bool)",
+        ),
+    ),
+    Case(
+        'mapping_enable_service_invalid',
+        '      topic: /valve\n',
+        '      topic: /valve\n      enable_service: start stop//valve\n',
+        (
+            "minimal.yaml:58:23: error: enable_service 'start stop//valve' of mapping 'valve' is not a valid ROS service name (expected /name, name or ~/name, each segment a letter or underscore then letters, digits, underscores)",
+        ),
+    ),
+    Case(
+        'mapping_enable_service_empty',
+        '      topic: /valve\n',
+        '      topic: /valve\n      enable_service: \'\'\n',
+        (
+            "minimal.yaml:58:7: error: enable_service of mapping 'valve' is empty (expected a ROS service name)",
+        ),
+    ),
+    Case(
+        'mapping_enable_service_of_another_mapping',
+        '      topic: /level\n',
+        '      topic: /level\n      enable_service: ~/enable_valve\n',
+        (
+            "minimal.yaml:55:5: error: enable_service '~/enable_valve' of mapping 'valve' is also that of 'level' (line 45) (expected one service per mapping)",
+        ),
+    ),
 )
 
 
@@ -669,7 +765,7 @@ V0_CASES: tuple[Case, ...] = (
         '      data_type: skiff.Bilge\n',
         '      data_type: skiff.Bilge\n      subject_id: 7\n',
         (
-            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, shares_data_type)",
+            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, shares_data_type, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(
@@ -735,7 +831,7 @@ V0_CASES: tuple[Case, ...] = (
         '      source_node_ids: [10]\n      fields:\n        data: level_mm\n  dronecan',
         '      source_node_ids: [10]\n      select: {level_mm: 1}\n      fields:\n        data: level_mm\n  dronecan',
         (
-            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(
@@ -914,6 +1010,22 @@ V0_CASES: tuple[Case, ...] = (
         'dronecan_namespaces: [dronecan]\ndronecan_types:\n  skiff.Bilge:\n    id: 20120\n    fields:\n      - {name: timestamp, type: ardupilot.gnss.Heading}',
         (
             'minimal_v0.yaml:16:9: error: DroneCAN type ardupilot.gnss.Heading of DroneCAN type skiff.Bilge is in namespace ardupilot, which dronecan_namespaces does not load (expected ardupilot or ardupilot.gnss in dronecan_namespaces)',
+        ),
+    ),
+    Case(
+        'v0_deadline_on_uavcan_to_ros',
+        '      select: {pump_id: 1}\n',
+        '      select: {pump_id: 1}\n      deadline: 1\n',
+        (
+            "minimal_v0.yaml:61:7: error: DroneCAN mapping 'bilge' goes UAVCAN->ROS: a deadline applies to commands (ros_to_uavcan) only (expected max_rate_hz to thin a stream, or no deadline)",
+        ),
+    ),
+    Case(
+        'v0_rate_negative',
+        '      destination_node_ids: [20]\n',
+        '      destination_node_ids: [20]\n      max_rate_hz: -1\n',
+        (
+            "minimal_v0.yaml:71:7: error: max_rate_hz of DroneCAN mapping 'motors' must be positive, found -1 (expected a rate in Hz above 0)",
         ),
     ),
 )
@@ -1341,7 +1453,7 @@ ROUTING_CASES: tuple[Case, ...] = (
         '      subject_id: 700\n',
         '      subject_id: 700\n      shares_data_type: true\n',
         (
-            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range)",
+            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(

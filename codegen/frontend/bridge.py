@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import astuple
+
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.reading import Reader, map_items, number, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.routing import node_ids_or_any
+from sam_codegen.frontend.traffic import TRAFFIC_KEYS, parse_traffic
 from sam_codegen.frontend.yaml_source import YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
 from sam_codegen.model.spec import (
@@ -75,13 +78,13 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
 
 _MAPPING_KEYS = (
     "direction", "topic", "subject_id", "source_node_ids", "destination_node_id", "frame_id",
-    "fields", "ignore", "uavcan_values", "on_out_of_range",
+    "fields", "ignore", "uavcan_values", "on_out_of_range", *TRAFFIC_KEYS,
 )
 # A DroneCAN message is keyed by its data type (no subject id) and broadcast (destinations, not one destination).
 _DRONECAN_MAPPING_KEYS = (
     "direction", "topic", "data_type", "select", "source_node_ids", "destination_node_ids", "frame_id",
     "fields", "ignore", "uavcan_values", "on_out_of_range",
-    "shares_data_type",
+    "shares_data_type", *TRAFFIC_KEYS,
 )
 
 
@@ -135,6 +138,7 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
         source_node_ids, destination_node_id, r.get("frame_id", str, None), links, ignore, uavcan_values, auto,
         policy if policy in ("saturate", "reject") else "saturate", pos, protocol, data_type, destination_node_ids,
         select, select_pos, any_node, any_pos, bool(dronecan and r.get("shares_data_type", bool, False)),
+        *astuple(parse_traffic(r, what, direction, diag)),
     )
     destination = "destination_node_ids" if dronecan else "destination_node_id"
     if direction == UAVCAN_TO_ROS and r.node(destination) is not None:

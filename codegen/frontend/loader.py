@@ -17,6 +17,7 @@ from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, p
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.services import parse_service_mapping
 from sam_codegen.frontend.topic_sources import implied_tf_topics, parse_published_by
+from sam_codegen.frontend.traffic import check_enable_services
 from sam_codegen.frontend.types import (
     parse_dronecan_type,
     parse_dsdl_service,
@@ -159,6 +160,8 @@ def parse_spec(root: YNode, file: str) -> Spec:
                 mapping = parse_mapping(key, pos, node, diag, protocol)
                 if mapping is not None:
                     mappings[protocol].append(mapping)
+        for protocol, protocol_mappings in mappings.items():
+            check_enable_services(protocol_mappings, protocol, diag)
         service_mappings = [m for key, pos, node in map_items(r.node("service_mappings"), "bridge service_mappings",
                                                               diag)
                             for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]

@@ -360,6 +360,22 @@ class Mapping:
     any_node: bool = False
     any_node_pos: Pos = NOWHERE
     shares_data_type: bool = False
+    # Run-time traffic control (sam_codegen.frontend.traffic): the latest message at most max_rate_hz times a second
+    # (None: every one); ROS->UAVCAN only, a command older than deadline_s seconds since the bridge received it is
+    # not sent (None: never too old); the initial state of the mapping's std_srvs/SetBool switch and its name.
+    max_rate_hz: float | None = None
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""  # "": ENABLE_SERVICE_DEFAULT
+
+    @property
+    def enable_service_name(self) -> str:
+        """The SetBool service that enables and disables the mapping at run time (a ROS name, resolved by the
+        bridge's node: `~/` is under the node's own name)."""
+        return self.enable_service or ENABLE_SERVICE_DEFAULT.format(name=self.name)
+
+
+ENABLE_SERVICE_DEFAULT = "~/enable_{name}"
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,9 @@ module                 job
 ``wiring``             the generated tables and converters -> run-time mappings
 ``layout``             which mappings and devices a bridge serves under a layout (one protocol of a mixed one)
 ``liveness``           the silence rules (grace per mapping, silent while the device is alive), used by ``silence``
+``rate_limit``         ``max_rate_hz`` and ``deadline`` as pure logic on an injected clock (issue 19), driven by the
+                       asyncio loop's timers from ``inbound`` and ``outbound``
+``switches``           enable/disable per mapping: its state and its std_srvs/SetBool service (issue 19)
 =====================  ==============================================================================================
 
 Cyphal v1 messages carry no destination: a command reaches its configured destination node because the
@@ -74,6 +77,10 @@ reason                 when
                        of the source were due in the gap (by its measured or nominal rate), not counted
                        beyond (unless the bridge's link was down: next reason). A source that restarted
                        meanwhile (heartbeat uptime shorter than the gap) is not counted.
+``rate_limited``       UAVCAN -> ROS: a message held for its ``max_rate_hz`` slot that a newer one replaced
+``coalesced``          ROS -> UAVCAN: likewise for a command
+``expired``            ROS -> UAVCAN: a command older than the mapping's ``deadline`` when it would have been sent
+``disabled``           the mapping was disabled (``enabled: false`` in the spec, or its SetBool service)
 ``lost_link_down``     Cyphal/CAN only, an estimate: transfers of an accepted source missed while the bridge's
                        own Cyphal link was down (see :mod:`.loss`: the transfer-id gap modulo 32 plus the
                        multiple of 32 closest to the source's rate x the time without data)

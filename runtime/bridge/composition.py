@@ -25,6 +25,7 @@ from sam_runtime.bridge.outbound import DEFAULT_QUEUE_SIZE, Outbound
 from sam_runtime.bridge.reporting import Reporter
 from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.bridge.silence import SilenceWatch
+from sam_runtime.bridge.switches import EnableServices, switches_of
 from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.cyphal_io.transport import quiet_late_media_completions
@@ -105,6 +106,7 @@ class Bridge:
         lock = threading.Lock()
         self.mappings = sel.mappings
         self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in sel.mappings}
+        self.switches = switches_of(sel.mappings)  # enable/disable per mapping (sam_runtime.bridge.switches)
         self.backend: Backend
         if sel.protocol == "dronecan":
             from sam_runtime.bridge.backends.dronecan import DroneCanBackend  # needs dronecan (the runtime extra)
@@ -188,18 +190,24 @@ class Bridge:
                                                                    codec),
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
                                             backend=backend)
+        for im in (im for g in inbound.groups.values() for im in g.mappings):
+            im.switch = self.switches[im.info.name]
+        for om in outbound.mappings.values():
+            om.switch = self.switches[om.info.name]
         silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in sel.mappings
                                 if m.direction == UAVCAN_TO_ROS], health.devices,
                                alive_since=health.alive_since, last_message=inbound.last_message,
                                listening_since=lambda: link.up_since)
         self.reporter = reporter = Reporter(
             lifetime, self.name, sel.mappings, self.counters, backend=backend, health=health, link=link,
-            inbound=inbound, outbound=outbound, silence=silence, ros=self.ros, period=self._diagnostics_period)
+            inbound=inbound, outbound=outbound, silence=silence, ros=self.ros, period=self._diagnostics_period,
+            switches=self.switches)
         health.add_handler(self._on_health)
         link.add_handler(lambda _event: reporter.publish_now())
         silence.add_handler(reporter.publish_now)
 
         self.ros.attach()
+        EnableServices(lifetime, self.ros, self.switches, on_change=reporter.publish_now).attach()
         health.attach(lifetime)
         inbound.attach()
         outbound.attach()

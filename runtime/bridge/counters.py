@@ -16,13 +16,18 @@ from typing import Any
 
 from sam_runtime.common.rate_log import DEFAULT_INTERVAL_S, RateLimitedLog
 
-__all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "MappingStats", "count_handler_error", "log"]
+__all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "INTENDED_DROPS", "MappingStats", "count_handler_error",
+           "count_superseded", "log"]
 
 log = logging.getLogger("sam_runtime.bridge")
 
 DEFAULT_LOG_INTERVAL_S = DEFAULT_INTERVAL_S
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
-                "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected")
+                "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected",
+                "rate_limited", "coalesced", "expired", "disabled")
+# Drops the spec asked for (max_rate_hz, a disabled mapping): counted like the others, but no sign of trouble, so
+# they do not make the mapping WARN on /diagnostics (an expired command does: it waited too long somewhere).
+INTENDED_DROPS = frozenset({"rate_limited", "coalesced", "disabled"})
 
 
 class MappingStats:
@@ -72,7 +77,8 @@ class MappingStats:
             return
         with self._lock:
             self.dropped[reason] += count
-            self.last_drop_monotonic = time.monotonic()
+            if reason not in INTENDED_DROPS:
+                self.last_drop_monotonic = time.monotonic()
 
     def reorder(self) -> None:
         with self._lock:
@@ -92,6 +98,11 @@ class MappingStats:
                 "last_drop_age_s": None if self.last_drop_monotonic is None
                 else round(time.monotonic() - self.last_drop_monotonic, 3),
             }
+
+
+def count_superseded(stats: MappingStats, reason: str, _item: Any) -> None:
+    """A held message or command a newer one replaced (a Pacer's ``supersede``: functools.partial of this)."""
+    stats.drop(reason)
 
 
 def count_handler_error(stats: Iterable[MappingStats], where: str, ex: Exception,

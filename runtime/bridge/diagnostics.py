@@ -1,6 +1,7 @@
 """The bridge's stats snapshot as diagnostic_msgs/DiagnosticArray: one status for the bridge (ERROR while its link
 is down), one per mapping (received, published, dropped and dropped.<reason>, saturated and saturated.<field>,
-rejected.<field>, out_of_order, the protocol stack's counters; WARN while it dropped within the last 10 s, or while
+rejected.<field>, out_of_order, the protocol stack's counters, the traffic control (enabled, enable_service,
+max_rate_hz, deadline_s); WARN while it dropped within the last 10 s, or while
 it gets nothing from a device whose heartbeat is alive for longer than its grace: sam_runtime.bridge.liveness), one per
 device (OK while its heartbeat is alive and its health means OK, WARN or ERROR as its health says, ERROR when the
 heartbeat is lost, STALE when never seen)."""
@@ -11,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "diagnostic_array"]
+__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "diagnostic_array", "traffic_values"]
 
 RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
 _PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
@@ -31,6 +32,17 @@ class Naming:
 def _port(m: Mapping[str, Any]) -> dict[str, Any]:
     """A mapping's port: its Cyphal subject id, or its DroneCAN data type id."""
     return {k: m[k] for k in ("subject_id", "data_type_id") if k in m}
+
+
+def traffic_values(m: Mapping[str, Any]) -> dict[str, Any]:
+    """A mapping's traffic control as diagnostic values: ``enabled``, ``enable_service``, and ``max_rate_hz`` /
+    ``deadline_s`` when it has them (its drops are under ``dropped.rate_limited``, ``.coalesced``, ``.expired``,
+    ``.disabled``)."""
+    out: dict[str, Any] = {"enabled": m.get("enabled", True), "enable_service": m.get("enable_service", "")}
+    for key in ("max_rate_hz", "deadline_s"):
+        if m.get(key) is not None:
+            out[key] = m[key]
+    return out
 
 
 def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any:
@@ -71,6 +83,7 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
         values.update({f"saturated.{k}": v for k, v in sorted(m["saturated"].items())})
         values.update({f"rejected.{k}": v for k, v in sorted(m["rejected_fields"].items())})
         values["out_of_order"] = m["out_of_order"]
+        values.update(traffic_values(m))
         below = dict(m.get(proto) or {})
         kinds = below.pop("error_kinds", {})
         problem_age = below.pop("last_problem_age_s", None)
@@ -89,6 +102,8 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
         bad = sum(int(below.get(k, 0)) for k in _PROBLEMS)
         if bad:
             msg += f", {bad} frames/transfers discarded by {naming.stack}"
+        if not m.get("enabled", True):  # drops it was told to make: OK unless something else is wrong
+            msg = f"disabled (std_srvs/SetBool {m.get('enable_service', '')}); " + msg
         live = m.get("liveness")
         if live is not None:
             values["liveness"] = live["state"]

@@ -24,19 +24,27 @@ Two paths, one accounting: the object path gets the protocol library's message o
 generated codec (``<mapping>_wire_to_ros``) turns them straight into the ROS message's CDR, published raw. A payload
 the codec refuses (``ValueError``: what the protocol library's deserializer would have refused) is counted below the
 bridge by the inlet (``Inlet.malformed``) and goes no further, as the library's own refusals do on the object path.
+
+Traffic control (issue 19): a disabled mapping (:mod:`.switches`) drops a transfer before converting it
+(``disabled``); a mapping with ``max_rate_hz`` publishes through a :class:`~.rate_limit.Pacer` on the loop's timers:
+the latest converted message at most that often, trailing edge, a held one replaced by a newer one counted as
+``rate_limited`` (its stamp was checked when it arrived); what is held when the bridge closes counts as ``shutdown``.
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend, Inlet
-from sam_runtime.bridge.counters import MappingStats, count_handler_error
+from sam_runtime.bridge.counters import MappingStats, count_handler_error, count_superseded
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.rate_limit import Pacer
+from sam_runtime.bridge.switches import MappingSwitch
 
 __all__ = ["InMapping", "Inbound", "PortGroup", "accepts"]
 
@@ -44,6 +52,8 @@ __all__ = ["InMapping", "Inbound", "PortGroup", "accepts"]
 def accepts(info: Any, src: int | None) -> bool:
     """Whether the mapping ``info`` takes a transfer from node ``src`` (its source node ids, or any node)."""
     return src in info.source_node_ids or (src is not None and getattr(info, "any_node", False))
+
+_DISABLED = object()  # a conversion result: the mapping was disabled, nothing converted
 
 
 @dataclass
@@ -62,6 +72,8 @@ class InMapping:
     # the wire path: to_ros / matches take payload bytes, to_ros returns (CDR bytes, header stamp ns or -1) or None
     raw: bool = False
     last_stamp_ns: dict[int, int] = field(default_factory=dict)  # per source: stamp of the last published message
+    switch: MappingSwitch = field(default_factory=lambda: MappingSwitch(""))  # enabled unless told (composition)
+    pacer: Pacer | None = None  # with max_rate_hz (Inbound makes it)
 
 
 @dataclass
@@ -97,15 +109,29 @@ class Inbound:
             g.any_source = any(getattr(im.info, "any_node", False) for im in g.mappings)
         self._receive_ns: Callable[[], int] = ros.receive_ns
         self._group_of = {im.info.name: g for g in groups for im in g.mappings}
+        for g in groups:
+            for im in g.mappings:
+                rate = getattr(im.info, "max_rate_hz", None)
+                if rate is not None and im.pacer is None:
+                    im.pacer = Pacer(rate, functools.partial(self._deliver, im),
+                                     functools.partial(count_superseded, im.stats, "rate_limited"))
 
     def attach(self) -> None:
         """The ROS publishers and the backend's subscriptions when the bridge starts (before the backend opens)."""
-        self.lifetime.add_hooks("UAVCAN -> ROS", start=self._start)
+        self.lifetime.add_hooks("UAVCAN -> ROS", start=self._start, close=self._close)
+
+    def _close(self) -> None:
+        for group in self.groups.values():
+            for im in group.mappings:
+                if im.pacer is not None and im.pacer.close() is not None:
+                    im.stats.drop("shutdown")
 
     def _start(self) -> None:
         for group in self.groups.values():
             for im in group.mappings:
                 im.ros_publisher = self._ros.publisher(im.info.topic, im.ros_cls)
+                if im.pacer is not None:
+                    im.pacer.loop = self.lifetime.loop
             group.inlet = self._backend.subscribe(group.port_name, group.port_id, group.dtype, self.handler(group),
                                                   raw=group.raw)
 
@@ -168,6 +194,9 @@ class Inbound:
         receive_ns = self._receive_ns() if takers else 0
         results: list[tuple[InMapping, Any, Exception | None]] = []
         for im in takers:
+            if not im.switch.enabled:
+                results.append((im, _DISABLED, None))
+                continue
             try:
                 results.append((im, im.to_ros(msg, receive_ns, im.stats), None))
             except ValueError as ex:
@@ -201,6 +230,9 @@ class Inbound:
             st.drop("lost_link_down", lost_est)
             rlog.note((name, "lost_link_down"), logging.WARNING, "about %d transfers from node %s missed "
                       "while the link was down (estimated from the nominal rate)", lost_est, src, count=lost_est)
+        if out is _DISABLED:
+            st.drop("disabled")
+            return
         if error is not None:
             st.drop("convert_error")
             rlog.note((name, "convert_error"), logging.ERROR, "conversion failed: %s: %s", type(error).__name__,
@@ -228,10 +260,22 @@ class Inbound:
                 rlog.note((name, "out_of_order"), logging.WARNING,
                           "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
                           src, stamp * 1e-9, last * 1e-9)
+        if im.pacer is not None:
+            im.pacer.offer(out)  # now, or when its slot comes (see the docstring)
+        else:
+            self._deliver(im, out)
+
+    def _deliver(self, im: InMapping, out: Any) -> None:
+        """Publish one converted message (at once, or from the pacer's timer). Never raises."""
+        st = im.stats
+        if not im.switch.enabled:  # held for its rate slot while the mapping was disabled
+            st.drop("disabled")
+            return
         try:
             im.ros_publisher.publish(out)  # CDR bytes on the wire path: rclpy publishes them raw
         except Exception as ex:
             st.drop("publish_error")
-            rlog.note((name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s", type(ex).__name__, ex)
+            self.lifetime.rlog.note((im.info.name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s",
+                                    type(ex).__name__, ex)
             return
         st.publish()

@@ -12,12 +12,21 @@ generated package would have published for that transfer had it received it at `
 the same conversion at a receive time one second and a bit later, so a caller can tell the fields that depend on
 the receive time (a device stamp of 0 becomes the receive time) from the others. Never raises for any payload
 (a payload the codec refuses is counted as ``deserialization_failures`` below the bridge, as live).
+Traffic control (issue 19): a mapping the spec starts disabled drops and counts (``disabled``) as live. A mapping's
+``max_rate_hz`` runs on the recorded receive times (``monotonic_s``) instead of the loop's clock: a message held for
+its slot comes out of the first :meth:`OfflineBridge.feed` at or after that slot (before that transfer's own
+publications, as live), and the ones still held at the end out of :meth:`OfflineBridge.finish`. Its ``cdr_later`` is
+the conversion of the transfer it came from.
 """
 
 from __future__ import annotations
 
 import asyncio
+import functools
+import heapq
+import itertools
 import logging
+import math
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,6 +38,7 @@ from sam_runtime.bridge.inbound import Inbound, InMapping
 from sam_runtime.bridge.layout import select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.switches import switches_of
 from sam_runtime.bridge.wiring import in_groups, missing_codecs, nominal_rates
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.genpkg import GeneratedPackage
@@ -91,6 +101,40 @@ class _Backend(Backend):
     @property
     def transfer_id_modulo(self) -> int:
         return 32 if self.protocol == "dronecan" else 2**64
+
+
+class _Timer:
+    def __init__(self) -> None:
+        self.cancelled = False
+
+    def cancel(self) -> None:
+        self.cancelled = True
+
+
+class _RecordedClock:
+    """The pacers' event loop offline: the recorded receive times are the clock, timers run when feed() passes
+    them (in time order, the clock at each one's time)."""
+
+    def __init__(self) -> None:
+        self.now = -math.inf
+        self._timers: list[tuple[float, int, Callable[[], Any], _Timer]] = []
+        self._seq = itertools.count()
+
+    def time(self) -> float:
+        return self.now
+
+    def call_at(self, when: float, callback: Callable[[], Any]) -> _Timer:
+        timer = _Timer()
+        heapq.heappush(self._timers, (when, next(self._seq), callback, timer))
+        return timer
+
+    def advance(self, to: float) -> None:
+        while self._timers and self._timers[0][0] <= to:
+            when, _, callback, timer = heapq.heappop(self._timers)
+            self.now = max(self.now, when)
+            if not timer.cancelled:
+                callback()
+        self.now = max(self.now, to)
 
 
 class _Collector:
@@ -157,13 +201,22 @@ class OfflineBridge:
 
         groups = in_groups(gen, None, self.counters, loss, sel.mappings, codec)
         self.inbound = Inbound(self.lifetime, groups, self._ros, backend)
+        self._clock = _RecordedClock()
+        self._convert: dict[str, Callable[..., Any]] = {}  # each mapping's own conversion
+        self._inputs: dict[str, tuple[bytes, int]] = {}  # each mapping's last converted (payload, receive_ns)
         self.inbound.attach()
         asyncio.run(self.lifetime.start())  # the start hooks: publishers and subscriptions, nothing periodic
         self._ros_type = {m.name: m.topic.ros_type for m in sel.mappings}
         for group in self.inbound.groups.values():
             for im in group.mappings:
                 im.ros_publisher = _Collector(self, im)
-        self._out: list[tuple[InMapping, bytes]] = []
+                # traffic control offline: the initial switch as live, the rate limit on the recorded times
+                im.switch = switches_of([im.info])[im.info.name]
+                if im.pacer is not None:
+                    im.pacer.loop = self._clock
+                self._convert[im.info.name] = convert = im.to_ros
+                im.to_ros = functools.partial(self._remembering, im.info.name, convert)
+        self._out: list[tuple[InMapping, bytes, tuple[bytes, int]]] = []
 
     @property
     def topics(self) -> dict[str, str]:
@@ -175,21 +228,40 @@ class OfflineBridge:
         return set(self._backend.handlers)
 
     def collect(self, im: InMapping, cdr: bytes) -> None:
-        self._out.append((im, cdr))
+        self._out.append((im, cdr, self._inputs[im.info.name]))
+
+    def _remembering(self, mapping: str, convert: Callable[..., Any], payload: bytes, receive_ns: int, stats: Any
+                     ) -> Any:
+        """The mapping's conversion, remembering its last converted input: what a publication came from (the
+        transfer itself, or for a message held for its rate slot the latest conversion: the held one)."""
+        out = convert(payload, receive_ns, stats)
+        if out is not None:
+            self._inputs[mapping] = (payload, receive_ns)
+        return out
 
     def feed(self, port_id: int, payload: bytes, source_node_id: int | None, transfer_id: int, monotonic_s: float,
              receive_ns: int) -> list[Published]:
         """One transfer of a subscribed port (others: nothing), as the live bridge handles it."""
-        handler = self._backend.handlers.get(port_id)
-        if handler is None:
-            return []
         self._out = []
-        self._ros.now_ns = receive_ns
-        handler(payload, source_node_id, transfer_id, monotonic_s)
+        self._clock.advance(monotonic_s)  # messages held for a rate slot that came before this transfer
+        handler = self._backend.handlers.get(port_id)
+        if handler is not None:
+            self._ros.now_ns = receive_ns
+            handler(payload, source_node_id, transfer_id, monotonic_s)
+        return self._published()
+
+    def finish(self) -> list[Published]:
+        """The end of the recording: the messages still held for their rate slot, as the live bridge publishes
+        them when the slot comes."""
+        self._out = []
+        self._clock.advance(math.inf)
+        return self._published()
+
+    def _published(self) -> list[Published]:
         out = []
-        for im, cdr in self._out:
+        for im, cdr, (payload, receive_ns) in self._out:
             try:
-                later = im.to_ros(payload, receive_ns + RECEIVE_TIME_PROBE_NS, _Scratch())
+                later = self._convert[im.info.name](payload, receive_ns + RECEIVE_TIME_PROBE_NS, _Scratch())
             except Exception:  # it converted once: the probe cannot fail differently, but never raise
                 later = None
             out.append(Published(im.info.topic.name, im.info.topic.ros_type, im.info.name, cdr,

@@ -8,21 +8,32 @@ Every message that is not published is counted once per mapping: ``convert_error
 ``not_sent`` (not every frame within the port's send timeout), ``shutdown`` (the bridge was closing),
 ``handler_error`` (a bug in this path). Nothing raises into the rclpy executor: an exception out of a callback
 would also leave the EventsExecutor's queued messages waiting for the next one.
+
+Traffic control (issue 19): a disabled mapping (:mod:`.switches`) drops a command before converting it, and one
+that was queued or held when it was disabled, as ``disabled``. With ``max_rate_hz`` the converted commands pass a
+:class:`~.rate_limit.Pacer` on the loop before the queue: the latest at most that often, a held one replaced by a
+newer one counted as ``coalesced``. With ``deadline_s`` each command carries the monotonic time the rclpy callback
+took it, and the worker drops it as ``expired`` when it is older than the deadline at the moment it would be sent
+(after waiting in the hand-off, the pacer or the queue). What is held when the bridge closes counts as ``shutdown``.
 """
 
 from __future__ import annotations
 
 import asyncio
+import functools
 import logging
+import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from sam_runtime.bridge.backend import Backend, LinkDownError, Outlet
-from sam_runtime.bridge.counters import MappingStats, count_handler_error, log
+from sam_runtime.bridge.counters import MappingStats, count_handler_error, count_superseded, log
 from sam_runtime.bridge.handoff import Handoff
 from sam_runtime.bridge.layout import port_id_of
 from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.bridge.rate_limit import Pacer, expired
+from sam_runtime.bridge.switches import MappingSwitch
 from sam_runtime.common.tasks import cancel_and_wait
 
 __all__ = ["DEFAULT_QUEUE_SIZE", "OutMapping", "Outbound"]
@@ -44,6 +55,9 @@ class OutMapping:
     worker: asyncio.Task[None] | None = None
     # the wire path: to_uavcan is the generated codec (CDR bytes of a raw subscription -> UAVCAN payload bytes)
     raw: bool = False
+    switch: MappingSwitch = field(default_factory=lambda: MappingSwitch(""))  # enabled unless told (composition)
+    pacer: Pacer | None = None  # with max_rate_hz (Outbound makes it)
+    deadline_s: float | None = None  # from the tables (Outbound sets it): queued items are (obj, received_s)
 
 
 class Outbound:
@@ -65,6 +79,14 @@ class Outbound:
         self._ros, self._backend = ros, backend
         self.label = backend.label if backend is not None else "UAVCAN"
         self.handoff: Handoff[OutMapping] = Handoff(self._enqueue, lambda om, _obj: om.stats.drop("shutdown"))
+        for om in mappings:
+            om.deadline_s = getattr(om.info, "deadline_s", None)
+            rate = getattr(om.info, "max_rate_hz", None)
+            if rate is not None and om.pacer is None:
+                om.pacer = Pacer(rate, functools.partial(self._put, om),
+                                 functools.partial(count_superseded, om.stats, "coalesced"))
+        self._timed = {topic: any(om.deadline_s is not None for om in oms) for topic, oms in self.by_topic.items()}
+        self.clock: Callable[[], float] = time.monotonic  # of the deadline check (tests may set their own)
 
     def attach(self) -> None:
         """Subscribe the command topics, advertise the ports, start the workers when the bridge starts (before the
@@ -81,11 +103,16 @@ class Outbound:
                                     raw=all(om.raw for om in oms))
         self.handoff.loop = self.lifetime.loop
         for om in self.mappings.values():
+            if om.pacer is not None:
+                om.pacer.loop = self.lifetime.loop
             om.queue = asyncio.Queue(maxsize=self.queue_size)
             om.worker = asyncio.create_task(self._worker(om), name=f"bridge-out-{om.info.name}")
 
     async def _close(self) -> None:
         self.handoff.drain()  # what the rclpy thread handed off last: counted as shutdown (see _enqueue)
+        for om in self.mappings.values():
+            if om.pacer is not None and om.pacer.close() is not None:
+                om.stats.drop("shutdown")
         stuck = await cancel_and_wait([om.worker for om in self.mappings.values() if om.worker is not None])
         if stuck:
             log.warning("%d bridge tasks did not stop", len(stuck))
@@ -101,9 +128,14 @@ class Outbound:
 
     def _convert_and_hand_off(self, oms: Sequence[OutMapping], msg: Any) -> None:
         rlog = self.lifetime.rlog
+        # the command's age counts from here, on the worker's clock (time.monotonic: thread-safe)
+        received = self.clock() if oms and self._timed.get(oms[0].info.topic.name) else 0.0
         for om in oms:
             st = om.stats
             st.receive()
+            if not om.switch.enabled:
+                st.drop("disabled")
+                continue
             try:
                 obj = om.to_uavcan(msg, st)
             except Exception as ex:
@@ -114,11 +146,20 @@ class Outbound:
             if obj is None:
                 st.drop("rejected")
                 continue
-            self.handoff.put(om, obj)
+            self.handoff.put(om, obj if om.deadline_s is None else (obj, received))
 
     # -------------------------------------------------------------------------------------------- asyncio loop
     def _enqueue(self, om: OutMapping, obj: Any) -> None:
-        """Queue for the mapping's worker (keeps the order, bounds the backlog)."""
+        """Queue for the mapping's worker (keeps the order, bounds the backlog), through its pacer if it has one."""
+        if om.queue is None or self.lifetime.closed:
+            om.stats.drop("shutdown")
+            return
+        if om.pacer is not None:
+            om.pacer.offer(obj)
+        else:
+            self._put(om, obj)
+
+    def _put(self, om: OutMapping, obj: Any) -> None:
         if om.queue is None or self.lifetime.closed:
             om.stats.drop("shutdown")
             return
@@ -134,6 +175,16 @@ class Outbound:
         name, rlog, lifetime = om.info.name, self.lifetime.rlog, self.lifetime
         while not lifetime.closed:
             obj = await om.queue.get()
+            if om.deadline_s is not None:
+                obj, received = obj
+                if expired(received, self.clock(), om.deadline_s):
+                    om.stats.drop("expired")
+                    rlog.note((name, "expired"), logging.WARNING, "a command older than its deadline (%.3f s) was "
+                              "not sent", om.deadline_s)
+                    continue
+            if not om.switch.enabled:  # queued before the mapping was disabled
+                om.stats.drop("disabled")
+                continue
             outlet = om.outlet
             if outlet is None or not outlet.ready or not self._link_up():
                 om.stats.drop("link_down")

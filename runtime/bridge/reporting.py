@@ -7,7 +7,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from sam_codegen.model.spec import UAVCAN_TO_ROS
@@ -21,6 +21,7 @@ from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.link import LinkSupervisor
 from sam_runtime.bridge.outbound import Outbound
 from sam_runtime.bridge.silence import SilenceWatch
+from sam_runtime.bridge.switches import MappingSwitch
 from sam_runtime.common.rate_log import RateLimitedLog
 
 __all__ = ["DIAGNOSTICS_TOPIC", "Reporter"]
@@ -34,11 +35,13 @@ class Reporter:
 
     def __init__(self, lifetime: Lifetime, name: str, mappings: Sequence[Any], counters: dict[str, MappingStats], *,
                  backend: Backend, health: DeviceHealth, link: LinkSupervisor, inbound: Inbound,
-                 outbound: Outbound, silence: SilenceWatch, ros: Any, period: float = 1.0) -> None:
+                 outbound: Outbound, silence: SilenceWatch, ros: Any, period: float = 1.0,
+                 switches: Mapping[str, MappingSwitch] | None = None) -> None:
         self.lifetime, self.name, self.mappings, self.counters = lifetime, name, list(mappings), counters
         self.backend, self.health, self.link = backend, health, link
         self.inbound, self.outbound, self.silence, self.ros = inbound, outbound, silence, ros
         self.period = float(period)
+        self.switches = dict(switches or {})
         self.naming = Naming(name, backend.protocol, backend.label, backend.stack)
         self._publisher: Any = None
 
@@ -72,6 +75,12 @@ class Reporter:
     def diagnostics_message(self) -> Any:
         return diagnostic_array(self.snapshot(), self.naming, self.ros.clock.now().to_msg())
 
+    def _traffic(self, m: Any) -> dict[str, Any]:
+        """A mapping's traffic control: its limits from the tables, its switch now."""
+        sw = self.switches.get(m.name)
+        return {"max_rate_hz": getattr(m, "max_rate_hz", None), "deadline_s": getattr(m, "deadline_s", None),
+                **(sw.snapshot() if sw is not None else {"enabled": True})}
+
     def snapshot(self) -> dict[str, Any]:
         """Every counter, the devices' heartbeats and the bridge itself. Polls the protocol stack's counters
         first, so the below-bridge drops are current."""
@@ -85,7 +94,7 @@ class Reporter:
             port_key = "data_type_id" if hasattr(m, "data_type") else "subject_id"
             entry = {"direction": m.direction, "topic": m.topic.name, port_key: port_id_of(m),
                      **({"data_type": m.data_type.name} if hasattr(m, "data_type") else {}),
-                     **(st.snapshot() if st else empty)}
+                     **(st.snapshot() if st else empty), **self._traffic(m)}
             if m.direction == UAVCAN_TO_ROS:
                 entry["source_node_ids"] = "any" if getattr(m, "any_node", False) else sorted(m.source_node_ids)
                 group = self.inbound.group_of(m.name)

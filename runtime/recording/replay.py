@@ -395,6 +395,14 @@ def replay(path: Path, converters: Iterable[Converter], *, out: Path | None = No
             replayed.setdefault(pub.topic, []).append(_Out(cdr, _as_delivered(pub.cdr_later), msg.log_time))
             if writer is not None:
                 writer.write(pub.topic, cdr, msg.log_time, msg.log_time)
+    last_log = transfers[-1][0].log_time if transfers else 0
+    for conv in by_protocol.values():  # what a converter still holds (a rate-limited mapping's last message)
+        finish = getattr(conv, "finish", None)
+        for pub in finish() if finish is not None else ():
+            cdr = _as_delivered(pub.cdr)
+            replayed.setdefault(pub.topic, []).append(_Out(cdr, _as_delivered(pub.cdr_later), last_log))
+            if writer is not None:
+                writer.write(pub.topic, cdr, last_log, last_log)
     elapsed = time.monotonic() - t0_wall
     if writer is not None:
         writer.close()

@@ -9,6 +9,7 @@ worded by wording.field_rows, as for Cyphal mappings. Imported only by the packa
 from __future__ import annotations
 
 from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
+from sam_codegen.targets.docs.traffic import traffic_words
 from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
 from sam_codegen.validate.mapping_rules import format_path
 from sam_codegen.validate.panic_duty import panic_duty
@@ -59,7 +60,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
             "select": ", ".join(f"{format_path(list(p))} = {v}" for p, _, v in rm.select),
             "elements": [f"{format_path(list(path))}[{u}]" for path, uses in rm.elements.items() for u in uses],
             "frame_id": m.frame_id, "rate": fmt_rate(rm.rate_hz), "auto": m.auto,
-            "on_out_of_range": m.on_out_of_range, "rows": rows,
+            "on_out_of_range": m.on_out_of_range, "rows": rows, "traffic": traffic_words(m),
         })
     chosen = spec.dronecan_namespaces
     namespaces = (f"{', '.join(f'`{n}`' for n in resolved.dronecan.namespaces)} (`dronecan_namespaces`: the data "

@@ -22,6 +22,7 @@ from pathlib import Path
 from sam_codegen.catalogs.ros_known import external_messages_to_generate
 from sam_codegen.model.spec import QOS_PROFILES, Mapping, Node, Port, Qos, Spec
 from sam_codegen.targets.docs.graph import ROS_TO_UAVCAN, SVG_NAME, UAVCAN_TO_ROS, Graph, PortIndex, mermaid_context
+from sam_codegen.targets.docs.traffic import traffic_words
 from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
 from sam_codegen.targets.nodes import nodes_package, params_file
 from sam_codegen.validate.mapping_rules import ResolvedMapping
@@ -338,6 +339,7 @@ def _mapping_rows(resolved: Resolved, subject_types: dict[int, str]) -> list[Row
             "auto": m.auto,
             "on_out_of_range": m.on_out_of_range,
             "rows": field_rows(rm) if rm is not None else [],
+            "traffic": traffic_words(m),
         })
     return rows
 

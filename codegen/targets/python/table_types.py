@@ -80,6 +80,14 @@ class MappingInfo:
     linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
     # `source_node_ids: any`: UAVCAN->ROS accepts every node (no source filter, so no spoofing protection)
     any_node: bool = False
+    # run-time traffic control (sam_runtime.bridge.rate_limit, .switches): the latest message at most
+    # max_rate_hz a second (None: every one); ROS->UAVCAN: a command older than deadline_s since the
+    # bridge received it is not sent; the mapping's initial state and its std_srvs/SetBool service
+    # (a ROS name the bridge's node resolves)
+    max_rate_hz: float | None = None
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)
@@ -135,6 +143,10 @@ class DroneCanMappingInfo:
     # `source_node_ids: any` / `destination_node_ids: any`: every node (the node id sets are empty);
     # UAVCAN->ROS then routes only on `select` and the items read
     any_node: bool = False
+    max_rate_hz: float | None = None  # these four as MappingInfo's
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)

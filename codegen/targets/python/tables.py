@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from sam_codegen.model.spec import Port, Qos, V0Struct
+from sam_codegen.model.spec import Mapping, Port, Qos, V0Struct
 from sam_codegen.render.filters import py_str
 from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
 from sam_codegen.targets import dsdl_v0
@@ -41,6 +41,12 @@ def _port_info(resolved: Resolved, port: Port) -> Call:
     args = (str(port.subject_id), py_str(port.type), py_str(py_module(struct.namespace)),
             py_str(py_class_name(struct)), py_literal(float(port.rate_hz)))
     return Call("PortInfo", args, ("subject_id", "dsdl_type", "dsdl_module", "dsdl_class", "rate_hz"))
+
+
+def _traffic(m: Mapping) -> dict[str, str]:
+    """A mapping's run-time traffic control as literals (the enable service with its default filled in)."""
+    return {"max_rate_hz": py_literal(m.max_rate_hz), "deadline_s": py_literal(m.deadline_s),
+            "enabled": py_literal(m.enabled), "enable_service": py_str(m.enable_service_name)}
 
 
 def cyphal_context(resolved: Resolved) -> dict[str, Any]:
@@ -74,7 +80,7 @@ def cyphal_context(resolved: Resolved) -> dict[str, Any]:
             "frame_id": py_str(m.frame_id) if m.frame_id is not None else "None",
             "rate_hz": py_literal(float(rm.rate_hz)), "on_out_of_range": py_str(m.on_out_of_range),
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
-            "exact_uavcan_fields": exact, "linked_uavcan_fields": linked, "any_node": m.any_node,
+            "exact_uavcan_fields": exact, "linked_uavcan_fields": linked, "any_node": m.any_node, **_traffic(m),
         })
     parameters = []
     for param in spec.parameters.values():
@@ -152,7 +158,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
             "to_ros": py_str(f"{m.name}_to_ros"), "to_uavcan": py_str(f"{m.name}_to_uavcan"),
             "exact_uavcan_fields": [py_str(s.uavcan) for s in rm.steps if s.uavcan_path and s.exact],
             "linked_uavcan_fields": [py_str(s.uavcan) for s in rm.steps if s.uavcan_path],
-            "any_node": m.any_node,
+            "any_node": m.any_node, **_traffic(m),
         })
     layouts = [{
         "name": py_str(layout.name), "description": layout.description,

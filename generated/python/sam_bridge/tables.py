@@ -76,6 +76,14 @@ class MappingInfo:
     linked_uavcan_fields: tuple[str, ...]  # every UAVCAN path the converters read or write
     # `source_node_ids: any`: UAVCAN->ROS accepts every node (no source filter, so no spoofing protection)
     any_node: bool = False
+    # run-time traffic control (sam_runtime.bridge.rate_limit, .switches): the latest message at most
+    # max_rate_hz a second (None: every one); ROS->UAVCAN: a command older than deadline_s since the
+    # bridge received it is not sent; the mapping's initial state and its std_srvs/SetBool service
+    # (a ROS name the bridge's node resolves)
+    max_rate_hz: float | None = None
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)
@@ -131,6 +139,10 @@ class DroneCanMappingInfo:
     # `source_node_ids: any` / `destination_node_ids: any`: every node (the node id sets are empty);
     # UAVCAN->ROS then routes only on `select` and the items read
     any_node: bool = False
+    max_rate_hz: float | None = None  # these four as MappingInfo's
+    deadline_s: float | None = None
+    enabled: bool = True
+    enable_service: str = ""
 
 
 @dataclass(frozen=True)
@@ -577,6 +589,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'accelerometer_latest[1]',
             'accelerometer_latest[2]',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_imu',
     ),
     MappingInfo(
         name='magnetic_field',
@@ -603,6 +619,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'magnetic_field_ga[2]',
             'magnetic_field_covariance',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_magnetic_field',
     ),
     MappingInfo(
         name='gps_fix',
@@ -630,6 +650,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'status',
             'position_covariance',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_gps_fix',
     ),
     MappingInfo(
         name='pressure',
@@ -645,6 +669,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='pressure_to_uavcan',
         exact_uavcan_fields=('static_pressure', 'static_pressure_variance'),
         linked_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_pressure',
     ),
     MappingInfo(
         name='battery_state',
@@ -666,6 +694,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'state_of_charge_pct',
             'state_of_health_pct',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_state',
     ),
     MappingInfo(
         name='altitude',
@@ -681,6 +713,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='altitude_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'altitude', 'altitude_variance'),
         linked_uavcan_fields=('timestamp.microsecond', 'altitude', 'altitude_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_altitude',
     ),
     MappingInfo(
         name='battery_info',
@@ -726,6 +762,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
             'model_instance_id',
             'model_name',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_info',
     ),
     MappingInfo(
         name='thruster_1_rpm',
@@ -741,6 +781,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_1_rpm_to_uavcan',
         exact_uavcan_fields=('rpm',),
         linked_uavcan_fields=('rpm',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_1_rpm',
     ),
     MappingInfo(
         name='thruster_2_rpm',
@@ -756,6 +800,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_2_rpm_to_uavcan',
         exact_uavcan_fields=('rpm',),
         linked_uavcan_fields=('rpm',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_2_rpm',
     ),
     MappingInfo(
         name='thrust_vector',
@@ -771,6 +819,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thrust_vector_to_uavcan',
         exact_uavcan_fields=('vertical_radians', 'horizontal_radians'),
         linked_uavcan_fields=('vertical_radians', 'horizontal_radians'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector',
     ),
     MappingInfo(
         name='ballast',
@@ -786,6 +838,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='ballast_to_uavcan',
         exact_uavcan_fields=('weight_1_offset_radians', 'weight_2_offset_radians'),
         linked_uavcan_fields=('weight_1_offset_radians', 'weight_2_offset_radians'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_ballast',
     ),
     MappingInfo(
         name='longitudinal_weight',
@@ -801,6 +857,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='longitudinal_weight_to_uavcan',
         exact_uavcan_fields=('percent',),
         linked_uavcan_fields=('percent',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight',
     ),
     MappingInfo(
         name='buoyancy_piston',
@@ -816,6 +876,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='buoyancy_piston_to_uavcan',
         exact_uavcan_fields=('percent',),
         linked_uavcan_fields=('percent',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston',
     ),
     MappingInfo(
         name='thruster_1_feedback',
@@ -837,6 +901,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_1_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
         linked_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_1_feedback',
     ),
     MappingInfo(
         name='thruster_2_feedback',
@@ -858,6 +926,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thruster_2_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
         linked_uavcan_fields=('timestamp.microsecond', 'rpm', 'current', 'temperature_c'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_2_feedback',
     ),
     MappingInfo(
         name='thrust_vector_feedback',
@@ -879,6 +951,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='thrust_vector_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'vertical_mrad', 'horizontal_mrad'),
         linked_uavcan_fields=('timestamp.microsecond', 'vertical_mrad', 'horizontal_mrad'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector_feedback',
     ),
     MappingInfo(
         name='longitudinal_weight_feedback',
@@ -900,6 +976,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='longitudinal_weight_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight_feedback',
     ),
     MappingInfo(
         name='buoyancy_piston_feedback',
@@ -921,6 +1001,10 @@ MAPPINGS: tuple[MappingInfo, ...] = (
         to_uavcan='buoyancy_piston_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.microsecond', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston_feedback',
     ),
 )
 
@@ -1106,6 +1190,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'accelerometer_latest[1]',
             'accelerometer_latest[2]',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_imu',
     ),
     DroneCanMappingInfo(
         name='magnetic_field',
@@ -1128,6 +1216,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'magnetic_field_ga[2]',
             'magnetic_field_covariance',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_magnetic_field',
     ),
     DroneCanMappingInfo(
         name='gps_fix',
@@ -1156,6 +1248,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'height_ellipsoid_mm',
             'status',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_gps_fix',
     ),
     DroneCanMappingInfo(
         name='pressure',
@@ -1173,6 +1269,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='pressure_to_uavcan',
         exact_uavcan_fields=('static_pressure', 'static_pressure_variance'),
         linked_uavcan_fields=('static_pressure', 'static_pressure_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_pressure',
     ),
     DroneCanMappingInfo(
         name='battery_state',
@@ -1190,6 +1290,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='battery_state_to_uavcan',
         exact_uavcan_fields=('voltage', 'current', 'state_of_charge_pct'),
         linked_uavcan_fields=('voltage', 'current', 'temperature', 'state_of_charge_pct'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_state',
     ),
     DroneCanMappingInfo(
         name='battery_info',
@@ -1237,6 +1341,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'model_instance_id',
             'model_name',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_battery_info',
     ),
     DroneCanMappingInfo(
         name='altitude',
@@ -1254,6 +1362,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='altitude_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'altitude', 'altitude_variance'),
         linked_uavcan_fields=('timestamp.usec', 'altitude', 'altitude_variance'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_altitude',
     ),
     DroneCanMappingInfo(
         name='thruster_rpms',
@@ -1271,6 +1383,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thruster_rpms_to_uavcan',
         exact_uavcan_fields=('rpm[0]', 'rpm[1]'),
         linked_uavcan_fields=('rpm[0]', 'rpm[1]'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_rpms',
     ),
     DroneCanMappingInfo(
         name='thrust_vector',
@@ -1294,6 +1410,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'commands[actuator_id=0].command_value',
             'commands[actuator_id=1].command_value',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector',
     ),
     DroneCanMappingInfo(
         name='ballast',
@@ -1317,6 +1437,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
             'commands[actuator_id=2].command_value',
             'commands[actuator_id=3].command_value',
         ),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_ballast',
     ),
     DroneCanMappingInfo(
         name='longitudinal_weight',
@@ -1334,6 +1458,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='longitudinal_weight_to_uavcan',
         exact_uavcan_fields=('commands[actuator_id=4].command_value',),
         linked_uavcan_fields=('commands[actuator_id=4].command_value',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight',
     ),
     DroneCanMappingInfo(
         name='buoyancy_piston',
@@ -1351,6 +1479,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='buoyancy_piston_to_uavcan',
         exact_uavcan_fields=('commands[actuator_id=5].command_value',),
         linked_uavcan_fields=('commands[actuator_id=5].command_value',),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston',
     ),
     DroneCanMappingInfo(
         name='thruster_1_feedback',
@@ -1368,6 +1500,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thruster_1_feedback_to_uavcan',
         exact_uavcan_fields=('rpm', 'current'),
         linked_uavcan_fields=('rpm', 'current', 'temperature'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_1_feedback',
     ),
     DroneCanMappingInfo(
         name='thruster_2_feedback',
@@ -1385,6 +1521,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thruster_2_feedback_to_uavcan',
         exact_uavcan_fields=('rpm', 'current'),
         linked_uavcan_fields=('rpm', 'current', 'temperature'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thruster_2_feedback',
     ),
     DroneCanMappingInfo(
         name='thrust_vector_feedback',
@@ -1402,6 +1542,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='thrust_vector_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'vertical_mrad', 'horizontal_mrad'),
         linked_uavcan_fields=('timestamp.usec', 'vertical_mrad', 'horizontal_mrad'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_thrust_vector_feedback',
     ),
     DroneCanMappingInfo(
         name='longitudinal_weight_feedback',
@@ -1419,6 +1563,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='longitudinal_weight_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_longitudinal_weight_feedback',
     ),
     DroneCanMappingInfo(
         name='buoyancy_piston_feedback',
@@ -1436,6 +1584,10 @@ DRONECAN_MAPPINGS: tuple[DroneCanMappingInfo, ...] = (
         to_uavcan='buoyancy_piston_feedback_to_uavcan',
         exact_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
         linked_uavcan_fields=('timestamp.usec', 'percent', 'encoder_count'),
+        max_rate_hz=None,
+        deadline_s=None,
+        enabled=True,
+        enable_service='~/enable_buoyancy_piston_feedback',
     ),
 )
 

@@ -134,3 +134,29 @@ def test_dronecan_payloads_decode_from_the_attached_definitions_alone(gen: Any, 
     assert got.integration_interval == pytest.approx(0.01)
     for n in names:
         assert parsed[n].get_data_type_signature() == dronecan.TYPENAMES[n].get_data_type_signature()
+
+
+def test_rate_limit_runs_on_the_recorded_times() -> None:
+    """tests/specs/weir.yaml: `level` at most 4 Hz, trailing edge, on the transfers' recorded receive times;
+    `level_raw` starts disabled (dropped, counted); what is still held comes out of finish()."""
+    from helpers.spec_build import generated_spec
+
+    from sam_runtime.genpkg import GeneratedPackage
+
+    gen = GeneratedPackage(generated_spec("weir"))
+    bridge = OfflineBridge(gen)
+    codec = gen.codec("cyphal")
+    times = [10.0 + 0.02 * i for i in range(30)]  # 50 Hz for 0.6 s: slots at 10.0, 10.25, 10.5
+    outs = [bridge.feed(100, bytes([i, 0, 0]), 10, i, t, RX + i) for i, t in enumerate(times)]
+    published = [(i, p.mapping) for i, out in enumerate(outs) for p in out]
+    # at once at 10.0; the one held at 10.24 out at its slot 10.25, with the next feed (10.26); the one held at
+    # 10.48 at its slot 10.5, with the transfer of 10.5 (before it: that one is held in turn)
+    assert published == [(0, "level"), (13, "level"), (25, "level")]
+    assert outs[13][0].cdr == codec.CODECS["level"][0](bytes([12, 0, 0]), RX + 12, _Stats())[0]
+    assert outs[25][0].cdr == codec.CODECS["level"][0](bytes([24, 0, 0]), RX + 24, _Stats())[0]
+    last = bridge.finish()
+    assert [p.mapping for p in last] == ["level"] and bridge.finish() == []
+    assert last[0].cdr == codec.CODECS["level"][0](bytes([29, 0, 0]), RX + 29, _Stats())[0]
+    st = bridge.stats()["mappings"]
+    assert st["level"]["published"] == 4 and st["level"]["dropped"] == {"rate_limited": 26}
+    assert st["level_raw"]["published"] == 0 and st["level_raw"]["dropped"] == {"disabled": 30}
