@@ -41,7 +41,7 @@ class VehicleView:
     """Subscribes on ``node`` (an rclpy Node of the main job); ``lines()`` renders the view."""
 
     def __init__(self, node: Any, tables: TablesModule, *, topics: dict[str, Any], diagnostics: dict[str, Any],
-                 hosted: list[str], truth_file: Path | None) -> None:
+                 hosted: list[str], truth_file: Path | None, frame_prefix: str = "") -> None:
         from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Path as PathMsg
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -49,6 +49,7 @@ class VehicleView:
 
         self.tables, self.topics, self.diagnostics = tables, topics, diagnostics
         self.hosted, self.truth_file = hosted, truth_file
+        self.frame_prefix = frame_prefix  # the vehicle's (sam1/): its frames on the shared /tf
         self.tf = TfBuffer()
         self.goal: Any = None
         self.plan: Any = None
@@ -122,7 +123,8 @@ class VehicleView:
     def lines(self) -> list[str]:
         out = [f"  {'VEHICLE':14} {'estimate (world -> base_link, sensors)':44} true (simulator)"]
         try:
-            tr = self.tf.lookup("world", "base_link", now_ns=time.time_ns(), max_age_s=TF_MAX_AGE_S)
+            tr = self.tf.lookup(self.frame_prefix + "world", self.frame_prefix + "base_link", now_ns=time.time_ns(),
+                                max_age_s=TF_MAX_AGE_S)
             ex, ey, ez = tr.translation
             yaw = euler_from_quaternion(tr.rotation)[2]
             est: dict[str, float] | None = {"x": ex, "y": ey, "depth": -ez, "yaw": yaw}

@@ -90,13 +90,13 @@ class Mission(MissionBase):
         stamp = self.get_clock().now().to_msg()
         if g.kind == "pose":
             msg = PoseStamped()
-            msg.header.stamp, msg.header.frame_id = stamp, "world"
+            msg.header.stamp, msg.header.frame_id = stamp, self.frame("world")
             msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = g.x, g.y, g.z
             msg.pose.orientation.w = 1.0
             self.publish_nav_goal(msg)
         else:
             heading = HeadingStamped(heading=g.heading, z=g.z)
-            heading.header.stamp, heading.header.frame_id = stamp, "world"
+            heading.header.stamp, heading.header.frame_id = stamp, self.frame("world")
             self.publish_nav_heading(heading)
         if not again:
             self.started_at = t
