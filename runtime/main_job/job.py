@@ -482,6 +482,7 @@ def run(opts: RunOptions) -> int:
         if opts.record is not None:
             children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
                                                 "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
+                                                *ns_args[:2],
                                                 *(["--layout", opts.layout] if opts.layout else []),
                                                 *(["--package", opts.package] if opts.package else [])],
                                    env, log_dir / "recorder.log"))
