@@ -36,8 +36,10 @@ from sam_runtime.cli_support import (
     EXIT_OK,
     EXIT_USAGE,
     add_generated_args,
+    add_namespace_args,
     add_transport_args,
     generated_package,
+    namespace_of,
     parse_params,
     require_runtime,
     serve,
@@ -95,12 +97,24 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
     _add_wire_arg(p)
+    add_namespace_args(p)
     p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
     return p
 
 
+def _namespace_or_exit(prog: str, args: argparse.Namespace) -> Any:
+    """The RosNamespace of the command line, or None after printing why it is not valid."""
+    try:
+        return namespace_of(args)
+    except ValueError as ex:
+        print(f"{prog}: {ex}", file=sys.stderr)
+        return None
+
+
 def bridge_main(argv: Sequence[str] | None = None) -> int:
     args = _bridge_parser().parse_args(argv)
+    if (namespace := _namespace_or_exit("sam-bridge", args)) is None:
+        return EXIT_USAGE
     require_runtime("bridge")
     stay_with_parent()
     setup_logging(args.log_level)
@@ -124,10 +138,11 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             dronecan_iface=args.dronecan_iface,
             dronecan_options={"time_sync": args.time_sync, "dna_server": args.dna_server},
             wire=args.wire,
+            namespace=namespace,
         )
         await bridge.start()
         print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
-              f"wire={bridge.wire}", flush=True)
+              f"wire={bridge.wire} namespace={namespace.namespace}", flush=True)
         try:
             deadline = None if args.duration is None else time.monotonic() + args.duration
             while not stop.is_set():
@@ -169,6 +184,9 @@ def _sim_parser() -> argparse.ArgumentParser:
                    help="heartbeats at once, but publish only once this file exists (for scripted tests)")
     p.add_argument("--record", type=Path, default=None, help="JSON lines of every message sent and received")
     p.add_argument("--report", type=Path, default=None, help="write the counters as JSON here at exit")
+    p.add_argument("--namespace", default=None, metavar="NS",
+                   help="the vehicle's ROS namespace, as the main job gives every child; the devices have no ROS "
+                        "side, so it only labels the READY line (their bus is --dronecan-iface / the transport)")
     _add_vehicle_args(p)
     return p
 
@@ -228,6 +246,9 @@ def _vehicle_options(args: argparse.Namespace) -> dict[str, Any]:
 
 def sim_main(argv: Sequence[str] | None = None) -> int:
     args = _sim_parser().parse_args(argv)
+    args.frame_prefix = None
+    if (namespace := _namespace_or_exit("sam-sim", args)) is None:
+        return EXIT_USAGE
     require_runtime("sim")
     stay_with_parent()
     setup_logging(args.log_level)
@@ -246,7 +267,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
         )
         sim = Simulator(generated_package(args), cfg)
         await sim.start()
-        print(f"READY sim devices={len(sim.devices)} transport={kind}", flush=True)
+        print(f"READY sim devices={len(sim.devices)} transport={kind} namespace={namespace.namespace}", flush=True)
         try:
             if args.start_file is not None:
                 while not args.start_file.exists() and not stop.is_set():
@@ -308,11 +329,14 @@ def _nodes_parser() -> argparse.ArgumentParser:
     _add_mission_args(p)
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
     p.add_argument("--log-level", default="INFO")
+    add_namespace_args(p, ros_args=True)
     return p
 
 
 def nodes_main(argv: Sequence[str] | None = None) -> int:
     args = _nodes_parser().parse_args(argv)
+    if (namespace := _namespace_or_exit("sam-nodes", args)) is None:
+        return EXIT_USAGE
     require_runtime("nodes")
     stay_with_parent()
     setup_logging(args.log_level)
@@ -337,13 +361,14 @@ def nodes_main(argv: Sequence[str] | None = None) -> int:
         print("sam-nodes: --goal/--mission need the mission node, which is not run", file=sys.stderr)
         return EXIT_USAGE
     try:
-        host = NodeHost(gen, plan, params_file=args.params_file, goals=goals)
+        host = NodeHost(gen, plan, params_file=args.params_file, goals=goals, namespace=namespace,
+                        ros_args=args.ros_args)
     except HostConfigError as ex:
         print(f"sam-nodes: {ex}", file=sys.stderr)
         return EXIT_ERROR
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: host.stop())
-    print(f"READY nodes {','.join(plan.run)} params={host.params_file}", flush=True)
+    print(f"READY nodes {','.join(plan.run)} params={host.params_file} namespace={namespace.namespace}", flush=True)
     try:
         host.spin(args.duration)
     finally:
@@ -384,6 +409,7 @@ def _run_parser() -> argparse.ArgumentParser:
     p.add_argument("--ros-prefix", type=Path, default=None,
                    help="install prefix of the generated ROS package (default: the running venv)")
     p.add_argument("--log-level", default="WARNING")
+    add_namespace_args(p)
     _add_vehicle_args(p, main_job=True)
     return p
 
@@ -408,6 +434,7 @@ def run_main(argv: Sequence[str] | None = None) -> int:
     try:
         _mission_goals(args)  # a bad mission file stops here, before anything starts
         sim_args = _sim_vehicle_argv(args)
+        namespace = namespace_of(args)
     except (MissionError, ValueError) as ex:
         print(f"sam-run: {ex}", file=sys.stderr)
         return EXIT_USAGE
@@ -422,7 +449,7 @@ def run_main(argv: Sequence[str] | None = None) -> int:
         window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
         argv=list(sys.argv[1:] if argv is None else argv), nodes=args.nodes, node_args=node_args,
         sim_args=sim_args, truth_file=args.truth_file, layout=args.layout, dronecan_iface=args.dronecan_iface,
-        wire=args.wire, record=args.record,
+        wire=args.wire, record=args.record, namespace=namespace,
     ))
 
 

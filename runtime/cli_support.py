@@ -119,6 +119,27 @@ def add_transport_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--log-level", default="INFO")
 
 
+def add_namespace_args(p: argparse.ArgumentParser, ros_args: bool = False) -> None:
+    """``--namespace`` and ``--frame-prefix`` (sam_runtime.common.ros_namespace); ``ros_args`` adds ``--ros-args``
+    (whose ``-r __ns:=NS`` sets the namespace too)."""
+    p.add_argument("--namespace", default=None, metavar="NS",
+                   help="the vehicle's ROS namespace (e.g. /sam1): the spec's relative topics resolve under it, "
+                        "absolute ones (and /tf, /tf_static, /diagnostics) stay global; also --ros-args -r "
+                        "__ns:=NS (default /)")
+    p.add_argument("--frame-prefix", default=None, metavar="PREFIX",
+                   help="before every frame id (tf2 convention: sam1/base_link); default: the namespace without "
+                        "its leading '/' plus '/' ('' for none)")
+    if ros_args:
+        p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the nodes")
+
+
+def namespace_of(args: argparse.Namespace) -> Any:
+    """The RosNamespace of ``add_namespace_args`` options (ValueError: one line)."""
+    from sam_runtime.common.ros_namespace import ros_namespace
+
+    return ros_namespace(args.namespace, getattr(args, "ros_args", None) or (), args.frame_prefix)
+
+
 def transport_kind(args: argparse.Namespace) -> str:
     if args.transport:
         return str(args.transport)

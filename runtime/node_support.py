@@ -15,7 +15,9 @@
   ``publish_static_transforms`` build the TFMessages.
 - Health: ``NodeSupport`` publishes the node's DiagnosticStatus on /diagnostics (at once on ``report`` and at
   1 Hz of wall time), counts and logs what would otherwise be lost (a subscriber callback that raised, a message
-  nobody handles, a rejected transform) without ending the node.
+  nobody handles, a rejected transform) without ending the node. A node in a namespace names its status with
+  it (``sam1/controller``: /diagnostics is global, two vehicles must stay apart there).
+- Namespaces: ``frame_prefix_of`` the prefix a node puts before its frame ids (sam_runtime.common.ros_namespace).
 
 rclpy and the message packages are imported when a function needs them, so the module imports anywhere.
 """
@@ -32,6 +34,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from sam_codegen.model.names import ros_parameter_name
+from sam_runtime.common.ros_namespace import ros_namespace
 from sam_runtime.tf_buffer import TfBuffer, TfError
 
 __all__ = [
@@ -44,11 +47,13 @@ __all__ = [
     "RuleSpec",
     "declare_parameters",
     "feed_tf",
+    "frame_prefix_of",
     "publish_static_transforms",
     "publish_transform",
     "qos_profile",
     "ros_parameter_name",
     "stamp_to_ns",
+    "status_name",
 ]
 
 DIAGNOSTICS_TOPIC = "/diagnostics"
@@ -376,15 +381,16 @@ def publish_transform(publisher: Any, parent: str, child: str, stamp: Any, trans
 
 
 def publish_static_transforms(node: Any, transforms: Sequence[tuple[str, str, Sequence[float], Sequence[float]]],
-                              topic: str, qos: Any) -> Any:
+                              topic: str, qos: Any, frame_prefix: str = "") -> Any:
     """Publish (parent, child, translation, rotation xyzw) static transforms once, in one TFMessage (a latched
-    topic keeps one message per publisher), stamped now; returns the publisher (keep it: it serves late
-    subscribers)."""
+    topic keeps one message per publisher), stamped now, every frame id after ``frame_prefix``; returns the
+    publisher (keep it: it serves late subscribers)."""
     from tf2_msgs.msg import TFMessage
 
     now = node.get_clock().now().nanoseconds
     publisher = node.create_publisher(TFMessage, topic, qos)
-    publisher.publish(TFMessage(transforms=[_transform_stamped(p, c, now, t, r) for p, c, t, r in transforms]))
+    publisher.publish(TFMessage(transforms=[_transform_stamped(frame_prefix + p, frame_prefix + c, now, t, r)
+                                            for p, c, t, r in transforms]))
     return publisher
 
 
@@ -426,6 +432,20 @@ def feed_tf(node: Any, buffer: TfBuffer, support: NodeSupport, tf_topic: str, tf
             static_topic: str | None = None, static_qos: Any = None) -> TfFeed:
     """Subscribe `buffer` to the TF topics (static_topic None: only dynamic transforms)."""
     return TfFeed(node, buffer, support, tf_topic, tf_qos, static_topic, static_qos)
+
+
+# ---- namespaces ---------------------------------------------------------------------------------------------------
+
+
+def frame_prefix_of(node: Any, frame_prefix: str | None = None) -> str:
+    """The frame prefix of a node: ``frame_prefix`` checked (``a/b`` -> ``a/b/``), or by default its namespace's
+    (``/sam1`` -> ``sam1/``, ``/`` -> ``""``); ValueError for an invalid one."""
+    return ros_namespace(node.get_namespace(), (), frame_prefix).frame_prefix
+
+
+def status_name(node: Any) -> str:
+    """A node's diagnostic status name: its name, after its namespace when it has one (``sam1/controller``)."""
+    return ros_namespace(node.get_namespace()).status_name(node.get_name())
 
 
 # ---- health ------------------------------------------------------------------------------------------------------
@@ -506,7 +526,7 @@ class NodeSupport:
                       f"{self._errors_since_report[-1]}"
         values = [KeyValue(key=str(k), value=str(v)) for k, v in self.values.items()]
         values += [KeyValue(key=k, value=str(v)) for k, v in sorted(self.counters.items())]
-        return DiagnosticStatus(level=bytes([int(level)]), name=self.node.get_name(), message=message,
+        return DiagnosticStatus(level=bytes([int(level)]), name=status_name(self.node), message=message,
                                 hardware_id=self.node.get_fully_qualified_name(), values=values)
 
     def publish(self) -> None:

@@ -197,7 +197,7 @@ CASES: tuple[Case, ...] = (
         '  /valve: {type: std_msgs/UInt8}',
         '  /valve/: {type: std_msgs/UInt8}',
         (
-            "minimal.yaml:26:3: error: topic name '/valve/' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:26:3: error: topic name '/valve/' is not a valid ROS name: it ends with '/' (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
             "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
             "minimal.yaml:67:17: error: node valve_control publishes undeclared topic '/valve' (expected a topic of `topics`)",
         ),
@@ -639,6 +639,56 @@ CASES: tuple[Case, ...] = (
         '      topic: /level\n      enable_service: ~/enable_valve\n',
         (
             "minimal.yaml:55:5: error: enable_service '~/enable_valve' of mapping 'valve' is also that of 'level' (line 45) (expected one service per mapping)",
+        ),
+    ),
+    Case(
+        'relative_topic_empty_segment',
+        '  /valve: {type: std_msgs/UInt8}',
+        '  core//valve: {type: std_msgs/UInt8}',
+        (
+            "minimal.yaml:26:3: error: topic name 'core//valve' is not a valid ROS name: it has an empty segment ('//') (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
+            "minimal.yaml:67:17: error: node valve_control publishes undeclared topic '/valve' (expected a topic of `topics`)",
+        ),
+    ),
+    Case(
+        'relative_topic_leading_digit',
+        '  /valve: {type: std_msgs/UInt8}',
+        '  2core/valve: {type: std_msgs/UInt8}',
+        (
+            "minimal.yaml:26:3: error: topic name '2core/valve' is not a valid ROS name: segment '2core' starts with a digit (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
+            "minimal.yaml:67:17: error: node valve_control publishes undeclared topic '/valve' (expected a topic of `topics`)",
+        ),
+    ),
+    Case(
+        'relative_topic_private',
+        '  /valve: {type: std_msgs/UInt8}',
+        '  ~/valve: {type: std_msgs/UInt8}',
+        (
+            "minimal.yaml:26:3: error: topic name '~/valve' is not a valid ROS name: private names ('~') are not supported (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
+            "minimal.yaml:67:17: error: node valve_control publishes undeclared topic '/valve' (expected a topic of `topics`)",
+        ),
+    ),
+    Case(
+        'relative_topic_substitution',
+        '  /valve: {type: std_msgs/UInt8}',
+        '  "{node}/valve": {type: std_msgs/UInt8}',
+        (
+            "minimal.yaml:26:3: error: topic name '{node}/valve' is not a valid ROS name: substitutions ('{...}') are not supported (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:54:5: error: mapping 'valve' uses undeclared topic '/valve' (expected a topic of `topics`)",
+            "minimal.yaml:67:17: error: node valve_control publishes undeclared topic '/valve' (expected a topic of `topics`)",
+        ),
+    ),
+    Case(
+        'relative_parameter_leading_digit',
+        '  /warn_level: {type',
+        '  warn/2level: {type',
+        (
+            "minimal.yaml:28:3: error: parameter name 'warn/2level' is not a valid ROS name: segment '2level' starts with a digit (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
+            "minimal.yaml:31:5: error: parameter rule names unknown parameter '/warn_level'",
+            "minimal.yaml:64:18: error: node logger reads undeclared parameter '/warn_level' (expected a parameter of `parameters`)",
         ),
     ),
 )

@@ -268,4 +268,23 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:4:27: error: ros.topics_message Topics would have no constant: the spec has no topics (expected topics, or no ros.topics_message)",
         ),
     ),
+    Case(
+        "parameter_shadows_the_frame_helpers",
+        (("  /alarm_level:", "  /frame: {type: integer, default: 1}\n  frame_prefix: {type: bool, default: false}\n  /alarm_level:"),
+         (VALVE_CONTROL, "  valve_control:\n    subscribes: [/level]\n    publishes: [/valve]\n    parameters: [/alarm_level, /frame, frame_prefix]\n")),
+        (
+            "minimal.yaml:70:32: error: node valve_control: parameter /frame would be frame, which shadows rclpy's Node.frame or the generated base's own (expected another name)",
+            "minimal.yaml:70:40: error: node valve_control: parameter frame_prefix would be frame_prefix, which shadows rclpy's Node.frame_prefix or the generated base's own (expected another name)",
+        ),
+    ),
+    Case(
+        "relative_and_absolute_topic_same_identifier",
+        ((TOPICS_END, TOPICS_END + "  gauge/level: {type: std_msgs/Bool}\n  /gauge/level: {type: std_msgs/Bool}\n"),
+         (VALVE_CONTROL, "  valve_control:\n    subscribes: [/level, gauge/level, /gauge/level]\n    publishes: [/valve]\n    parameters: [/alarm_level]\n")),
+        (
+            "minimal.yaml:68:26: error: node valve_control subscribes to gauge/level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
+            "minimal.yaml:68:39: error: node valve_control subscribes to /gauge/level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
+            "minimal.yaml:68:39: error: node valve_control: subscribing /gauge/level and subscribing gauge/level would both be on_gauge_level in the generated base (expected names that stay distinct as Python identifiers)",
+        ),
+    ),
 )

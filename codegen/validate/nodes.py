@@ -54,7 +54,7 @@ RCLPY_NODE_ATTRIBUTES = frozenset({
     "services", "set_descriptor", "set_parameters", "set_parameters_atomically", "subscriptions", "timers",
     "undeclare_parameter", "wait_for_node", "waitables",
 })
-BASE_ATTRIBUTES = frozenset({"tf", "report_status", "NODE_NAME"})
+BASE_ATTRIBUTES = frozenset({"tf", "report_status", "NODE_NAME", "frame", "frame_prefix"})
 
 
 # ---- names ---------------------------------------------------------------------------------------------------

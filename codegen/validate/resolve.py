@@ -15,6 +15,7 @@ from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.ros_names import NAME_RULES, ros_name_problem
 from sam_codegen.model.spec import Constant, DsdlService, DsdlStruct, Field, RosMessage, RosService, Spec, V0Struct
 from sam_codegen.model.types import (
     DSDL_NAMESPACE_COMPONENT,
@@ -23,7 +24,6 @@ from sam_codegen.model.types import (
     ROS_FIELD_NAME,
     ROS_MESSAGE_NAME,
     ROS_PACKAGE_NAME,
-    ROS_TOPIC_NAME,
     DsdlType,
     RosType,
     is_dsdl_identifier,
@@ -41,7 +41,6 @@ from sam_codegen.validate.topics_message import topics_message
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
-_PARAM_NAME = ROS_TOPIC_NAME
 _CONVERTER_LOCALS = frozenset({"src", "msg", "stats", "receive_ns", "us", "stamp", "typing", "collections"})
 # Types inside types: the cycle check, the layouts and the codecs walk them recursively, a few frames a level, and
 # a spec whose YAML is flat can still chain thousands. ROS's own messages nest at most ~6 levels.
@@ -261,8 +260,8 @@ class _Validator:
             if t.publisher not in s.nodes:
                 self.error(t.pos, f"transform {t.parent}->{t.child} is published by unknown node {t.publisher!r}")
         for p in s.parameters.values():
-            if not _PARAM_NAME.fullmatch(p.name):
-                self.error(p.pos, f"parameter name {p.name!r} is not a valid ROS name", "/name")
+            if (why := ros_name_problem(p.name)) is not None:
+                self.error(p.pos, f"parameter name {p.name!r} is not a valid ROS name: {why}", NAME_RULES)
         for rule in s.parameter_rules:
             left, right = s.parameters.get(rule.left), s.parameters.get(rule.right)
             for name, param in ((rule.left, left), (rule.right, right)):
@@ -283,9 +282,8 @@ class _Validator:
     def check_topics_and_nodes(self) -> None:
         s = self.spec
         for topic in s.topics.values():
-            if not ROS_TOPIC_NAME.fullmatch(topic.name):
-                self.error(topic.pos, f"topic name {topic.name!r} is not a valid ROS name",
-                           "/segment[/segment...], each a letter or underscore then letters, digits, underscores")
+            if (why := ros_name_problem(topic.name)) is not None:
+                self.error(topic.pos, f"topic name {topic.name!r} is not a valid ROS name: {why}", NAME_RULES)
             if "/" not in topic.type:
                 self.error(topic.pos, f"topic {topic.name} type {topic.type!r} needs its package", "pkg/Name")
             elif self.ros.get(topic.type) is None:

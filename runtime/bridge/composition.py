@@ -28,6 +28,7 @@ from sam_runtime.bridge.silence import SilenceWatch
 from sam_runtime.bridge.switches import EnableServices, switches_of
 from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 from sam_runtime.genpkg import GeneratedPackage
 
@@ -65,6 +66,10 @@ class Bridge:
         message's CDR and back, with raw ROS publishers and subscriptions and the backend's transport-level ports;
         ``object``: the object converters between the protocol library's message objects and ROS messages (the
         readable reference; also taken, with a warning, when the generated package has no codecs).
+    :param namespace: the vehicle's namespace and frame prefix (sam_runtime.common.ros_namespace): the ROS nodes
+        are created in it, so the spec's relative topics resolve there; the frame prefix goes before every
+        frame_id the bridge writes and the namespace before its diagnostic statuses' names. A non-empty frame
+        prefix takes the object path: the wire codecs carry the spec's frame ids in their constant bytes.
     """
 
     def __init__(
@@ -86,9 +91,15 @@ class Bridge:
         dronecan_iface: str = "mcast-lo:",
         dronecan_options: Mapping[str, Any] | None = None,
         wire: str = "codec",
+        namespace: RosNamespace | None = None,
     ) -> None:
         if wire not in WIRE_PATHS:
             raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
+        self.namespace = namespace or RosNamespace()
+        if self.namespace.frame_prefix and wire == "codec":
+            log.info("frame prefix %r: the object path (the wire codecs hold the spec's frame ids)",
+                     self.namespace.frame_prefix)
+            wire = "object"
         self.wire = wire
         self.gen = gen
         self.tables = tables = gen.tables()
@@ -119,7 +130,8 @@ class Bridge:
         self._dronecan_options = dict(dronecan_options or {})
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
                            rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
-                           qos_depth=qos_depth, command_reliability=command_reliability)
+                           qos_depth=qos_depth, command_reliability=command_reliability,
+                           namespace=self.namespace.node_namespace)
         self.health = DeviceHealth(sel.devices, self.node_id)
         self.backend.on_device_status(self.health.on_status)
         self.link = LinkSupervisor(self.lifetime, self.backend)
@@ -186,6 +198,7 @@ class Bridge:
 
         self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss, sel.mappings,
                                                              codec), self.ros, backend)
+        inbound.frame_prefix = self.namespace.frame_prefix
         self.outbound = outbound = Outbound(lifetime, out_mappings(self.gen, convert, self.counters, sel.mappings,
                                                                    codec),
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
@@ -199,9 +212,9 @@ class Bridge:
                                alive_since=health.alive_since, last_message=inbound.last_message,
                                listening_since=lambda: link.up_since)
         self.reporter = reporter = Reporter(
-            lifetime, self.name, sel.mappings, self.counters, backend=backend, health=health, link=link,
-            inbound=inbound, outbound=outbound, silence=silence, ros=self.ros, period=self._diagnostics_period,
-            switches=self.switches)
+            lifetime, self.namespace.status_name(self.name), sel.mappings, self.counters, backend=backend,
+            health=health, link=link, inbound=inbound, outbound=outbound, silence=silence, ros=self.ros,
+            period=self._diagnostics_period, switches=self.switches)
         health.add_handler(self._on_health)
         link.add_handler(lambda _event: reporter.publish_now())
         silence.add_handler(reporter.publish_now)

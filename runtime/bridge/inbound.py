@@ -104,6 +104,7 @@ class Inbound:
         self.lifetime = lifetime
         self._ros, self._backend = ros, backend
         self.groups = {g.port_id: g for g in groups}
+        self.frame_prefix = ""  # before every frame id written (sam_runtime.common.ros_namespace); object path only
         for g in groups:
             g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
             g.any_source = any(getattr(im.info, "any_node", False) for im in g.mappings)
@@ -247,6 +248,8 @@ class Inbound:
             hdr = out.header
             if not hdr.frame_id and im.info.frame_id:
                 hdr.frame_id = im.info.frame_id
+            if self.frame_prefix and hdr.frame_id:
+                hdr.frame_id = self.frame_prefix + hdr.frame_id
             if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
                 hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
             stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec

@@ -38,7 +38,7 @@ class RosSide:
 
     def __init__(self, lifetime: Lifetime, name: str, *, ros_args: Sequence[str] = (), parameters: Sequence[Any] = (),
                  rules: Sequence[Any] = (), overrides: Mapping[str, Any] | None = None, qos_depth: int | None = None,
-                 command_reliability: str | None = None) -> None:
+                 command_reliability: str | None = None, namespace: str | None = None) -> None:
         if command_reliability not in (None, "reliable", "best_effort"):
             raise BridgeConfigError(f"command_reliability must be reliable or best_effort, not {command_reliability!r}")
         self.lifetime = lifetime
@@ -48,6 +48,7 @@ class RosSide:
         self._overrides = dict(overrides or {})
         self.qos_depth = None if qos_depth is None else int(qos_depth)
         self.command_reliability = command_reliability
+        self.namespace = namespace  # the node's (None: "/" or an __ns remap in ros_args); relative topics resolve there
         self.context: Any = None
         self.node: Any = None
         self.clock: Any = None
@@ -75,7 +76,7 @@ class RosSide:
         cli_args = None
         if self._ros_args:
             cli_args = self._ros_args if self._ros_args[0] == "--ros-args" else ["--ros-args", *self._ros_args]
-        self.node = Node(self.name, context=self.context, cli_args=cli_args)
+        self.node = Node(self.name, namespace=self.namespace, context=self.context, cli_args=cli_args)
         self.clock = self.node.get_clock()
         self.ros_time_active = bool(self.clock.ros_time_is_active)
         self.node.add_post_set_parameters_callback(self._after_set_parameters)

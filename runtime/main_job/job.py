@@ -56,6 +56,7 @@ from sam_codegen.project.workspace import (
 )
 from sam_runtime.bridge.layout import protocols_in_use
 from sam_runtime.cli_support import PARENT_ENV_VAR
+from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
 from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError, ensure_ros_package
 from sam_runtime.main_job.demo import demo_message
@@ -99,6 +100,7 @@ class RunOptions:
     dronecan_iface: str = "mcast-lo:"
     wire: str = "codec"  # the bridges' path: the generated wire codecs, or "object" (the object converters)
     record: Path | None = None  # an MCAP file: the recorder (sam-codegen record) runs as one more child
+    namespace: Any = None  # sam_runtime.common.ros_namespace.RosNamespace: the bridge's, the nodes' and the view's
 
 
 # ============================================================================================ formatting
@@ -191,7 +193,7 @@ class LiveView:
     Its ROS node is ``<bridge>_monitor`` (the name it always had)."""
 
     def __init__(self, tables: TablesModule, gen: Any, *, window: float = 2.0, demo_commands: bool = False,
-                 hosted: list[str] | None = None, truth_file: Path | None = None) -> None:
+                 hosted: list[str] | None = None, truth_file: Path | None = None, namespace: Any = None) -> None:
         import rclpy
         from diagnostic_msgs.msg import DiagnosticArray
         from rclpy.node import Node
@@ -201,7 +203,8 @@ class LiveView:
         self.tables, self.window = tables, window
         self.ctx = rclpy.Context()
         rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node(f"{tables.BRIDGE_NAME}_monitor", context=self.ctx)
+        self.namespace = namespace or RosNamespace()
+        self.node = Node(f"{tables.BRIDGE_NAME}_monitor", namespace=self.namespace.node_namespace, context=self.ctx)
         best_effort = QoSProfile(depth=50, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.BEST_EFFORT)
         self.topics: dict[str, _TopicState] = {}
         for m in tables.MAPPINGS:
@@ -222,7 +225,7 @@ class LiveView:
         self.view = None
         if hosted:
             self.view = VehicleView(self.node, tables, topics=self.topics, diagnostics=self.diagnostics,
-                                    hosted=hosted, truth_file=truth_file)
+                                    hosted=hosted, truth_file=truth_file, frame_prefix=self.namespace.frame_prefix)
         if demo_commands:
             for m in tables.MAPPINGS:
                 if m.direction == ROS_TO_UAVCAN and m.topic.name not in seen:
@@ -240,8 +243,11 @@ class LiveView:
 
     def _on_diag(self, arr: Any) -> None:
         bridge = str(self.tables.BRIDGE_NAME)
+        own = self.namespace.status_name("")  # "" or "sam1/": another vehicle's statuses are not this view's
         for s in arr.status:
-            self.diagnostics[status_key(s.name, bridge)] = {
+            if not s.name.startswith(own):
+                continue
+            self.diagnostics[status_key(s.name[len(own):], bridge)] = {
                 "level": int(s.level[0]) if isinstance(s.level, bytes | bytearray) else int(s.level),
                 "message": s.message, "hardware_id": s.hardware_id,
                 "values": {kv.key: kv.value for kv in s.values}, "at": time.monotonic(),
@@ -463,26 +469,29 @@ def run(opts: RunOptions) -> int:
             say(f"no implementation for node(s) {', '.join(missing)} of the spec"
                 + (f"; hosting {', '.join(hosted)}" if hosted else "; demo commands move the actuators"))
         truth = (opts.truth_file or log_dir / "truth.json").resolve()
-        children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth)],
+        ns_args = opts.namespace.argv() if opts.namespace is not None else []
+        children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth),
+                                       *ns_args[:2]],
                                env, log_dir / "sim.log"))
         layout = opts.layout or tables.DEFAULT_LAYOUT
         protocols = protocols_in_use(tables, layout)
         for proto in protocols if len(protocols) > 1 else [None]:
             name = "bridge" if proto is None else f"bridge_{proto}"
-            children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire,
+            children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire, *ns_args,
                                           *(["--protocol", proto] if proto else [])], env, log_dir / f"{name}.log"))
         if opts.record is not None:
             children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
                                                 "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
+                                                *ns_args[:2],
                                                 *(["--layout", opts.layout] if opts.layout else []),
                                                 *(["--package", opts.package] if opts.package else [])],
                                    env, log_dir / "recorder.log"))
         if hosted:
             gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
-            children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or [])], env,
+            children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or []), *ns_args], env,
                                    log_dir / "nodes.log"))
         live = LiveView(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
-                               truth_file=truth)
+                               truth_file=truth, namespace=opts.namespace)
 
         tty = sys.stdout.isatty() and not opts.plain
         started = time.monotonic()

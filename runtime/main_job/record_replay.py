@@ -40,6 +40,7 @@ from sam_runtime.cli_support import (
     wait_for_stop,
     write_json_atomic,
 )
+from sam_runtime.common.ros_namespace import ros_namespace
 from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
 from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError
 from sam_runtime.recording.reading import read_recording
@@ -65,6 +66,9 @@ def _record_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-bus", dest="bus", action="store_false", help="record the ROS topics only")
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
     p.add_argument("--log-level", default="INFO")
+    p.add_argument("--namespace", default=None, metavar="NS",
+                   help="the vehicle's ROS namespace: the spec's relative topics are recorded under it (channels keep "
+                        "the names as the spec writes them; default /)")
     return p
 
 
@@ -73,7 +77,8 @@ def record_main(argv: Sequence[str] | None = None) -> int:
     require_runtime("run")
     try:
         check_target(args.file)  # before anything starts
-    except RecordingTargetError as ex:
+        namespace = ros_namespace(args.namespace).node_namespace
+    except (RecordingTargetError, ValueError) as ex:
         print(f"sam-record: {ex}", file=sys.stderr)
         return EXIT_ERROR
     stay_with_parent()
@@ -81,7 +86,8 @@ def record_main(argv: Sequence[str] | None = None) -> int:
 
     async def run(stop: asyncio.Event) -> int:
         rec = Recorder(generated_package(args), RecorderConfig(args.file, layout=args.layout, iface=args.iface,
-                                                               dronecan_iface=args.dronecan_iface, bus=args.bus))
+                                                               dronecan_iface=args.dronecan_iface, bus=args.bus,
+                                                               namespace=namespace))
         summary: dict[str, Any] = {}
         try:
             await rec.start()

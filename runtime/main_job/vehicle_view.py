@@ -41,7 +41,7 @@ class VehicleView:
     """Subscribes on ``node`` (an rclpy Node of the main job); ``lines()`` renders the view."""
 
     def __init__(self, node: Any, tables: TablesModule, *, topics: dict[str, Any], diagnostics: dict[str, Any],
-                 hosted: list[str], truth_file: Path | None) -> None:
+                 hosted: list[str], truth_file: Path | None, frame_prefix: str = "") -> None:
         from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Path as PathMsg
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -49,6 +49,7 @@ class VehicleView:
 
         self.tables, self.topics, self.diagnostics = tables, topics, diagnostics
         self.hosted, self.truth_file = hosted, truth_file
+        self.frame_prefix = frame_prefix  # the vehicle's (sam1/): its frames on the shared /tf
         self.tf = TfBuffer()
         self.goal: Any = None
         self.plan: Any = None
@@ -57,19 +58,20 @@ class VehicleView:
         reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        names = {t.name: t for t in tables.TOPICS}
+        # SAM's topics by their names, absolute or (a spec for a namespaced vehicle) relative: /nav_goal or nav_goal
+        names = {"/" + t.name.lstrip("/"): t for t in tables.TOPICS}
         self._subs = [node.create_subscription(TFMessage, "/tf", lambda m: self._on_tf(m, False),
                                                QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)),
                       node.create_subscription(TFMessage, "/tf_static", lambda m: self._on_tf(m, True), latched)]
         if "/nav_goal" in names:
-            self._subs.append(node.create_subscription(PoseStamped, "/nav_goal", self._on_goal, reliable))
+            self._subs.append(node.create_subscription(PoseStamped, names["/nav_goal"].name, self._on_goal, reliable))
         if "/global_plan" in names:
-            self._subs.append(node.create_subscription(PathMsg, "/global_plan", self._on_plan, reliable))
+            self._subs.append(node.create_subscription(PathMsg, names["/global_plan"].name, self._on_plan, reliable))
         for topic, cb, qos in (("/nav_heading", self._on_goal, reliable), ("/abort", self._on_abort, latched)):
             if topic in names:
                 t = names[topic]
                 cls = getattr(__import__(t.ros_module, fromlist=[t.ros_class]), t.ros_class)
-                self._subs.append(node.create_subscription(cls, topic, cb, qos))
+                self._subs.append(node.create_subscription(cls, t.name, cb, qos))
 
     # ---------------------------------------------------------------------------------- inputs
     def _on_tf(self, msg: Any, static: bool) -> None:
@@ -115,14 +117,15 @@ class VehicleView:
             return None
 
     def _last(self, topic: str) -> Any:
-        st = self.topics.get(topic)
+        st = self.topics.get(topic) or self.topics.get(topic[1:])  # as the spec writes it: absolute or relative
         return None if st is None else st.last
 
     # ---------------------------------------------------------------------------------- rendering
     def lines(self) -> list[str]:
         out = [f"  {'VEHICLE':14} {'estimate (world -> base_link, sensors)':44} true (simulator)"]
         try:
-            tr = self.tf.lookup("world", "base_link", now_ns=time.time_ns(), max_age_s=TF_MAX_AGE_S)
+            tr = self.tf.lookup(self.frame_prefix + "world", self.frame_prefix + "base_link", now_ns=time.time_ns(),
+                                max_age_s=TF_MAX_AGE_S)
             ex, ey, ez = tr.translation
             yaw = euler_from_quaternion(tr.rotation)[2]
             est: dict[str, float] | None = {"x": ex, "y": ey, "depth": -ez, "yaw": yaw}

@@ -144,8 +144,9 @@ class Planner:
     ``safe_depth``/``safe_altitude``."""
 
     def __init__(self, config: PlannerConfig | None = None, *, safe_depth: float = 50.0,
-                 safe_altitude: float = 5.0) -> None:
+                 safe_altitude: float = 5.0, goal_frame: str = GOAL_FRAME) -> None:
         self.config = config or PlannerConfig()
+        self.goal_frame = goal_frame  # world as the vehicle names it (with its frame prefix: sam1/world)
         self.safe_depth = safe_depth
         self.safe_altitude = safe_altitude
         self.goal: Goal | None = None
@@ -156,7 +157,7 @@ class Planner:
         return GoalDecision(False, reason)
 
     def _check_frame(self, frame_id: str) -> str:
-        return "" if frame_id == GOAL_FRAME else f"goal frame {frame_id!r} is not {GOAL_FRAME!r}"
+        return "" if frame_id == self.goal_frame else f"goal frame {frame_id!r} is not {self.goal_frame!r}"
 
     def set_pose_goal(self, t: float, frame_id: str, x: float, y: float, z: float,
                       orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)) -> GoalDecision:

@@ -46,9 +46,9 @@ class Controller(ControllerBase):
         t = now_s(self)
         poses = [(p.pose.position.x, p.pose.position.y, p.pose.position.z) for p in msg.poses]
         refused = ""
-        if msg.header.frame_id != GOAL_FRAME:
+        if msg.header.frame_id != self.frame(GOAL_FRAME):
             refused = "frame"
-            why = f"plan in frame {msg.header.frame_id!r}, not {GOAL_FRAME!r}"
+            why = f"plan in frame {msg.header.frame_id!r}, not {self.frame(GOAL_FRAME)!r}"
         elif not all(math.isfinite(v) for pose in poses for v in pose):
             refused = "not_finite"
             why = "plan with a non-finite pose"
@@ -75,7 +75,7 @@ class Controller(ControllerBase):
         assert self.tf is not None
         try:
             now_ns = self.get_clock().now().nanoseconds
-            self.tf.lookup("odom", "base_link", now_ns=now_ns, max_age_s=ODOM_MAX_AGE_S)
+            self.tf.lookup(self.frame("odom"), self.frame("base_link"), now_ns=now_ns, max_age_s=ODOM_MAX_AGE_S)
             tr = self.lookup_world_to_base_link(max_age_s=WORLD_MAX_AGE_S)
         except TfError as ex:
             self.pose_problem = str(ex)
@@ -103,7 +103,7 @@ class Controller(ControllerBase):
         buoyancy = PercentStamped(percent=float(c.buoyancy_pct))
         for msg in (rpms, angles, ballast, weight, buoyancy):
             msg.header.stamp = stamp
-            msg.header.frame_id = "base_link"
+            msg.header.frame_id = self.frame("base_link")
         self.publish_thruster_rpms(rpms)
         self.publish_thruster_angles(angles)
         self.publish_ballast_angles(ballast)

@@ -5,6 +5,10 @@ default, so every node declares its parameters with one value), one executor, ea
 small host node publishes the spec's static frames on /tf_static once (latched). The mission node gets its goals
 from ``goals`` (``--goal``/``--mission``; default: the demo mission).
 
+``namespace`` (sam_runtime.common.ros_namespace: ``--namespace``, or ``__ns:=`` among ``ros_args``): every node
+of the host, the host node too, is created in it (the spec's relative topics resolve under it, the parameters file's
+``/**`` still matches) with its frame prefix (the static frames too), so a second vehicle's host can run beside.
+
 Nothing a node does ends the host: subscriber callbacks are guarded by the generated bases, timers by
 :func:`sam_runtime.nodes.common.guarded_timer`; anything else that escapes the executor is counted and logged here
 and the host spins on. It stops on ``stop()`` (the CLI: SIGINT/SIGTERM) or after ``duration``.
@@ -21,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.nav.mission import MissionGoal
 from sam_runtime.nodes import ImplementationError, implemented, load_implementation, unimplemented
 
@@ -68,7 +73,8 @@ class NodeHost:
     """The nodes of ``plan`` in one rclpy context; ``spin`` until stopped, then ``close``."""
 
     def __init__(self, gen: Any, plan: HostPlan, *, params_file: Path | None = None,
-                 goals: tuple[MissionGoal, ...] | None = None, domain_id: int | None = None) -> None:
+                 goals: tuple[MissionGoal, ...] | None = None, domain_id: int | None = None,
+                 namespace: RosNamespace | None = None, ros_args: Sequence[str] = ()) -> None:
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
@@ -81,6 +87,8 @@ class NodeHost:
             raise HostConfigError(f"parameters file {params} does not exist"
                                   + ("" if params_file is not None else " (run `sam-codegen build`)"))
         self.params_file = params
+        self.namespace = ns = namespace or RosNamespace()
+        extra = list(ros_args)[1:] if list(ros_args)[:1] == ["--ros-args"] else list(ros_args)
         classes = {}
         for name in plan.run:
             try:
@@ -88,7 +96,7 @@ class NodeHost:
             except (ImplementationError, ImportError) as ex:
                 raise HostConfigError(f"node {name}: {ex}") from None
         self.ctx = rclpy.Context()
-        rclpy.init(args=["--ros-args", "--params-file", str(params)], context=self.ctx, domain_id=domain_id,
+        rclpy.init(args=["--ros-args", "--params-file", str(params), *extra], context=self.ctx, domain_id=domain_id,
                    signal_handler_options=SignalHandlerOptions.NO)
         self.executor = SingleThreadedExecutor(context=self.ctx)
         self.nodes: dict[str, Any] = {}
@@ -96,12 +104,13 @@ class NodeHost:
         self._last_error_log = -float("inf")
         self._stop = False
         try:
-            self.host_node = Node(f"{self.tables.VEHICLE}_node_host", context=self.ctx)
+            self.host_node = Node(f"{self.tables.VEHICLE}_node_host", namespace=ns.node_namespace, context=self.ctx)
             nodes_package = importlib.import_module(self.tables.NODES_PACKAGE)
-            self.static_publisher = nodes_package.publish_static_transforms(self.host_node)
+            self.static_publisher = nodes_package.publish_static_transforms(self.host_node, ns.frame_prefix)
             self.executor.add_node(self.host_node)
             for name, cls in classes.items():
-                kwargs: dict[str, Any] = {"context": self.ctx}
+                kwargs: dict[str, Any] = {"context": self.ctx, "namespace": ns.node_namespace,
+                                          "frame_prefix": ns.frame_prefix}
                 if name == "mission" and goals is not None:
                     kwargs["goals"] = goals
                 try:

@@ -43,6 +43,11 @@ class Mission(MissionBase):
                                + "; ".join(g.describe() for g in self.goals))
         self.status(Level.OK, "waiting for the motion planner and world -> base_link")
 
+    def _own_topic(self, leaf: str) -> str:
+        """The resolved name of this node's publisher whose last segment is ``leaf`` (/nav_goal, or /sam1/nav_goal
+        in a namespace when the spec names it relative)."""
+        return next((p.topic_name for p in self.publishers if p.topic_name.rsplit("/", 1)[-1] == leaf), "/" + leaf)
+
     @property
     def goal(self) -> MissionGoal:
         return self.goals[self.index]
@@ -60,7 +65,7 @@ class Mission(MissionBase):
         goal = self.goal
         if goal.kind == "pose":
             self.distance = math.hypot(goal.x - x, goal.y - y)
-        planners = self.count_subscribers("/nav_goal" if goal.kind == "pose" else "/nav_heading")
+        planners = self.count_subscribers(self._own_topic("nav_goal" if goal.kind == "pose" else "nav_heading"))
         if self.started_at is None:
             if planners == 0:
                 self.status(Level.OK, "waiting for the motion planner", **self._values(t))
@@ -90,13 +95,13 @@ class Mission(MissionBase):
         stamp = self.get_clock().now().to_msg()
         if g.kind == "pose":
             msg = PoseStamped()
-            msg.header.stamp, msg.header.frame_id = stamp, "world"
+            msg.header.stamp, msg.header.frame_id = stamp, self.frame("world")
             msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = g.x, g.y, g.z
             msg.pose.orientation.w = 1.0
             self.publish_nav_goal(msg)
         else:
             heading = HeadingStamped(heading=g.heading, z=g.z)
-            heading.header.stamp, heading.header.frame_id = stamp, "world"
+            heading.header.stamp, heading.header.frame_id = stamp, self.frame("world")
             self.publish_nav_heading(heading)
         if not again:
             self.started_at = t

@@ -17,7 +17,7 @@ from typing import Any
 from sam_nodes.motion_planner import MotionPlannerBase
 
 from sam_runtime.nav.controller import ControllerPose
-from sam_runtime.nav.motion_planner import Goal, Plan, Planner, PlannerConfig
+from sam_runtime.nav.motion_planner import GOAL_FRAME, Goal, Plan, Planner, PlannerConfig
 from sam_runtime.nodes.common import Level, StatusReporter, guarded_timer, now_s
 from sam_runtime.tf_buffer import TfError, TfStale
 
@@ -40,7 +40,8 @@ def _goal_text(plan: Plan) -> str:
 class MotionPlanner(MotionPlannerBase):
     def __init__(self, *, config: PlannerConfig | None = None, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        self.planner = Planner(config, safe_depth=self.safe_depth, safe_altitude=self.safe_altitude)
+        self.planner = Planner(config, safe_depth=self.safe_depth, safe_altitude=self.safe_altitude,
+                               goal_frame=self.frame(GOAL_FRAME))
         self.altitude = (math.nan, -math.inf)  # (range, time received)
         self.plan: Plan | None = None
         self.published = 0
@@ -126,7 +127,7 @@ class MotionPlanner(MotionPlannerBase):
 
         path = Path()
         path.header.stamp = self.get_clock().now().to_msg()
-        path.header.frame_id = plan.frame_id
+        path.header.frame_id = self.frame(plan.frame_id)
         for x, y, z, qx, qy, qz, qw in plan.poses:
             ps = PoseStamped()
             ps.header = path.header

@@ -71,7 +71,7 @@ class PerformanceMonitor(PerformanceMonitorBase):
 
         msg = Abort(active=bool(active), reason=reason)
         msg.header.stamp = self.get_clock().now().to_msg()
-        msg.header.frame_id = "base_link"
+        msg.header.frame_id = self.frame("base_link")
         self.publish_abort(msg)
         self.aborts_published += 1
 
@@ -84,7 +84,7 @@ class PerformanceMonitor(PerformanceMonitorBase):
         buoyancy = PercentStamped(percent=float(out.buoyancy_pct if out.buoyancy_pct is not None else 100.0))
         for msg in (rpms, buoyancy):
             msg.header.stamp = stamp
-            msg.header.frame_id = "base_link"
+            msg.header.frame_id = self.frame("base_link")
         self.publish_thruster_rpms(rpms)
         self.publish_buoyancy_piston_position(buoyancy)
 

@@ -87,6 +87,8 @@ class RecorderConfig:
     dronecan_iface: str = "mcast-lo:"
     ros: bool = True
     bus: bool = True
+    # the vehicle's ROS namespace (None: /): relative topics are subscribed under it; channels keep the spec's names
+    namespace: str | None = None
 
 
 def layout_protocols(tables: Any, layout: str | None) -> tuple[str, list[str]]:
@@ -269,7 +271,7 @@ class Recorder:
 
         self._ctx = rclpy.Context()
         rclpy.init(args=[], context=self._ctx, signal_handler_options=SignalHandlerOptions.NO)
-        self._node = Node(f"{self.tables.BRIDGE_NAME}_recorder", context=self._ctx)
+        self._node = Node(f"{self.tables.BRIDGE_NAME}_recorder", namespace=self.config.namespace, context=self._ctx)
         for topic, (ros_type, qos) in channels.items():
             pkg, _, cls_name = ros_type.split("/")
             try:

@@ -118,9 +118,10 @@ def test_contract_api(resolved: Resolved, files: dict[str, str]) -> None:
         members = _members(source, cls)
         init = members["__init__"]
         assert isinstance(init, ast.FunctionDef)
-        assert [a.arg for a in init.args.kwonlyargs] == ["node_name", "namespace", "parameter_overrides"]
+        assert [a.arg for a in init.args.kwonlyargs] == ["node_name", "namespace", "parameter_overrides",
+                                                         "frame_prefix"]
         assert init.args.kwarg is not None and init.args.kwarg.arg == "node_kwargs"
-        expected = {"__init__", "report_status"}
+        expected = {"__init__", "report_status", "frame"}
         expected |= {"on_" + t.strip("/").replace("/", "_") for t in node.subscribes}
         expected |= {"publish_" + t.strip("/").replace("/", "_") for t in node.publishes}
         expected |= {p.lstrip("/").replace("/", "_") for p in node.parameters}

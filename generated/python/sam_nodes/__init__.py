@@ -58,12 +58,14 @@ STATIC_TRANSFORMS: tuple[tuple[str, str, Vector, Quaternion], ...] = (
 )
 
 
-def publish_static_transforms(node: Any) -> Any:
-    """Publish STATIC_TRANSFORMS once on /tf_static from `node` (an rclpy Node), stamped now.
+def publish_static_transforms(node: Any, frame_prefix: str = "") -> Any:
+    """Publish STATIC_TRANSFORMS once on /tf_static from `node` (an rclpy Node), stamped now,
+    each frame id after `frame_prefix` (a vehicle's, e.g. ``sam1/``).
 
     Returns the publisher: keep a reference, it serves subscribers that start later (transient local).
     """
     from sam_runtime import node_support
 
     return node_support.publish_static_transforms(
-        node, STATIC_TRANSFORMS, "/tf_static", node_support.qos_profile("reliable", "transient_local", 1))
+        node, STATIC_TRANSFORMS, "/tf_static", node_support.qos_profile("reliable", "transient_local", 1),
+        frame_prefix)

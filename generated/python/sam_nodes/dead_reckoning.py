@@ -9,11 +9,14 @@ frames come from the spec::
         def on_imu(self, msg: Imu) -> None:
             ...
 
-``DeadReckoningBase(*, node_name=None, namespace=None, parameter_overrides=None, **node_kwargs)``: the node is
-named ``dead_reckoning`` unless node_name says otherwise; node_kwargs go to rclpy's Node (context, cli_args,
-...); parameter_overrides ({name: value}, spec or ROS names) win over the node's --params-file values, which
-win over the spec defaults. A value out of range or breaking a rule raises
-sam_runtime.node_support.ParameterConfigError.
+``DeadReckoningBase(*, node_name=None, namespace=None, parameter_overrides=None, frame_prefix=None,
+**node_kwargs)``: the node is named ``dead_reckoning`` unless node_name says otherwise; in ``namespace`` (or
+an ``__ns`` remap) the spec's relative topic names resolve under it, absolute ones stay; node_kwargs go to
+rclpy's Node (context, cli_args, ...); parameter_overrides ({name: value}, spec or ROS names) win over the
+node's --params-file values, which win over the spec defaults. A value out of range or breaking a rule raises
+sam_runtime.node_support.ParameterConfigError. ``frame_prefix`` (default: the node's namespace, ``sam1/`` in
+``/sam1``; ``\"\"`` for none) goes before every frame id the base publishes or looks up; ``self.frame(name)``
+gives a spec frame with it.
 
 Subscriptions (override the method; the default counts and drops; a method that raises is counted, logged and
 shown on /diagnostics, and the node goes on):
@@ -76,8 +79,10 @@ class DeadReckoningBase(Node):
     """Node dead_reckoning: subclass it and override the on_* methods (see the module docstring)."""
 
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
-                 parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
+                 parameter_overrides: Mapping[str, Any] | None = None, frame_prefix: str | None = None,
+                 **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
+        self.frame_prefix = node_support.frame_prefix_of(self, frame_prefix)
         self._gen_support = node_support.NodeSupport(self)
         self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
@@ -138,7 +143,12 @@ class DeadReckoningBase(Node):
     ) -> None:
         """Publish the pose of base_link in odom on /tf (ValueError for a bad value)."""
         node_support.publish_transform(
-            self._gen_pub_tf, "odom", "base_link", stamp, translation, rotation)
+            self._gen_pub_tf, self.frame("odom"), self.frame("base_link"), stamp, translation,
+            rotation)
+
+    def frame(self, name: str) -> str:
+        """A spec frame id as this node writes and looks it up: with the frame prefix (empty stays empty)."""
+        return f"{self.frame_prefix}{name}" if name else name
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""

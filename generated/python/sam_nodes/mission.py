@@ -8,11 +8,14 @@ frames come from the spec::
     class Mission(MissionBase):
         ...
 
-``MissionBase(*, node_name=None, namespace=None, parameter_overrides=None, **node_kwargs)``: the node is named
-``mission`` unless node_name says otherwise; node_kwargs go to rclpy's Node (context, cli_args, ...);
-parameter_overrides ({name: value}, spec or ROS names) win over the node's --params-file values, which win
-over the spec defaults. A value out of range or breaking a rule raises
-sam_runtime.node_support.ParameterConfigError.
+``MissionBase(*, node_name=None, namespace=None, parameter_overrides=None, frame_prefix=None,
+**node_kwargs)``: the node is named ``mission`` unless node_name says otherwise; in ``namespace`` (or an
+``__ns`` remap) the spec's relative topic names resolve under it, absolute ones stay; node_kwargs go to
+rclpy's Node (context, cli_args, ...); parameter_overrides ({name: value}, spec or ROS names) win over the
+node's --params-file values, which win over the spec defaults. A value out of range or breaking a rule raises
+sam_runtime.node_support.ParameterConfigError. ``frame_prefix`` (default: the node's namespace, ``sam1/`` in
+``/sam1``; ``\"\"`` for none) goes before every frame id the base publishes or looks up; ``self.frame(name)``
+gives a spec frame with it.
 
 Subscriptions (override the method; the default counts and drops; a method that raises is counted, logged and
 shown on /diagnostics, and the node goes on):
@@ -66,8 +69,10 @@ class MissionBase(Node):
     """Node mission: subclass it and override the on_* methods (see the module docstring)."""
 
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
-                 parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
+                 parameter_overrides: Mapping[str, Any] | None = None, frame_prefix: str | None = None,
+                 **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
+        self.frame_prefix = node_support.frame_prefix_of(self, frame_prefix)
         self._gen_support = node_support.NodeSupport(self)
         self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
@@ -95,8 +100,12 @@ class MissionBase(Node):
     ) -> tf_buffer.Transform:
         """The pose of base_link in world (raises tf_buffer.TfError subclasses)."""
         assert self.tf is not None
-        return self.tf.lookup("world", "base_link", now_ns=self.get_clock().now().nanoseconds,
-                              max_age_s=max_age_s, time_ns=time_ns)
+        return self.tf.lookup(self.frame("world"), self.frame("base_link"),
+                              now_ns=self.get_clock().now().nanoseconds, max_age_s=max_age_s, time_ns=time_ns)
+
+    def frame(self, name: str) -> str:
+        """A spec frame id as this node writes and looks it up: with the frame prefix (empty stays empty)."""
+        return f"{self.frame_prefix}{name}" if name else name
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""

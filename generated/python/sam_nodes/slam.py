@@ -9,11 +9,14 @@ come from the spec::
         def on_gps_fix(self, msg: NavSatFix) -> None:
             ...
 
-``SlamBase(*, node_name=None, namespace=None, parameter_overrides=None, **node_kwargs)``: the node is named
-``slam`` unless node_name says otherwise; node_kwargs go to rclpy's Node (context, cli_args, ...);
-parameter_overrides ({name: value}, spec or ROS names) win over the node's --params-file values, which win
-over the spec defaults. A value out of range or breaking a rule raises
-sam_runtime.node_support.ParameterConfigError.
+``SlamBase(*, node_name=None, namespace=None, parameter_overrides=None, frame_prefix=None, **node_kwargs)``:
+the node is named ``slam`` unless node_name says otherwise; in ``namespace`` (or an ``__ns`` remap) the spec's
+relative topic names resolve under it, absolute ones stay; node_kwargs go to rclpy's Node (context, cli_args,
+...); parameter_overrides ({name: value}, spec or ROS names) win over the node's --params-file values, which
+win over the spec defaults. A value out of range or breaking a rule raises
+sam_runtime.node_support.ParameterConfigError. ``frame_prefix`` (default: the node's namespace, ``sam1/`` in
+``/sam1``; ``\"\"`` for none) goes before every frame id the base publishes or looks up; ``self.frame(name)``
+gives a spec frame with it.
 
 Subscriptions (override the method; the default counts and drops; a method that raises is counted, logged and
 shown on /diagnostics, and the node goes on):
@@ -68,8 +71,10 @@ class SlamBase(Node):
     """Node slam: subclass it and override the on_* methods (see the module docstring)."""
 
     def __init__(self, *, node_name: str | None = None, namespace: str | None = None,
-                 parameter_overrides: Mapping[str, Any] | None = None, **node_kwargs: Any) -> None:
+                 parameter_overrides: Mapping[str, Any] | None = None, frame_prefix: str | None = None,
+                 **node_kwargs: Any) -> None:
         super().__init__(node_name or NODE_NAME, namespace=namespace, **node_kwargs)
+        self.frame_prefix = node_support.frame_prefix_of(self, frame_prefix)
         self._gen_support = node_support.NodeSupport(self)
         self._gen_parameters = node_support.declare_parameters(
             self, PARAMETERS, RULES, overrides=parameter_overrides, partners=PARTNERS)
@@ -93,15 +98,20 @@ class SlamBase(Node):
     ) -> tf_buffer.Transform:
         """The pose of base_link in odom (raises tf_buffer.TfError subclasses)."""
         assert self.tf is not None
-        return self.tf.lookup("odom", "base_link", now_ns=self.get_clock().now().nanoseconds,
-                              max_age_s=max_age_s, time_ns=time_ns)
+        return self.tf.lookup(self.frame("odom"), self.frame("base_link"),
+                              now_ns=self.get_clock().now().nanoseconds, max_age_s=max_age_s, time_ns=time_ns)
 
     def publish_world_to_odom(
         self, stamp: Any, translation: tuple[float, float, float], rotation: tuple[float, float, float, float]
     ) -> None:
         """Publish the pose of odom in world on /tf (ValueError for a bad value)."""
         node_support.publish_transform(
-            self._gen_pub_tf, "world", "odom", stamp, translation, rotation)
+            self._gen_pub_tf, self.frame("world"), self.frame("odom"), stamp, translation,
+            rotation)
+
+    def frame(self, name: str) -> str:
+        """A spec frame id as this node writes and looks it up: with the frame prefix (empty stays empty)."""
+        return f"{self.frame_prefix}{name}" if name else name
 
     def report_status(self, level: int, message: str, **values: Any) -> None:
         """Publish this node's DiagnosticStatus on /diagnostics now (repeated every second until the next)."""

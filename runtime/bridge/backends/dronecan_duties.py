@@ -100,7 +100,8 @@ class DroneCanDuties:
 
         self._loop = asyncio.get_running_loop()
         base = self.ros.name
-        self._node = node = Node(f"{base}_dronecan_duties", context=self.ros.context)
+        self._node = node = Node(f"{base}_dronecan_duties", namespace=self.ros.node.get_namespace(),
+                                 context=self.ros.context)
         for nid, name in sorted(self.devices.items()):
             node.create_service(Trigger, f"/{base}/{name}/get_node_info", _service(self._get_node_info, nid))
             node.create_service(Trigger, f"/{base}/{name}/restart", _service(self._restart, nid))
