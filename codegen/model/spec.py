@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import Final, Literal
 
 from sam_codegen.model.diagnostics import NOWHERE, Pos
+from sam_codegen.model.expr import ExprSource, UavcanExpr
 from sam_codegen.model.types import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
@@ -316,6 +317,7 @@ class FieldLink:
     limits: tuple[float, float] | None = None
     pos: Pos = NOWHERE
     round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
+    expr: ExprSource | None = None  # `{expr: "..."}`: the ROS field computed from UAVCAN fields (model.expr)
 
 
 @dataclass(frozen=True)
@@ -340,6 +342,10 @@ class Mapping:
     destination_node_ids: list[int] = field(default_factory=list)
     select: dict[str, Scalar] = field(default_factory=dict)
     select_pos: Pos = NOWHERE
+    # ROS -> UAVCAN: UAVCAN fields computed from ROS fields (model.expr); UAVCAN -> ROS: the ROS fields that keep
+    # their type's default (0, false, empty) on purpose (every other ROS field must be written).
+    uavcan_exprs: list[UavcanExpr] = field(default_factory=list)
+    ros_defaults: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)

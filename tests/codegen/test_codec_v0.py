@@ -41,7 +41,8 @@ from hypothesis import strategies as st
 
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml",
-         "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml"}
+         "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",
+         "relay": ROOT / "tests" / "specs" / "relay.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
@@ -298,7 +299,10 @@ if not WORKER:
 
         generated = tmp_path / "generated"  # built afresh: the codecs of the generator as it is
         build(SPECS[spec], generated)
-        prefix = built_prefix(ros_packages_in_order(ROOT / "generated" / "ros"))  # SAM's messages (others: installed)
+        packages = ros_packages_in_order(ROOT / "generated" / "ros")  # SAM's messages (others: installed)
+        if spec == "relay":  # and relay.yaml's own (its LightsCommand mapping takes a relay_msgs/Led)
+            packages = [*packages, *ros_packages_in_order(generated / "ros")]
+        prefix = built_prefix(packages)
         config = {"spec": str(SPECS[spec]), "generated": str(generated)}
         proc = run_child(["-m", "pytest", __file__, "-q", "-p", "no:cacheprovider", "--rootdir", str(ROOT),
                           "-W", "error::RuntimeWarning"], prefix, domain_id(70 + sorted(SPECS).index(spec)),
