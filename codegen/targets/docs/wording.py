@@ -213,7 +213,8 @@ def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
             rows.append({"ros": format_path(list(fs.path)), "arrow": arrow, "uavcan": None, "conversion": text})
     rows.extend(link_row(link) for link in links)
     for name in m.ros_defaults:  # kept at the type's default on purpose
-        rows.append({"ros": name, "arrow": "", "uavcan": None, "conversion": "default (0, false, empty) where nothing writes it"})
+        rows.append({"ros": name, "arrow": "", "uavcan": None,
+                     "conversion": "default (0, false, empty) where nothing writes it"})
     for fs in plan.uavcan_fields:
         if isinstance(fs.op, SetConstant) and not fs.op.select:
             rows.append({"ros": None, "arrow": arrow, "uavcan": format_path(list(fs.path)),
