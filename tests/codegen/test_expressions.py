@@ -286,8 +286,9 @@ def _plan(resolved: Any, name: str) -> Any:
 
 def test_relay_plan(relay: Any) -> None:
     """Class 1: int(data) of a bool, into a float16: evaluated as a float, nothing to check (0 and 1 fit).
-    Class 3: the colour fields saturate... no: the mapping rejects, each a Clamp into uint5/uint6 after the
-    trunc(). Class 2: the leak predicate is a bool, nothing after it."""
+    Class 3: the lights mapping rejects what does not fit, each colour a Clamp into uint5 / uint6 after the
+    trunc() (min(..., 31) bounds blue above: only its low bound is checked). Class 2: the leak predicate is a bool,
+    nothing after it."""
     (relay_link,) = _plan(relay, "relay_dvl").to_uavcan
     assert [type(op) for op in relay_link.ops] == [Evaluate] and relay_link.ops[0].as_float
     lights = {link.step.uavcan: link for link in _plan(relay, "lights").to_uavcan}
@@ -405,3 +406,27 @@ def test_relay_codecs_run(relay: Any, tmp_path: Path) -> None:
     bits = int.from_bytes(codec.rail_ros_to_wire(CDR + struct.pack("<f", 300.0), stats), "little")
     assert (bits & 1, bits >> 1 & 0x7F, bits >> 8 & 0x3FFFF) == (1, 127, 2**17 - 1)
     assert codec.rail_ros_to_wire(CDR + struct.pack("<f", float("nan")), stats) is None
+
+
+@pytest.mark.parametrize(("value", "expected", "saturations"), [
+    (200000.0, 131071, 1), (-1e30, -131072, 2), (1500.7, 1500, 0), (float("inf"), 131071, 2)])
+def test_out_of_range_commands_saturate_never_wrap(value: float, expected: int, saturations: int) -> None:
+    """200000 rpm into an int18 is 131071 (a wrapping bridge sends -62144 and reverses the thruster); the trunc()
+    of what int64 cannot hold (an infinity too) saturates into int64 first, then into int18. Each is counted."""
+    from sam_codegen.conversion_plan import lower_expr
+    from sam_codegen.targets.python.statements import Assign, check_statements
+
+    node = typed("trunc(x * 2) >> 1")
+    ops = lower_expr(node, DsdlType("int", 18), reject=False)
+    assert ops[1:] == [Clamp("integer", -131072, 131071, False)]
+    writer = ExpressionWriter(lambda path: f"env[{path[0][0]!r}]", LocalNames(set()), "'k'", False)
+    text = writer.write(node)
+    statements = [*writer.statements, Assign("v", text), *check_statements("v", ops, "'k'")]
+    draft = FunctionDraft("f", ["env", "stats"], "Any", ["The command."], statements=statements,
+                          result=["return v"])
+    body = environment().from_string('{% import "python/statements.j2" as s %}{{ s.function(f) }}').render(f=draft)
+    namespace: dict[str, Any] = {}
+    exec(body, {}, namespace)
+    stats = _Stats()
+    assert namespace["f"]({"x": value}, stats) == expected
+    assert len(stats.saturated) == saturations
