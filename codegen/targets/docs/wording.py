@@ -160,9 +160,9 @@ def describe_expression(link: LinkPlan, op: Evaluate) -> str:
     """An expression link: the expression in the spec's syntax, then what can happen to its value."""
     target = str(link.step.ros_type) if link.to_ros else str(link.step.uavcan_type)
     notes: list[str] = []
-    if link.has(RejectNaN):
-        notes.append("NaN rejected")
     calls = _calls(op.tree)
+    if link.has(RejectNaN) or calls & {"trunc", "round"}:
+        notes.append("NaN rejected")
     if calls & {"trunc", "round"}:
         notes.append(" and ".join(sorted(calls & {"trunc", "round"})) + " beyond int64 "
                      + _policy(link, "saturated"))
