@@ -153,6 +153,8 @@ class _Parser:
         if kind == "number":
             self.i += 1
             number = float(value) if any(c in value for c in ".eE") else int(value)
+            if number in (float("inf"), float("-inf")):
+                raise ExprSyntaxError(f"the number {value} is beyond a float64", col)
             return PNum(number, col)
         if kind == "op" and value in ("true", "false"):
             self.i += 1

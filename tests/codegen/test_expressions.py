@@ -87,6 +87,7 @@ def test_precedence_and_spelling(text: str, spelled: str) -> None:
     ("min(a)", "min() takes 2 arguments, not 1", 0),
     ("a + ", "expected a field, a number or '(', found the end", 3),
     ("x % 2", "unexpected '%' (write trunc() or a shift)", 2),
+    ("x * 1e999", "the number 1e999 is beyond a float64", 4),
 ])
 def test_syntax_errors_say_where(text: str, message: str, col: int) -> None:
     with pytest.raises(ExprSyntaxError) as exc:
@@ -430,3 +431,24 @@ def test_out_of_range_commands_saturate_never_wrap(value: float, expected: int, 
     stats = _Stats()
     assert namespace["f"]({"x": value}, stats) == expected
     assert len(stats.saturated) == saturations
+
+
+ALPHABET = st.sampled_from(list("ab xyfrs()+-*/<>=!.,[]0123456789_e") + ["and", "or", "not", "trunc(", "min(",
+                                                                         "int(", "true", "<<", ">>", "=="])
+
+
+@settings(max_examples=400, deadline=None, database=None)
+@given(st.lists(ALPHABET, max_size=40).map("".join))
+def test_any_text_parses_or_is_a_syntax_error(text: str) -> None:
+    """No spec text makes the parser or the checker raise anything but their own errors (never a traceback)."""
+    try:
+        tree = parse_expr(text)
+    except ExprSyntaxError as exc:
+        assert 0 <= exc.col <= max(len(text), 0) and exc.message
+        return
+    try:
+        node = check_expr(tree, _resolve)
+    except ExprError as exc:
+        assert 0 <= exc.col <= len(text) and exc.message
+        return
+    assert typed(spell(node)) == node  # what it says is what it reads
