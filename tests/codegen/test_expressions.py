@@ -306,13 +306,14 @@ def test_relay_plan(relay: Any) -> None:
 
 
 def test_relay_docs_rows(relay: Any) -> None:
-    rows = {row["uavcan"] or row["ros"]: row["conversion"]
+    """The interface reference words an expression in the spec's syntax, beside the fields it reads."""
+    rows = {(row["ros"], row["uavcan"]): row["conversion"]
             for name in ("relay_dvl", "lights", "leak")
             for row in field_rows(next(rm for rm in relay.dronecan_mappings if rm.mapping.name == name))}
-    assert rows["commands[actuator_id=7].command_value"] == "= int(data) → float16"
-    assert rows["commands[light_id=1].color.red"] == \
+    assert rows[("data", "commands[actuator_id=7].command_value")] == "= int(data) → float16"
+    assert rows[("a, r", "commands[light_id=1].color.red")] == \
         "= trunc(a * r * 255) >> 3 → uint5 (NaN rejected, trunc beyond int64 rejected, beyond uint5 rejected)"
-    assert rows["data"] == "= position == 100 → bool"
+    assert rows[("data", "position")] == "= position == 100 → bool"
 
 
 def _package(tmp_path: Path, resolved: Any) -> Any:

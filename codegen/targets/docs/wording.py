@@ -44,7 +44,7 @@ from sam_codegen.conversion_plan import (
     lower_link,
     lower_mapping,
 )
-from sam_codegen.model.expr import EBinary, ECall, ENode, EUnary, spell
+from sam_codegen.model.expr import EBinary, ECall, ENode, EUnary, fields_of, spell
 from sam_codegen.model.spec import Scalar
 from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step, format_path
@@ -199,7 +199,9 @@ def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
         for fs in plan.uavcan_fields if isinstance(fs.op, SetConstant) and fs.op.select]
 
     def link_row(link: LinkPlan) -> dict[str, object]:
-        return {"ros": link.step.ros, "arrow": arrow, "uavcan": link.step.uavcan or None,
+        step = link.step
+        reads = ", ".join(f.text for f in fields_of(step.expr)) if step.expr is not None else ""  # an expression's
+        return {"ros": step.ros or reads or None, "arrow": arrow, "uavcan": step.uavcan or reads or None,
                 "conversion": describe_link(link)}
 
     links = list(plan.to_ros if to_ros else plan.to_uavcan)
