@@ -434,8 +434,8 @@ def test_out_of_range_commands_saturate_never_wrap(value: float, expected: int, 
     assert len(stats.saturated) == saturations
 
 
-ALPHABET = st.sampled_from(list("ab xyfrs()+-*/<>=!.,[]0123456789_e") + ["and", "or", "not", "trunc(", "min(",
-                                                                         "int(", "true", "<<", ">>", "=="])
+ALPHABET = st.sampled_from([*"ab xyfrs()+-*/<>=!.,[]0123456789_e", "and", "or", "not", "trunc(", "min(", "int(",
+                            "true", "<<", ">>", "=="])
 
 
 @settings(max_examples=400, deadline=None, database=None)
