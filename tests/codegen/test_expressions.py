@@ -312,7 +312,7 @@ def test_relay_docs_rows(relay: Any) -> None:
             for row in field_rows(next(rm for rm in relay.dronecan_mappings if rm.mapping.name == name))}
     assert rows[("data", "commands[actuator_id=7].command_value")] == "= int(data) → float16"
     assert rows[("a, r", "commands[light_id=1].color.red")] == \
-        "= trunc(a * r * 255) >> 3 → uint5 (NaN rejected, trunc beyond int64 rejected, beyond uint5 rejected)"
+        "= trunc(a * r * 255) >> 3 → uint5 (NaN rejected, trunc beyond int64 rejected, out of range rejected)"
     assert rows[("data", "position")] == "= position == 100 → bool"
 
 

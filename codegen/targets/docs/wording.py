@@ -166,8 +166,8 @@ def describe_expression(link: LinkPlan, op: Evaluate) -> str:
     if calls & {"trunc", "round"}:
         notes.append(" and ".join(sorted(calls & {"trunc", "round"})) + " beyond int64 "
                      + _policy(link, "saturated"))
-    if link.has(Clamp):
-        notes.append(f"beyond {target} " + _policy(link, "saturated"))
+    if link.has(Clamp):  # into the target's range, worded as every other link's
+        notes.append("out of range rejected" if link.reject else "saturating")
     return f"= {spell(op.tree)} → {target}" + (f" ({', '.join(notes)})" if notes else "")
 
 
