@@ -3,7 +3,8 @@
 `lower_mapping(rm)` decides, for both converters of a mapping (UAVCAN -> ROS and ROS -> UAVCAN), what each link
 does to its value, in order: scale and offset, representation changes, NaN rejection, rounding, clamping with its
 policy (saturate or reject; finite-only for float32, infinities too for float16, round-into-range for float ->
-integer), padding, cutting, tables, timestamps and constants. The renderers only word it: targets.python (through
+integer), padding, cutting, tables, timestamps and constants, and mapping expressions (Evaluate: a typed tree of
+model.expr, followed by the same checks into the target field). The renderers only word it: targets.python (through
 its statements) turns the operations into statements, the wire codecs do the same with their own reads and
 writes, and targets.docs words the same operations in the interface reference. Nothing here knows Python syntax.
 

@@ -1,5 +1,8 @@
 """Bridge mappings: each `ros_field: uavcan_field` line resolved against both types and the conversion rules,
-and the check that every UAVCAN field of a mapping is mapped, ignored or given a value."""
+and the check that every UAVCAN field of a mapping is mapped, ignored or given a value. Mapping expressions
+(`{expr: ...}` lines, `uavcan_exprs`) are type-checked by validate.expressions against the paths resolved here;
+in a UAVCAN -> ROS mapping every ROS field is written (a link, a value, an expression, the bridge's header) or
+listed in `ros_defaults`."""
 
 from __future__ import annotations
 
