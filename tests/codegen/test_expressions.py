@@ -225,6 +225,7 @@ def run_generated(node: ENode, env: dict[str, Any], reject: bool) -> tuple[Any, 
     draft = FunctionDraft("f", ["env", "stats"], "Any", ["The expression."], statements=writer.statements,
                           result=[f"return {text}"])
     body = environment().from_string('{% import "python/statements.j2" as s %}{{ s.function(f) }}').render(f=draft)
+    assert max(len(line) for line in body.splitlines()) <= 110, body  # long expressions are split into locals
     namespace: dict[str, Any] = {}
     divide = _support_divide()
     exec(body, {"_support": type("S", (), {"divide": staticmethod(divide)})}, namespace)
@@ -242,7 +243,9 @@ def _support_divide() -> Any:
 
 EXPRESSIONS = ["a * r >> 3", "trunc(x * s) >> 2", "round(x / y) - a", "min(trunc(x), a) + max(b, 3)",
                "f or x > 0.5 and not f", "y == 100", "int(f) * 2 - b", "x / (a - 3)", "trunc(s / x)",
-               "abs(a) << 4", "-x * 2.5 + s"]
+               "abs(a) << 4", "-x * 2.5 + s",
+               "max(trunc(x * s / (y + 1.5)) >> 3, min(a * r * b, abs(a - b) << 2)) - round(s / 2) * int(f or "
+               "y >= 0.25 and x != s)"]
 FLOATS = st.one_of(st.floats(allow_nan=True, allow_infinity=True, width=32), st.sampled_from([0.0, -0.0, 100.0]))
 
 
@@ -393,14 +396,16 @@ def test_relay_codecs_run(relay: Any, tmp_path: Path) -> None:
     assert (msg.commands[0].color.red, msg.commands[0].color.green, msg.commands[0].color.blue) == (31, 63, 31)
     assert stats.saturated["led.commands[light_id=0].color.red"] == 1
     assert stats.rejected == {"lights.commands[light_id=1].color.red": 1}
-    # Cyphal: hull_leak = flooded or water_mm > 40 and pressure_pa >= 1.5e5; hull_depth saturates into int16
-    def hull(water: int, pressure: float, flooded: bool) -> bytes:
+    # Cyphal: hull_leak = flooded or probes[1] or water_mm > 40 and pressure_pa >= 1.5e5; hull_depth saturates into int16
+    def hull(water: int, pressure: float, flooded: bool, probe: bool = False) -> bytes:
         bits = (water & 0xFFF) | struct.unpack("<I", struct.pack("<f", pressure))[0] << 12 | int(flooded) << 44
-        return bits.to_bytes(6, "little")
+        return (bits | int(probe) << 46).to_bytes(6, "little")  # probes[0..2] at bits 45..47
 
     assert codec.hull_leak_wire_to_ros(hull(41, 2e5, False), 0, stats)[0][:5] == CDR + b"\x01"
     assert codec.hull_leak_wire_to_ros(hull(41, 1e5, False), 0, stats)[0][:5] == CDR + b"\x00"
     assert codec.hull_leak_wire_to_ros(hull(-5, 0.0, True), 0, stats)[0][:5] == CDR + b"\x01"
+    assert codec.hull_leak_wire_to_ros(hull(0, 0.0, False, probe=True), 0, stats)[0][:5] == CDR + b"\x01"
+    assert codec.hull_leak_wire_to_ros(hull(0, 0.0, False), 0, stats)[0][:5] == CDR + b"\x00"
     assert codec.hull_depth_wire_to_ros(hull(10, 981.0, False), 0, stats)[0][:6] == CDR + struct.pack("<h", 100 - 20)
     assert codec.hull_depth_wire_to_ros(hull(0, 1e9, False), 0, stats)[0][:6] == CDR + struct.pack("<h", 32767)
     assert stats.saturated["hull_depth.data"] == 1

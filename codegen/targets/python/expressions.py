@@ -31,6 +31,8 @@ from sam_codegen.targets.python.statements import Assign, Bound, NanReject, Stat
 __all__ = ["ExpressionWriter"]
 
 _INT64_EDGE = py_literal(float(2**63))  # the first float beyond int64 (and -it the last one in it)
+LINE_BUDGET = 60  # an operator's operands together (the statement's target and indentation fit beside them)
+HOIST_OVER = 20  # an operand longer than this is bound to a local when they do not fit
 
 
 class ExpressionWriter:
@@ -53,23 +55,39 @@ class ExpressionWriter:
             return f"({text})" if mine < parent else text
         assert isinstance(node, EBinary)
         if node.op == "div" and node.divisor_may_be_zero:
-            return f"_support.divide({self.write(node.left)}, {self.write(node.right)})"
+            return "_support.divide(" + ", ".join(self.fit([self.write(node.left), self.write(node.right)])) + ")"
         mine = precedence(node.op)
         left = mine + 1 if node.op in ("eq", "ne", "lt", "le", "gt", "ge") else mine  # Python chains comparisons
         right = mine + 1
         if node.op == "or":  # `a and b` inside `or` in parentheses (ruff's RUF021: the precedence made clear)
             left = right = precedence("and") + 1
-        text = f"{self.write(node.left, left)} {SPELLING[node.op]} {self.write(node.right, right)}"
+        a, b = self.fit([self.write(node.left, left), self.write(node.right, right)])
+        text = f"{a} {SPELLING[node.op]} {b}"
         return f"({text})" if mine < parent else text
+
+    def fit(self, parts: list[str]) -> list[str]:
+        """Operands whose text together passes LINE_BUDGET: the longer ones bound to locals first (expressions have
+        no side effects and raise nothing, so evaluating an operand early changes no result), so that every
+        generated line stays within the line limit."""
+        if sum(len(p) for p in parts) <= LINE_BUDGET:
+            return parts
+        out = []
+        for part in parts:
+            if len(part) > HOIST_OVER:
+                var = self.names.new("e")
+                self.statements.append(Assign(var, part))
+                part = var
+            out.append(part)
+        return out
 
     def call(self, node: ECall) -> str:
         if node.func in ("trunc", "round"):
             var = self.names.new(node.func)
-            self.statements.append(Assign(var, self.write(node.args[0])))
+            self.statements.append(Assign(var, self.fit([self.write(node.args[0])])[0]))
             self.statements.append(NanReject(var, self.key))
             edge = _INT64_EDGE
             checks = ((f"{var} >= {edge}", str(INT64[1])), (f"{var} < -{edge}", str(INT64[0])))
             convert = "int" if node.func == "trunc" else "round"  # int() truncates toward zero
             self.statements.append(Bound(var, checks, self.key, self.reject, f"{var} = {convert}({var})"))
             return var
-        return f"{node.func}(" + ", ".join(self.write(a) for a in node.args) + ")"
+        return f"{node.func}(" + ", ".join(self.fit([self.write(a) for a in node.args])) + ")"
