@@ -396,7 +396,8 @@ def test_relay_codecs_run(relay: Any, tmp_path: Path) -> None:
     assert (msg.commands[0].color.red, msg.commands[0].color.green, msg.commands[0].color.blue) == (31, 63, 31)
     assert stats.saturated["led.commands[light_id=0].color.red"] == 1
     assert stats.rejected == {"lights.commands[light_id=1].color.red": 1}
-    # Cyphal: hull_leak = flooded or probes[1] or water_mm > 40 and pressure_pa >= 1.5e5; hull_depth saturates into int16
+    # Cyphal: hull_leak = flooded or probes[1] or water_mm > 40 and pressure_pa >= 1.5e5;
+    # hull_depth saturates into int16
     def hull(water: int, pressure: float, flooded: bool, probe: bool = False) -> bytes:
         bits = (water & 0xFFF) | struct.unpack("<I", struct.pack("<f", pressure))[0] << 12 | int(flooded) << 44
         return (bits | int(probe) << 46).to_bytes(6, "little")  # probes[0..2] at bits 45..47
