@@ -545,6 +545,39 @@ CASES: tuple[Case, ...] = (
             'minimal.yaml:23:5: error: a mapping key must be a plain scalar',
         ),
     ),
+    # Issue 17: mapping expressions on Cyphal.
+    Case(
+        'expr_cyphal_float_into_uint8',
+        '      fields:\n        data: open_pct\n',
+        '      fields: {}\n      uavcan_exprs: {open_pct: "data * 2.5"}\n',
+        (
+            "minimal.yaml:60:33: error: mapping 'valve', UAVCAN field 'open_pct': open_pct is uint8, the expression gives a float (write trunc(...) or round(...))",
+        ),
+    ),
+    Case(
+        'expr_cyphal_unknown_ros_field',
+        '      fields:\n        data: open_pct\n',
+        '      fields: {}\n      uavcan_exprs: {open_pct: "round(level * 2.5)"}\n',
+        (
+            "minimal.yaml:60:39: error: mapping 'valve', UAVCAN field 'open_pct': unknown field: std_msgs/UInt8 has no field 'level'",
+        ),
+    ),
+    Case(
+        'expr_cyphal_syntax_in_uavcan_exprs',
+        '      fields:\n        data: open_pct\n',
+        '      fields: {}\n      uavcan_exprs:\n        open_pct: "min(data, 100"\n',
+        (
+            "minimal.yaml:61:33: error: the expression of UAVCAN field 'open_pct' in uavcan_exprs of mapping 'valve': expected ')' or ',', found the end",
+        ),
+    ),
+    Case(
+        'expr_cyphal_into_time',
+        '        header.stamp: timestamp.microsecond\n',
+        '        header.stamp: {expr: "timestamp.microsecond + 1"}\n',
+        (
+            "minimal.yaml:52:31: error: mapping 'level', field 'header.stamp': an expression sets a bool or numeric scalar, header.stamp is builtin_interfaces/Time",
+        ),
+    ),
 )
 
 
