@@ -112,7 +112,8 @@ def _tables_and_classes(generated: Path, topics: list[str]) -> tuple[dict[str, t
     from sam_runtime.genpkg import GeneratedPackage
 
     gen = GeneratedPackage(generated)
-    by_topic = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
+    tables = gen.tables()
+    by_topic = {m.topic.name: m.topic for m in [*tables.MAPPINGS, *getattr(tables, "DRONECAN_MAPPINGS", ())]}
     missing = [t for t in topics if t not in by_topic]
     if missing:
         raise SystemExit(f"topics not in the generated tables: {missing}")
@@ -224,7 +225,8 @@ def publish(args: argparse.Namespace) -> int:
             items = plan["topics"][t]
             if i < len(items):
                 msg = _fill(classes[t](), items[i])
-                msg.header.stamp = node.get_clock().now().to_msg()
+                if hasattr(msg, "header"):  # (a message without a header, std_msgs/Bool, is sent as it is)
+                    msg.header.stamp = node.get_clock().now().to_msg()
                 pubs[t].publish(msg)
                 sent[t] += 1
         delay = t0 + (i + 1) * period - time.monotonic()
