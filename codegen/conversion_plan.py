@@ -3,7 +3,8 @@
 `lower_mapping(rm)` decides, for both converters of a mapping (UAVCAN -> ROS and ROS -> UAVCAN), what each link
 does to its value, in order: scale and offset, representation changes, NaN rejection, rounding, clamping with its
 policy (saturate or reject; finite-only for float32, infinities too for float16, round-into-range for float ->
-integer), padding, cutting, tables, timestamps and constants. The renderers only word it: targets.python (through
+integer), padding, cutting, tables, timestamps and constants, and mapping expressions (Evaluate: a typed tree of
+model.expr, followed by the same checks into the target field). The renderers only word it: targets.python (through
 its statements) turns the operations into statements, the wire codecs do the same with their own reads and
 writes, and targets.docs words the same operations in the interface reference. Nothing here knows Python syntax.
 
@@ -17,6 +18,7 @@ import re
 from dataclasses import dataclass
 from typing import Final, Literal
 
+from sam_codegen.model.expr import ENode
 from sam_codegen.model.spec import Scalar
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from sam_codegen.validate.mapping_rules import Key, PathSeg, ResolvedMapping, Step
@@ -296,8 +298,18 @@ class RequireLength:
     length: int
 
 
+@dataclass(frozen=True)
+class Evaluate:
+    """The value is an expression of source fields (model.expr's typed tree; its trunc()/round() check their own
+    range with the link's policy); `as_float`: an int result stored into a float field. The checks after it
+    (RejectNaN for a float result, Clamp into the target) follow as for any value."""
+
+    tree: ENode
+    as_float: bool
+
+
 Op = (Convert | Scale | Offset | RejectNaN | Limits | Clamp | Round | Table | TimestampToRos | TimestampFromRos
-      | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | SetConstant)
+      | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | SetConstant | Evaluate)
 EXPRESSION_OPS = (Convert, Scale, Offset)  # pure arithmetic on the value; everything else may drop or fix it
 CHECK_OPS = (RejectNaN, Limits, Clamp, Round)
 
@@ -431,7 +443,46 @@ def _convert(src: str, dst: str) -> list[Op]:
     return [Convert(src, dst)] if src != dst else []
 
 
+def expr_target(t: DsdlType | RosType) -> DsdlType:
+    """The DSDL scalar whose range an expression's value must fit into a field of type `t` (ROS or DSDL).
+
+    >>> str(expr_target(RosType("int16"))), str(expr_target(RosType("uint8"))), expr_target(RosType("float64")).bits
+    ('int16', 'uint8', 64)
+    """
+    if isinstance(t, DsdlType):
+        return t
+    if t.base == "bool":
+        return DsdlType("bool", 1)
+    if t.base in ROS_FLOAT_BITS:
+        return DsdlType("float", ROS_FLOAT_BITS[t.base])
+    lo, hi = ROS_INT_RANGES[t.base]
+    return DsdlType("int" if lo < 0 else "uint", (hi - lo).bit_length())
+
+
+def lower_expr(tree: ENode, target: DsdlType, reject: bool) -> list[Op]:
+    """An expression into a target scalar: evaluated, a NaN result dropped, then into the target's range.
+
+    >>> from sam_codegen.model.expr import EField
+    >>> lower_expr(EField((("p", None),), "p", DsdlType("int", 7), "int", (-64, 63)), DsdlType("uint", 5), False)[1:]
+    [Clamp(mode='integer', low=0, high=31, reject=False)]
+    """
+    as_float = target.kind == "float" and tree.kind == "int"
+    ops: list[Op] = [Evaluate(tree, as_float)]
+    if tree.kind == "bool":
+        return ops
+    if tree.kind == "float":
+        ops.append(RejectNaN())
+    ops += [op for op in range_ops(tree.kind == "float", tree.range, target, None, reject)
+            if not isinstance(op, RejectNaN)]
+    return ops
+
+
 def _lower_to_ros(s: Step, reject: bool) -> list[Op]:
+    if s.kind == "expr":
+        if s.uavcan_path:  # a ROS -> UAVCAN expression: nothing to say towards ROS
+            return []
+        assert s.expr is not None
+        return lower_expr(s.expr, expr_target(s.ros_type), reject)
     if s.kind == "value":
         return [SetConstant(s.value)]  # type: ignore[arg-type]
     uav = s.uavcan_type
@@ -464,6 +515,9 @@ def _lower_to_ros(s: Step, reject: bool) -> list[Op]:
 def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
     uav = s.uavcan_type
     assert uav is not None
+    if s.kind == "expr":
+        assert s.expr is not None
+        return lower_expr(s.expr, uav, reject)
     if s.kind == "time":
         lo, hi = uav.range
         return [TimestampFromRos(hi if TIME_US_MAX_FROM_ROS > hi else None, lo if TIME_US_MIN < lo else None,
@@ -530,7 +584,7 @@ def lower_mapping(rm: ResolvedMapping) -> MappingPlan:
             required.append(RequireLength(array_path, max(uses) + 1))
     return MappingPlan(
         name=m.name, direction=m.direction, reject=reject, ros_fields=tuple(ros_fields),
-        to_ros=tuple(lower_link(s, TO_ROS, m.name, reject) for s in rm.steps),
+        to_ros=tuple(lower_link(s, TO_ROS, m.name, reject) for s in rm.steps if s.ros_path),
         to_uavcan=tuple(lower_link(s, TO_UAVCAN, m.name, reject) for s in rm.steps if s.uavcan_path),
         uavcan_fields=tuple([*(FieldSet(p, t, SetConstant(v)) for p, t, v in rm.uavcan_values),
                              *(FieldSet(p, t, SetConstant(v, select=True)) for p, t, v in rm.select)]),

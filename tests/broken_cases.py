@@ -87,7 +87,7 @@ CASES: tuple[Case, ...] = (
         '      subject_id: 100\n',
         '      subject_id: 100\n      subjectid: 100\n',
         (
-            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(
@@ -214,7 +214,7 @@ CASES: tuple[Case, ...] = (
     Case(
         'required_field_unmapped_to_ros',
         '        level: level_mm\n',
-        '',
+        '        level: {value: 3}\n',
         (
             "minimal.yaml:45:5: error: required field left unmapped: UAVCAN field 'level_mm' (int18) of buoy.Level.0.1 is neither mapped nor ignored in mapping 'level' (expected a `ros_field: level_mm` line or `level_mm` in ignore)",
         ),
@@ -691,6 +691,38 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:64:18: error: node logger reads undeclared parameter '/warn_level' (expected a parameter of `parameters`)",
         ),
     ),
+    Case(
+        'expr_cyphal_float_into_uint8',
+        '      fields:\n        data: open_pct\n',
+        '      fields: {}\n      uavcan_exprs: {open_pct: "data * 2.5"}\n',
+        (
+            "minimal.yaml:60:33: error: mapping 'valve', UAVCAN field 'open_pct': open_pct is uint8, the expression gives a float (write trunc(...) or round(...))",
+        ),
+    ),
+    Case(
+        'expr_cyphal_unknown_ros_field',
+        '      fields:\n        data: open_pct\n',
+        '      fields: {}\n      uavcan_exprs: {open_pct: "round(level * 2.5)"}\n',
+        (
+            "minimal.yaml:60:39: error: mapping 'valve', UAVCAN field 'open_pct': unknown field: std_msgs/UInt8 has no field 'level'",
+        ),
+    ),
+    Case(
+        'expr_cyphal_syntax_in_uavcan_exprs',
+        '      fields:\n        data: open_pct\n',
+        '      fields: {}\n      uavcan_exprs:\n        open_pct: "min(data, 100"\n',
+        (
+            "minimal.yaml:61:33: error: the expression of UAVCAN field 'open_pct' in uavcan_exprs of mapping 'valve': expected ')' or ',', found the end",
+        ),
+    ),
+    Case(
+        'expr_cyphal_into_time',
+        '        header.stamp: timestamp.microsecond\n',
+        '        header.stamp: {expr: "timestamp.microsecond + 1"}\n',
+        (
+            "minimal.yaml:52:31: error: mapping 'level', field 'header.stamp': an expression sets a bool or numeric scalar, header.stamp is builtin_interfaces/Time",
+        ),
+    ),
 )
 
 
@@ -815,7 +847,7 @@ V0_CASES: tuple[Case, ...] = (
         '      data_type: skiff.Bilge\n',
         '      data_type: skiff.Bilge\n      subject_id: 7\n',
         (
-            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, shares_data_type, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, shares_data_type, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(
@@ -881,7 +913,7 @@ V0_CASES: tuple[Case, ...] = (
         '      source_node_ids: [10]\n      fields:\n        data: level_mm\n  dronecan',
         '      source_node_ids: [10]\n      select: {level_mm: 1}\n      fields:\n        data: level_mm\n  dronecan',
         (
-            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(
@@ -1076,6 +1108,128 @@ V0_CASES: tuple[Case, ...] = (
         '      destination_node_ids: [20]\n      max_rate_hz: -1\n',
         (
             "minimal_v0.yaml:71:7: error: max_rate_hz of DroneCAN mapping 'motors' must be positive, found -1 (expected a rate in Hz above 0)",
+        ),
+    ),
+    Case(
+        'expr_unknown_field',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "level_cm * 2"}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:57:5: error: required field left unmapped: UAVCAN field 'level_mm' (int13) of skiff.Bilge is neither mapped nor ignored in DroneCAN mapping 'bilge' (expected a `ros_field: level_mm` line or `level_mm` in ignore)",
+            "minimal_v0.yaml:64:23: error: DroneCAN mapping 'bilge', field 'data': unknown field: skiff.Bilge has no field 'level_cm'",
+        ),
+    ),
+    Case(
+        'expr_bool_into_number',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "level_mm > 3"}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:23: error: DroneCAN mapping 'bilge', field 'data': data is int16, the expression gives a bool (write int(...) for 0 or 1)",
+        ),
+    ),
+    Case(
+        'expr_float_into_integer',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "level_mm * 0.5"}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:23: error: DroneCAN mapping 'bilge', field 'data': data is int16, the expression gives a float (write trunc(...) or round(...))",
+        ),
+    ),
+    Case(
+        'expr_bool_as_number',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "(level_mm > 3) + 1"}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:33: error: DroneCAN mapping 'bilge', field 'data': level_mm > 3 is a bool, not a number (write int(level_mm > 3) for 0 or 1)",
+        ),
+    ),
+    Case(
+        'expr_division_by_zero',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "trunc(level_mm / 0)"}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:38: error: DroneCAN mapping 'bilge', field 'data': division by zero (level_mm / 0)",
+        ),
+    ),
+    Case(
+        'expr_syntax',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "level_mm && 1"}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:32: error: the expression of field 'data' of mapping 'bilge': unexpected '&' (write `and`)",
+        ),
+    ),
+    Case(
+        'expr_with_scale',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "level_mm", scale: 2}\n      ignore: [timestamp]',
+        (
+            "minimal_v0.yaml:64:9: error: field 'data' of mapping 'bilge' has 'expr' and 'scale' (expected 'expr' alone (it says the whole conversion))",
+        ),
+    ),
+    Case(
+        'expr_shift_of_float',
+        '        data: "commands[actuator_id=2].command_value"\n',
+        '        {}\n      uavcan_exprs: {"commands[actuator_id=2].command_value": "data >> 2"}\n',
+        (
+            "minimal_v0.yaml:81:69: error: DroneCAN mapping 'rudder', UAVCAN field 'commands[actuator_id=2].command_value': `>>` shifts integers, data is a float (write trunc() or round() first)",
+        ),
+    ),
+    Case(
+        'expr_shift_by_field',
+        '        data: "commands[actuator_id=2].command_value"\n',
+        '        {}\n      uavcan_exprs: {"commands[actuator_id=2].command_value": "int(data > 0) << trunc(data)"}\n',
+        (
+            "minimal_v0.yaml:81:81: error: DroneCAN mapping 'rudder', UAVCAN field 'commands[actuator_id=2].command_value': the shift amount must be a constant 0..63, not trunc(data)",
+        ),
+    ),
+    Case(
+        'expr_in_ros_to_uavcan_fields',
+        '        data: "commands[actuator_id=2].command_value"\n',
+        '        data: {expr: "x"}\n',
+        (
+            "minimal_v0.yaml:74:5: error: required field left unmapped: UAVCAN field 'commands[actuator_id=2].command_value' (float16) of uavcan.equipment.actuator.ArrayCommand gets no value in DroneCAN mapping 'rudder' (expected a `ros_field: commands[actuator_id=2].command_value` line or an entry in uavcan_values)",
+            "minimal_v0.yaml:80:9: error: DroneCAN mapping 'rudder', field 'data': an `expr` line computes a ROS field from UAVCAN fields; a ROS->UAVCAN mapping computes UAVCAN fields from ROS fields in uavcan_exprs",
+        ),
+    ),
+    Case(
+        'uavcan_exprs_in_uavcan_to_ros',
+        '      ignore: [timestamp]\n',
+        '      ignore: [timestamp]\n      uavcan_exprs: {level_mm: "data"}\n',
+        (
+            "minimal_v0.yaml:66:22: error: DroneCAN mapping 'bilge' goes UAVCAN->ROS: uavcan_exprs compute UAVCAN fields of a ROS->UAVCAN mapping (expected `ros_field: {expr: ...}` lines in fields)",
+        ),
+    ),
+    Case(
+        'ros_field_unwritten',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        {}\n      ignore: [timestamp, level_mm]',
+        (
+            "minimal_v0.yaml:57:5: error: ROS field 'data' (int16) of std_msgs/Int16 is written by nothing in DroneCAN mapping 'bilge': it would always keep its default (expected a `data: <uavcan field>` line, `data: {value: ...}`, `data: {expr: ...}` or `data` in ros_defaults)",
+        ),
+    ),
+    Case(
+        'ros_defaults_written',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: level_mm\n      ignore: [timestamp]\n      ros_defaults: [data]',
+        (
+            "minimal_v0.yaml:57:5: error: ROS field 'data' is in ros_defaults of DroneCAN mapping 'bilge' but the mapping writes it (expected ros_defaults lists only fields nothing writes)",
+        ),
+    ),
+    Case(
+        'ros_defaults_in_ros_to_uavcan',
+        '        y: rpm[1]\n',
+        '        y: rpm[1]\n      ros_defaults: [z]\n',
+        (
+            "minimal_v0.yaml:66:5: error: DroneCAN mapping 'motors' goes ROS->UAVCAN: ros_defaults name ROS fields a UAVCAN->ROS mapping leaves unwritten",
+        ),
+    ),
+    Case(
+        'expr_reads_no_field',
+        '        data: level_mm\n      ignore: [timestamp]',
+        '        data: {expr: "1 + 2"}\n      ignore: [timestamp, level_mm]',
+        (
+            "minimal_v0.yaml:64:23: error: DroneCAN mapping 'bilge', field 'data': the expression reads no field (a constant is a `value`, or an entry of uavcan_values)",
         ),
     ),
 )
@@ -1503,7 +1657,7 @@ ROUTING_CASES: tuple[Case, ...] = (
         '      subject_id: 700\n',
         '      subject_id: 700\n      shares_data_type: true\n',
         (
-            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, max_rate_hz, deadline, enabled, enable_service)",
+            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
         ),
     ),
     Case(

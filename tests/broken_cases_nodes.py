@@ -282,8 +282,8 @@ CASES: tuple[Case, ...] = (
         ((TOPICS_END, TOPICS_END + "  gauge/level: {type: std_msgs/Bool}\n  /gauge/level: {type: std_msgs/Bool}\n"),
          (VALVE_CONTROL, "  valve_control:\n    subscribes: [/level, gauge/level, /gauge/level]\n    publishes: [/valve]\n    parameters: [/alarm_level]\n")),
         (
-            "minimal.yaml:68:26: error: node valve_control subscribes to gauge/level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
-            "minimal.yaml:68:39: error: node valve_control subscribes to /gauge/level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN)",
+            "minimal.yaml:68:26: error: node valve_control subscribes to gauge/level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN, or `published_by: external` on the topic)",
+            "minimal.yaml:68:39: error: node valve_control subscribes to /gauge/level, which nobody publishes (expected a topic some node publishes, or one the bridge publishes from UAVCAN, or `published_by: external` on the topic)",
             "minimal.yaml:68:39: error: node valve_control: subscribing /gauge/level and subscribing gauge/level would both be on_gauge_level in the generated base (expected names that stay distinct as Python identifiers)",
         ),
     ),

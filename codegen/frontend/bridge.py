@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import astuple
-
 from sam_codegen.frontend.bus import parse_bus
+from sam_codegen.frontend.expr_parser import ExprSyntaxError, parse_expr
 from sam_codegen.frontend.reading import Reader, map_items, number, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.routing import node_ids_or_any
 from sam_codegen.frontend.traffic import TRAFFIC_KEYS, parse_traffic
 from sam_codegen.frontend.yaml_source import YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
+from sam_codegen.model.expr import ExprSource, PNum, UavcanExpr
 from sam_codegen.model.spec import (
     DIRECTIONS,
     PROTOCOLS,
@@ -27,14 +27,40 @@ from sam_codegen.model.spec import (
 __all__ = ["parse_device", "parse_layout", "parse_link", "parse_mapping"]
 
 
+def _expression(node: YNode | None, what: str, diag: Diagnostics) -> ExprSource | None:
+    """A mapping expression (model.expr), parsed; a syntax error is reported at its column."""
+    if node is None:
+        return None
+    text = scalar(node, str, what, diag)
+    if text is None:
+        return None
+    assert isinstance(node, YScalar)
+    start = node.pos if not node.quoted else Pos(node.pos.file, node.pos.line, node.pos.column + 1)
+    try:
+        tree = parse_expr(text)
+    except ExprSyntaxError as exc:
+        diag.error(ExprSource(text, PNum(0, 0), start).at(exc.col), f"{what}: {exc.message}")
+        return None
+    return ExprSource(text, tree, start)
+
+
 def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics) -> FieldLink | None:
     what = f"field {ros_path!r} of mapping {mapping!r}"
     if isinstance(node, YScalar):
         path = scalar(node, str, what, diag)
         return FieldLink(ros_path, path, pos=pos) if path is not None else None
-    r = Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round"))
+    r = Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round", "expr"))
     if not r.ok:
         return None
+    if r.node("expr") is not None:
+        others = [key for key in ("from", "scale", "offset", "table", "value", "limits", "round")
+                  if r.node(key) is not None]
+        if others:
+            diag.error(pos, f"{what} has 'expr' and " + ", ".join(repr(k) for k in others),
+                       "'expr' alone (it says the whole conversion)")
+            return None
+        expr = _expression(r.node("expr"), f"the expression of {what}", diag)
+        return FieldLink(ros_path, pos=pos, expr=expr) if expr is not None else None
     uavcan_path = r.get("from", str, None)
     scale = number(r.node("scale"), f"'scale' of {what}", diag)
     offset = number(r.node("offset"), f"'offset' of {what}", diag)
@@ -78,12 +104,12 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
 
 _MAPPING_KEYS = (
     "direction", "topic", "subject_id", "source_node_ids", "destination_node_id", "frame_id",
-    "fields", "ignore", "uavcan_values", "on_out_of_range", *TRAFFIC_KEYS,
+    "fields", "ignore", "uavcan_values", "on_out_of_range", "uavcan_exprs", "ros_defaults", *TRAFFIC_KEYS,
 )
 # A DroneCAN message is keyed by its data type (no subject id) and broadcast (destinations, not one destination).
 _DRONECAN_MAPPING_KEYS = (
     "direction", "topic", "data_type", "select", "source_node_ids", "destination_node_ids", "frame_id",
-    "fields", "ignore", "uavcan_values", "on_out_of_range",
+    "fields", "ignore", "uavcan_values", "on_out_of_range", "uavcan_exprs", "ros_defaults",
     "shares_data_type", *TRAFFIC_KEYS,
 )
 
@@ -133,12 +159,18 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
         value = scalar(value_node, (bool, int, float), f"uavcan value {path!r} of {what}", diag)
         if value is not None:
             uavcan_values[path] = value
+    uavcan_exprs: list[UavcanExpr] = []
+    for path, key_pos, value_node in map_items(r.node("uavcan_exprs"), f"uavcan_exprs of {what}", diag):
+        expr = _expression(value_node, f"the expression of UAVCAN field {path!r} in uavcan_exprs of {what}", diag)
+        if expr is not None:
+            uavcan_exprs.append(UavcanExpr(path, expr, key_pos))
+    ros_defaults = [p for p, _ in str_list(r.node("ros_defaults"), f"ros_defaults of {what}", diag)]
     mapping = Mapping(
         name, direction or UAVCAN_TO_ROS, r.get("topic", str) or "", 0 if dronecan else r.get("subject_id", int) or 0,
         source_node_ids, destination_node_id, r.get("frame_id", str, None), links, ignore, uavcan_values, auto,
         policy if policy in ("saturate", "reject") else "saturate", pos, protocol, data_type, destination_node_ids,
         select, select_pos, any_node, any_pos, bool(dronecan and r.get("shares_data_type", bool, False)),
-        *astuple(parse_traffic(r, what, direction, diag)),
+        **vars(parse_traffic(r, what, direction, diag)), uavcan_exprs=uavcan_exprs, ros_defaults=ros_defaults,
     )
     destination = "destination_node_ids" if dronecan else "destination_node_id"
     if direction == UAVCAN_TO_ROS and r.node(destination) is not None:

@@ -35,6 +35,7 @@ __all__ = ["MAX_ALIAS_NODES_FLOOR", "MAX_ALIAS_NODES_PER_NODE", "MAX_DEPTH", "YM
 class YScalar:
     pos: Pos
     value: Any
+    quoted: bool = False  # written in quotes: its text starts one column after pos (mapping expressions' columns)
 
 
 @dataclass
@@ -272,7 +273,7 @@ class _Composer:
         node = yaml.ScalarNode(tag, event.value, event.start_mark, event.end_mark, style=event.style)
         self.made += 1
         try:
-            return YScalar(pos, self.constructor.construct_object(node, deep=True))
+            return YScalar(pos, self.constructor.construct_object(node, deep=True), event.style in ("'", '"'))
         except yaml.YAMLError as exc:
             self.error(pos, f"bad scalar: {exc}")
             return YScalar(pos, None)

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import Final, Literal
 
 from sam_codegen.model.diagnostics import NOWHERE, Pos
+from sam_codegen.model.expr import ExprSource, UavcanExpr
 from sam_codegen.model.types import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
@@ -330,6 +331,7 @@ class FieldLink:
     limits: tuple[float, float] | None = None
     pos: Pos = NOWHERE
     round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
+    expr: ExprSource | None = None  # `{expr: "..."}`: the ROS field computed from UAVCAN fields (model.expr)
 
 
 @dataclass(frozen=True)
@@ -367,6 +369,10 @@ class Mapping:
     deadline_s: float | None = None
     enabled: bool = True
     enable_service: str = ""  # "": ENABLE_SERVICE_DEFAULT
+    # ROS -> UAVCAN: UAVCAN fields computed from ROS fields (model.expr); UAVCAN -> ROS: the ROS fields that keep
+    # their type's default (0, false, empty) on purpose (every other ROS field must be written).
+    uavcan_exprs: list[UavcanExpr] = field(default_factory=list)
+    ros_defaults: list[str] = field(default_factory=list)
 
     @property
     def enable_service_name(self) -> str:

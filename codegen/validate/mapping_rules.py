@@ -12,6 +12,7 @@ import re
 from dataclasses import dataclass, field
 
 from sam_codegen.model.diagnostics import NOWHERE, Pos
+from sam_codegen.model.expr import ENode
 from sam_codegen.model.spec import Constant, DsdlStruct, Field, FieldLink, Mapping, RosMessage, Scalar
 from sam_codegen.model.types import (
     ROS_FLOAT_BITS,
@@ -159,7 +160,7 @@ def auto_links(struct: DsdlStruct, pos: Pos) -> list[FieldLink]:
 class Step:
     """One resolved link, ready for an emitter. Paths are relative to the ROS / UAVCAN message."""
 
-    kind: str  # number | array | time | table | value | string
+    kind: str  # number | array | time | table | value | string | expr
     ros_path: tuple[PathSeg, ...]
     ros_type: RosType
     uavcan_path: tuple[PathSeg, ...] = ()
@@ -172,6 +173,9 @@ class Step:
     limits: tuple[float, float] | None = None
     exact: bool = True  # UAVCAN -> ROS -> UAVCAN gives the value back
     pos: Pos = NOWHERE
+    # kind `expr`: the typed expression (model.expr) computing the target from source fields. To ROS: ros_path is
+    # the target, uavcan_path empty; to UAVCAN (uavcan_exprs): uavcan_path the target, ros_path empty.
+    expr: ENode | None = None
 
     @property
     def ros(self) -> str:

@@ -1,14 +1,19 @@
 """Bridge mappings: each `ros_field: uavcan_field` line resolved against both types and the conversion rules,
-and the check that every UAVCAN field of a mapping is mapped, ignored or given a value."""
+and the check that every UAVCAN field of a mapping is mapped, ignored or given a value. Mapping expressions
+(`{expr: ...}` lines, `uavcan_exprs`) are type-checked by validate.expressions against the paths resolved here;
+in a UAVCAN -> ROS mapping every ROS field is written (a link, a value, an expression, the bridge's header) or
+listed in `ros_defaults`."""
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import Any, TypeVar
 
 from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.expr import ExprSource, fields_of, names_of
 from sam_codegen.model.spec import (
     ROS_TO_UAVCAN,
     UAVCAN_TO_ROS,
@@ -24,6 +29,7 @@ from sam_codegen.model.spec import (
     V0Struct,
 )
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from sam_codegen.validate.expressions import ExprError, check_expr, check_target
 from sam_codegen.validate.mapping_rules import (
     HEADER,
     TIME,
@@ -189,12 +195,20 @@ class MappingValidator:
         uavcan_values: list[tuple[tuple[PathSeg, ...], DsdlType, Scalar]] = []
         ros_targets: dict[str, Pos] = {}
         self.failed_paths: set[str] = set()
+        self.failed_ros: set[str] = set()  # ROS fields of failed links
         for link in links:
             step = self.resolve_link(link, ros_message, struct, mapping, what)
             if step is None:
                 # Its UAVCAN side is reported already; do not report it again as unmapped.
                 if link.uavcan_path:
                     self.failed_paths.add(link.uavcan_path.split("[")[0].split(".")[0])
+                if link.expr is not None:  # its fields are reported already
+                    self.failed_paths |= {n.split("[")[0].split(".")[0] for n in names_of(link.expr.tree)}
+                self.failed_ros.add(link.ros_path)  # and its target
+                try:
+                    self.ros_leaf(ros_message, parse_path(link.ros_path))
+                except RuleError:  # a ROS path that does not resolve: which fields are written is unclear
+                    self.failed_ros.add("")
                 continue
             if step.ros in ros_targets:
                 self.error(link.pos, f"ROS field {step.ros!r} is set twice in {what}")
@@ -238,6 +252,7 @@ class MappingValidator:
                 self.error(mapping.pos, f"ignore of {what}: {exc}")
             else:
                 self.ignored.add(format_path(path))
+        steps += self.resolve_uavcan_exprs(mapping, ros_message, struct, what, steps)
         elements, elements_ok = self.check_elements(mapping, what)
         resolved = ResolvedMapping(mapping, ros_message, struct, steps, uavcan_values, has_header, rate_hz, select,
                                    elements)
@@ -310,6 +325,8 @@ class MappingValidator:
         try:
             ros_path = parse_path(link.ros_path)
             ros_type = self.ros_leaf(ros_message, ros_path)
+            if link.expr is not None:
+                return self.resolve_expr_link(link, link.expr, ros_path, ros_type, struct, mapping, what)
             if link.value is not None:
                 if mapping.direction == ROS_TO_UAVCAN:
                     raise RuleError("a `value` sets a ROS field; a ROS->UAVCAN mapping sets UAVCAN fields with "
@@ -423,6 +440,8 @@ class MappingValidator:
         mapping = resolved.mapping
         self.direction = mapping.direction
         linked = {s.uavcan for s in resolved.steps if s.uavcan_path} | self.failed_paths
+        linked |= {f.text for s in resolved.steps if s.expr is not None and not s.uavcan_path
+                   for f in fields_of(s.expr)}  # what UAVCAN -> ROS expressions read
         valued = {format_path(list(p)) for p, _, _ in resolved.uavcan_values}
         selected = {format_path(list(p)) for p, _, _ in resolved.select}
         # UAVCAN->ROS may also publish a select field (esc_index routed on and reported); ROS->UAVCAN sets it once
@@ -432,14 +451,152 @@ class MappingValidator:
         linked |= selected
         struct = resolved.dsdl_struct
         if mapping.direction == UAVCAN_TO_ROS:
+            self.check_ros_written(resolved, what)
             for path, t in self.uncovered(struct, "", linked | self.ignored):
                 self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
                            f"{struct.name} is neither mapped nor ignored in {what}",
                            f"a `ros_field: {path}` line or `{path}` in ignore")
         else:
+            if mapping.ros_defaults:
+                self.error(mapping.pos, f"{what} goes ROS->UAVCAN: ros_defaults name ROS fields a UAVCAN->ROS "
+                           "mapping leaves unwritten")
             for path, t in self.uncovered(struct, "", linked | valued):
                 self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
                            f"{struct.name} gets no value in {what}",
                            f"a `ros_field: {path}` line or an entry in uavcan_values")
             for path in sorted(linked & valued):
                 self.error(mapping.pos, f"UAVCAN field {path!r} is both mapped and in uavcan_values in {what}")
+
+    # ---- mapping expressions (model.expr) and the ROS fields a UAVCAN -> ROS mapping writes -----------------------
+
+    def check_expression(self, source: ExprSource, resolve: Callable[[list], DsdlType | RosType],
+                         target: DsdlType | RosType, target_name: str, what: str) -> Step | None:
+        """The typed tree of an expression whose names `resolve` finds, checked against its target; None when
+        reported (at the column of the offending node)."""
+        def field_type(path_text: str) -> DsdlType | RosType:
+            try:
+                return resolve(parse_path(path_text))
+            except _Reported:
+                raise
+            except RuleError as exc:
+                raise ValueError(f"unknown field: {exc}") from None
+
+        try:
+            tree = check_expr(source.tree, field_type)
+            check_target(tree, target, target_name)
+        except _Reported:
+            return None
+        except ExprError as exc:
+            self.error(source.at(exc.col), f"{what}: {exc.message}")
+            return None
+        return Step("expr", (), RosType("float64"), pos=source.pos, exact=False, expr=tree)
+
+    def resolve_expr_link(self, link: FieldLink, source: ExprSource, ros_path: list, ros_type: RosType,
+                          struct: DsdlStruct, mapping: Mapping, what: str) -> Step | None:
+        """`ros_field: {expr: "..."}` in a UAVCAN -> ROS mapping: the ROS field computed from UAVCAN fields."""
+        if mapping.direction == ROS_TO_UAVCAN:
+            raise RuleError("an `expr` line computes a ROS field from UAVCAN fields; a ROS->UAVCAN mapping "
+                            "computes UAVCAN fields from ROS fields in uavcan_exprs")
+        step = self.check_expression(source, lambda path: self.dsdl_leaf(struct, path), ros_type, link.ros_path,
+                                     f"{what}, field {link.ros_path!r}")
+        if step is None:
+            return None
+        return Step("expr", tuple(ros_path), ros_type, pos=link.pos, exact=False, expr=step.expr)
+
+    def resolve_uavcan_exprs(self, mapping: Mapping, ros_message: RosMessage, struct: DsdlStruct, what: str,
+                             linked: list[Step]) -> list[Step]:
+        """`uavcan_exprs: {uavcan_field: "..."}` of a ROS -> UAVCAN mapping: UAVCAN fields computed from ROS
+        fields."""
+        steps: list[Step] = []
+        if mapping.uavcan_exprs and mapping.direction == UAVCAN_TO_ROS:
+            self.error(mapping.uavcan_exprs[0].pos, f"{what} goes UAVCAN->ROS: uavcan_exprs compute UAVCAN fields "
+                       "of a ROS->UAVCAN mapping", "`ros_field: {expr: ...}` lines in fields")
+            return steps
+        for entry in mapping.uavcan_exprs:
+            try:
+                path = parse_path(entry.uavcan_path)
+                target = self.dsdl_leaf(struct, path)
+            except _Reported:
+                self.failed_paths.add(entry.uavcan_path.split("[")[0].split(".")[0])
+                continue
+            except RuleError as exc:
+                self.error(entry.pos, f"uavcan_exprs of {what}: {exc}")
+                continue
+            step = self.check_expression(entry.expr, lambda p: self.ros_leaf(ros_message, p), target,
+                                         entry.uavcan_path, f"{what}, UAVCAN field {entry.uavcan_path!r}")
+            if step is None:
+                self.failed_paths.add(entry.uavcan_path.split("[")[0].split(".")[0])
+            else:
+                if any(s.uavcan == format_path(path) for s in [*linked, *steps]):
+                    self.error(entry.pos, f"UAVCAN field {entry.uavcan_path!r} is both mapped and in uavcan_exprs "
+                               f"in {what}", "one of them")
+                    continue
+                steps.append(Step("expr", (), RosType("float64"), tuple(path), target, pos=entry.pos, exact=False,
+                                  expr=step.expr))
+        return steps
+
+    def check_ros_written(self, resolved: ResolvedMapping, what: str) -> None:
+        """UAVCAN -> ROS: every ROS field gets a value (a link, a `value`, an `expr`; header.stamp and frame_id
+        from the bridge) or is listed in ros_defaults: a field nothing writes would always read 0 / false."""
+        m = resolved.mapping
+        message = resolved.ros_message
+        written = {s.ros for s in resolved.steps if s.ros_path} | self.failed_ros
+        if "" in written:
+            return  # a link names a ROS field that does not resolve: reported already, coverage would only guess
+        if resolved.has_header:
+            written.add("header")  # stamp: the source's or the receive time; frame_id: the mapping's
+        defaults: set[str] = set()
+        for text in m.ros_defaults:
+            try:
+                segments = parse_path(text)
+                self.ros_leaf(message, segments)
+            except _Reported:
+                continue
+            except RuleError as exc:
+                self.error(m.pos, f"ros_defaults of {what}: {exc}")
+                continue
+            name = format_path(segments)
+            if name in written:
+                self.error(m.pos, f"ROS field {name!r} is in ros_defaults of {what} but the mapping writes it",
+                           "ros_defaults lists only fields nothing writes")
+            defaults.add(name)
+        for path, t, elements in self.ros_unwritten(message, "", written, defaults):
+            self.error(m.pos, f"ROS field {path!r} ({t}) of {message.full_name} is written by nothing in {what}"
+                       + (f" (elements {elements})" if elements else "") + ": it would always keep its default",
+                       f"a `{path}: <uavcan field>` line, `{path}: {{value: ...}}`, `{path}: {{expr: ...}}` or "
+                       f"`{path}` in ros_defaults")
+
+    def ros_unwritten(self, message: RosMessage, prefix: str, written: set[str], defaults: set[str]
+                      ) -> list[tuple[str, RosType, str]]:
+        """The fields of `message` (paths under `prefix`) that nothing writes and no default names, each as large
+        as possible; a fixed array written in part is one entry with the elements left (a default naming a
+        field covers everything under it that nothing writes)."""
+        out: list[tuple[str, RosType, str]] = []
+        for f in message.fields:
+            assert isinstance(f.type, RosType)
+            path, t = prefix + f.name, f.type
+            if path in written or path in defaults:
+                continue
+            if not t.is_primitive and self.ros.get(t.base) is None and t.base != TIME:
+                continue  # an unknown type: reported with its declaration
+            if not any(p.startswith((path + ".", path + "[")) for p in written):
+                out.append((path, t, ""))
+            elif t.array == "fixed":
+                element = t.element
+                nested = self.ros.get(element.base) if not element.is_primitive else None
+                left = []
+                for i in range(t.capacity or 0):
+                    item = f"{path}[{i}]"
+                    if item in written or item in defaults:
+                        continue
+                    if nested is not None and any(p.startswith(item + ".") for p in written):
+                        out += self.ros_unwritten(nested, item + ".", written, defaults)
+                    else:
+                        left.append(str(i))
+                if left:
+                    out.append((path, t, ", ".join(left)))
+            elif not t.array and not t.is_primitive and self.ros.get(t.base) is not None:
+                out += self.ros_unwritten(self.ros.get(t.base), path + ".", written, defaults)  # type: ignore[arg-type]
+            else:
+                out.append((path, t, ""))
+        return out

@@ -11,7 +11,7 @@ In this process (no ROS needed):
 
 In a child process with SAM's ROS package (as tests/test_v0_converters.py does it; the spec's own v0 types added by
 sam_runtime.dronecan_io.types.ensure_types, never dronecan.load_dsdl), hypothesis property tests for every DroneCAN
-mapping of SAM's spec and of tests/specs/{ferry,minimal_v0,buoy_v0,trawler_v0,seiner}.yaml:
+mapping of SAM's spec and of tests/specs/{ferry,minimal_v0,buoy_v0,trawler_v0,seiner,relay}.yaml:
 
 (a) random dronecan messages -> dronecan's bytes (``Transfer(payload=obj).payload``) -> ``<m>_wire_to_ros`` gives
     the CDR of ``<m>_to_ros`` (NaN-aware), its stamp, the same counts, and ``WIRE_MATCHES`` agrees with ``MATCHES``;
@@ -43,7 +43,7 @@ ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml",
          "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",
          "trawler_v0": ROOT / "tests" / "specs" / "trawler_v0.yaml",
-         "seiner": ROOT / "tests" / "specs" / "seiner.yaml"}
+         "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
@@ -300,7 +300,10 @@ if not WORKER:
 
         generated = tmp_path / "generated"  # built afresh: the codecs of the generator as it is
         build(SPECS[spec], generated)
-        prefix = built_prefix(ros_packages_in_order(ROOT / "generated" / "ros"))  # SAM's messages (others: installed)
+        packages = ros_packages_in_order(ROOT / "generated" / "ros")  # SAM's messages (others: installed)
+        if spec == "relay":  # and relay.yaml's own (its LightsCommand mapping takes a relay_msgs/Led)
+            packages = [*packages, *ros_packages_in_order(generated / "ros")]
+        prefix = built_prefix(packages)
         config = {"spec": str(SPECS[spec]), "generated": str(generated)}
         proc = run_child(["-m", "pytest", __file__, "-q", "-p", "no:cacheprovider", "--rootdir", str(ROOT),
                           "-W", "error::RuntimeWarning"], prefix, domain_id(70 + sorted(SPECS).index(spec)),

@@ -113,7 +113,7 @@ def _tables_and_classes(generated: Path, topics: list[str]) -> tuple[dict[str, t
 
     gen = GeneratedPackage(generated)
     tables = gen.tables()
-    by_topic = {m.topic.name: m.topic for m in (*tables.MAPPINGS, *getattr(tables, "DRONECAN_MAPPINGS", ()))}
+    by_topic = {m.topic.name: m.topic for m in [*tables.MAPPINGS, *getattr(tables, "DRONECAN_MAPPINGS", ())]}
     missing = [t for t in topics if t not in by_topic]
     if missing:
         raise SystemExit(f"topics not in the generated tables: {missing}")
@@ -225,7 +225,7 @@ def publish(args: argparse.Namespace) -> int:
             items = plan["topics"][t]
             if i < len(items):
                 msg = _fill(classes[t](), items[i])
-                if hasattr(msg, "header"):  # (std_msgs/Int32 and the like have none)
+                if hasattr(msg, "header"):  # (a message without a header, std_msgs/Bool, is sent as it is)
                     msg.header.stamp = node.get_clock().now().to_msg()
                 pubs[t].publish(msg)
                 sent[t] += 1

@@ -25,6 +25,7 @@ from sam_codegen.conversion_plan import (
     Clamp,
     Convert,
     DecodeUtf8,
+    Evaluate,
     FixedLength,
     Limits,
     LinkPlan,
@@ -33,6 +34,7 @@ from sam_codegen.conversion_plan import (
     Pad,
     PlanDirection,
     ReceiveTime,
+    RejectNaN,
     Scale,
     SetConstant,
     Table,
@@ -42,6 +44,7 @@ from sam_codegen.conversion_plan import (
     lower_link,
     lower_mapping,
 )
+from sam_codegen.model.expr import EBinary, ECall, ENode, EUnary, fields_of, spell
 from sam_codegen.model.spec import Scalar
 from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step, format_path
@@ -100,6 +103,8 @@ def describe_link(link: LinkPlan) -> str:
     first = ops[0] if ops else None
     if isinstance(first, SetConstant):
         return f"constant {fmt_number(first.value)}"
+    if isinstance(first, Evaluate):
+        return describe_expression(link, first)
     ros = step.ros_type
     uav = step.uavcan_type
     assert uav is not None
@@ -151,6 +156,31 @@ def describe_link(link: LinkPlan) -> str:
     return text + (f" ({', '.join(notes)})" if notes else "")
 
 
+def describe_expression(link: LinkPlan, op: Evaluate) -> str:
+    """An expression link: the expression in the spec's syntax, then what can happen to its value."""
+    target = str(link.step.ros_type) if link.to_ros else str(link.step.uavcan_type)
+    notes: list[str] = []
+    calls = _calls(op.tree)
+    if link.has(RejectNaN) or calls & {"trunc", "round"}:
+        notes.append("NaN rejected")
+    if calls & {"trunc", "round"}:
+        notes.append(" and ".join(sorted(calls & {"trunc", "round"})) + " beyond int64 "
+                     + _policy(link, "saturated"))
+    if link.has(Clamp):  # into the target's range, worded as every other link's
+        notes.append("out of range rejected" if link.reject else "saturating")
+    return f"= {spell(op.tree)} → {target}" + (f" ({', '.join(notes)})" if notes else "")
+
+
+def _calls(node: ENode) -> set[str]:
+    if isinstance(node, ECall):
+        return {node.func}.union(*(_calls(a) for a in node.args))
+    if isinstance(node, EUnary):
+        return _calls(node.arg)
+    if isinstance(node, EBinary):
+        return _calls(node.left) | _calls(node.right)
+    return set()
+
+
 def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
     """The conversion of one field link in words, in the direction the bridge runs it (its plan, described)."""
     plan_direction: PlanDirection = "to_ros" if direction == UAVCAN_TO_ROS else "to_uavcan"
@@ -169,7 +199,9 @@ def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
         for fs in plan.uavcan_fields if isinstance(fs.op, SetConstant) and fs.op.select]
 
     def link_row(link: LinkPlan) -> dict[str, object]:
-        return {"ros": link.step.ros, "arrow": arrow, "uavcan": link.step.uavcan or None,
+        step = link.step
+        reads = ", ".join(f.text for f in fields_of(step.expr)) if step.expr is not None else ""  # an expression's
+        return {"ros": step.ros or reads or None, "arrow": arrow, "uavcan": step.uavcan or reads or None,
                 "conversion": describe_link(link)}
 
     links = list(plan.to_ros if to_ros else plan.to_uavcan)
@@ -182,6 +214,9 @@ def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
             text = "receive time" if isinstance(fs.op, ReceiveTime) else f"constant {fs.op.value}"
             rows.append({"ros": format_path(list(fs.path)), "arrow": arrow, "uavcan": None, "conversion": text})
     rows.extend(link_row(link) for link in links)
+    for name in m.ros_defaults:  # kept at the type's default on purpose
+        rows.append({"ros": name, "arrow": "", "uavcan": None,
+                     "conversion": "default (0, false, empty) where nothing writes it"})
     for fs in plan.uavcan_fields:
         if isinstance(fs.op, SetConstant) and not fs.op.select:
             rows.append({"ros": None, "arrow": arrow, "uavcan": format_path(list(fs.path)),

@@ -26,6 +26,7 @@ from sam_codegen.conversion_plan import (
     Clamp,
     DecodeUtf8,
     EncodeUtf8,
+    Evaluate,
     FixedLength,
     LinkPlan,
     MaxLength,
@@ -43,9 +44,11 @@ from sam_codegen.conversion_plan import (
     lower_link,
     lower_mapping,
 )
+from sam_codegen.model.expr import fields_of
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.targets.python import statements as pys
+from sam_codegen.targets.python.expressions import ExpressionWriter
 from sam_codegen.targets.python.module import ConvertModule, FunctionDraft, TableConstant
 from sam_codegen.targets.python.names import LocalNames, access, identifier, py_attr
 from sam_codegen.targets.python.statements import (
@@ -139,8 +142,8 @@ class MappingEmitter:
         rm = self.rm
         names = LocalNames(self.module.module_names)
         fn = self.signatures.to_ros(self)
-        steps = list(rm.steps)
-        listed = self.uavcan.bind(self, fn, names, steps)
+        steps = [s for s in rm.steps if s.ros_path]  # (a ROS -> UAVCAN expression sets nothing in ROS)
+        listed = self.uavcan.bind(self, fn, names, read_steps(steps, TO_ROS))
 
         def uav_read(path: tuple) -> str:
             if path[-1][1] is not None:
@@ -172,6 +175,8 @@ class MappingEmitter:
         first = ops[0] if ops else None
         if isinstance(first, SetConstant):
             return [(s.ros_path, typed_literal(first.value, s.ros_type.base))]
+        if isinstance(first, Evaluate):
+            return [(s.ros_path, self.evaluate(link, first, s.ros, uav_read, names, statements))]
         assert s.uavcan_type is not None
         read = uav_read(s.uavcan_path)
         if isinstance(first, TimestampToRos):
@@ -229,7 +234,7 @@ class MappingEmitter:
         names = LocalNames(self.module.module_names)
         fn = self.signatures.to_uavcan(self)
         steps = [s for s in rm.steps if s.uavcan_path]
-        reads = self.ros.bind(self, fn, names, steps)
+        reads = self.ros.bind(self, fn, names, read_steps(steps, TO_UAVCAN))
         root = self.module.dsdl_ctor(rm.dsdl_struct)
         for s in steps:
             value = self.step_to_uavcan(s, names, reads, fn.statements)
@@ -249,6 +254,8 @@ class MappingEmitter:
         key = repr(link.key)
         uav = s.uavcan_type
         first = ops[0] if ops else None
+        if isinstance(first, Evaluate):
+            return self.evaluate(link, first, s.uavcan, reads.value, names, statements)
         if isinstance(first, TimestampFromRos):
             sec, nanosec = reads.time(s.ros_path)
             var = names.new("us")
@@ -286,6 +293,17 @@ class MappingEmitter:
             statements.append(helper)
         return var
 
+    def evaluate(self, link: LinkPlan, op: Evaluate, target: str, read: Callable[[tuple], str], names: LocalNames,
+                 statements: list[Statement]) -> str:
+        """An expression link: its trunc()/round() statements, the value bound to a local, then its checks."""
+        writer = ExpressionWriter(read, names, repr(link.key), link.reject)
+        text = writer.write(op.tree)
+        statements.extend(writer.statements)
+        var = names.new(target)
+        statements.append(Assign(var, f"float({text})" if op.as_float else text))
+        statements.extend(pys.check_statements(var, link.ops[1:], repr(link.key)))
+        return var
+
     def scalar_to_uavcan(self, link: LinkPlan, names: LocalNames, read: str, statements: list[Statement]) -> str:
         """A number link's operations in order: its arithmetic builds an expression, the first check binds it to a
         local (limits come before the inverse scale/offset: they are in ROS units)."""
@@ -307,6 +325,22 @@ class MappingEmitter:
         if pending:
             statements.append(Assign(var, pys.to_uavcan_expr(var, pending)))
         return var
+
+
+def read_steps(steps: list[Step], direction: PlanDirection) -> list[Step]:
+    """The steps as the readers see them: an expression step becomes one plain `number` step per source field it
+    reads (a UAVCAN field to ROS, a ROS field to UAVCAN), so that every reader binds what expressions read."""
+    out: list[Step] = []
+    for s in steps:
+        if s.kind != "expr" or s.expr is None:
+            out.append(s)
+            continue
+        for f in fields_of(s.expr):
+            if direction == TO_ROS:
+                out.append(Step("number", (), RosType("float64"), f.path, f.source, pos=s.pos))
+            else:
+                out.append(Step("number", f.path, f.source, pos=s.pos))
+    return out
 
 
 # ---- convert.py's strategies -------------------------------------------------------------------------------------

@@ -22,6 +22,7 @@ import ast
 from pathlib import Path
 from typing import Any, ClassVar
 
+from sam_codegen.model.expr import fields_of
 from sam_codegen.model.spec import DsdlStruct, RosMessage, V0Struct
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
@@ -175,6 +176,8 @@ class V0WireReader:
             paths += [path for path, _, _ in self.rm.select]
         else:
             paths += [s.uavcan_path for s in self.rm.steps if s.uavcan_path]
+            paths += [f.path for s in self.rm.steps if s.expr is not None and not s.uavcan_path
+                      for f in fields_of(s.expr)]  # what UAVCAN -> ROS expressions read
         return {self.wire_path(p) for p in paths}
 
     def decode(self, names: LocalNames, wanted: set[WirePath]) -> list[str]:

@@ -8,7 +8,8 @@ Standard library only.
 
 from __future__ import annotations
 
-__all__ = ["ConversionStats", "WireError", "clamp_finite_floats", "clamp_floats", "clamp_ints", "round_ints"]
+__all__ = ["ConversionStats", "WireError", "clamp_finite_floats", "clamp_floats", "clamp_ints", "divide",
+           "round_ints"]
 
 _INF = float("inf")
 
@@ -103,3 +104,13 @@ def round_ints(
             return None
         stats.saturate(key)
     return out
+
+
+def divide(a: float, b: float) -> float:
+    """a / b of a mapping expression as IEEE 754 has it where Python raises: x / 0 is +-inf by the sign of x
+    (the divisor's zero taken as +0), 0 / 0 and NaN / 0 are NaN."""
+    if b:
+        return a / b
+    if a != a or a == 0:
+        return _INF - _INF
+    return _INF if a > 0 else -_INF
