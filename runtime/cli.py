@@ -90,8 +90,9 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--protocol", choices=("cyphal", "dronecan"), default=None,
                    help="the half of a mixed layout this bridge serves (one bridge per protocol; default: the "
                         "layout's only protocol)")
-    p.add_argument("--time-sync", action="store_true",
-                   help="DroneCAN: be the bus's GlobalTimeSync master (1 Hz)")
+    p.add_argument("--time-sync", action=argparse.BooleanOptionalAction, default=None,
+                   help="be (or not) the bus's time-sync master (Cyphal uavcan.time.Synchronization, DroneCAN "
+                        "GlobalTimeSync); default: the spec's bridge.time_sync, on unless it says otherwise")
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
     _add_wire_arg(p)
@@ -122,8 +123,9 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             layout=args.layout,
             protocol=args.protocol,
             dronecan_iface=args.dronecan_iface,
-            dronecan_options={"time_sync": args.time_sync, "dna_server": args.dna_server},
+            dronecan_options={"dna_server": args.dna_server},
             wire=args.wire,
+            time_sync=args.time_sync,
         )
         await bridge.start()
         print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
@@ -169,6 +171,9 @@ def _sim_parser() -> argparse.ArgumentParser:
                    help="heartbeats at once, but publish only once this file exists (for scripted tests)")
     p.add_argument("--record", type=Path, default=None, help="JSON lines of every message sent and received")
     p.add_argument("--report", type=Path, default=None, help="write the counters as JSON here at exit")
+    p.add_argument("--device-clocks", action=argparse.BooleanOptionalAction, default=True,
+                   help="each device its own clock, 5..120 s off, following the bus's time-sync master and stamping "
+                        "0 (unknown) until synchronised (default); --no-device-clocks: one shared stamp clock")
     _add_vehicle_args(p)
     return p
 
@@ -242,7 +247,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
             bridge_node_id=args.bridge_node_id,
             devices=None if not args.devices else [d.strip() for d in args.devices.split(",") if d.strip()],
             rate_scale=args.rate_scale, record=args.record, layout=args.layout, dronecan_iface=args.dronecan_iface,
-            **_vehicle_options(args),
+            device_clocks=args.device_clocks, **_vehicle_options(args),
         )
         sim = Simulator(generated_package(args), cfg)
         await sim.start()

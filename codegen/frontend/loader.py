@@ -15,6 +15,7 @@ from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mappin
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, text_of
+from sam_codegen.frontend.time_sync import parse_time_sync
 from sam_codegen.frontend.types import parse_dronecan_type, parse_dsdl_struct, parse_ros_message
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
@@ -132,7 +133,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     bridge_node = top.node("bridge")
     bridge = None
     if bridge_node is not None:
-        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings"))
+        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "time_sync"))
         name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
         mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
         for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
@@ -141,7 +142,8 @@ def parse_spec(root: YNode, file: str) -> Spec:
                 mapping = parse_mapping(key, pos, node, diag, protocol)
                 if mapping is not None:
                     mappings[protocol].append(mapping)
-        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"])
+        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
+                        parse_time_sync(r.node("time_sync"), "bridge time_sync", diag))
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
         nodes[key] = parse_node(key, pos, node, diag)

@@ -343,12 +343,22 @@ class Mapping:
 
 
 @dataclass(frozen=True)
+class TimeSync:
+    """`bridge.time_sync`: the bridge as the bus's time-sync master on both protocols (frontend.time_sync)."""
+
+    enabled: bool = True
+    period_s: float = 0.5
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
 class Bridge:
     name: str
     node_id: int
     mappings: list[Mapping] = field(default_factory=list)  # Cyphal
     pos: Pos = NOWHERE
     dronecan_mappings: list[Mapping] = field(default_factory=list)
+    time_sync: TimeSync = field(default_factory=TimeSync)
 
     @property
     def all_mappings(self) -> list[Mapping]:

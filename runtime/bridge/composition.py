@@ -13,6 +13,7 @@ from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend, BridgeConfigError
 from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
+from sam_runtime.bridge.backends.time_sync_messages import sync_message
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
@@ -24,6 +25,7 @@ from sam_runtime.bridge.outbound import DEFAULT_QUEUE_SIZE, Outbound
 from sam_runtime.bridge.reporting import Reporter
 from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.bridge.silence import SilenceWatch
+from sam_runtime.bridge.time_sync import DEFAULT_TIME_SYNC_PERIOD_S, StampWatch, TimeSyncMaster
 from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.cyphal_io.transport import quiet_late_media_completions
@@ -63,6 +65,8 @@ class Bridge:
         message's CDR and back, with raw ROS publishers and subscriptions and the backend's transport-level ports;
         ``object``: the object converters between the protocol library's message objects and ROS messages (the
         readable reference; also taken, with a warning, when the generated package has no codecs).
+    :param time_sync: be the bus's time-sync master (:mod:`.time_sync`): True/False override the spec's
+        ``bridge.time_sync`` (None: the spec's; on by default).
     """
 
     def __init__(
@@ -84,6 +88,7 @@ class Bridge:
         dronecan_iface: str = "mcast-lo:",
         dronecan_options: Mapping[str, Any] | None = None,
         wire: str = "codec",
+        time_sync: bool | None = None,
     ) -> None:
         if wire not in WIRE_PATHS:
             raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
@@ -114,6 +119,15 @@ class Bridge:
             self.backend = CyphalBackend(f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.transport_config,
                                          rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
         self._dronecan_options = dict(dronecan_options or {})
+        # The bus's time-sync master: the spec's bridge.time_sync unless the caller says (dronecan_options'
+        # "time_sync", the older spelling, too); generated packages from before the key: on, at its default period.
+        override = self._dronecan_options.pop("time_sync", None) if time_sync is None else time_sync
+        self._dronecan_options.pop("time_sync", None)
+        period = getattr(tables, "TIME_SYNC_PERIOD_S", DEFAULT_TIME_SYNC_PERIOD_S)
+        if override is not None:
+            period = (period or DEFAULT_TIME_SYNC_PERIOD_S) if override else None
+        self.time_sync_period: float | None = period
+        self.time_sync: StampWatch | None = None
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
                            rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
                            qos_depth=qos_depth, command_reliability=command_reliability)
@@ -207,9 +221,25 @@ class Bridge:
         if sel.protocol == "dronecan":
             self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **self._dronecan_options)
             self.duties.attach()
+        self.time_sync = self._time_sync(sel.protocol)
+        inbound.on_stamp = self.time_sync.on_stamp
+        reporter.time_sync = self.time_sync
         link.attach()
         reporter.attach()
         self.ros.attach_spinner()
+
+    def _time_sync(self, protocol: str) -> StampWatch:
+        """The time-sync master (advertised before the link opens; its task starts after it) and the stamp watch."""
+        master = None
+        if self.time_sync_period is not None:
+            msg = sync_message(protocol)
+            outlet = self.backend.advertise("time_sync", msg.port_id, msg.dtype)
+            master = TimeSyncMaster(self.lifetime, outlet, msg.make, self.ros.receive_ns, self.time_sync_period,
+                                    msg.max_interval_s, msg.label)
+            master.attach()
+        key = "DRONECAN_DEVICE_STAMPED_MAPPINGS" if protocol == "dronecan" else "DEVICE_STAMPED_MAPPINGS"
+        return StampWatch(self.lifetime, frozenset(getattr(self.tables, key, frozenset())), self.selection.devices,
+                          master)
 
     def _on_health(self, nid: int, event: str, device: bool) -> None:
         if event == "restarted":

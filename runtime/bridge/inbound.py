@@ -85,6 +85,8 @@ class Inbound:
         for g in groups:
             g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
         self._receive_ns: Callable[[], int] = ros.receive_ns
+        # (mapping, source, stamp ns, receive ns) of every published message with a header: the time-sync watch
+        self.on_stamp: Callable[[str, int, int, int], None] | None = None
         self._group_of = {im.info.name: g for g in groups for im in g.mappings}
 
     def attach(self) -> None:
@@ -217,6 +219,8 @@ class Inbound:
                 rlog.note((name, "out_of_order"), logging.WARNING,
                           "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
                           src, stamp * 1e-9, last * 1e-9)
+            if self.on_stamp is not None:
+                self.on_stamp(name, src, stamp, receive_ns)
         try:
             im.ros_publisher.publish(out)  # CDR bytes on the wire path: rclpy publishes them raw
         except Exception as ex:

@@ -11,6 +11,7 @@ from typing import Any
 from sam_runtime.cyphal_io.transport import aclose, make_node, quiet_late_media_completions, transport_from_env
 from sam_runtime.sim.devices import PHYSICS, SAM_ACTUATORS, generic_fill, physics_key
 from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
+from sam_runtime.sim.time_sync import CYPHAL_MAX_INTERVAL_S
 
 __all__ = ["CyphalDevices"]
 
@@ -65,8 +66,6 @@ class CyphalDevices:
                     int(msg.previous_transmission_timestamp_microsecond), int(tr.timestamp.monotonic_ns)))
 
     def sync_params(self, dev: SimDevice) -> tuple[float, int]:
-        from sam_runtime.sim.time_sync import CYPHAL_MAX_INTERVAL_S
-
         return CYPHAL_MAX_INTERVAL_S, int(dev.node.presentation.transport.protocol_parameters.transfer_id_modulo)
 
     async def close(self, devices: list[SimDevice]) -> None:

@@ -278,12 +278,13 @@ class Simulator:
         if dev.clock is not None:  # its synchronised time, or 0 ("unknown") before it synchronised
             synced = None if dev.sync is None else dev.sync.to_master(dev.clock.local_us(time.monotonic_ns()))
             now_us = dev.state.stamp_us = 0 if synced is None else synced
-            if synced is None:
+        adapter = self._adapter(dev)
+        obj = adapter.blank(pp, t, now_us)
+        if dev.clock is not None and hasattr(obj, "timestamp"):  # counted where the message carries its stamp
+            if now_us == 0:
                 dev.stamps_unknown += 1
             else:
                 dev.stamps_synchronised += 1
-        adapter = self._adapter(dev)
-        obj = adapter.blank(pp, t, now_us)
         if pp.physics is not None:
             pp.physics(obj, dev.state, self.vehicle, t, dt * self.vehicle.time_scale, self.vehicle.rng)
         adapter.finish(dev, pp, obj, t, now_us)

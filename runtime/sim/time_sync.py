@@ -41,7 +41,7 @@ def device_offset_us(name: str) -> int:
 
 @dataclass
 class DeviceClock:
-    """A device's local clock: ``base_us(mono_ns)`` (the simulator's stamp clock at a monotonic time) + ``offset_us``."""
+    """A device's local clock: the simulator's stamp clock at a monotonic time, plus ``offset_us``."""
 
     epoch_us: int  # the stamp clock at mono0_ns
     mono0_ns: int

@@ -55,3 +55,6 @@ class TablesModule(Protocol):
     STATIC_TRANSFORMS: tuple[StaticTransformInfo, ...]
     TRANSFORMS: tuple[TransformInfo, ...]
     NODES: tuple[NodeInfo, ...]
+    TIME_SYNC_PERIOD_S: float | None  # the bridge's time-sync master; None: off
+    DEVICE_STAMPED_MAPPINGS: frozenset[str]  # Cyphal UAVCAN -> ROS mappings whose header.stamp is the device's
+    DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str]  # the same of the DroneCAN mappings
