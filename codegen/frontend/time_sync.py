@@ -40,8 +40,8 @@ def parse_time_sync(node: YNode | None, what: str, diag: Diagnostics) -> TimeSyn
     period = r.get("period_s", (int, float), DEFAULT_PERIOD_S)
     if period is not None and not MIN_PERIOD_S <= period <= MAX_PERIOD_S:
         diag.error(r.key_pos("period_s"), f"period_s {period} of {what} is out of range",
-                   f"{MIN_PERIOD_S}..{MAX_PERIOD_S} s (DroneCAN GlobalTimeSync: 40..1100 ms; Cyphal "
-                   f"uavcan.time.Synchronization: at most 1 s)")
+                   f"{MIN_PERIOD_S}..{MAX_PERIOD_S} s: DroneCAN GlobalTimeSync 40..1100 ms, Cyphal "
+                   f"uavcan.time.Synchronization at most 1 s")
         period = None
     return TimeSync(True if enabled is None else bool(enabled), DEFAULT_PERIOD_S if period is None else float(period),
                     r.pos)

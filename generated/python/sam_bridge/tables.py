@@ -1784,7 +1784,8 @@ NODES: tuple[NodeInfo, ...] = (
 
 # The bridge's time-sync master on both protocols (bridge.time_sync): its period in seconds; None: off.
 TIME_SYNC_PERIOD_S: float | None = 0.5
-# The UAVCAN -> ROS mappings whose header.stamp is the device's own timestamp (0 = unknown: the receive time, counted).
+# The UAVCAN -> ROS mappings (Cyphal, DroneCAN) whose header.stamp is the device's own timestamp (0 = unknown:
+# the receive time, counted).
 DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
     'altitude',
     'buoyancy_piston_feedback',
