@@ -252,6 +252,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
         sim = Simulator(generated_package(args), cfg)
         await sim.start()
         print(f"READY sim devices={len(sim.devices)} transport={kind}", flush=True)
+        synchronised = asyncio.ensure_future(_say_when_synchronised(sim, stop))
         try:
             if args.start_file is not None:
                 while not args.start_file.exists() and not stop.is_set():
@@ -269,6 +270,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
                     if not done.done():
                         done.cancel()
         finally:
+            synchronised.cancel()
             report = sim.report()
             await sim.close()
             if args.report:
@@ -277,6 +279,15 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
 
     return serve("sam-sim", run, (GeneratedPackageError, TransportConfigError, ValueError))
+
+
+async def _say_when_synchronised(sim: Any, stop: asyncio.Event) -> None:
+    """Print SYNCHRONISED once every device's clock follows the bus's time-sync master (for scripts and tests that
+    want only synchronised stamps: they open the start gate after it)."""
+    while not sim.synchronised and not stop.is_set():
+        await asyncio.sleep(0.05)
+    if not stop.is_set():
+        print("SYNCHRONISED", flush=True)
 
 
 # ============================================================================================ nodes

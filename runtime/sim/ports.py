@@ -37,6 +37,7 @@ class PubPort:
     late: int = 0
     failed: int = 0
     busy: bool = False  # a publish in flight
+    last_stamp_us: int = 0  # the last synchronised stamp of the port: its stamps only increase
     extra: Any = None  # the protocol adapter's
 
     def __post_init__(self) -> None:

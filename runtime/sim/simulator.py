@@ -242,6 +242,12 @@ class Simulator:
         self._running.set()
 
     @property
+    def synchronised(self) -> bool:
+        """Whether every powered device with its own clock follows the time-sync master (True without clocks)."""
+        return all(d.sync is not None and d.sync.synchronised for d in self.devices if d.clock is not None and
+                   d.powered)
+
+    @property
     def publishing_done(self) -> bool:
         return self._publishing_until is not None and time.monotonic() >= self._publishing_until and all(
             pp.task is None or pp.task.done() for d in self.devices for pp in d.pubs)
@@ -277,6 +283,8 @@ class Simulator:
         t, now_us = self.vehicle.t(), self.vehicle.now_us()
         if dev.clock is not None:  # its synchronised time, or 0 ("unknown") before it synchronised
             synced = None if dev.sync is None else dev.sync.to_master(dev.clock.local_us(time.monotonic_ns()))
+            if synced is not None:  # an adjustment never sends its stamps back in time (the port's last one)
+                synced = pp.last_stamp_us = max(synced, pp.last_stamp_us + 1)
             now_us = dev.state.stamp_us = 0 if synced is None else synced
         adapter = self._adapter(dev)
         obj = adapter.blank(pp, t, now_us)
