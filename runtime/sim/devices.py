@@ -24,26 +24,9 @@ from typing import Any
 
 from sam_runtime.physics.vehicle import SimulatedVehicle, Vehicle
 
-__all__ = [
-    "PHYSICS",
-    "SAM_ACTUATORS",
-    "DeviceState",
-    "PhysicsFn",
-    "VehicleState",
-    "device_stamp_us",
-    "fill_altitude",
-    "fill_battery",
-    "fill_gnss",
-    "fill_imu",
-    "fill_magnetometer",
-    "fill_position_feedback",
-    "fill_pressure",
-    "fill_thrust_vector_feedback",
-    "generic_fill",
-    "physics_key",
-    "set_field",
-    "vehicle_actuator",
-]
+__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "PhysicsFn", "VehicleState", "device_stamp_us", "fill_altitude",
+           "fill_battery", "fill_gnss", "fill_imu", "fill_magnetometer", "fill_position_feedback", "fill_pressure",
+           "fill_thrust_vector_feedback", "generic_fill", "physics_key", "set_field", "vehicle_actuator"]
 
 _log = logging.getLogger("sam_runtime.sim.simulator")
 
