@@ -233,9 +233,10 @@ class Bridge:
         master = None
         if self.time_sync_period is not None:
             msg = sync_message(protocol)
-            # (a port name with a dot: no mapping's, as mapping names are identifiers; on Cyphal its register
-            # uavcan.pub.time.synchronization.id defaults to the type's fixed subject id)
+            # (a port name with a dot: no mapping's, as mapping names are identifiers; the type's fixed port id, no
+            # register)
             outlet = self.backend.advertise("time.synchronization", msg.port_id, msg.dtype)
+            outlet.fixed_port = True
             master = TimeSyncMaster(self.lifetime, outlet, msg.make, self.ros.receive_ns, self.time_sync_period,
                                     msg.max_interval_s, msg.label)
             master.attach()
