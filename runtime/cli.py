@@ -92,8 +92,9 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--protocol", choices=("cyphal", "dronecan"), default=None,
                    help="the half of a mixed layout this bridge serves (one bridge per protocol; default: the "
                         "layout's only protocol)")
-    p.add_argument("--time-sync", action="store_true",
-                   help="DroneCAN: be the bus's GlobalTimeSync master (1 Hz)")
+    p.add_argument("--time-sync", action=argparse.BooleanOptionalAction, default=None,
+                   help="be (or not) the bus's time-sync master (Cyphal uavcan.time.Synchronization, DroneCAN "
+                        "GlobalTimeSync); default: the spec's bridge.time_sync, on unless it says otherwise")
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
     _add_wire_arg(p)
@@ -136,9 +137,10 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             layout=args.layout,
             protocol=args.protocol,
             dronecan_iface=args.dronecan_iface,
-            dronecan_options={"time_sync": args.time_sync, "dna_server": args.dna_server},
+            dronecan_options={"dna_server": args.dna_server},
             wire=args.wire,
             namespace=namespace,
+            time_sync=args.time_sync,
         )
         await bridge.start()
         print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
@@ -187,6 +189,9 @@ def _sim_parser() -> argparse.ArgumentParser:
     p.add_argument("--namespace", default=None, metavar="NS",
                    help="the vehicle's ROS namespace, as the main job gives every child; the devices have no ROS "
                         "side, so it only labels the READY line (their bus is --dronecan-iface / the transport)")
+    p.add_argument("--device-clocks", action=argparse.BooleanOptionalAction, default=True,
+                   help="each device its own clock, 5..120 s off, following the bus's time-sync master and stamping "
+                        "0 (unknown) until synchronised (default); --no-device-clocks: one shared stamp clock")
     _add_vehicle_args(p)
     return p
 
@@ -263,11 +268,12 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
             bridge_node_id=args.bridge_node_id,
             devices=None if not args.devices else [d.strip() for d in args.devices.split(",") if d.strip()],
             rate_scale=args.rate_scale, record=args.record, layout=args.layout, dronecan_iface=args.dronecan_iface,
-            **_vehicle_options(args),
+            device_clocks=args.device_clocks, **_vehicle_options(args),
         )
         sim = Simulator(generated_package(args), cfg)
         await sim.start()
         print(f"READY sim devices={len(sim.devices)} transport={kind} namespace={namespace.namespace}", flush=True)
+        synchronised = asyncio.ensure_future(_say_when_synchronised(sim, stop))
         try:
             if args.start_file is not None:
                 while not args.start_file.exists() and not stop.is_set():
@@ -285,6 +291,7 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
                     if not done.done():
                         done.cancel()
         finally:
+            synchronised.cancel()
             report = sim.report()
             await sim.close()
             if args.report:
@@ -293,6 +300,15 @@ def sim_main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
 
     return serve("sam-sim", run, (GeneratedPackageError, TransportConfigError, ValueError))
+
+
+async def _say_when_synchronised(sim: Any, stop: asyncio.Event) -> None:
+    """Print SYNCHRONISED once every device's clock follows the bus's time-sync master (for scripts and tests that
+    want only synchronised stamps: they open the start gate after it)."""
+    while not sim.synchronised and not stop.is_set():
+        await asyncio.sleep(0.05)
+    if not stop.is_set():
+        print("SYNCHRONISED", flush=True)
 
 
 # ============================================================================================ nodes

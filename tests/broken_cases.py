@@ -723,6 +723,32 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:52:31: error: mapping 'level', field 'header.stamp': an expression sets a bool or numeric scalar, header.stamp is builtin_interfaces/Time",
         ),
     ),
+    Case(
+        'time_sync_period_out_of_range',
+        '  node_id: 100\n  mappings:',
+        '  node_id: 100\n  time_sync: {period_s: 2}\n  mappings:',
+        (
+            'minimal.yaml:44:15: error: period_s 2 of bridge time_sync is out of range (expected 0.04..1.0 s: DroneCAN GlobalTimeSync 40..1100 ms, Cyphal uavcan.time.Synchronization at most 1 s)',
+        ),
+    ),
+    Case(
+        'time_sync_not_a_mapping',
+        '  node_id: 100\n  mappings:',
+        '  node_id: 100\n  time_sync: sometimes\n  mappings:',
+        (
+            "minimal.yaml:44:14: error: bridge time_sync must be a mapping, true or false, found str 'sometimes' (expected {enabled: true, period_s: 0.5}, true or false)",
+        ),
+    ),
+    Case(
+        'time_sync_unknown_key_and_wrong_kinds',
+        '  node_id: 100\n  mappings:',
+        '  node_id: 100\n  time_sync: {enabled: 1, period_s: fast, rate_hz: 2}\n  mappings:',
+        (
+            "minimal.yaml:44:24: error: 'enabled' of bridge time_sync must be bool, found int 1 (expected bool)",
+            "minimal.yaml:44:37: error: 'period_s' of bridge time_sync must be int or number, found str 'fast' (expected int or number)",
+            "minimal.yaml:44:43: error: unknown field 'rate_hz' in bridge time_sync (expected one of enabled, period_s)",
+        ),
+    ),
 )
 
 

@@ -16,6 +16,7 @@ from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.services import parse_service_mapping
+from sam_codegen.frontend.time_sync import parse_time_sync
 from sam_codegen.frontend.topic_sources import implied_tf_topics, parse_published_by
 from sam_codegen.frontend.traffic import check_enable_services
 from sam_codegen.frontend.types import (
@@ -151,7 +152,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     bridge = None
     if bridge_node is not None:
         r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty",
-                                                 "service_mappings"))
+                                                 "service_mappings", "time_sync"))
         name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
         mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
         for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
@@ -167,6 +168,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
                             for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]
         bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
                         service_mappings=service_mappings,
+                        time_sync=parse_time_sync(r.node("time_sync"), "bridge time_sync", diag),
                         panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"))
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):

@@ -435,6 +435,15 @@ class ServiceMapping:
 
 
 @dataclass(frozen=True)
+class TimeSync:
+    """`bridge.time_sync`: the bridge as the bus's time-sync master on both protocols (frontend.time_sync)."""
+
+    enabled: bool = True
+    period_s: float = 0.5
+    pos: Pos = NOWHERE
+
+
+@dataclass(frozen=True)
 class Bridge:
     name: str
     node_id: int
@@ -446,6 +455,7 @@ class Bridge:
     panic_duty: str | None = None
     panic_duty_pos: Pos = NOWHERE
     service_mappings: list[ServiceMapping] = field(default_factory=list)
+    time_sync: TimeSync = field(default_factory=TimeSync)
 
     @property
     def all_mappings(self) -> list[Mapping]:

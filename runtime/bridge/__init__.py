@@ -41,6 +41,8 @@ module                 job
 ``rate_limit``         ``max_rate_hz`` and ``deadline`` as pure logic on an injected clock (issue 19), driven by the
                        asyncio loop's timers from ``inbound`` and ``outbound``
 ``switches``           enable/disable per mapping: its state and its std_srvs/SetBool service (issue 19)
+``time_sync``          the bus's time-sync master (both protocols; its message per protocol in
+                       ``backends.time_sync_messages``) and the watch on the devices' stamps (unknown, off, error)
 =====================  ==============================================================================================
 
 Cyphal v1 messages carry no destination: a command reaches its configured destination node because the
@@ -105,7 +107,8 @@ message is still published), rejected ones under ``rejected.<...>``.
   holds data back, and the stamp tells ROS consumers (tf2, message_filters, estimators) what to do with it.
   A device that restarted (its heartbeat's uptime went down; on Cyphal/UDP also its transfer ids starting over)
   may have restarted its clock: its next stamp is compared with nothing.
-- Unknown timestamps (0): the ROS receive time. float16 NaN/+-inf from a device are passed to ROS unchanged
+- Unknown timestamps (0): the ROS receive time, counted per device (``time_sync``: a device not synchronised
+  yet). float16 NaN/+-inf from a device are passed to ROS unchanged
   (float32/float64 hold them); the devices' ranges are the consumers' business.
 - Logging is bounded: the first occurrence of a (mapping, reason) is a WARNING at once, later ones are
   summed and logged at most once per ``log_interval`` seconds (default 10) with the count since the previous

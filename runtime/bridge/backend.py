@@ -105,6 +105,7 @@ class Outlet(abc.ABC):
     port_name: str  # e.g. uavcan.pub.thruster_1_rpm
     port_id: int | None
     send_timeout: float  # seconds a publish may take before it counts as not sent
+    fixed_port: bool = False  # the type's fixed port id: no register configures it (the time-sync master's)
 
     @property
     @abc.abstractmethod

@@ -14,6 +14,7 @@ from sam_runtime.bridge.backend import Backend, BridgeConfigError
 from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
 from sam_runtime.bridge.backends.dronecan_services import DroneCanServices
+from sam_runtime.bridge.backends.time_sync_messages import sync_message
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
@@ -26,6 +27,7 @@ from sam_runtime.bridge.reporting import Reporter
 from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.bridge.silence import SilenceWatch
 from sam_runtime.bridge.switches import EnableServices, switches_of
+from sam_runtime.bridge.time_sync import DEFAULT_TIME_SYNC_PERIOD_S, StampWatch, TimeSyncMaster
 from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.ros_namespace import RosNamespace
@@ -70,6 +72,8 @@ class Bridge:
         are created in it, so the spec's relative topics resolve there; the frame prefix goes before every
         frame_id the bridge writes and the namespace before its diagnostic statuses' names. A non-empty frame
         prefix takes the object path: the wire codecs carry the spec's frame ids in their constant bytes.
+    :param time_sync: be the bus's time-sync master (:mod:`.time_sync`): True/False override the spec's
+        ``bridge.time_sync`` (None: the spec's; on by default).
     """
 
     def __init__(
@@ -92,6 +96,7 @@ class Bridge:
         dronecan_options: Mapping[str, Any] | None = None,
         wire: str = "codec",
         namespace: RosNamespace | None = None,
+        time_sync: bool | None = None,
     ) -> None:
         if wire not in WIRE_PATHS:
             raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
@@ -128,6 +133,15 @@ class Bridge:
             self.backend = CyphalBackend(f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.transport_config,
                                          rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
         self._dronecan_options = dict(dronecan_options or {})
+        # The bus's time-sync master: the spec's bridge.time_sync unless the caller says (dronecan_options'
+        # "time_sync", the older spelling, too); generated packages from before the key: on, at its default period.
+        override = self._dronecan_options.pop("time_sync", None) if time_sync is None else time_sync
+        self._dronecan_options.pop("time_sync", None)
+        period = getattr(tables, "TIME_SYNC_PERIOD_S", DEFAULT_TIME_SYNC_PERIOD_S)
+        if override is not None:
+            period = (period or DEFAULT_TIME_SYNC_PERIOD_S) if override else None
+        self.time_sync_period: float | None = period
+        self.time_sync: StampWatch | None = None
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
                            rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
                            qos_depth=qos_depth, command_reliability=command_reliability,
@@ -240,9 +254,28 @@ class Bridge:
                 self.services = DroneCanServices(lifetime, backend, self.ros, served,
                                                  diagnostics_period=self._diagnostics_period)
                 self.services.attach()
+        self.time_sync = self._time_sync(sel.protocol)
+        inbound.on_stamp = self.time_sync.on_stamp
+        reporter.time_sync = self.time_sync
         link.attach()
         reporter.attach()
         self.ros.attach_spinner()
+
+    def _time_sync(self, protocol: str) -> StampWatch:
+        """The time-sync master (advertised before the link opens; its task starts after it) and the stamp watch."""
+        master = None
+        if self.time_sync_period is not None:
+            msg = sync_message(protocol)
+            # (a port name with a dot: no mapping's, as mapping names are identifiers; the type's fixed port id, no
+            # register)
+            outlet = self.backend.advertise("time.synchronization", msg.port_id, msg.dtype)
+            outlet.fixed_port = True
+            master = TimeSyncMaster(self.lifetime, outlet, msg.make, self.ros.receive_ns, self.time_sync_period,
+                                    msg.max_interval_s, msg.label)
+            master.attach()
+        key = "DRONECAN_DEVICE_STAMPED_MAPPINGS" if protocol == "dronecan" else "DEVICE_STAMPED_MAPPINGS"
+        return StampWatch(self.lifetime, frozenset(getattr(self.tables, key, frozenset())), self.selection.devices,
+                          master)
 
     def _on_health(self, nid: int, event: str, device: bool) -> None:
         if event == "restarted":

@@ -4,7 +4,7 @@ rejected.<field>, out_of_order, the protocol stack's counters, the traffic contr
 max_rate_hz, deadline_s); WARN while it dropped within the last 10 s, or while
 it gets nothing from a device whose heartbeat is alive for longer than its grace: sam_runtime.bridge.liveness), one per
 device (OK while its heartbeat is alive and its health means OK, WARN or ERROR as its health says, ERROR when the
-heartbeat is lost, STALE when never seen)."""
+heartbeat is lost, STALE when never seen), and one for the bus's time (:func:`time_sync_status`)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "diagnostic_array", "traffic_values"]
+__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "diagnostic_array", "time_sync_status", "traffic_values"]
 
 RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
 _PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
@@ -129,4 +129,44 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
         arr.status.append(DiagnosticStatus(
             level=level, name=f"{naming.bridge}/device/{name}", hardware_id=f"{proto} node {d['node_id']}",
             message=msg, values=kv({k: v for k, v in d.items() if k not in ("seen", "level")})))
+    ts = snap.get("time_sync")
+    if ts is not None:
+        arr.status.append(time_sync_status(ts, naming, DiagnosticStatus, kv))
     return arr
+
+
+def time_sync_status(ts: Mapping[str, Any], naming: Naming, status_cls: Any, kv: Any) -> Any:
+    """``<bridge>/time_sync``: the master (running: messages sent within 3 periods) and, per device, whether its
+    stamps are synchronised, their counts and the median error receive time - stamp. OK while the master sends and
+    every device's last stamp was synchronised; WARN otherwise (not yet, or not following); ERROR when the
+    master's sends fail."""
+    master = ts.get("master")
+    values: dict[str, Any] = {}
+    problems: list[str] = []
+    level = 0
+    if master is None:
+        values["master"] = "off"
+    else:
+        age = master["last_sent_age_s"]
+        running = age is not None and age <= 3 * master["period_s"]
+        values.update({"master": "running" if running else "not sending", "master.message": master["message"],
+                       "master.period_s": master["period_s"], "master.sent": master["sent"],
+                       "master.failed": master["failed"]})
+        if not running:
+            level = 2
+            problems.append("the master is not sending")
+    unsynced = []
+    for name, d in ts["devices"].items():
+        values[f"{name}.synchronised"] = d["synchronised"]
+        values.update({f"{name}.{k}": d[k] for k in ("stamps_known", "stamps_unknown", "stamps_off")})
+        if "error_ms" in d:
+            values[f"{name}.error_ms.median"] = d["error_ms"]["median"]
+        if not d["synchronised"]:
+            unsynced.append(name)
+    if unsynced:
+        level = max(level, 1)
+        problems.append("not synchronised: " + ", ".join(unsynced))
+    msg = "; ".join(problems) or (f"{len(ts['devices'])} devices synchronised" if master is not None else
+                                  f"master off; {len(ts['devices'])} devices synchronised")
+    return status_cls(level=bytes([level]), name=f"{naming.bridge}/time_sync", hardware_id="time sync", message=msg,
+                      values=kv(values))

@@ -109,6 +109,8 @@ class Inbound:
             g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
             g.any_source = any(getattr(im.info, "any_node", False) for im in g.mappings)
         self._receive_ns: Callable[[], int] = ros.receive_ns
+        # (mapping, source, stamp ns, receive ns) of every published message with a header: the time-sync watch
+        self.on_stamp: Callable[[str, int, int, int], None] | None = None
         self._group_of = {im.info.name: g for g in groups for im in g.mappings}
         for g in groups:
             for im in g.mappings:
@@ -263,6 +265,8 @@ class Inbound:
                 rlog.note((name, "out_of_order"), logging.WARNING,
                           "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
                           src, stamp * 1e-9, last * 1e-9)
+            if self.on_stamp is not None:
+                self.on_stamp(name, src, stamp, receive_ns)
         if im.pacer is not None:
             im.pacer.offer(out)  # now, or when its slot comes (see the docstring)
         else:

@@ -44,6 +44,7 @@ class Reporter:
         self.switches = dict(switches or {})
         self.naming = Naming(name, backend.protocol, backend.label, backend.stack)
         self._publisher: Any = None
+        self.time_sync: Any = None  # the time-sync master and stamp watch (sam_runtime.bridge.time_sync)
 
     def attach(self) -> None:
         """The /diagnostics publisher and its timer once the ROS node exists."""
@@ -143,5 +144,6 @@ class Reporter:
             "mappings": mappings,
             "devices": devices,
             "other_nodes": others,
+            **({"time_sync": self.time_sync.snapshot()} if self.time_sync is not None else {}),
         }
 

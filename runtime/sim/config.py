@@ -49,3 +49,7 @@ class SimConfig:
                                 battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
                                 params=self.vehicle_params, noise=self.noise)
     log_interval: float = 10.0  # failed publications: the first logged at once, then a count per interval
+    # Each device its own clock (an offset of 5..120 s from the computers', sam_runtime.sim.time_sync), following the
+    # bus's time-sync master and stamping 0 ("unknown") until it synchronised; off: the shared stamp clock, as
+    # under a time scale other than 1 (the vehicle's time is then not the computers')
+    device_clocks: bool = True

@@ -11,6 +11,7 @@ from typing import Any
 from sam_runtime.cyphal_io.transport import aclose, make_node, quiet_late_media_completions, transport_from_env
 from sam_runtime.sim.devices import PHYSICS, SAM_ACTUATORS, generic_fill, physics_key
 from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
+from sam_runtime.sim.time_sync import CYPHAL_MAX_INTERVAL_S
 
 __all__ = ["CyphalDevices"]
 
@@ -55,13 +56,25 @@ class CyphalDevices:
         for pp in dev.pubs:
             pp.publisher = dev.node.make_publisher(pp.dtype, pp.port.subject_id)
             pp.publisher.send_timeout = 1.0
+        if dev.clock is not None:  # its clock follows the bus's time-sync master (fixed subject 7168)
+            import uavcan.time
+
+            sync = dev.extra = dev.node.make_subscriber(uavcan.time.Synchronization_1_0)
+            sync.receive_in_background(
+                lambda msg, tr, dev=dev: self.sim.on_time_sync(
+                    dev, int(tr.source_node_id if tr.source_node_id is not None else 0xFFFF), int(tr.transfer_id),
+                    int(msg.previous_transmission_timestamp_microsecond), int(tr.timestamp.monotonic_ns)))
+
+    def sync_params(self, dev: SimDevice) -> tuple[float, int]:
+        return CYPHAL_MAX_INTERVAL_S, int(dev.node.presentation.transport.protocol_parameters.transfer_id_modulo)
 
     async def close(self, devices: list[SimDevice]) -> None:
         """Close the devices' ports, then their nodes (never raises)."""
         ports = [p.publisher for d in devices for p in d.pubs] + [s.subscriber for d in devices for s in d.subs]
+        ports += [d.extra for d in devices]  # the time-sync subscribers
         nodes = [d.node for d in devices]
         for d in devices:
-            d.node = None
+            d.node = d.extra = None
             for pp in d.pubs:
                 pp.publisher = None
             for sp in d.subs:

@@ -24,8 +24,8 @@ from typing import Any
 
 from sam_runtime.physics.vehicle import SimulatedVehicle, Vehicle
 
-__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "PhysicsFn", "VehicleState", "fill_altitude", "fill_battery",
-           "fill_gnss", "fill_imu", "fill_magnetometer", "fill_position_feedback", "fill_pressure",
+__all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "PhysicsFn", "VehicleState", "device_stamp_us", "fill_altitude",
+           "fill_battery", "fill_gnss", "fill_imu", "fill_magnetometer", "fill_position_feedback", "fill_pressure",
            "fill_thrust_vector_feedback", "generic_fill", "physics_key", "set_field", "vehicle_actuator"]
 
 _log = logging.getLogger("sam_runtime.sim.simulator")
@@ -83,6 +83,9 @@ class DeviceState:
     position: dict[str, float] = field(default_factory=dict)  # model state, e.g. percent, rpm
     last_update: float | None = None  # VehicleState.t() of the last model step
     extra: dict[str, Any] = field(default_factory=dict)
+    # The stamp of the message being made, in the device's synchronised time (0: not synchronised yet, "unknown");
+    # None: the shared stamp clock (no device clocks, e.g. under a time scale)
+    stamp_us: int | None = None
 
     def approach(self, key: str, target: float, rate_per_s: float, t: float, initial: float = 0.0) -> float:
         """Move position[key] toward target at rate_per_s since the last call; returns the new value."""
@@ -169,6 +172,12 @@ def set_field(obj: Any, name: str, value: Any) -> None:
             _log.debug("%s.%s = %r refused: %s", type(obj).__name__, name, value, ex)
 
 
+def device_stamp_us(dev: DeviceState, veh: VehicleState) -> int:
+    """The stamp of the device's message now: its synchronised time (0 before it synchronised), or the shared stamp
+    clock when the devices have no clocks of their own."""
+    return veh.now_us() if dev.stamp_us is None else dev.stamp_us
+
+
 def _stamp(obj: Any, name: str, us: int) -> None:
     """A timestamp field: Cyphal's SynchronizedTimestamp (``microsecond``) or UAVCAN v0's Timestamp (``usec``)."""
     sub = getattr(obj, name, None)
@@ -188,7 +197,7 @@ def fill_imu(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float,
          full_covariance: bool = True) -> None:
     veh.sync(t)
     m = veh.model.sensors.imu()
-    _stamp(obj, "timestamp", veh.now_us())
+    _stamp(obj, "timestamp", device_stamp_us(dev, veh))
     set_field(obj, "integration_interval", dt)
     set_field(obj, "rate_gyro_latest", list(m.gyro))
     set_field(obj, "rate_gyro_integral", [g * dt for g in m.gyro])
@@ -214,7 +223,7 @@ def fill_magnetometer(obj: Any, dev: DeviceState, veh: VehicleState, t: float, d
 def fill_gnss(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
     fix = veh.model.sensors.gps()
-    _stamp(obj, "timestamp", veh.now_us())
+    _stamp(obj, "timestamp", device_stamp_us(dev, veh))
     set_field(obj, "latitude_deg_1e8", round(fix.lat * 1e8))
     set_field(obj, "longitude_deg_1e8", round(fix.lon * 1e8))
     set_field(obj, "status", fix.status)
@@ -242,7 +251,7 @@ def fill_pressure(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: f
 
 def fill_altitude(obj: Any, dev: DeviceState, veh: VehicleState, t: float, dt: float, rng: random.Random) -> None:
     veh.sync(t)
-    _stamp(obj, "timestamp", veh.now_us())
+    _stamp(obj, "timestamp", device_stamp_us(dev, veh))
     set_field(obj, "altitude", veh.model.sensors.altitude())
     set_field(obj, "altitude_variance", veh.model.sensors.noise.altitude ** 2)
 
@@ -279,7 +288,7 @@ def _thruster_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: float, 
     rpm = vehicle_actuator(dev, veh, t, "rpm")
     if rpm is None:
         rpm = dev.approach("rpm", float(dev.command.get("rpm", 0)), 2000.0, t)  # spins up at 2000 rpm/s
-    _stamp(obj, "timestamp", veh.now_us())
+    _stamp(obj, "timestamp", device_stamp_us(dev, veh))
     set_field(obj, "rpm", round(max(-131072, min(131071, rpm))))
     set_field(obj, "current", 0.3 + 2.0 * abs(rpm) / 1000.0)
     set_field(obj, "temperature_c", int(min(127, 25 + abs(rpm) / 200.0)))
@@ -292,7 +301,7 @@ def fill_thrust_vector_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t
     if v is None or h is None:  # 0.5 rad/s servos
         v = dev.approach("vertical", float(dev.command.get("vertical_radians", 0.0)), 0.5, t)
         h = dev.approach("horizontal", float(dev.command.get("horizontal_radians", 0.0)), 0.5, t)
-    _stamp(obj, "timestamp", veh.now_us())
+    _stamp(obj, "timestamp", device_stamp_us(dev, veh))
     set_field(obj, "vertical_mrad", int(max(-4096, min(4095, round(v * 1000)))))
     set_field(obj, "horizontal_mrad", int(max(-4096, min(4095, round(h * 1000)))))
 
@@ -303,7 +312,7 @@ def fill_position_feedback(obj: Any, dev: DeviceState, veh: VehicleState, t: flo
     if pct is None:
         target = float(dev.command.get("percent", 50.0))
         pct = dev.approach("percent", max(0.0, min(100.0, target)), 10.0, t, initial=50.0)  # 10 %/s
-    _stamp(obj, "timestamp", veh.now_us())
+    _stamp(obj, "timestamp", device_stamp_us(dev, veh))
     set_field(obj, "percent", pct)
     set_field(obj, "encoder_count", round(pct * 100))  # 10 000 counts over the full travel
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 import asyncio
 import hashlib
 import logging
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,12 +51,14 @@ from sam_runtime.sim.devices_dronecan import (
     to_builtin_v0,
 )
 from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
+from sam_runtime.sim.time_sync import DRONECAN_MAX_INTERVAL_S
 
 __all__ = ["DroneCanDevices", "ensure_types", "type_problems"]
 
 _log = logging.getLogger("sam_runtime.sim.simulator")
 NODE_STATUS_INTERVAL_S = 1.0
 RESTART_NODE = "uavcan.protocol.RestartNode"
+TIME_SYNC = "uavcan.protocol.GlobalTimeSync"
 
 
 @dataclass
@@ -204,7 +207,8 @@ class DroneCanDevices:
         info.software_version.major = 1
         info.hardware_version.major = 1
         info.hardware_version.unique_id = hashlib.sha256(name.encode()).digest()[:16]
-        accept = Acceptance(dev.info.node_id, frozenset(sp.ident for sp in dev.subs))
+        sync_id = {int(dronecan.TYPENAMES[TIME_SYNC].default_dtid)} if dev.clock is not None else set()
+        accept = Acceptance(dev.info.node_id, frozenset({sp.ident for sp in dev.subs} | sync_id))
         driver = make_driver(self.iface, accept=accept) if self._kind == "mcast-lo" else make_driver(self.iface)
         gate = FrameGate(driver)
         try:
@@ -232,7 +236,15 @@ class DroneCanDevices:
             transfer = event.transfer
             if transfer.service_not_message:
                 return  # requests: GetNodeInfo (dronecan's), RestartNode (below)
-            sp = subs.get(str(event.message._type.full_name))
+            type_name = str(event.message._type.full_name)
+            if type_name == TIME_SYNC:  # its clock follows the bus's GlobalTimeSync master
+                if dev.node is event.node and transfer.source_node_id:
+                    ts = transfer.ts_monotonic
+                    rx_ns = time.monotonic_ns() if ts is None else int(ts * 1e9)
+                    self.sim.on_time_sync(dev, int(transfer.source_node_id), int(transfer.transfer_id),
+                                          int(event.message.previous_transmission_timestamp_usec), rx_ns)
+                return
+            sp = subs.get(type_name)
             if sp is None or dev.node is not event.node:
                 return
             try:
@@ -327,6 +339,9 @@ class DroneCanDevices:
                 if inp in names:
                     state[names[inp]] = inputs[inp]  # as the Cyphal command field (rpm, percent, ...)
         return inputs
+
+    def sync_params(self, dev: SimDevice) -> tuple[float, int]:
+        return DRONECAN_MAX_INTERVAL_S, 32  # v0 transfer ids are 5 bits
 
     def record(self, port: Any, obj: Any, transmitted: bool) -> dict[str, Any]:
         t = port.port.data_type

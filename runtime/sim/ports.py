@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from sam_runtime.genpkg import GeneratedPackage
 from sam_runtime.sim.config import SimConfig
 from sam_runtime.sim.devices import DeviceState, PhysicsFn
+from sam_runtime.sim.time_sync import DeviceClock, SyncSlave
 
 if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
@@ -36,6 +37,7 @@ class PubPort:
     late: int = 0
     failed: int = 0
     busy: bool = False  # a publish in flight
+    last_stamp_us: int = 0  # the last synchronised stamp of the port: its stamps only increase
     extra: Any = None  # the protocol adapter's
 
     def __post_init__(self) -> None:
@@ -79,6 +81,11 @@ class SimDevice:
     power_cycles: int = 0
     protocol: str = "cyphal"
     extra: Any = None  # the protocol adapter's (DroneCAN: the NodeLoop)
+    # Its own clock and time-sync slave (sam_runtime.sim.time_sync); None: it stamps with the shared stamp clock
+    clock: DeviceClock | None = None
+    sync: SyncSlave | None = None  # a new one at each power-on (unsynchronised after a reboot)
+    stamps_synchronised: int = 0  # messages it stamped in the master's time
+    stamps_unknown: int = 0  # messages it stamped 0 ("unknown") because it had not synchronised yet
 
 
 class DeviceHost(Protocol):
@@ -95,6 +102,9 @@ class DeviceHost(Protocol):
 
     async def restart(self, name: str) -> None:
         """Power the device off, then on again."""
+
+    def on_time_sync(self, dev: SimDevice, master: int, transfer_id: int, prev_tx_us: int, rx_mono_ns: int) -> None:
+        """A time-sync message from node ``master`` reached ``dev`` at monotonic time ``rx_mono_ns``."""
 
 
 class DeviceAdapter(Protocol):
@@ -128,3 +138,7 @@ class DeviceAdapter(Protocol):
 
     def record(self, port: Any, obj: Any, transmitted: bool) -> dict[str, Any]:
         """A JSON-able record of a message (as transmitted)."""
+
+    def sync_params(self, dev: SimDevice) -> tuple[float, int]:
+        """The protocol's time sync: the longest interval between two messages of a master (s), the transfer id
+        modulo of the device's transport."""

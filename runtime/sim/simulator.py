@@ -18,7 +18,12 @@
   ignored.
 - Timestamps: microseconds on a monotonic clock whose epoch is the wall-clock time at start (realistic
   ROS stamps, never jumping); with ``time_scale`` the vehicle's clock (and the stamps) run that many times
-  faster than the wall clock, and so do the publication rates.
+  faster than the wall clock, and so do the publication rates. Device clocks (``SimConfig.device_clocks``, at time
+  scale 1): each device's own clock runs 5..120 s off (:mod:`sam_runtime.sim.time_sync`) and follows the bus's
+  time-sync master (Cyphal ``uavcan.time.Synchronization``, DroneCAN ``GlobalTimeSync``); its messages carry
+  the synchronised time, or 0 ("unknown", both protocols' convention, which the bridge stamps with its receive
+  time and counts) until it has synchronised, again after each reboot. Counted per device (``time_sync`` in
+  :meth:`Simulator.report`, with the synchronised clock's error against the computers' clock).
 - Ground truth: ``Simulator.truth()`` in process, and ``truth_file`` (JSON lines when it ends in ``.jsonl``,
   else one JSON object replaced atomically) at ``truth_rate_hz`` of vehicle time.
 
@@ -56,6 +61,7 @@ from sam_runtime.sim.devices import (
     physics_key,
 )
 from sam_runtime.sim.ports import DeviceAdapter, PubPort, SimDevice, SubPort
+from sam_runtime.sim.time_sync import DeviceClock, SyncSlave, device_offset_us
 
 if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
@@ -113,6 +119,9 @@ class Simulator:
                                  f"{protocol} firmware")
             if wanted is None or name in wanted:
                 self.devices.append(SimDevice(info, DeviceState(name, info.node_id), protocol=protocol))
+        if self.config.device_clocks and self.vehicle.time_scale == 1.0:
+            for dev in self.devices:
+                dev.clock = DeviceClock(self.vehicle.epoch_us, self.vehicle.mono0_ns, device_offset_us(dev.info.name))
         self._adapters: dict[str, DeviceAdapter] = {}
         for protocol in {d.protocol for d in self.devices}:
             if protocol == "dronecan":
@@ -163,6 +172,9 @@ class Simulator:
     def _open_device(self, dev: SimDevice) -> None:
         """The device's node (heartbeats start at once) and its ports."""
         self._adapter(dev).open(dev)
+        if dev.clock is not None:  # a (re)booted device has not synchronised yet
+            max_interval, modulo = self._adapter(dev).sync_params(dev)
+            dev.sync = SyncSlave(max_interval_s=max_interval, tid_modulo=modulo)
         dev.powered = True
 
     def _start_device_tasks(self, dev: SimDevice, restart: bool = False) -> None:
@@ -230,6 +242,12 @@ class Simulator:
         self._running.set()
 
     @property
+    def synchronised(self) -> bool:
+        """Whether every powered device with its own clock follows the time-sync master (True without clocks)."""
+        return all(d.sync is not None and d.sync.synchronised for d in self.devices if d.clock is not None and
+                   d.powered)
+
+    @property
     def publishing_done(self) -> bool:
         return self._publishing_until is not None and time.monotonic() >= self._publishing_until and all(
             pp.task is None or pp.task.done() for d in self.devices for pp in d.pubs)
@@ -263,8 +281,18 @@ class Simulator:
     def make_sample(self, dev: SimDevice, pp: PubPort, dt: float) -> Any:
         """One message of the port: generic values, then the device's physics (if known)."""
         t, now_us = self.vehicle.t(), self.vehicle.now_us()
+        if dev.clock is not None:  # its synchronised time, or 0 ("unknown") before it synchronised
+            synced = None if dev.sync is None else dev.sync.to_master(dev.clock.local_us(time.monotonic_ns()))
+            if synced is not None:  # an adjustment never sends its stamps back in time (the port's last one)
+                synced = pp.last_stamp_us = max(synced, pp.last_stamp_us + 1)
+            now_us = dev.state.stamp_us = 0 if synced is None else synced
         adapter = self._adapter(dev)
         obj = adapter.blank(pp, t, now_us)
+        if dev.clock is not None and hasattr(obj, "timestamp"):  # counted where the message carries its stamp
+            if now_us == 0:
+                dev.stamps_unknown += 1
+            else:
+                dev.stamps_synchronised += 1
         if pp.physics is not None:
             pp.physics(obj, dev.state, self.vehicle, t, dt * self.vehicle.time_scale, self.vehicle.rng)
         adapter.finish(dev, pp, obj, t, now_us)
@@ -355,6 +383,16 @@ class Simulator:
             self._write_record("rx", dev, sp, msg, source=src, accepted=accepted,
                                seq=sp.accepted if accepted else sp.rejected)
 
+    def on_time_sync(self, dev: SimDevice, master: int, transfer_id: int, prev_tx_us: int, rx_mono_ns: int) -> None:
+        """A time-sync message reached ``dev``: its slave follows the master (the local time of reception from the
+        transport's receive timestamp)."""
+        if dev.clock is None or dev.sync is None:
+            return
+        if dev.sync.on_message(master, transfer_id, prev_tx_us, dev.clock.local_us(rx_mono_ns), rx_mono_ns * 1e-9) \
+                and dev.sync.adjustments == 1:
+            _log.info("%s: synchronised to the time of node %d (offset %+.6f s)", dev.info.name, master,
+                      dev.sync.offset_us * 1e-6 if dev.sync.offset_us is not None else 0.0)
+
     # ---------------------------------------------------------------------------------- truth
     def truth(self) -> dict[str, Any]:
         """The vehicle's true state now (see :meth:`sam_runtime.physics.vehicle.Vehicle.truth`), with the sim's stamp
@@ -420,6 +458,7 @@ class Simulator:
                     } for s in d.subs
                 },
                 "position": dict(d.state.position),
+                **({"time_sync": _time_sync_report(d)} if d.clock is not None else {}),
             }
         truth = self.truth()
         since = self._publishing_since
@@ -432,6 +471,21 @@ class Simulator:
             "vehicle": truth,
             "rejected_vehicle_commands": self.vehicle.vehicle.rejected_commands,
         }
+
+
+def _time_sync_report(d: SimDevice) -> dict[str, Any]:
+    """A device's clock and time sync: its offset from the computers' time, whether it follows a master, and
+    the error of its synchronised time against the computers' clock now (the simulator shares it: ground truth)."""
+    assert d.clock is not None
+    sync = d.sync
+    now_ns = time.time_ns()
+    synced = None if sync is None else sync.to_master(d.clock.local_us(time.monotonic_ns()))
+    return {"clock_offset_us": d.clock.offset_us, "synchronised": synced is not None,
+            "master": None if sync is None else sync.master, "adjustments": 0 if sync is None else sync.adjustments,
+            "restarts": 0 if sync is None else sync.restarts,
+            "last_correction_us": None if sync is None else sync.last_correction_us,
+            "error_us": None if synced is None else synced - now_ns // 1000,
+            "stamps_synchronised": d.stamps_synchronised, "stamps_unknown": d.stamps_unknown}
 
 
 def _json_default(o: Any) -> Any:

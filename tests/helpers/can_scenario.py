@@ -117,6 +117,8 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
         result["devices"] = bridge.stats()["devices"]
         result["parameters"] = check_parameters(bridge)
 
+        # the devices' clocks follow the bridge's (its time-sync master): every stamp is a device's own
+        await wait_for(lambda: sim.synchronised, 20, "the devices' clocks synchronised")
         plan = command_plan(tables, args.commands)
         t0 = time.monotonic()
         sim.start_publishing(duration=args.duration)

@@ -109,6 +109,7 @@ def _sensor_run(gen: Any, d: Path, env: dict[str, str], in_maps: list[Any], topi
             return s if subs_ok and devs_ok else None
 
         before = poll_until(bridge_sees_probe_and_devices, 20, "the bridge's publishers matching the probe")
+        sim.wait_line("SYNCHRONISED", 30)  # the devices' clocks follow the bridge's: every stamp a device's own
         (d / "go").touch()
         sim.wait_line("DONE", WINDOW_S + 30)
         assert sim.wait(15) == 0

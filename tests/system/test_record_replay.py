@@ -245,7 +245,10 @@ def test_replay_through_the_same_spec_reproduces_the_recorded_topics(recorded: R
         assert d["identical"] + d["receive_time_only"] == d["recorded"] >= MIN_PER_TOPIC, (topic, d)
         # the only fields allowed to differ: the stamp the bridge takes from its own clock
         assert set(d["receive_time_fields"]) <= {"header.stamp.sec", "header.stamp.nanosec"}, (topic, d)
-    assert report["topics"]["/imu"]["identical"] == report["topics"]["/imu"]["recorded"]  # device-stamped: bytes
+    # device-stamped: the same bytes, but for what the IMU sent before its clock followed the bridge's time-sync
+    # master (stamp 0, unknown: the bridge's receive time), at most its first seconds (100 Hz) after the bridge started
+    imu = report["topics"]["/imu"]
+    assert imu["recorded"] - 300 <= imu["identical"] <= imu["recorded"], imu
     new = read_recording(out)
     assert new.complete and set(new.topics()) >= bridged | {CYPHAL_TOPIC}
     assert len(new.transfers()) == report["transfers"]

@@ -281,6 +281,7 @@ def _bridge_summary(spec: Spec, topic_users: TopicUsers, subject_types: dict[int
         "subscribes": [name for name, (_, subscribers) in topic_users.items() if bridge.name in subscribers],
         "uavcan_publishes": bridge_ports(ROS_TO_UAVCAN),
         "uavcan_subscribes": bridge_ports(UAVCAN_TO_ROS),
+        "time_sync_period": bridge.time_sync.period_s if bridge.time_sync.enabled else None,
     }
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from sam_codegen.model.spec import Mapping, Port, Qos, V0Struct
+from sam_codegen.model.spec import UAVCAN_TO_ROS, Mapping, Port, Qos, V0Struct
 from sam_codegen.render.filters import py_str
 from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
 from sam_codegen.targets import dsdl_v0
@@ -26,7 +26,8 @@ from sam_codegen.validate.nodes import class_name, node_topic_qos
 from sam_codegen.validate.panic_duty import panic_duty
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["cyphal_context", "dronecan_context", "nodes_context", "table_types_source", "tables_context"]
+__all__ = ["cyphal_context", "dronecan_context", "nodes_context", "table_types_source", "tables_context",
+           "time_sync_context"]
 
 
 def _ros_type_parts(full: str) -> tuple[str, str, str]:
@@ -104,7 +105,22 @@ def cyphal_context(resolved: Resolved) -> dict[str, Any]:
         "bridge_node_id": str(bridge.node_id) if bridge else "None",
         "devices": devices, "topics": topics,
         "mappings": mappings, "parameters": parameters, "rules": rules, "frames": frames,
+        **time_sync_context(resolved),
     }
+
+
+def time_sync_context(resolved: Resolved) -> dict[str, Any]:
+    """The bridge's time-sync master (its period, None when off or without a bridge) and, per protocol, the
+    UAVCAN->ROS mappings whose header.stamp is the device's own timestamp (0 = unknown: the receive time, counted)."""
+    bridge = resolved.spec.bridge
+    period = bridge.time_sync.period_s if bridge is not None and bridge.time_sync.enabled else None
+
+    def stamped(mappings: list[Any]) -> list[str]:
+        return [py_str(n) for n in sorted({rm.mapping.name for rm in mappings
+                                           if rm.mapping.direction == UAVCAN_TO_ROS and rm.stamp_from_source})]
+
+    return {"time_sync_period": py_literal(period), "device_stamped": stamped(resolved.mappings),
+            "dronecan_device_stamped": stamped(resolved.dronecan_mappings)}
 
 
 def _type_info(struct: V0Struct) -> str:

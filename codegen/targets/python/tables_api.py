@@ -57,3 +57,6 @@ class TablesModule(Protocol):
     NODES: tuple[NodeInfo, ...]
     DRONECAN_NAMESPACES: tuple[str, ...] | None  # None: every namespace dronecan loads
     DRONECAN_PANIC_DUTY: str  # "builtin" | "mappings" | "both"
+    TIME_SYNC_PERIOD_S: float | None  # the bridge's time-sync master; None: off
+    DEVICE_STAMPED_MAPPINGS: frozenset[str]  # Cyphal UAVCAN -> ROS mappings whose header.stamp is the device's
+    DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str]  # the same of the DroneCAN mappings

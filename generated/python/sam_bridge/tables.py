@@ -1945,3 +1945,26 @@ NODES: tuple[NodeInfo, ...] = (
         ),
     ),
 )
+
+# The bridge's time-sync master on both protocols (bridge.time_sync): its period in seconds; None: off.
+TIME_SYNC_PERIOD_S: float | None = 0.5
+# The UAVCAN -> ROS mappings (Cyphal, DroneCAN) whose header.stamp is the device's own timestamp (0 = unknown:
+# the receive time, counted).
+DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
+    'altitude',
+    'buoyancy_piston_feedback',
+    'gps_fix',
+    'imu',
+    'longitudinal_weight_feedback',
+    'thrust_vector_feedback',
+    'thruster_1_feedback',
+    'thruster_2_feedback',
+})
+DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
+    'altitude',
+    'buoyancy_piston_feedback',
+    'gps_fix',
+    'imu',
+    'longitudinal_weight_feedback',
+    'thrust_vector_feedback',
+})

@@ -294,7 +294,8 @@ class CyphalBackend(Backend):
                 transport.add_error_hook(self._on_transport_error)
             rxq = self.rx_queue_size if self.rx_queue_size > 0 else None
             for pub in self._pubs:
-                pub.port_id = resolve_subject(node.registry, "pub", pub.name, pub.dtype, pub.spec_id)
+                pub.port_id = pub.spec_id if pub.fixed_port else resolve_subject(node.registry, "pub", pub.name,
+                                                                                  pub.dtype, pub.spec_id)
                 if pub.raw_sender is not None:
                     pub.raw_sender.reopen(transport, pub.port_id, pub.dtype)
                     pub.publisher = pub.raw_sender

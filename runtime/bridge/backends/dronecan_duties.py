@@ -10,8 +10,8 @@ lifetime beside the DroneCAN backend:
   ``panic=False`` (the spec's ``panic_duty: mappings``: its own mappings of Panic instead) leaves Panic alone; beside
   a mapping of Panic on the wire path (``panic_duty: both``) the tapped Panic transfers are shared with the node, so
   both see every Panic;
-- optional: the bus's ``uavcan.protocol.GlobalTimeSync`` master (1 Hz, with the previous transmission's time) and a
-  dynamic node id allocation server (dronecan's CentralizedServer with its NodeMonitor, in memory).
+- optional: a dynamic node id allocation server (dronecan's CentralizedServer with its NodeMonitor, in memory).
+  (The bus's GlobalTimeSync master is sam_runtime.bridge.time_sync's, on both protocols.)
 
 The services live on a ROS node of their own with its own executor thread: a service call waits (at most
 ``timeout`` s) for the device's answer, and must never hold up the bridge's command path, which the bridge's
@@ -25,7 +25,6 @@ import asyncio
 import json
 import logging
 import threading
-import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -36,7 +35,6 @@ __all__ = ["DroneCanDuties", "node_info_json"]
 
 PANIC_MIN_MESSAGES = 3
 PANIC_INTERVAL_S = 0.1
-TIME_SYNC_PERIOD_S = 1.0
 
 
 def node_info_json(node_id: int, response: Any) -> str:
@@ -69,27 +67,23 @@ class DroneCanDuties:
     :param devices: node id -> device name."""
 
     def __init__(self, lifetime: Lifetime, backend: Any, ros: Any, devices: Mapping[int, str], *,
-                 time_sync: bool = False, dna_server: bool = False, timeout: float = 1.0, panic: bool = True) -> None:
+                 dna_server: bool = False, timeout: float = 1.0, panic: bool = True) -> None:
         self.lifetime, self.backend, self.ros = lifetime, backend, ros
         self.devices = dict(devices)
         self.panic = bool(panic)  # the built-in Panic duty (off: the spec's mappings of Panic handle it)
-        self.time_sync, self.dna_server, self.timeout = bool(time_sync), bool(dna_server), float(timeout)
-        self.counts: dict[str, int] = {"panic_in": 0, "panic_out": 0, "time_sync_sent": 0, "requests": 0,
-                                       "request_timeouts": 0}
+        self.dna_server, self.timeout = bool(dna_server), float(timeout)
+        self.counts: dict[str, int] = {"panic_in": 0, "panic_out": 0, "requests": 0, "request_timeouts": 0}
         self._loop: asyncio.AbstractEventLoop | None = None
         self._node: Any = None  # the ROS node of the services
         self._executor: Any = None
         self._thread: threading.Thread | None = None
         self._panic_pub: Any = None
-        self._prev_sync_us: int = 0
         self._dna: Any = None
 
     def attach(self) -> None:
         """Before the link opens (the backend calls our hook at each open), after the bridge's ROS node."""
         self.backend.on_open(self._on_open)
         self.lifetime.add_hooks("DroneCAN duties", start=self._start, close=self._close)
-        if self.time_sync:
-            self.lifetime.every(TIME_SYNC_PERIOD_S, "GlobalTimeSync", self._send_time_sync)
 
     # ------------------------------------------------------------------------------------------------ ROS side
     def _start(self) -> None:
@@ -250,27 +244,6 @@ class DroneCanDuties:
             from dronecan.app.node_monitor import NodeMonitor
 
             self._dna = CentralizedServer(node, NodeMonitor(node))
-        self._prev_sync_us = 0
-
-    def _send_time_sync(self) -> None:
-        """GlobalTimeSync master: each message carries the time the previous one was sent (0 the first time)."""
-        import dronecan
-
-        node = self.backend.node
-        if node is None:
-            self._prev_sync_us = 0
-            return
-        now_us = time.time_ns() // 1000
-        try:
-            node.broadcast(dronecan.uavcan.protocol.GlobalTimeSync(
-                previous_transmission_timestamp_usec=self._prev_sync_us))
-        except Exception as ex:
-            self.lifetime.errors["time_sync_error"] += 1
-            log.warning("GlobalTimeSync: %s: %s", type(ex).__name__, ex)
-            self._prev_sync_us = 0
-            return
-        self._prev_sync_us = now_us
-        self.counts["time_sync_sent"] += 1
 
 
 def _service(answer: Callable[[int, Any], Any], nid: int) -> Callable[[Any, Any], Any]:

@@ -168,7 +168,9 @@ def test_every_sam_device_broadcasts_its_v0_types_at_nominal_rates_with_the_vehi
     last = res["last"]
     imu = last[(11, "uavcan.equipment.ahrs.RawIMU")]
     assert imu.accelerometer_latest[2] == pytest.approx(9.81, abs=0.3) and abs(imu.accelerometer_latest[0]) < 0.3
-    assert len(imu.covariance) == 6 and abs(imu.timestamp.usec / 1e6 - time.time()) < 60  # the diagonal
+    assert len(imu.covariance) == 6  # the diagonal
+    # no time-sync master on this bus: the device never synchronised its clock, so its stamps are unknown (0)
+    assert imu.timestamp.usec == 0 and res["report"]["devices"]["imu"]["time_sync"]["synchronised"] is False
     mag = last[(12, "uavcan.equipment.ahrs.MagneticFieldStrength")]
     assert 0.45 < math.dist((0, 0, 0), list(mag.magnetic_field_ga)) < 0.6  # Gauss, Stockholm
     fix = last[(13, "uavcan.equipment.gnss.Fix2")]
@@ -458,7 +460,7 @@ def test_a_non_sam_spec_gets_generic_v0_values_with_its_selections_and_its_own_a
     assert last[(33, ESC_STATUS)].esc_index == 2  # drive_3's mappings select esc_index 2
     leak = last[(40, "ferry.hull.LeakReport")]
     assert leak.device_id == 4 and {1, 5} <= {c.compartment for c in leak.compartments}
-    assert abs(last[(31, "ferry.drive.Telemetry")].timestamp.usec / 1e6 - time.time()) < 60
+    assert last[(31, "ferry.drive.Telemetry")].timestamp.usec == 0  # no time-sync master: unknown
     devices = res["report"]["devices"]
     raw = "dronecan:uavcan.equipment.esc.RawCommand"
     assert [devices[d]["commands"][raw]["last"] for d in ("drive_1", "drive_2", "drive_3")] == [
