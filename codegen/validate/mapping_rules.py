@@ -172,6 +172,7 @@ class Step:
     limits: tuple[float, float] | None = None
     exact: bool = True  # UAVCAN -> ROS -> UAVCAN gives the value back
     pos: Pos = NOWHERE
+    elements: ResolvedMapping | None = None  # kind "elements": the element mapping (validate.element_mappings)
 
     @property
     def ros(self) -> str:

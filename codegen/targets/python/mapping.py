@@ -25,6 +25,7 @@ from sam_codegen.conversion_plan import (
     TO_UAVCAN,
     Clamp,
     DecodeUtf8,
+    ElementMapping,
     EncodeUtf8,
     FixedLength,
     LinkPlan,
@@ -46,6 +47,7 @@ from sam_codegen.conversion_plan import (
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.targets.python import statements as pys
+from sam_codegen.targets.python.elements import element_to_ros, element_to_uavcan
 from sam_codegen.targets.python.module import ConvertModule, FunctionDraft, TableConstant
 from sam_codegen.targets.python.names import LocalNames, access, identifier, py_attr
 from sam_codegen.targets.python.statements import (
@@ -156,7 +158,8 @@ class MappingEmitter:
             elif isinstance(fs.op, ReceiveTime):
                 self.module.insert(root, (*fs.path, ("sec", None)), "receive_ns // 1_000_000_000")
                 self.module.insert(root, (*fs.path, ("nanosec", None)), "receive_ns % 1_000_000_000")
-        for s in steps:
+        # element mappings last: their elements take the message's stamp, which a time link computes
+        for s in [*(s for s in steps if s.kind != "elements"), *(s for s in steps if s.kind == "elements")]:
             for path, value in self.step_to_ros(s, names, uav_read, fn.statements):
                 self.module.insert(root, path, value)
         fn.result = self.module.format_return(root, names)
@@ -170,6 +173,8 @@ class MappingEmitter:
         ops = link.ops
         key = repr(link.key)
         first = ops[0] if ops else None
+        if isinstance(first, ElementMapping):
+            return element_to_ros(self, s, names, uav_read, statements)
         if isinstance(first, SetConstant):
             return [(s.ros_path, typed_literal(first.value, s.ros_type.base))]
         assert s.uavcan_type is not None
@@ -249,6 +254,8 @@ class MappingEmitter:
         key = repr(link.key)
         uav = s.uavcan_type
         first = ops[0] if ops else None
+        if isinstance(first, ElementMapping):
+            return element_to_uavcan(self, s, names, reads, statements)
         if isinstance(first, TimestampFromRos):
             sec, nanosec = reads.time(s.ros_path)
             var = names.new("us")
