@@ -6,9 +6,9 @@ Each element mapping becomes a pair of module functions of its own, made by a Ma
 fields get every check, saturation, table and stats key a mapping's fields get (keys `<mapping>.<ros array>[].<field>`).
 The mapping's own function calls it once per element:
 
-- to ROS: the elements in order; an element that rejects drops the message; an element's header gets the message's
-  stamp (the source timestamp, or the receive time: `receive_ns` of the element function is the message's stamp)
-  and the mapping's frame_id;
+- to ROS: the elements in order; the first element that rejects drops the message (counted once, by it); an
+  element's header gets the message's stamp (the source timestamp, or the receive time: `receive_ns` of the element
+  function is the message's stamp) and the mapping's frame_id;
 - to UAVCAN: a bounded array is cut to its capacity first (saturate: counted under `<mapping>.<uavcan array>`) or
   the message rejected, then the elements are converted; a fixed array is padded with default elements or cut.
 
@@ -99,8 +99,8 @@ def element_to_ros(em: Any, s: Step, names: LocalNames, uav_read: Any, statement
     var = names.new(s.ros)
     stamp = _stamp_ns(em, statements)
     source = em.uavcan.as_list(uav_read(s.uavcan_path))
-    statements.append(Assign(var, f"[{base}_to_ros(x, {stamp}, stats) for x in {source}]"))
-    statements.append(_DropIfNone(var))
+    statements.append(_ElementLoop(var, names.new("element"), names.new("item"), source,
+                                   f"{base}_to_ros({{}}, {stamp}, stats)"))
     return [(s.ros_path, var)]
 
 
@@ -115,8 +115,8 @@ def element_to_uavcan(em: Any, s: Step, names: LocalNames, reads: Any, statement
     for op in link.ops[1:]:
         if isinstance(op, MaxLength):  # cut before converting: the elements cut are not converted (nor counted)
             statements.append(CutToMaxLength(items, op.capacity, key, op.reject, False))
-    statements.append(Assign(var, f"[{base}_to_uavcan(x, stats) for x in {items}]"))
-    statements.append(_DropIfNone(var))
+    statements.append(_ElementLoop(var, names.new("element"), names.new("item"), items,
+                                   f"{base}_to_uavcan({{}}, stats)"))
     for op in link.ops[1:]:
         if isinstance(op, FixedLength):
             assert s.uavcan_type is not None
@@ -126,8 +126,17 @@ def element_to_uavcan(em: Any, s: Step, names: LocalNames, reads: Any, statement
 
 
 @dataclass(frozen=True)
-class _DropIfNone(Statement):
-    """An element rejected (counted by its own function): the message is dropped."""
+class _ElementLoop(Statement):
+    """`var` = the elements of `source` converted one by one by `call` (its `{}` the element); the first element
+    rejected (counted by the element function, once) drops the message, as a mapping's first rejected field does."""
 
-    kind: ClassVar[str] = "element_rejected"
+    kind: ClassVar[str] = "element_loop"
     var: str
+    element: str
+    item: str
+    source: str
+    call: str
+
+    @property
+    def call_element(self) -> str:
+        return self.call.format(self.element)

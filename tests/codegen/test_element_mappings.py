@@ -1,0 +1,256 @@
+"""Element mappings (issue 17, class 4): arrays of composites converted element by element, tests/specs/power_v0.yaml.
+
+In this process: the spec is valid, each POWER_CASES row of tests/broken_cases.py gives its exact errors, a Cyphal
+mapping with `each` is refused with an exact error, the plan holds an ElementMapping with the array's length rule,
+the docs word the element fields, and the wire codec module leaves element mappings to the object converters.
+
+In a child process with the spec's ROS package built (hypothesis, dronecan's transport and rclpy's serialization as
+the oracles): ConsumedChargeArray -> ConsumedCharges gives every element's values and the message's header in every
+element; Commands -> ArrayCommand gives the first 15 elements (float16 saturated and counted), the cut counted once
+under `actuators.commands`; with on_out_of_range: reject, more than 15 elements or a value beyond float16 drops the
+message, counted.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import json
+import math
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SPEC = ROOT / "tests" / "specs" / "power_v0.yaml"
+WORKER_ENV = "SAM_ELEMENT_MAPPINGS_WORKER"
+WORKER = os.environ.get(WORKER_ENV)
+REJECT = ("      destination_node_ids: [31]\n", "      destination_node_ids: [31]\n      on_out_of_range: reject\n")
+
+
+# ============================================================================================ parent
+
+if not WORKER:
+    from broken_cases import POWER_CASES, Case
+
+    from sam_codegen.conversion_plan import ElementMapping, MaxLength, lower_mapping
+    from sam_codegen.frontend.loader import load_spec_file
+    from sam_codegen.model.diagnostics import SpecError
+    from sam_codegen.validate.resolve import validate
+
+    BASE = SPEC.read_text(encoding="utf-8")
+
+    def _errors(path: Path) -> list[str]:
+        try:
+            validate(load_spec_file(path))
+        except SpecError as exc:
+            return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
+        return []
+
+    def test_power_spec_is_valid() -> None:
+        assert _errors(SPEC) == []
+
+    @pytest.mark.parametrize("case", POWER_CASES, ids=lambda c: c.name)
+    def test_broken_power_spec(case: Case, tmp_path: Path) -> None:
+        assert BASE.count(case.old) == 1, f"case {case.name} no longer applies to power_v0.yaml"
+        path = tmp_path / "power_v0.yaml"
+        path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
+        assert _errors(path) == list(case.errors)
+
+    def test_cyphal_element_mapping_is_refused(tmp_path: Path) -> None:
+        """The Cyphal converters and codecs do not render element mappings: the generator says so."""
+        text = (ROOT / "tests" / "specs" / "barge.yaml").read_text(encoding="utf-8")
+        edits = [
+            ("messages:\n", "messages:\n  TagMsg:\n    description: A tag.\n    fields:\n"
+             "      - {name: code, type: uint32}\n      - {name: checked, type: bool}\n"),
+            ("      - {name: name, type: string}\n  HoldOrder:",
+             "      - {name: name, type: string}\n      - {name: tags, type: \"barge_msgs/TagMsg[]\"}\n  HoldOrder:"),
+            ("        name: name\n      ignore: [hold.open, tag.checked, faults, history]",
+             "        name: name\n        tags: {each: history, fields: {code: code, checked: checked}}\n"
+             "      ignore: [hold.open, tag.checked, faults]"),
+        ]
+        for old, new in edits:
+            assert text.count(old) == 1, old
+            text = text.replace(old, new, 1)
+        path = tmp_path / "barge.yaml"
+        path.write_text(text, encoding="utf-8")
+        errors = _errors(path)
+        assert len(errors) == 1, errors
+        assert errors[0].endswith(
+            "error: mapping 'hold_state', field 'tags': element mappings (`each`) are supported in DroneCAN mappings "
+            "only; a Cyphal mapping cannot map arrays of composites yet"), errors
+        assert errors[0].startswith("barge.yaml:"), errors
+
+    def test_plan_holds_the_element_mapping() -> None:
+        resolved = validate(load_spec_file(SPEC))
+        by_name = {rm.mapping.name: rm for rm in resolved.dronecan_mappings}
+        plan = lower_mapping(by_name["actuators"])
+        (link,) = plan.to_uavcan
+        element, cut = link.ops
+        assert isinstance(element, ElementMapping) and element.uavcan_element == "uavcan.equipment.actuator.Command"
+        assert cut == MaxLength(15, False, False)
+        keys = [inner.key for inner in element.plan.to_uavcan]
+        assert keys == ["actuators.commands[].actuator_id", "actuators.commands[].command_type",
+                        "actuators.commands[].command_value"]
+        to_ros = lower_mapping(by_name["charges"]).to_ros
+        elements = next(link for link in to_ros if link.step.kind == "elements")
+        assert [type(op) for op in elements.ops] == [ElementMapping]
+
+    def test_docs_and_codec_module(tmp_path: Path) -> None:
+        from sam_codegen.build import build
+
+        build(SPEC, tmp_path / "generated")
+        docs = (tmp_path / "generated" / "docs" / "interfaces.md").read_text(encoding="utf-8")
+        assert ("| `commands[].value` | → | `commands[].command_value` | float32 → float16 (narrowed, saturating) |"
+                in docs)
+        assert "element by element, power\\_msgs/Command → uavcan.equipment.actuator.Command (over 15 elements cut" \
+            in docs
+        assert "each element's header: the message's stamp and frame id" in docs
+        codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
+        assert "'charges'" not in codec.split("CODECS:")[1]  # no wire codec: the runtime uses the object path
+
+    from helpers.ros_packages import missing_tools, run_child
+    from helpers.runtime_support import domain_id
+
+    @pytest.mark.ros
+    @pytest.mark.slow
+    @pytest.mark.skipif(missing_tools() is not None, reason=str(missing_tools()))
+    def test_element_converters_with_dronecan_and_rclpy(tmp_path: Path) -> None:
+        pytest.importorskip("dronecan")
+        from helpers.spec_build import built_spec
+
+        from sam_codegen.build import build
+
+        built = built_spec("power_v0")
+        strict_spec = tmp_path / "power_v0.yaml"
+        strict_spec.write_text(BASE.replace(*REJECT, 1), encoding="utf-8")
+        build(strict_spec, tmp_path / "strict")
+        config = {"generated": str(built.generated), "strict": str(tmp_path / "strict")}
+        proc = run_child(["-m", "pytest", __file__, "-q", "-p", "no:cacheprovider", "--rootdir", str(ROOT),
+                          "-W", "error::RuntimeWarning"], built.prefix, domain_id(77),
+                         {WORKER_ENV: json.dumps(config), "ROS_PYTHON_CHECK_FIELDS": "1"}, timeout=900)
+        report = proc.stdout[-12000:] + proc.stderr[-4000:]
+        assert proc.returncode == 0, f"worker tests failed:\n{report}"
+        assert " passed" in proc.stdout and " skipped" not in proc.stdout and " failed" not in proc.stdout, report
+
+
+# ============================================================================================ worker
+
+if WORKER:
+    import dronecan
+    import numpy as np
+    from dronecan.transport import Transfer
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    CONFIG = json.loads(WORKER)
+    GENERATED = Path(CONFIG["generated"])
+    sys.path.insert(0, str(GENERATED / "python"))
+    convert = importlib.import_module("power_bridge.convert_v0")
+    convert.load_types(GENERATED)
+    _strict_spec = importlib.util.spec_from_file_location(
+        "power_bridge.convert_v0_strict", Path(CONFIG["strict"]) / "python" / "power_bridge" / "convert_v0.py")
+    assert _strict_spec is not None and _strict_spec.loader is not None
+    strict = importlib.util.module_from_spec(_strict_spec)
+    sys.modules["power_bridge.convert_v0_strict"] = strict
+    _strict_spec.loader.exec_module(strict)
+    from power_msgs.msg import Command, Commands
+
+    SETTINGS = settings(max_examples=int(os.environ.get("SAM_CONVERTERS_EXAMPLES", "60")), deadline=None,
+                        database=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    RECEIVE_NS = 1_700_000_000_123_456_789
+    F32 = st.floats(width=32, allow_nan=True, allow_infinity=True)
+    RCLPY_F32 = st.floats(width=32, allow_nan=True, allow_infinity=True).filter(
+        lambda x: not math.isfinite(x) or abs(x) < float(np.finfo(np.float32).max))
+
+    def wire(msg: Any) -> Any:
+        """The message through dronecan's frames and back (what the bridge receives or sends)."""
+        frames = Transfer(payload=msg, source_node_id=30, transfer_id=3).to_frames()
+        received = Transfer()
+        received.data_type_id = dronecan.get_dronecan_data_type(msg).default_dtid
+        received.service_not_message = False
+        received.from_frames(frames)
+        return received.payload
+
+    def same(a: float, b: float) -> bool:
+        return (math.isnan(a) and math.isnan(b)) or a == b
+
+    @SETTINGS
+    @given(usec=st.one_of(st.just(0), st.integers(1, 2**56 - 1)),
+           items=st.lists(st.tuples(st.integers(0, 2**16 - 1), F32), max_size=15))
+    def test_consumed_charges_to_ros(usec: int, items: list[tuple[int, float]]) -> None:
+        types = dronecan.TYPENAMES
+        msg = types["power.ConsumedChargeArray"](
+            timestamp=types["uavcan.Timestamp"](usec=usec),
+            charges=[types["power.ConsumedCharge"](circuit_id=c, charge=q) for c, q in items])
+        received = wire(msg)  # dronecan's cast included: a float32 beyond its range becomes +-FLT_MAX
+        stats = convert.ConversionStats()
+        ros = convert.charges_to_ros(received, RECEIVE_NS, stats)
+        assert ros is not None, stats.rejected
+        ros = deserialize_message(serialize_message(ros), type(ros))
+        assert len(ros.charges) == len(items)
+        stamp = ros.header.stamp
+        expected_ns = RECEIVE_NS if usec == 0 else min(usec * 1000, (2**31 - 1) * 10**9 + 999_999_999)
+        assert stamp.sec * 10**9 + stamp.nanosec == expected_ns
+        for element, sent, (circuit, _) in zip(ros.charges, received.charges, items, strict=True):
+            assert element.circuit_id == circuit
+            assert same(element.charge, sent.charge)
+            assert element.header == ros.header  # the message's stamp and frame id
+        assert ros.header.frame_id == "base_link"
+        assert not stats.rejected and not stats.saturated
+        back = convert.charges_to_uavcan(ros, stats)  # and back: the same payload
+        assert back is not None
+        if usec != 0 and usec * 1000 == expected_ns:  # a stamp Time holds: the same payload
+            assert Transfer(payload=back).payload == Transfer(payload=msg).payload
+
+    COMMANDS = st.lists(st.tuples(st.integers(0, 255), st.integers(0, 255), RCLPY_F32), max_size=30)
+
+    def _commands(items: list[tuple[int, int, float]]) -> Commands:
+        return Commands(commands=[Command(actuator_id=a, command_type=t, value=v) for a, t, v in items])
+
+    @SETTINGS
+    @given(items=COMMANDS)
+    def test_commands_to_array_command(items: list[tuple[int, int, float]]) -> None:
+        ros = deserialize_message(serialize_message(_commands(items)), Commands)
+        stats = convert.ConversionStats()
+        out = convert.actuators_to_uavcan(ros, stats)
+        assert out is not None, stats.rejected
+        received = wire(out)
+        kept = items[:15]
+        assert len(received.commands) == len(kept)
+        assert stats.saturated.get("actuators.commands", 0) == (1 if len(items) > 15 else 0)
+        beyond = 0
+        for cmd, (actuator, kind, value) in zip(received.commands, kept, strict=True):
+            value = float(np.float32(value))
+            expected = value if math.isnan(value) else max(-65504.0, min(65504.0, value))
+            beyond += not math.isnan(value) and abs(value) > 65504.0
+            assert (cmd.actuator_id, cmd.command_type) == (actuator, kind)
+            assert same(cmd.command_value, float(np.float16(expected)))
+        assert stats.saturated.get("actuators.commands[].command_value", 0) == beyond
+        assert not stats.rejected
+
+    @SETTINGS
+    @given(items=COMMANDS)
+    def test_commands_rejected_beyond_capacity_or_range(items: list[tuple[int, int, float]]) -> None:
+        ros = deserialize_message(serialize_message(_commands(items)), Commands)
+        stats = strict.ConversionStats()
+        out = strict.actuators_to_uavcan(ros, stats)
+        kept_beyond = any(not math.isnan(v) and abs(float(np.float32(v))) > 65504.0 for _, _, v in items)
+        if len(items) > 15:
+            assert out is None and stats.rejected == {"actuators.commands": 1}
+        elif kept_beyond:
+            assert out is None and stats.rejected == {"actuators.commands[].command_value": 1}
+        else:
+            assert out is not None and len(wire(out).commands) == len(items) and not stats.rejected
+        assert not stats.saturated
+
+    def test_sixteen_commands_cut_to_fifteen_and_counted() -> None:
+        stats = convert.ConversionStats()
+        out = convert.actuators_to_uavcan(_commands([(i, 0, float(i)) for i in range(16)]), stats)
+        assert out is not None
+        assert [c.actuator_id for c in wire(out).commands] == list(range(15))
+        assert stats.saturated == {"actuators.commands": 1}
