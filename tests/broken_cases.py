@@ -1116,4 +1116,45 @@ POWER_CASES: tuple[Case, ...] = (
             "power_v0.yaml:81:9: error: UAVCAN field 'command_type' is both mapped and in uavcan_values in DroneCAN mapping 'actuators', elements of 'commands'",
         ),
     ),
+    Case(
+        'element_array_also_by_key',
+        '            value: command_value\n',
+        '            value: command_value\n        foo: commands[actuator_id=3].command_value\n',
+        (
+            "power_v0.yaml:81:9: error: DroneCAN mapping 'actuators', field 'commands': commands is mapped element by element here and also named by field 'foo'; one way for one array",
+            "power_v0.yaml:87:9: error: DroneCAN mapping 'actuators', field 'foo': power_msgs/Commands has no field 'foo'",
+        ),
+    ),
+    Case(
+        'element_array_also_valued',
+        '      destination_node_ids: [31]\n',
+        '      destination_node_ids: [31]\n      uavcan_values: {"commands[actuator_id=1].command_type": 1}\n',
+        (
+            "power_v0.yaml:82:9: error: DroneCAN mapping 'actuators', field 'commands': commands is mapped element by element here and also named by uavcan_values 'commands[actuator_id=1].command_type'; one way for one array",
+        ),
+    ),
+    Case(
+        'element_ros_fixed_array',
+        '      - {name: commands, type: "power_msgs/Command[]"}\n',
+        '      - {name: commands, type: "power_msgs/Command[3]"}\n',
+        (
+            "power_v0.yaml:81:9: error: DroneCAN mapping 'actuators', field 'commands': `each` maps into a ROS sequence (T[] or T[<=N]), commands is a fixed-size array (power_msgs/Command[3])",
+        ),
+    ),
+    Case(
+        'element_ros_bounded_too_small',
+        '      - {name: charges, type: "power_msgs/ConsumedCharge[]"}\n',
+        '      - {name: charges, type: "power_msgs/ConsumedCharge[<=4]"}\n',
+        (
+            "power_v0.yaml:70:9: error: DroneCAN mapping 'charges', field 'charges': charges (power_msgs/ConsumedCharge[<=4]) holds fewer elements than charges (power.ConsumedCharge[<=15])",
+        ),
+    ),
+    Case(
+        'element_ros_field_ignored_only',
+        '            charge: charge\n',
+        '          ignore: [charge]\n',
+        (
+            "power_v0.yaml:70:9: error: ROS element field 'charge' (float64) of power_msgs/ConsumedCharge is set by nothing in DroneCAN mapping 'charges', elements of 'charges' (expected a `charge: <UAVCAN element field>` line in its fields)",
+        ),
+    ),
 )

@@ -11,6 +11,7 @@ Invariants:
 - an element's ROS header is the message's: the same stamp (the source timestamp, or the receive time) and the
   mapping's frame_id; UAVCAN -> ROS, every other ROS element field must be set by a line;
 - the element mapping is named `<mapping>.<ros array>[]`: its stats keys read `<mapping>.<ros array>[].<field>`;
+- an array mapped element by element is named by no other line, value or selection of the mapping;
 - element mappings do not nest (an element field with `each` is refused), index no element (`each: a[0]` is
   refused) and are DroneCAN only for now (a Cyphal mapping with `each` is refused: the Cyphal converters and codecs
   do not render them).
@@ -51,6 +52,14 @@ def resolve_elements(v: Any, link: FieldLink, ros_path: list[PathSeg], ros_type:
         raise RuleError(f"`each` takes an array of composites, {link.each} is {uav_type}")
     if ros_type.array == "bounded" and (ros_type.capacity or 0) < (uav_type.capacity or 0):
         raise RuleError(f"{link.ros_path} ({ros_type}) holds fewer elements than {link.each} ({uav_type})")
+    others = [f"field {other.ros_path!r}" for other in mapping.links if other is not link
+              and other.uavcan_path is not None and _under(other.uavcan_path, link.each)]
+    others += [f"{key} {path!r}" for key, paths in (("uavcan_values", mapping.uavcan_values),
+                                                    ("select", mapping.select)) for path in paths
+               if _under(path, link.each)]
+    if others:
+        raise RuleError(f"{link.each} is mapped element by element here and also named by " + ", ".join(others)
+                        + "; one way for one array")
     nested = [inner for inner in link.element_links if inner.each is not None]
     for inner in nested:
         v.error(inner.pos, f"{what}, elements of {link.ros_path!r}, field {inner.ros_path!r}: element mappings "
@@ -98,3 +107,8 @@ def _parse_uav(text: str) -> list[PathSeg]:
         raise RuleError(f"{format_path(path)} names an array element; `each` maps a whole array")
     return path
 
+
+
+def _under(path: str, array: str) -> bool:
+    """`path` names `array` or something in it."""
+    return path == array or path.startswith((array + "[", array + "."))

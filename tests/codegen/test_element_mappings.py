@@ -112,6 +112,24 @@ if not WORKER:
         codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
         assert "'charges'" not in codec.split("CODECS:")[1]  # no wire codec: the runtime uses the object path
 
+    GOLDEN = ROOT / "tests" / "golden" / "elements"
+
+    def test_golden_converters_and_docs(tmp_path: Path) -> None:
+        """power_v0's DroneCAN converters and its mapping docs, byte for byte (SAM_UPDATE_GOLDEN=1 rewrites them)."""
+        from sam_codegen.build import build
+
+        build(SPEC, tmp_path / "generated")
+        produced = {
+            "convert_v0.py.golden": (tmp_path / "generated" / "python" / "power_bridge" / "convert_v0.py"),
+            "interfaces.md.golden": tmp_path / "generated" / "docs" / "interfaces.md",
+        }
+        for name, path in produced.items():
+            text = path.read_text(encoding="utf-8")
+            if os.environ.get("SAM_UPDATE_GOLDEN") == "1":
+                GOLDEN.mkdir(parents=True, exist_ok=True)
+                (GOLDEN / name).write_text(text, encoding="utf-8")
+            assert text == (GOLDEN / name).read_text(encoding="utf-8"), f"{name} differs from its golden copy"
+
     from helpers.ros_packages import missing_tools, run_child
     from helpers.runtime_support import domain_id
 
