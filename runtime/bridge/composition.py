@@ -24,7 +24,14 @@ from sam_runtime.bridge.outbound import DEFAULT_QUEUE_SIZE, Outbound
 from sam_runtime.bridge.reporting import Reporter
 from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.bridge.silence import SilenceWatch
-from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
+from sam_runtime.bridge.wiring import (
+    check_destinations,
+    codec_gaps,
+    in_groups,
+    missing_codecs,
+    nominal_rates,
+    out_mappings,
+)
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 from sam_runtime.genpkg import GeneratedPackage
@@ -163,9 +170,8 @@ class Bridge:
         codec = self.gen.codec(self.selection.protocol)
         missing = missing_codecs(codec, self.selection.mappings)
         if missing:
-            log.warning("%s: the generated package has no wire codecs for %s (built by an older sam-codegen? run "
-                        "`sam-codegen build`): using the object converters", self.name,
-                        "any mapping" if codec is None else ", ".join(missing))
+            log.warning("%s: the generated package has no wire codecs for %s: using the object converters",
+                        self.name, codec_gaps(codec, missing))
             self.wire = "object"
             return None
         return codec

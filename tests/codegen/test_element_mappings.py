@@ -2,7 +2,8 @@
 
 In this process: the spec is valid, each POWER_CASES row of tests/broken_cases.py gives its exact errors, a Cyphal
 mapping with `each` is refused with an exact error, the plan holds an ElementMapping with the array's length rule,
-the docs word the element fields, and the wire codec module leaves element mappings to the object converters.
+the docs word the element fields, and the wire codec module leaves element mappings to the object converters
+(OBJECT_ONLY says why; the runtime's warning, or the offline bridge's error, quotes it).
 
 In a child process with the spec's ROS package built (hypothesis, dronecan's transport and rclpy's serialization as
 the oracles): ConsumedChargeArray -> ConsumedCharges gives every element's values and the message's header in every
@@ -110,7 +111,24 @@ if not WORKER:
             in docs
         assert "each element's header: the message's stamp and frame id" in docs
         codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
-        assert "'charges'" not in codec.split("CODECS:")[1]  # no wire codec: the runtime uses the object path
+        registry, object_only = codec.split("CODECS:")[1].split("OBJECT_ONLY:")
+        assert "'charges'" not in registry and "'actuators'" not in registry  # no wire codec yet
+        assert "'charges': 'arrays of composites converted element by element'," in object_only
+
+    def test_the_runtime_says_why_a_mapping_has_no_codec() -> None:
+        from types import SimpleNamespace
+
+        from sam_runtime.bridge.wiring import codec_gaps, missing_codecs
+
+        codec = SimpleNamespace(CODECS={"a": None}, OBJECT_ONLY={"charges": "arrays of composites converted element "
+                                                                           "by element"})
+        mappings = [SimpleNamespace(name=n) for n in ("a", "charges", "old")]
+        missing = missing_codecs(codec, mappings)
+        assert missing == ["charges", "old"]
+        assert codec_gaps(codec, missing) == (
+            "charges (arrays of composites converted element by element): the object converters only; "
+            "old (built by an older sam-codegen? run `sam-codegen build`)")
+        assert codec_gaps(None, ["x"]) == "any mapping (built by an older sam-codegen? run `sam-codegen build`)"
 
     GOLDEN = ROOT / "tests" / "golden" / "elements"
 

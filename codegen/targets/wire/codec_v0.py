@@ -335,6 +335,8 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         "functions": functions,
         "matches": predicates,
         "mappings": [rm.mapping.name for rm in mappings],
+        "object_only": [(rm.mapping.name, "arrays of composites converted element by element")
+                        for rm in resolved.dronecan_mappings if has_elements(rm)],
         "constants": consts.lines(),
         "prelude": MODULE_PRELUDE,
         "helpers": HELPERS.strip("\n").splitlines(),
