@@ -91,7 +91,8 @@ def resolve_elements(v: Any, link: FieldLink, ros_path: list[PathSeg], ros_type:
             setattr(v, k, value)
     if resolved is None or len(v.diag.items) > errors_before:
         return None
-    return Step("elements", tuple(ros_path), ros_type, tuple(uav_path), uav_type, pos=link.pos, elements=resolved)
+    return Step("elements", tuple(ros_path), ros_type, tuple(uav_path), uav_type, pos=link.pos, elements=resolved,
+                exact=all(s.exact for s in resolved.steps))
 
 
 class _ElementTopic:
