@@ -138,7 +138,7 @@ def codec_gaps(codec: Any, missing: Sequence[str]) -> str:
     stale = [name for name in missing if name not in reasons]
     parts = []
     if known:
-        parts.append("; ".join(known) + ": the object converters only")
+        parts.append("; ".join(known))
     if stale or codec is None:
         parts.append(("any mapping" if codec is None else ", ".join(stale))
                      + " (built by an older sam-codegen? run `sam-codegen build`)")

@@ -126,7 +126,7 @@ if not WORKER:
         missing = missing_codecs(codec, mappings)
         assert missing == ["charges", "old"]
         assert codec_gaps(codec, missing) == (
-            "charges (arrays of composites converted element by element): the object converters only; "
+            "charges (arrays of composites converted element by element); "
             "old (built by an older sam-codegen? run `sam-codegen build`)")
         assert codec_gaps(None, ["x"]) == "any mapping (built by an older sam-codegen? run `sam-codegen build`)"
 
