@@ -100,6 +100,25 @@ if not WORKER:
         elements = next(link for link in to_ros if link.step.kind == "elements")
         assert [type(op) for op in elements.ops] == [ElementMapping]
 
+    def test_fixed_uavcan_array_is_cut_before_and_padded_after(tmp_path: Path) -> None:
+        """Into a fixed UAVCAN array: longer cut before the elements are converted, shorter padded with default
+        elements after; counted once under the array either way."""
+        from sam_codegen.build import build
+        from sam_codegen.conversion_plan import FixedLength
+
+        spec = tmp_path / "power_v0.yaml"
+        spec.write_text(BASE.replace('"power.ConsumedCharge[<=15]"', '"power.ConsumedCharge[3]"', 1), encoding="utf-8")
+        resolved = validate(load_spec_file(spec))
+        (rm,) = [rm for rm in resolved.dronecan_mappings if rm.mapping.name == "charges"]
+        link = next(link for link in lower_mapping(rm).to_uavcan if link.step.kind == "elements")
+        assert [type(op) for op in link.ops] == [ElementMapping, FixedLength] and link.ops[1] == FixedLength(3, False)
+        build(spec, tmp_path / "generated")
+        code = (tmp_path / "generated" / "python" / "power_bridge" / "convert_v0.py").read_text(encoding="utf-8")
+        body = code.split("def charges_to_uavcan(")[1].split("\ndef ")[0]
+        cut, loop, pad = (body.index("del charges_items[3:]"), body.index("for element in charges_items:"),
+                          body.index("[_TYPENAMES['power.ConsumedCharge']()] * 3"))
+        assert cut < loop < pad and body.count("stats.saturate('charges.charges')") == 2  # one of the two runs
+
     def test_docs_and_codec_module(tmp_path: Path) -> None:
         from sam_codegen.build import build
 

@@ -10,7 +10,8 @@ The mapping's own function calls it once per element:
   element's header gets the message's stamp (the source timestamp, or the receive time: `receive_ns` of the element
   function is the message's stamp) and the mapping's frame_id;
 - to UAVCAN: a bounded array is cut to its capacity first (saturate: counted under `<mapping>.<uavcan array>`) or
-  the message rejected, then the elements are converted; a fixed array is padded with default elements or cut.
+  the message rejected, then the elements are converted; a fixed array is cut the same way, or padded with default
+  elements after the conversion (counted once either way).
 
 The functions are collected in ConvertModule.extra_functions, which the module emitters append after the mappings'
 own functions (the registry indexes those by position).
@@ -113,8 +114,11 @@ def element_to_uavcan(em: Any, s: Step, names: LocalNames, reads: Any, statement
     var = names.new(s.uavcan)
     statements.append(Assign(items, f"list({reads.value(s.ros_path)})"))
     for op in link.ops[1:]:
-        if isinstance(op, MaxLength):  # cut before converting: the elements cut are not converted (nor counted)
-            statements.append(CutToMaxLength(items, op.capacity, key, op.reject, False))
+        # cut before converting: the elements cut are not converted (nor counted); a fixed array is padded after
+        # (its default elements are UAVCAN ones), so either way the length is counted once
+        if isinstance(op, (MaxLength, FixedLength)):
+            statements.append(CutToMaxLength(items, op.capacity if isinstance(op, MaxLength) else op.size, key,
+                                             op.reject, False))
     statements.append(_ElementLoop(var, names.new("element"), names.new("item"), items,
                                    f"{base}_to_uavcan({{}}, stats)"))
     for op in link.ops[1:]:
