@@ -12,9 +12,8 @@ Invariants:
   mapping's frame_id; UAVCAN -> ROS, every other ROS element field must be set by a line;
 - the element mapping is named `<mapping>.<ros array>[]`: its stats keys read `<mapping>.<ros array>[].<field>`;
 - an array mapped element by element is named by no other line, value or selection of the mapping;
-- element mappings do not nest (an element field with `each` is refused), index no element (`each: a[0]` is
-  refused) and are DroneCAN only for now (a Cyphal mapping with `each` is refused: the Cyphal converters and codecs
-  do not render them).
+- element mappings do not nest (an element field with `each` is refused) and index no element (`each: a[0]` is
+  refused); they serve Cyphal and DroneCAN mappings alike.
 """
 
 from __future__ import annotations
@@ -36,9 +35,6 @@ def resolve_elements(v: Any, link: FieldLink, ros_path: list[PathSeg], ros_type:
     Raises RuleError for what is wrong with the line itself (reported at the line by the caller); reports the
     element fields' own errors at their lines and returns None then."""
     assert link.each is not None
-    if mapping.protocol != "dronecan":
-        raise RuleError("element mappings (`each`) are supported in DroneCAN mappings only; a Cyphal mapping "
-                        "cannot map arrays of composites yet")
     if any(index is not None for _, index in ros_path):
         raise RuleError(f"{link.ros_path} names an array element; `each` maps a whole array")
     if ros_type.is_primitive or not ros_type.array:

@@ -1,7 +1,8 @@
 """Element mappings (issue 17, class 4): arrays of composites converted element by element, tests/specs/power_v0.yaml.
 
 In this process: the spec is valid, each POWER_CASES row of tests/broken_cases.py gives its exact errors, a Cyphal
-mapping with `each` is refused with an exact error, the plan holds an ElementMapping with the array's length rule,
+mapping with `each` (tests/specs/barge.yaml with HoldState.tags <- Manifest.history) generates element functions in
+convert.py, the plan holds an ElementMapping with the array's length rule,
 the docs word the element fields, and the wire codec module leaves element mappings to the object converters
 (OBJECT_ONLY says why; the runtime's warning, or the offline bridge's error, quotes it).
 
@@ -9,7 +10,8 @@ In a child process with the spec's ROS package built (hypothesis, dronecan's tra
 the oracles): ConsumedChargeArray -> ConsumedCharges gives every element's values and the message's header in every
 element; Commands -> ArrayCommand gives the first 15 elements (float16 saturated and counted), the cut counted once
 under `actuators.commands`; with on_out_of_range: reject, more than 15 elements or a value beyond float16 drops the
-message, counted.
+message, counted. Likewise on Cyphal with pycyphal's compiled classes: Manifest.history (Tag[<=3]) -> HoldState.tags
+and back, the cut beyond 3 and uint24 saturation counted.
 """
 
 from __future__ import annotations
@@ -29,12 +31,35 @@ ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "tests" / "specs" / "power_v0.yaml"
 WORKER_ENV = "SAM_ELEMENT_MAPPINGS_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
+CYPHAL_WORKER_ENV = "SAM_ELEMENT_MAPPINGS_CYPHAL_WORKER"
+CYPHAL_WORKER = os.environ.get(CYPHAL_WORKER_ENV)
+BARGE_EDITS = (
+    ("messages:\n", "messages:\n  TagMsg:\n    description: A tag.\n    fields:\n"
+     "      - {name: code, type: uint32}\n      - {name: checked, type: bool}\n"),
+    ("      - {name: name, type: string}\n  HoldOrder:",
+     "      - {name: name, type: string}\n      - {name: tags, type: \"barge_msgs/TagMsg[]\"}\n  HoldOrder:"),
+    ("        name: name\n      ignore: [hold.open, tag.checked, faults, history]",
+     "        name: name\n        tags: {each: history, fields: {code: code, checked: checked}}\n"
+     "      ignore: [hold.open, tag.checked, faults]"),
+)
+
+
+def barge_with_tags() -> str:
+    """tests/specs/barge.yaml with HoldState.tags (TagMsg[]) mapped element by element from Manifest.history
+    (barge.cargo.Tag.1.0[<=3]): a Cyphal element mapping."""
+    text = (ROOT / "tests" / "specs" / "barge.yaml").read_text(encoding="utf-8")
+    for old, new in BARGE_EDITS:
+        assert text.count(old) == 1, old
+        text = text.replace(old, new, 1)
+    return text
+
+
 REJECT = ("      destination_node_ids: [31]\n", "      destination_node_ids: [31]\n      on_out_of_range: reject\n")
 
 
 # ============================================================================================ parent
 
-if not WORKER:
+if not WORKER and not CYPHAL_WORKER:
     from broken_cases import POWER_CASES, Case
 
     from sam_codegen.conversion_plan import ElementMapping, MaxLength, lower_mapping
@@ -61,29 +86,21 @@ if not WORKER:
         path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
         assert _errors(path) == list(case.errors)
 
-    def test_cyphal_element_mapping_is_refused(tmp_path: Path) -> None:
-        """The Cyphal converters and codecs do not render element mappings: the generator says so."""
-        text = (ROOT / "tests" / "specs" / "barge.yaml").read_text(encoding="utf-8")
-        edits = [
-            ("messages:\n", "messages:\n  TagMsg:\n    description: A tag.\n    fields:\n"
-             "      - {name: code, type: uint32}\n      - {name: checked, type: bool}\n"),
-            ("      - {name: name, type: string}\n  HoldOrder:",
-             "      - {name: name, type: string}\n      - {name: tags, type: \"barge_msgs/TagMsg[]\"}\n  HoldOrder:"),
-            ("        name: name\n      ignore: [hold.open, tag.checked, faults, history]",
-             "        name: name\n        tags: {each: history, fields: {code: code, checked: checked}}\n"
-             "      ignore: [hold.open, tag.checked, faults]"),
-        ]
-        for old, new in edits:
-            assert text.count(old) == 1, old
-            text = text.replace(old, new, 1)
-        path = tmp_path / "barge.yaml"
-        path.write_text(text, encoding="utf-8")
-        errors = _errors(path)
-        assert len(errors) == 1, errors
-        assert errors[0].endswith(
-            "error: mapping 'hold_state', field 'tags': element mappings (`each`) are supported in DroneCAN mappings "
-            "only; a Cyphal mapping cannot map arrays of composites yet"), errors
-        assert errors[0].startswith("barge.yaml:"), errors
+    def test_cyphal_element_mapping_generates_object_converters(tmp_path: Path) -> None:
+        """The same construct in a Cyphal mapping: element functions in convert.py, no wire codec (OBJECT_ONLY)."""
+        from sam_codegen.build import build
+
+        spec = tmp_path / "spec" / "barge.yaml"
+        spec.parent.mkdir()
+        spec.write_text(barge_with_tags(), encoding="utf-8")
+        assert _errors(spec) == []
+        build(spec, tmp_path / "generated")
+        python = tmp_path / "generated" / "python" / "barge_bridge"
+        convert = (python / "convert.py").read_text(encoding="utf-8")
+        assert "def _hold_state_tags_item_to_ros(" in convert and "for element in list(src.history):" in convert
+        codec = (python / "codec.py").read_text(encoding="utf-8")
+        assert "OBJECT_ONLY: dict[str, str] = {\n    'hold_state': 'arrays of composites converted element by " \
+            "element',\n}" in codec
 
     def test_plan_holds_the_element_mapping() -> None:
         resolved = validate(load_spec_file(SPEC))
@@ -192,7 +209,88 @@ if not WORKER:
         assert " passed" in proc.stdout and " skipped" not in proc.stdout and " failed" not in proc.stdout, report
 
 
-# ============================================================================================ worker
+    @pytest.mark.ros
+    @pytest.mark.slow
+    @pytest.mark.skipif(missing_tools() is not None, reason=str(missing_tools()))
+    def test_cyphal_element_converters_with_pycyphal_and_rclpy(tmp_path: Path) -> None:
+        pytest.importorskip("pycyphal")
+        from helpers.ros_packages import built_prefix
+
+        from sam_codegen.build import build
+        from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
+
+        spec = tmp_path / "spec" / "barge.yaml"
+        spec.parent.mkdir()
+        spec.write_text(barge_with_tags(), encoding="utf-8")
+        generated = tmp_path / "generated"
+        build(spec, generated)
+        saved = list(sys.path)
+        try:  # compiled here (cached by content); the worker only puts it on its path
+            dsdl = ensure_compiled([generated / "dsdl" / "barge"], ROOT / ".cache" / "dsdl")
+        finally:
+            sys.path[:] = saved
+        prefix = built_prefix([generated / "ros" / "barge_msgs"])
+        config = {"python": str(generated / "python"), "dsdl": str(dsdl)}
+        proc = run_child(["-m", "pytest", __file__, "-q", "-p", "no:cacheprovider", "--rootdir", str(ROOT),
+                          "-W", "error::RuntimeWarning"], prefix, domain_id(78),
+                         {CYPHAL_WORKER_ENV: json.dumps(config), "ROS_PYTHON_CHECK_FIELDS": "1"}, timeout=900)
+        report = proc.stdout[-12000:] + proc.stderr[-4000:]
+        assert proc.returncode == 0, f"worker tests failed:\n{report}"
+        assert " passed" in proc.stdout and " skipped" not in proc.stdout and " failed" not in proc.stdout, report
+
+
+# ============================================================================================ workers
+
+if CYPHAL_WORKER:
+    import numpy as np
+    import pycyphal.dsdl
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    CYPHAL_CONFIG = json.loads(CYPHAL_WORKER)
+    sys.path.insert(0, CYPHAL_CONFIG["dsdl"])
+    sys.path.insert(0, CYPHAL_CONFIG["python"])
+    barge_convert = importlib.import_module("barge_bridge.convert")
+    import barge.cargo
+    from barge_msgs.msg import HoldState, TagMsg
+
+    C_SETTINGS = settings(max_examples=int(os.environ.get("SAM_CONVERTERS_EXAMPLES", "60")), deadline=None,
+                          database=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    C_RECEIVE_NS = 1_700_000_000_123_456_789
+
+    def cyphal_wire(obj: Any) -> Any:
+        """What the receiver of `obj` gets: serialized and deserialized by pycyphal."""
+        return pycyphal.dsdl.deserialize(type(obj), list(pycyphal.dsdl.serialize(obj)))
+
+    @C_SETTINGS
+    @given(tags=st.lists(st.tuples(st.integers(0, 2**24 - 1), st.booleans()), max_size=3),
+           usec=st.integers(1, 2**40))
+    def test_manifest_history_to_ros_tags(tags: list[tuple[int, bool]], usec: int) -> None:
+        manifest = barge.cargo.Manifest_1_0(
+            history=[barge.cargo.Tag_1_0(code=c, checked=k) for c, k in tags])
+        manifest.timestamp.microsecond = usec
+        stats = barge_convert.ConversionStats()
+        ros = barge_convert.hold_state_to_ros(cyphal_wire(manifest), C_RECEIVE_NS, stats)
+        assert ros is not None, stats.rejected
+        ros = deserialize_message(serialize_message(ros), HoldState)
+        assert [(t.code, t.checked) for t in ros.tags] == tags
+
+    @C_SETTINGS
+    @given(tags=st.lists(st.tuples(st.integers(0, 2**32 - 1), st.booleans()), max_size=6))
+    def test_hold_state_tags_to_history(tags: list[tuple[int, bool]]) -> None:
+        msg = HoldState(tags=[TagMsg(code=c, checked=k) for c, k in tags])
+        stats = barge_convert.ConversionStats()
+        out = barge_convert.hold_state_to_uavcan(deserialize_message(serialize_message(msg), HoldState), stats)
+        assert out is not None, stats.rejected
+        got = [(int(t.code), bool(t.checked)) for t in cyphal_wire(out).history]
+        kept = tags[:3]
+        assert got == [(min(c, 2**24 - 1), k) for c, k in kept]
+        assert stats.saturated.get("hold_state.history", 0) == (1 if len(tags) > 3 else 0)
+        assert stats.saturated.get("hold_state.tags[].code", 0) == sum(c > 2**24 - 1 for c, _ in kept)
+        assert not stats.rejected
+        assert np.all(np.asarray([t.code for t in out.history], dtype=np.int64) < 2**24)
+
 
 if WORKER:
     import dronecan

@@ -99,7 +99,7 @@ def element_to_ros(em: Any, s: Step, names: LocalNames, uav_read: Any, statement
     base = _functions(em, s)
     var = names.new(s.ros)
     stamp = _stamp_ns(em, statements)
-    source = em.uavcan.as_list(uav_read(s.uavcan_path))
+    source = f"list({uav_read(s.uavcan_path)})"  # dronecan's ArrayValue, pycyphal's list of objects
     statements.append(_ElementLoop(var, names.new("element"), names.new("item"), source,
                                    f"{base}_to_ros({{}}, {stamp}, stats)"))
     return [(s.ros_path, var)]
