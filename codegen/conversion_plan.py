@@ -308,8 +308,19 @@ class Evaluate:
     as_float: bool
 
 
+@dataclass(frozen=True)
+class ElementMapping:
+    """An array of composites converted element by element: `plan` is the element mapping's own plan (its links
+    relative to one element, in the same direction); the array's length ops (MaxLength, FixedLength) follow it.
+    An element whose conversion rejects drops the whole message; an element's ROS header is the message's."""
+
+    plan: MappingPlan
+    ros_element: str  # the ROS element message (pkg/Name)
+    uavcan_element: str  # the UAVCAN element type's full name
+
+
 Op = (Convert | Scale | Offset | RejectNaN | Limits | Clamp | Round | Table | TimestampToRos | TimestampFromRos
-      | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | SetConstant | Evaluate)
+      | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | SetConstant | Evaluate | ElementMapping)
 EXPRESSION_OPS = (Convert, Scale, Offset)  # pure arithmetic on the value; everything else may drop or fix it
 CHECK_OPS = (RejectNaN, Limits, Clamp, Round)
 
@@ -560,6 +571,8 @@ def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
 
 def lower_link(step: Step, direction: PlanDirection, mapping: str, reject: bool) -> LinkPlan:
     """The operations of one link in one direction (`mapping`: the mapping's name, for the stats key)."""
+    if step.kind == "elements":
+        return lower_elements(step, direction, mapping, reject)
     if direction == TO_ROS:
         return LinkPlan(step, TO_ROS, f"{mapping}.{step.ros}", tuple(_lower_to_ros(step, reject)), reject)
     return LinkPlan(step, TO_UAVCAN, f"{mapping}.{step.uavcan}", tuple(_lower_to_uavcan(step, reject)), reject)
@@ -590,3 +603,22 @@ def lower_mapping(rm: ResolvedMapping) -> MappingPlan:
                              *(FieldSet(p, t, SetConstant(v, select=True)) for p, t, v in rm.select)]),
         required=tuple(required),
     )
+
+
+def lower_elements(step: Step, direction: PlanDirection, mapping: str, reject: bool) -> LinkPlan:
+    """An element mapping in one direction: the element plan, then the array's length (to UAVCAN: beyond a bounded
+    array's capacity cut (saturate) or rejected; into a fixed one padded with default elements or cut)."""
+    assert step.elements is not None and step.uavcan_type is not None
+    uav = step.uavcan_type
+    element = ElementMapping(lower_mapping(step.elements), step.ros_type.base, uav.composite or "")
+    if direction == TO_ROS:
+        return LinkPlan(step, TO_ROS, f"{mapping}.{step.ros}", (element,), reject)
+    ops: list[Op] = [element]
+    cap = uav.capacity or 0
+    ros_fixed = step.ros_type.array == "fixed"
+    if uav.array == "fixed":
+        if not (ros_fixed and step.ros_type.capacity == cap):
+            ops.append(FixedLength(cap, reject))
+    elif step.ros_type.array == "dynamic" or (step.ros_type.capacity or 0) > cap:
+        ops.append(MaxLength(cap, False, reject))
+    return LinkPlan(step, TO_UAVCAN, f"{mapping}.{step.uavcan}", tuple(ops), reject)

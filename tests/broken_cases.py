@@ -1745,3 +1745,174 @@ ROUTING_CASES: tuple[Case, ...] = (
         ),
     ),
 )
+
+
+POWER_CASES: tuple[Case, ...] = (
+    Case(
+        'element_unknown_uavcan_field',
+        '            charge: charge\n',
+        '            charge: charge_ah\n',
+        (
+            "power_v0.yaml:70:9: error: required field left unmapped: UAVCAN field 'charge' (float32) of power.ConsumedCharge is neither mapped nor ignored in DroneCAN mapping 'charges', elements of 'charges' (expected a `ros_field: charge` line or `charge` in ignore)",
+            "power_v0.yaml:74:13: error: DroneCAN mapping 'charges', elements of 'charges', field 'charge': power.ConsumedCharge has no field 'charge_ah'",
+        ),
+    ),
+    Case(
+        'element_unknown_ros_field',
+        '            circuit_id: circuit_id\n',
+        '            circuit: circuit_id\n',
+        (
+            "power_v0.yaml:70:9: error: ROS element field 'circuit_id' (uint16) of power_msgs/ConsumedCharge is set by nothing in DroneCAN mapping 'charges', elements of 'charges' (expected a `circuit_id: <UAVCAN element field>` line in its fields)",
+            "power_v0.yaml:73:13: error: DroneCAN mapping 'charges', elements of 'charges', field 'circuit': power_msgs/ConsumedCharge has no field 'circuit'",
+        ),
+    ),
+    Case(
+        'element_type_mismatch',
+        '            circuit_id: circuit_id\n',
+        '            circuit_id: charge\n            foo: circuit_id\n',
+        (
+            "power_v0.yaml:73:13: error: DroneCAN mapping 'charges', elements of 'charges', field 'circuit_id': a UAVCAN float32 maps to a ROS float, not uint16 (or to an integer with `round: true`)",
+            "power_v0.yaml:74:13: error: DroneCAN mapping 'charges', elements of 'charges', field 'foo': power_msgs/ConsumedCharge has no field 'foo'",
+        ),
+    ),
+    Case(
+        'element_uavcan_field_unmapped',
+        '            charge: charge\n',
+        '',
+        (
+            "power_v0.yaml:70:9: error: ROS element field 'charge' (float64) of power_msgs/ConsumedCharge is set by nothing in DroneCAN mapping 'charges', elements of 'charges' (expected a `charge: <UAVCAN element field>` line in its fields)",
+            "power_v0.yaml:70:9: error: required field left unmapped: UAVCAN field 'charge' (float32) of power.ConsumedCharge is neither mapped nor ignored in DroneCAN mapping 'charges', elements of 'charges' (expected a `ros_field: charge` line or `charge` in ignore)",
+        ),
+    ),
+    Case(
+        'element_uavcan_field_no_value',
+        '            command_type: command_type\n',
+        '',
+        (
+            "power_v0.yaml:81:9: error: required field left unmapped: UAVCAN field 'command_type' (uint8) of uavcan.equipment.actuator.Command gets no value in DroneCAN mapping 'actuators', elements of 'commands' (expected a `ros_field: command_type` line or an entry in uavcan_values)",
+        ),
+    ),
+    Case(
+        'element_nested',
+        '            charge: charge\n',
+        '            charge: {each: charges, fields: {a: b}}\n',
+        (
+            "power_v0.yaml:74:13: error: DroneCAN mapping 'charges', elements of 'charges', field 'charge': element mappings do not nest (an element field with `each`) (expected a mapping of its own for the inner array)",
+        ),
+    ),
+    Case(
+        'element_each_not_composite_array',
+        '          each: charges\n',
+        '          each: timestamp\n',
+        (
+            "power_v0.yaml:62:5: error: required field left unmapped: UAVCAN field 'charges' (power.ConsumedCharge[<=15]) of power.ConsumedChargeArray is neither mapped nor ignored in DroneCAN mapping 'charges' (expected a `ros_field: charges` line or `charges` in ignore)",
+            "power_v0.yaml:70:9: error: DroneCAN mapping 'charges', field 'charges': `each` takes an array of composites, timestamp is uavcan.Timestamp",
+        ),
+    ),
+    Case(
+        'element_ros_not_array',
+        '        charges:\n          each: charges\n',
+        '        header:\n          each: charges\n',
+        (
+            "power_v0.yaml:62:5: error: ROS field 'charges' (power_msgs/ConsumedCharge[]) of power_msgs/ConsumedCharges is written by nothing in DroneCAN mapping 'charges': it would always keep its default (expected a `charges: <uavcan field>` line, `charges: {value: ...}`, `charges: {expr: ...}` or `charges` in ros_defaults)",
+            "power_v0.yaml:70:9: error: DroneCAN mapping 'charges', field 'header': `each` maps an array of messages element by element, header is std_msgs/Header",
+        ),
+    ),
+    Case(
+        'element_link_key_outside',
+        '          each: commands\n',
+        '          each: commands\n          scale: 2\n',
+        (
+            "power_v0.yaml:83:11: error: field 'commands' of mapping 'actuators' maps elements (`each`): 'scale' belongs to its element fields (expected `scale` inside `fields`)",
+        ),
+    ),
+    Case(
+        'element_fields_missing',
+        '          each: commands\n          fields:\n            actuator_id: actuator_id\n            command_type: command_type\n            value: command_value\n',
+        '          each: commands\n',
+        (
+            "power_v0.yaml:81:9: error: field 'commands' of mapping 'actuators' maps elements of 'commands' but has no `fields` (expected fields: {<ROS element field>: <UAVCAN element field>})",
+        ),
+    ),
+    Case(
+        'element_each_missing',
+        '          each: commands\n',
+        '',
+        (
+            "power_v0.yaml:81:9: error: field 'commands' of mapping 'actuators' has `fields` but no `each` (the UAVCAN array whose elements it maps) (expected each: <UAVCAN array of composites>)",
+        ),
+    ),
+    Case(
+        'composite_array_without_each',
+        '        charges:\n          each: charges\n          fields:\n            circuit_id: circuit_id\n            charge: charge\n',
+        '        charges: charges\n',
+        (
+            "power_v0.yaml:70:9: error: DroneCAN mapping 'charges', field 'charges': charges is power_msgs/ConsumedCharge[]: map it element by element with `{each: <UAVCAN array>, fields: {...}}`",
+        ),
+    ),
+    Case(
+        'element_each_indexed',
+        '          each: charges\n',
+        '          each: charges[0]\n',
+        (
+            "power_v0.yaml:70:9: error: DroneCAN mapping 'charges', field 'charges': charges[0] names an array element; `each` maps a whole array",
+        ),
+    ),
+    Case(
+        'element_value_unknown',
+        '          each: commands\n',
+        '          each: commands\n          uavcan_values: {command_kind: 1}\n',
+        (
+            "power_v0.yaml:81:9: error: uavcan_values of DroneCAN mapping 'actuators', elements of 'commands': uavcan.equipment.actuator.Command has no field 'command_kind'",
+        ),
+    ),
+    Case(
+        'element_value_and_link',
+        '          each: commands\n',
+        '          each: commands\n          uavcan_values: {command_type: 1}\n',
+        (
+            "power_v0.yaml:81:9: error: UAVCAN field 'command_type' is both mapped and in uavcan_values in DroneCAN mapping 'actuators', elements of 'commands'",
+        ),
+    ),
+    Case(
+        'element_array_also_by_key',
+        '            value: command_value\n',
+        '            value: command_value\n        foo: commands[actuator_id=3].command_value\n',
+        (
+            "power_v0.yaml:81:9: error: DroneCAN mapping 'actuators', field 'commands': commands is mapped element by element here and also named by field 'foo'; one way for one array",
+            "power_v0.yaml:87:9: error: DroneCAN mapping 'actuators', field 'foo': power_msgs/Commands has no field 'foo'",
+        ),
+    ),
+    Case(
+        'element_array_also_valued',
+        '      destination_node_ids: [31]\n',
+        '      destination_node_ids: [31]\n      uavcan_values: {"commands[actuator_id=1].command_type": 1}\n',
+        (
+            "power_v0.yaml:82:9: error: DroneCAN mapping 'actuators', field 'commands': commands is mapped element by element here and also named by uavcan_values 'commands[actuator_id=1].command_type'; one way for one array",
+        ),
+    ),
+    Case(
+        'element_ros_fixed_array',
+        '      - {name: commands, type: "power_msgs/Command[]"}\n',
+        '      - {name: commands, type: "power_msgs/Command[3]"}\n',
+        (
+            "power_v0.yaml:81:9: error: DroneCAN mapping 'actuators', field 'commands': `each` maps into a ROS sequence (T[] or T[<=N]), commands is a fixed-size array (power_msgs/Command[3])",
+        ),
+    ),
+    Case(
+        'element_ros_bounded_too_small',
+        '      - {name: charges, type: "power_msgs/ConsumedCharge[]"}\n',
+        '      - {name: charges, type: "power_msgs/ConsumedCharge[<=4]"}\n',
+        (
+            "power_v0.yaml:70:9: error: DroneCAN mapping 'charges', field 'charges': charges (power_msgs/ConsumedCharge[<=4]) holds fewer elements than charges (power.ConsumedCharge[<=15])",
+        ),
+    ),
+    Case(
+        'element_ros_field_ignored_only',
+        '            charge: charge\n',
+        '          ignore: [charge]\n',
+        (
+            "power_v0.yaml:70:9: error: ROS element field 'charge' (float64) of power_msgs/ConsumedCharge is set by nothing in DroneCAN mapping 'charges', elements of 'charges' (expected a `charge: <UAVCAN element field>` line in its fields)",
+        ),
+    ),
+)

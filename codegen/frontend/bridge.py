@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from sam_codegen.frontend.bus import parse_bus
+from sam_codegen.frontend.element_links import element_link
 from sam_codegen.frontend.expr_parser import ExprSyntaxError, parse_expr
 from sam_codegen.frontend.reading import Reader, map_items, number, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.routing import node_ids_or_any
@@ -49,9 +50,12 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
     if isinstance(node, YScalar):
         path = scalar(node, str, what, diag)
         return FieldLink(ros_path, path, pos=pos) if path is not None else None
-    r = Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round", "expr"))
+    r = Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round", "expr", "each",
+                                  "fields", "ignore", "uavcan_values"))
     if not r.ok:
         return None
+    if any(r.node(key) is not None for key in ("each", "fields", "ignore", "uavcan_values")):
+        return element_link(ros_path, pos, r, mapping, diag, _link)
     if r.node("expr") is not None:
         others = [key for key in ("from", "scale", "offset", "table", "value", "limits", "round")
                   if r.node(key) is not None]

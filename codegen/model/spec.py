@@ -332,6 +332,12 @@ class FieldLink:
     pos: Pos = NOWHERE
     round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
     expr: ExprSource | None = None  # `{expr: "..."}`: the ROS field computed from UAVCAN fields (model.expr)
+    # An element mapping (`ros_array: {each: uavcan_array, fields: {...}}`): arrays of composites converted element
+    # by element, `element_links` relative to the elements (validate.element_mappings); `each` the UAVCAN array.
+    each: str | None = None
+    element_links: tuple[FieldLink, ...] = ()
+    element_ignore: tuple[str, ...] = ()
+    element_values: tuple[tuple[str, Scalar], ...] = ()  # the element's uavcan_values (ROS -> UAVCAN constants)
 
 
 @dataclass(frozen=True)

@@ -176,6 +176,7 @@ class Step:
     # kind `expr`: the typed expression (model.expr) computing the target from source fields. To ROS: ros_path is
     # the target, uavcan_path empty; to UAVCAN (uavcan_exprs): uavcan_path the target, ros_path empty.
     expr: ENode | None = None
+    elements: ResolvedMapping | None = None  # kind "elements": the element mapping (validate.element_mappings)
 
     @property
     def ros(self) -> str:

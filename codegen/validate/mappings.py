@@ -29,6 +29,7 @@ from sam_codegen.model.spec import (
     V0Struct,
 )
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
+from sam_codegen.validate.element_mappings import resolve_elements
 from sam_codegen.validate.expressions import ExprError, check_expr, check_target
 from sam_codegen.validate.mapping_rules import (
     HEADER,
@@ -327,6 +328,8 @@ class MappingValidator:
             ros_type = self.ros_leaf(ros_message, ros_path)
             if link.expr is not None:
                 return self.resolve_expr_link(link, link.expr, ros_path, ros_type, struct, mapping, what)
+            if link.each is not None:  # an array of composites, element by element
+                return resolve_elements(self, link, ros_path, ros_type, struct, mapping, what)
             if link.value is not None:
                 if mapping.direction == ROS_TO_UAVCAN:
                     raise RuleError("a `value` sets a ROS field; a ROS->UAVCAN mapping sets UAVCAN fields with "
@@ -346,7 +349,9 @@ class MappingValidator:
                     raise RuleError(f"builtin_interfaces/Time receives a microsecond integer, not {uav_type}")
                 return Step("time", tuple(ros_path), ros_type, tuple(uav_path), uav_type, pos=link.pos)
             if not ros_type.is_primitive:
-                raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one")
+                raise RuleError(f"{link.ros_path} is a {ros_type.base}; map its fields one by one" if not ros_type.array
+                                else f"{link.ros_path} is {ros_type}: map it element by element with "
+                                "`{each: <UAVCAN array>, fields: {...}}`")
             if link.limits is not None and (ros_type.array or ros_type.base not in {*ROS_INT_RANGES, *ROS_FLOAT_BITS}):
                 raise RuleError("limits apply to numeric scalar fields")
             if link.limits is not None and mapping.direction == UAVCAN_TO_ROS:  # the converters apply none there
@@ -451,7 +456,8 @@ class MappingValidator:
         linked |= selected
         struct = resolved.dsdl_struct
         if mapping.direction == UAVCAN_TO_ROS:
-            self.check_ros_written(resolved, what)
+            if not mapping.name.endswith("[]"):  # an element mapping's (`<mapping>.<array>[]`): element_mappings
+                self.check_ros_written(resolved, what)  # checks its fields, with advice that fits `fields`
             for path, t in self.uncovered(struct, "", linked | self.ignored):
                 self.error(mapping.pos, f"required field left unmapped: UAVCAN field {path!r} ({t}) of "
                            f"{struct.name} is neither mapped nor ignored in {what}",

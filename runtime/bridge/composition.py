@@ -28,7 +28,14 @@ from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.bridge.silence import SilenceWatch
 from sam_runtime.bridge.switches import EnableServices, switches_of
 from sam_runtime.bridge.time_sync import DEFAULT_TIME_SYNC_PERIOD_S, StampWatch, TimeSyncMaster
-from sam_runtime.bridge.wiring import check_destinations, in_groups, missing_codecs, nominal_rates, out_mappings
+from sam_runtime.bridge.wiring import (
+    check_destinations,
+    codec_gaps,
+    in_groups,
+    missing_codecs,
+    nominal_rates,
+    out_mappings,
+)
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.cyphal_io.transport import quiet_late_media_completions
@@ -193,9 +200,8 @@ class Bridge:
         codec = self.gen.codec(self.selection.protocol)
         missing = missing_codecs(codec, self.selection.mappings)
         if missing:
-            log.warning("%s: the generated package has no wire codecs for %s (built by an older sam-codegen? run "
-                        "`sam-codegen build`): using the object converters", self.name,
-                        "any mapping" if codec is None else ", ".join(missing))
+            log.warning("%s: the generated package has no wire codecs for %s: using the object converters",
+                        self.name, codec_gaps(codec, missing))
             self.wire = "object"
             return None
         return codec

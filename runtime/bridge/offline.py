@@ -39,7 +39,7 @@ from sam_runtime.bridge.layout import select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
 from sam_runtime.bridge.switches import switches_of
-from sam_runtime.bridge.wiring import in_groups, missing_codecs, nominal_rates
+from sam_runtime.bridge.wiring import codec_gaps, in_groups, missing_codecs, nominal_rates
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.genpkg import GeneratedPackage
 
@@ -183,7 +183,7 @@ class OfflineBridge:
         missing = missing_codecs(codec, sel.mappings)
         if missing:
             raise BridgeConfigError(f"the generated package {gen.root} has no wire codecs for "
-                                    f"{', '.join(missing)}: run `sam-codegen build`")
+                                    f"{codec_gaps(codec, missing)}")
         if sel.protocol == "cyphal":
             gen.compile_dsdl()  # the groups name the ports' compiled classes
         self.rlog = RateLimitedLog(log)

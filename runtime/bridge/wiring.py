@@ -20,7 +20,8 @@ from sam_runtime.cyphal_io.ports import subscription_names
 if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
 
-__all__ = ["check_destinations", "find_converter", "in_groups", "missing_codecs", "nominal_rates", "out_mappings"]
+__all__ = ["check_destinations", "codec_gaps", "find_converter", "in_groups", "missing_codecs", "nominal_rates",
+           "out_mappings"]
 
 
 def find_converter(convert: Any, m: Any, which: int) -> Callable[..., Any]:
@@ -127,3 +128,18 @@ def out_mappings(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
     return [OutMapping(m, codec.CODECS[m.name][1] if codec is not None else find_converter(convert, m, 1),
                        counters[m.name], gen.ros_class(m.topic), _dtype(gen, m), raw=codec is not None)
             for m in (gen.tables().MAPPINGS if mappings is None else mappings) if m.direction == ROS_TO_UAVCAN]
+
+
+def codec_gaps(codec: Any, missing: Sequence[str]) -> str:
+    """Why the codec module has no codecs for `missing`: the reasons it gives (OBJECT_ONLY: constructs the wire
+    codecs do not render yet), else an older build."""
+    reasons = getattr(codec, "OBJECT_ONLY", {})
+    known = [f"{name} ({reasons[name]})" for name in missing if name in reasons]
+    stale = [name for name in missing if name not in reasons]
+    parts = []
+    if known:
+        parts.append("; ".join(known))
+    if stale or codec is None:
+        parts.append(("any mapping" if codec is None else ", ".join(stale))
+                     + " (built by an older sam-codegen? run `sam-codegen build`)")
+    return "; ".join(parts)

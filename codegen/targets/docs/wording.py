@@ -25,6 +25,7 @@ from sam_codegen.conversion_plan import (
     Clamp,
     Convert,
     DecodeUtf8,
+    ElementMapping,
     Evaluate,
     FixedLength,
     Limits,
@@ -37,6 +38,7 @@ from sam_codegen.conversion_plan import (
     RejectNaN,
     Scale,
     SetConstant,
+    StaticFrameId,
     Table,
     TimestampFromRos,
     TimestampToRos,
@@ -101,6 +103,8 @@ def describe_link(link: LinkPlan) -> str:
     direction the bridge runs it. Out-of-range handling follows the mapping's on_out_of_range."""
     step, ops, to_ros = link.step, link.ops, link.to_ros
     first = ops[0] if ops else None
+    if isinstance(first, ElementMapping):
+        return describe_elements(link, first)
     if isinstance(first, SetConstant):
         return f"constant {fmt_number(first.value)}"
     if isinstance(first, Evaluate):
@@ -213,7 +217,9 @@ def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
         for fs in plan.ros_fields:  # the receive-time stamp (when no link sets it), the frame id
             text = "receive time" if isinstance(fs.op, ReceiveTime) else f"constant {fs.op.value}"
             rows.append({"ros": format_path(list(fs.path)), "arrow": arrow, "uavcan": None, "conversion": text})
-    rows.extend(link_row(link) for link in links)
+    for link in links:
+        rows.append(link_row(link))
+        rows.extend(element_rows(link, arrow))  # an element mapping: its element fields, one row each
     for name in m.ros_defaults:  # kept at the type's default on purpose
         rows.append({"ros": name, "arrow": "", "uavcan": None,
                      "conversion": "default (0, false, empty) where nothing writes it"})
@@ -226,4 +232,44 @@ def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:
     return rows
 
 
-__all__ = ["describe_link", "describe_step", "field_rows", "fmt_number", "fmt_rate"]
+def describe_elements(link: LinkPlan, element: ElementMapping) -> str:
+    """An element mapping: element by element, the element header, the array's length rule."""
+    src, dst = ((element.uavcan_element, element.ros_element) if link.to_ros
+                else (element.ros_element, element.uavcan_element))
+    notes: list[str] = []
+    if link.to_ros and any(isinstance(fs.op, (ReceiveTime, StaticFrameId)) for fs in element.plan.ros_fields):
+        notes.append("each element's header: the message's stamp and frame id")
+    for op in link.ops[1:]:
+        if isinstance(op, FixedLength):
+            notes.append(f"other lengths {_policy(link, 'padded or cut')}")
+        elif isinstance(op, MaxLength):
+            notes.append(f"over {op.capacity} elements {_policy(link, 'cut')}")
+    notes.append("an element rejected drops the message")
+    return f"element by element, {src} → {dst} ({', '.join(notes)})"
+
+
+def element_rows(link: LinkPlan, arrow: str) -> list[dict[str, object]]:
+    """The rows of an element mapping's element fields (`array[].field`), after the array's own row."""
+    first = link.ops[0] if link.ops else None
+    if not isinstance(first, ElementMapping):
+        return []
+    ros, uav = link.step.ros, link.step.uavcan
+    plan = first.plan
+    rows: list[dict[str, object]] = []
+    for inner in plan.to_ros if link.to_ros else plan.to_uavcan:
+        rows.append({"ros": f"{ros}[].{inner.step.ros}", "arrow": arrow,
+                     "uavcan": f"{uav}[].{inner.step.uavcan}" if inner.step.uavcan else None,
+                     "conversion": describe_link(inner)})
+    if not link.to_ros:
+        for fs in plan.uavcan_fields:
+            if isinstance(fs.op, SetConstant):
+                rows.append({"ros": None, "arrow": arrow, "uavcan": f"{uav}[].{format_path(list(fs.path))}",
+                             "conversion": f"constant {fmt_number(fs.op.value)}"})
+    else:
+        for ignored in link.step.elements.mapping.ignore if link.step.elements is not None else []:
+            rows.append({"ros": None, "arrow": "", "uavcan": f"{uav}[].{ignored}", "conversion": "ignored"})
+    return rows
+
+
+__all__ = ["describe_elements", "describe_link", "describe_step", "element_rows", "field_rows", "fmt_number",
+           "fmt_rate"]

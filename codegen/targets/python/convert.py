@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from sam_codegen.render.templating import render
+from sam_codegen.targets.python.elements import element_function_names
 from sam_codegen.targets.python.factories import dsdl_factory, ros_factory
 from sam_codegen.targets.python.mapping import CyphalObjectReader, MappingEmitter, ObjectSignatures, RosObjectReader
 from sam_codegen.targets.python.module import ConvertModule, PycyphalObjects
@@ -58,11 +59,13 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {f"{rm.mapping.name}_to_ros" for rm in resolved.mappings}
         | {f"{rm.mapping.name}_to_uavcan" for rm in resolved.mappings}
         | {"CONVERTERS", "ConversionStats", "Callable", "Any", "_NAN", "_INF", "FAST_CONSTRUCTORS", "_np", "_support"}
+        | element_function_names(resolved.mappings)
     )
     functions = []
     for rm in resolved.mappings:
         emitter = object_emitter(module, rm)
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
+    functions.extend(module.extra_functions)  # element mappings' functions, after the registry's
     ros_imports: dict[str, list[str]] = {}
     for full, alias in sorted(module.ros_aliases.items()):
         package, name = full.split("/")

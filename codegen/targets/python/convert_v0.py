@@ -17,6 +17,7 @@ from sam_codegen.model.spec import V0Struct
 from sam_codegen.render.filters import py_str
 from sam_codegen.render.templating import render
 from sam_codegen.targets import dsdl_v0
+from sam_codegen.targets.python.elements import element_function_names
 from sam_codegen.targets.python.mapping import MappingEmitter, ObjectSignatures, RosObjectReader
 from sam_codegen.targets.python.mapping_v0 import TYPENAMES, DroneCanObjects, V0ObjectReader, matches
 from sam_codegen.targets.python.module import ConvertModule
@@ -38,6 +39,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         | {f"_matches_{rm.mapping.name}" for rm in resolved.dronecan_mappings}
         | {"CONVERTERS", "MATCHES", "TYPES", "CUSTOM_DSDL_DIRS", "ConversionStats", "Callable", "Any", "Path",
            "_NAN", "_INF", TYPENAMES, "dronecan", "_item", "_always", "check_types", "load_types", "_support"}
+        | element_function_names(resolved.dronecan_mappings)
     )
     functions, predicates = [], []
     for rm in resolved.dronecan_mappings:
@@ -46,6 +48,7 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
         to_uavcan = emitter.to_uavcan()
         functions.append((to_ros, to_uavcan))
         predicates.append((rm.mapping.name, matches(emitter)))
+    functions.extend(module.extra_functions)  # element mappings' functions, after the registry's
     ros_imports: dict[str, list[str]] = {}
     for full, alias in sorted(module.ros_aliases.items()):
         if full not in objects.used_ros:

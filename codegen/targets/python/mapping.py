@@ -25,6 +25,7 @@ from sam_codegen.conversion_plan import (
     TO_UAVCAN,
     Clamp,
     DecodeUtf8,
+    ElementMapping,
     EncodeUtf8,
     Evaluate,
     FixedLength,
@@ -48,6 +49,7 @@ from sam_codegen.model.expr import fields_of
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.targets.python import statements as pys
+from sam_codegen.targets.python.elements import element_to_ros, element_to_uavcan
 from sam_codegen.targets.python.expressions import ExpressionWriter
 from sam_codegen.targets.python.module import ConvertModule, FunctionDraft, TableConstant
 from sam_codegen.targets.python.names import LocalNames, access, identifier, py_attr
@@ -159,7 +161,8 @@ class MappingEmitter:
             elif isinstance(fs.op, ReceiveTime):
                 self.module.insert(root, (*fs.path, ("sec", None)), "receive_ns // 1_000_000_000")
                 self.module.insert(root, (*fs.path, ("nanosec", None)), "receive_ns % 1_000_000_000")
-        for s in steps:
+        # element mappings last: their elements take the message's stamp, which a time link computes
+        for s in [*(s for s in steps if s.kind != "elements"), *(s for s in steps if s.kind == "elements")]:
             for path, value in self.step_to_ros(s, names, uav_read, fn.statements):
                 self.module.insert(root, path, value)
         fn.result = self.module.format_return(root, names)
@@ -173,6 +176,8 @@ class MappingEmitter:
         ops = link.ops
         key = repr(link.key)
         first = ops[0] if ops else None
+        if isinstance(first, ElementMapping):
+            return element_to_ros(self, s, names, uav_read, statements)
         if isinstance(first, SetConstant):
             return [(s.ros_path, typed_literal(first.value, s.ros_type.base))]
         if isinstance(first, Evaluate):
@@ -256,6 +261,8 @@ class MappingEmitter:
         first = ops[0] if ops else None
         if isinstance(first, Evaluate):
             return self.evaluate(link, first, s.uavcan, reads.value, names, statements)
+        if isinstance(first, ElementMapping):
+            return element_to_uavcan(self, s, names, reads, statements)
         if isinstance(first, TimestampFromRos):
             sec, nanosec = reads.time(s.ros_path)
             var = names.new("us")

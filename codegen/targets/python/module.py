@@ -127,6 +127,8 @@ class ConvertModule:
     tables: list[TableConstant] = field(default_factory=list)
     module_names: set[str] = field(default_factory=set)
     lengths: dict[tuple, int] = field(default_factory=dict)  # the current mapping's arrays sized by use
+    # Functions beside the mappings' own (targets.python.elements: one pair per element mapping), emitted after them
+    extra_functions: list[tuple[FunctionDraft, FunctionDraft]] = field(default_factory=list)
 
     def start(self, rm: ResolvedMapping) -> None:
         """Begin the functions of mapping `rm`: the arrays it builds element by element get their lengths."""

@@ -24,6 +24,7 @@ from typing import Any, ClassVar
 from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.templating import render
+from sam_codegen.targets.python.elements import has_elements
 from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
 from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft
 from sam_codegen.targets.python.names import LocalNames
@@ -215,12 +216,15 @@ def codec_context(resolved: Resolved) -> dict[str, Any]:
     consts = Constants("_W")
     build = CyphalWire(resolved, consts)
     module = ConvertModule(resolved, build)
-    for rm in resolved.mappings:
+    # Element mappings (arrays of composites, targets.python.elements) have no wire codec yet: a bridge that has
+    # one runs on the object converters (the runtime falls back when CODECS lacks a mapping; OBJECT_ONLY says why).
+    mappings = [rm for rm in resolved.mappings if not has_elements(rm)]
+    for rm in mappings:
         module.ros_aliases.setdefault(rm.ros_message.full_name, rm.ros_message.full_name)
-    module.module_names = set(MODULE_NAMES) | {f"{rm.mapping.name}_wire_to_ros" for rm in resolved.mappings} \
-        | {f"{rm.mapping.name}_ros_to_wire" for rm in resolved.mappings}
+    module.module_names = set(MODULE_NAMES) | {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} \
+        | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
     functions = []
-    for rm in resolved.mappings:
+    for rm in mappings:
         emitter = MappingEmitter(module, rm, CyphalWireReader(build), CdrReader(resolved, consts), WireSignatures())
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
     return {
@@ -229,7 +233,9 @@ def codec_context(resolved: Resolved) -> dict[str, Any]:
         "constants": consts.lines(),
         "tables": module.tables,
         "functions": functions,
-        "mappings": [rm.mapping.name for rm in resolved.mappings],
+        "mappings": [rm.mapping.name for rm in mappings],
+        "object_only": [(rm.mapping.name, "arrays of composites converted element by element")
+                        for rm in resolved.mappings if has_elements(rm)],
     }
 
 

@@ -27,6 +27,7 @@ from sam_codegen.model.spec import DsdlStruct, RosMessage, V0Struct
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.pysource import py_literal, typed_literal
 from sam_codegen.render.templating import render
+from sam_codegen.targets.python.elements import has_elements
 from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
 from sam_codegen.targets.python.mapping_v0 import Predicate, bind_required_elements, matches
 from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft, KeyedItems
@@ -316,7 +317,9 @@ def _context(resolved: Resolved) -> dict[str, Any]:
     assert resolved.dronecan is not None
     build = DroneCanWire(resolved, consts, V0Layout(resolved.dronecan.get))
     module = ConvertModule(resolved, build, ros_aliases=ros_aliases(resolved, resolved.dronecan_mappings))
-    mappings = resolved.dronecan_mappings
+    # Element mappings (arrays of composites, targets.python.elements) have no wire codec yet: a bridge that has
+    # one runs on the object converters (the runtime falls back when CODECS lacks a mapping).
+    mappings = [rm for rm in resolved.dronecan_mappings if not has_elements(rm)]
     module.module_names = (
         {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
         | {f"_wire_matches_{rm.mapping.name}" for rm in mappings}
@@ -335,6 +338,8 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         "functions": functions,
         "matches": predicates,
         "mappings": [rm.mapping.name for rm in mappings],
+        "object_only": [(rm.mapping.name, "arrays of composites converted element by element")
+                        for rm in resolved.dronecan_mappings if has_elements(rm)],
         "constants": consts.lines(),
         "prelude": MODULE_PRELUDE,
         "helpers": HELPERS.strip("\n").splitlines(),

@@ -1,0 +1,67 @@
+"""The power board of tests/specs/power_v0.yaml (node 30) in its own process: a plain ``dronecan`` node that knows
+the spec's own types the way the runtime gives them to dronecan (sam_runtime.dronecan_io.types.ensure_types).
+
+python power_board.py --generated DIR --iface mcast-lo:<bus>:<port> --start-file F
+
+Prints ``READY``; once F exists, broadcasts one power.ConsumedChargeArray (timestamp 1 700 000 000.25 s, circuits
+1..15 with charge circuit * 0.5 Ah) and one with no element, printing ``PUBLISHED``. On SIGTERM or when
+``--max-life`` runs out: ``SUMMARY {}``, exit 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+
+BOARD_ID = 30
+USEC = 1_700_000_000_250_000
+
+
+def main() -> int:
+    p = argparse.ArgumentParser()
+    p.add_argument("--generated", required=True)
+    p.add_argument("--iface", required=True)
+    p.add_argument("--start-file", required=True)
+    p.add_argument("--max-life", type=float, default=120.0)
+    args = p.parse_args()
+
+    import dronecan
+
+    from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
+    from sam_runtime.dronecan_io.types import ensure_types
+    from sam_runtime.genpkg import GeneratedPackage
+
+    ensure_types(GeneratedPackage(Path(args.generated)))
+    array = dronecan.TYPENAMES["power.ConsumedChargeArray"]
+    charge = dronecan.TYPENAMES["power.ConsumedCharge"]
+    stamp = dronecan.TYPENAMES["uavcan.Timestamp"]
+    spec = parse_iface(args.iface)
+    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=BOARD_ID,
+                              node_status_interval=0.5, mode=0)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    print("READY", flush=True)
+    published = False
+    end = time.monotonic() + args.max_life
+    try:
+        while not stop.is_set() and time.monotonic() < end:
+            node.spin(0.05)
+            if not published and Path(args.start_file).exists():
+                published = True
+                node.broadcast(array(timestamp=stamp(usec=USEC),
+                                     charges=[charge(circuit_id=c, charge=c * 0.5) for c in range(1, 16)]))
+                node.spin(0.01)
+                node.broadcast(array(timestamp=stamp(usec=USEC + 1_000_000), charges=[]))
+                print("PUBLISHED", flush=True)
+    finally:
+        node.close()
+    print("SUMMARY {}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
