@@ -28,6 +28,7 @@ import threading
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 
@@ -74,9 +75,7 @@ class DroneCanDuties:
         self.dna_server, self.timeout = bool(dna_server), float(timeout)
         self.counts: dict[str, int] = {"panic_in": 0, "panic_out": 0, "requests": 0, "request_timeouts": 0}
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._node: Any = None  # the ROS node of the services
-        self._executor: Any = None
-        self._thread: threading.Thread | None = None
+        self._spinner: SpinThread | None = None  # the services' node on its executor thread
         self._panic_pub: Any = None
         self._dna: Any = None
 
@@ -94,7 +93,7 @@ class DroneCanDuties:
 
         self._loop = asyncio.get_running_loop()
         base = self.ros.name
-        self._node = node = Node(f"{base}_dronecan_duties", namespace=self.ros.node.get_namespace(),
+        node = Node(f"{base}_dronecan_duties", namespace=self.ros.node.get_namespace(),
                                  context=self.ros.context)
         for nid, name in sorted(self.devices.items()):
             node.create_service(Trigger, f"/{base}/{name}/get_node_info", _service(self._get_node_info, nid))
@@ -102,29 +101,14 @@ class DroneCanDuties:
         if self.panic:
             self._panic_pub = node.create_publisher(String, f"/{base}/panic_received", 10)
             node.create_subscription(String, f"/{base}/panic", self._on_ros_panic, 10)
-        self._executor = SingleThreadedExecutor(context=self.ros.context)
-        self._executor.add_node(node)
-        self._thread = threading.Thread(target=self._spin, name=f"{base}-dronecan-duties", daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        while not self.lifetime.closed and self.ros.context.ok():
-            try:
-                self._executor.spin_once(timeout_sec=0.1)
-            except Exception as ex:  # the context shutting down under us, or a callback's bug
-                if self.lifetime.closed:
-                    return
-                self.lifetime.errors["dronecan_duties_error"] += 1
-                log.warning("DroneCAN duties: %s: %s", type(ex).__name__, ex)
+        executor = SingleThreadedExecutor(context=self.ros.context)
+        self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-dronecan-duties",
+                                   "dronecan_duties_error", "DroneCAN duties")
+        self._spinner.start()
 
     def _close(self) -> None:
-        if self._thread is not None:
-            self._thread.join(timeout=2.0)
-        for step in (lambda: self._executor.shutdown(timeout_sec=1.0), lambda: self._node.destroy_node()):
-            try:
-                step()
-            except Exception:
-                pass
+        if self._spinner is not None:
+            self._spinner.close()
 
     # ------------------------------------------------------------------------------------------------ requests
     def _request(self, request: Any, nid: int) -> Any:

@@ -32,7 +32,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from sam_runtime.bridge.counters import log
+from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["DroneCanServices", "from_uavcan", "to_uavcan"]
@@ -159,9 +159,7 @@ class DroneCanServices:
         self._finished: collections.OrderedDict[tuple[int, int, int], str] = collections.OrderedDict()
         self._sending: _Call | None = None  # the call node.request is sending (its transfer id comes by the hook)
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._node: Any = None
-        self._executor: Any = None
-        self._thread: threading.Thread | None = None
+        self._spinner: SpinThread | None = None  # the services' node on its executor thread
         self._diag_pub: Any = None
 
     def attach(self) -> None:
@@ -176,7 +174,7 @@ class DroneCanServices:
 
         self._loop = asyncio.get_running_loop()
         base = self.ros.name
-        self._node = node = Node(f"{base}_services", context=self.ros.context)
+        node = Node(f"{base}_services", context=self.ros.context)
         group = ReentrantCallbackGroup()
         for m in self.mappings:
             srv_type = getattr(importlib.import_module(m.ros_module), m.ros_class)
@@ -187,29 +185,14 @@ class DroneCanServices:
             self._diag_pub = node.create_publisher(DiagnosticArray, "/diagnostics", 10)
             node.create_timer(self.diagnostics_period, self.publish_diagnostics, callback_group=group)
         threads = max(_EXECUTOR_THREADS, 2 * len(self.mappings))  # two calls in flight per mapping at least
-        self._executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
-        self._executor.add_node(node)
-        self._thread = threading.Thread(target=self._spin, name=f"{base}-services", daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        while not self.lifetime.closed and self.ros.context.ok():
-            try:
-                self._executor.spin_once(timeout_sec=0.1)
-            except Exception as ex:  # the context shutting down under us, or a callback's bug
-                if self.lifetime.closed:
-                    return
-                self.lifetime.errors["service_executor_error"] += 1
-                log.warning("service mappings: %s: %s", type(ex).__name__, ex)
+        executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
+        self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-services",
+                                   "service_executor_error", "service mappings")
+        self._spinner.start()
 
     def _close(self) -> None:
-        if self._thread is not None:
-            self._thread.join(timeout=2.0)
-        for step in (lambda: self._executor.shutdown(timeout_sec=1.0), lambda: self._node.destroy_node()):
-            try:
-                step()
-            except Exception:
-                pass
+        if self._spinner is not None:
+            self._spinner.close()
 
     def _callback(self, m: Any) -> Any:
         return lambda request, response: self.serve(m, request, response)

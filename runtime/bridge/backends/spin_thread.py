@@ -1,0 +1,46 @@
+"""A ROS executor spun on a thread of its own, for the bridge's service nodes (DroneCAN duties, service mappings).
+
+Invariants: the thread spins until the bridge's lifetime closes or the ROS context shuts down; an exception out of
+a spin (a callback's bug, the context going away) is counted in ``lifetime.errors[error_key]`` and logged, never
+raised; ``close()`` joins the thread (2 s at most), then shuts the executor down and destroys the node, ignoring what
+a context already shut down says.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Any
+
+log = logging.getLogger(__name__)
+
+
+class SpinThread:
+    def __init__(self, lifetime: Any, context: Any, executor: Any, node: Any, name: str, error_key: str,
+                 what: str) -> None:
+        self.lifetime, self.context, self.executor, self.node = lifetime, context, executor, node
+        self.error_key, self.what = error_key, what
+        executor.add_node(node)
+        self.thread = threading.Thread(target=self._spin, name=name, daemon=True)
+
+    def start(self) -> None:
+        self.thread.start()
+
+    def _spin(self) -> None:
+        while not self.lifetime.closed and self.context.ok():
+            try:
+                self.executor.spin_once(timeout_sec=0.1)
+            except Exception as ex:  # the context shutting down under us, or a callback's bug
+                if self.lifetime.closed:
+                    return
+                self.lifetime.errors[self.error_key] += 1
+                log.warning("%s: %s: %s", self.what, type(ex).__name__, ex)
+
+    def close(self) -> None:
+        if self.thread.is_alive():
+            self.thread.join(timeout=2.0)
+        for step in (lambda: self.executor.shutdown(timeout_sec=1.0), self.node.destroy_node):
+            try:
+                step()
+            except Exception:  # the context is gone already: nothing left to release
+                pass
