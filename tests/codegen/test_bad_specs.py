@@ -7,27 +7,17 @@ from pathlib import Path
 
 import pytest
 from broken_cases import CASES, Case
+from helpers.spec_errors import spec_errors
 
 from sam_codegen.cli import main
-from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.model.diagnostics import SpecError
-from sam_codegen.validate.resolve import validate
 
 SPECS = Path(__file__).parents[1] / "specs"
 BASE = (SPECS / "minimal.yaml").read_text(encoding="utf-8")
 REAL_SPEC = Path(__file__).parents[2] / "spec" / "interfaces.yaml"
 
 
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
-
-
 def test_base_spec_is_valid() -> None:
-    assert _errors(SPECS / "minimal.yaml") == []
+    assert spec_errors(SPECS / "minimal.yaml") == []
 
 
 def test_there_are_many_cases() -> None:
@@ -40,7 +30,7 @@ def test_broken_spec(case: Case, tmp_path: Path) -> None:
     assert case.old in BASE, f"case {case.name} no longer applies to minimal.yaml"
     path = tmp_path / "minimal.yaml"
     path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
-    assert _errors(path) == list(case.errors)
+    assert spec_errors(path) == list(case.errors)
 
 
 def test_cli_reports_all_errors_and_leaves_output_alone(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -75,6 +65,6 @@ def test_document_puts_two_types_on_thruster_angles(tmp_path: Path) -> None:
     assert ours in text
     path = tmp_path / "interfaces.yaml"
     path.write_text(text.replace(ours, "  /thruster_angles: {type: sam_msgs/BallastAngles"), encoding="utf-8")
-    errors = _errors(path)
+    errors = spec_errors(path)
     assert any("topic '/thruster_angles' is declared twice" in e and "two types on one topic" in e
                and "sam_msgs/ThrusterAngles and sam_msgs/BallastAngles" in e for e in errors), errors

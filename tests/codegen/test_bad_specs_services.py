@@ -7,10 +7,7 @@ from pathlib import Path
 
 import pytest
 from broken_cases import SERVICE_CASES, Case
-
-from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.model.diagnostics import SpecError
-from sam_codegen.validate.resolve import validate
+from helpers.spec_errors import spec_errors
 
 pytest.importorskip("dronecan")
 
@@ -18,16 +15,8 @@ SPECS = Path(__file__).parents[1] / "specs"
 BASE = (SPECS / "auv_services.yaml").read_text(encoding="utf-8")
 
 
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
-
-
 def test_base_spec_is_valid() -> None:
-    assert _errors(SPECS / "auv_services.yaml") == []
+    assert spec_errors(SPECS / "auv_services.yaml") == []
 
 
 def test_cases_are_distinct() -> None:
@@ -39,4 +28,4 @@ def test_broken_spec(case: Case, tmp_path: Path) -> None:
     assert BASE.count(case.old) == 1, f"case {case.name} no longer applies to auv_services.yaml"
     path = tmp_path / "auv_services.yaml"
     path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
-    assert _errors(path) == list(case.errors)
+    assert spec_errors(path) == list(case.errors)

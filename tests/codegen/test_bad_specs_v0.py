@@ -9,27 +9,17 @@ from pathlib import Path
 
 import pytest
 from broken_cases import V0_CASES, Case
+from helpers.spec_errors import spec_errors
 
 from sam_codegen.cli import main
-from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.model.diagnostics import SpecError
-from sam_codegen.validate.resolve import validate
 
 SPECS = Path(__file__).parents[1] / "specs"
 BASE = (SPECS / "minimal_v0.yaml").read_text(encoding="utf-8")
 SAM_SPEC = Path(__file__).parents[2] / "spec" / "interfaces.yaml"
 
 
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
-
-
 def test_base_spec_is_valid() -> None:
-    assert _errors(SPECS / "minimal_v0.yaml") == []
+    assert spec_errors(SPECS / "minimal_v0.yaml") == []
 
 
 def test_there_are_many_cases() -> None:
@@ -42,7 +32,7 @@ def test_broken_spec(case: Case, tmp_path: Path) -> None:
     assert BASE.count(case.old) == 1, f"case {case.name} no longer applies to minimal_v0.yaml"
     path = tmp_path / "minimal_v0.yaml"
     path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
-    assert _errors(path) == list(case.errors)
+    assert spec_errors(path) == list(case.errors)
 
 
 def _sam_with(tmp_path: Path, old: str, new: str) -> list[str]:
@@ -50,7 +40,7 @@ def _sam_with(tmp_path: Path, old: str, new: str) -> list[str]:
     assert text.count(old) == 1, old
     path = tmp_path / "interfaces.yaml"
     path.write_text(text.replace(old, new, 1), encoding="utf-8")
-    return _errors(path)
+    return spec_errors(path)
 
 
 def test_layout_may_not_split_a_mapping(tmp_path: Path) -> None:
@@ -79,7 +69,7 @@ def test_without_the_standard_definitions_one_clear_error(tmp_path: Path, monkey
     empty = tmp_path / "nothing"
     empty.mkdir()
     monkeypatch.setenv("DRONECAN_DSDL_PATH", str(empty))
-    errors = _errors(SPECS / "minimal_v0.yaml")
+    errors = spec_errors(SPECS / "minimal_v0.yaml")
     assert errors == [
         "minimal_v0.yaml:15:9: error: unknown DroneCAN type 'uavcan.Timestamp' in DroneCAN type skiff.Bilge "
         "(expected a type of dronecan_types or a standard one, by its full name (e.g. uavcan.Timestamp))",
@@ -101,4 +91,4 @@ def test_dronecan_dsdl_path_replaces_the_package_definitions(tmp_path: Path, mon
     shutil.copytree(uavcan, own / "uavcan")
     monkeypatch.setenv("DRONECAN_DSDL_PATH", str(own))
     assert standard_roots() == [own / "uavcan"]
-    assert _errors(SPECS / "minimal_v0.yaml") == []
+    assert spec_errors(SPECS / "minimal_v0.yaml") == []

@@ -10,6 +10,7 @@ from typing import Any
 
 import pydsdl
 import pytest
+from helpers.spec_errors import spec_errors
 
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.model.diagnostics import Pos, SpecError
@@ -229,7 +230,6 @@ def _minimal(tmp_path: Path, rate: str) -> Path:
 
 def test_build_prints_the_budget_and_refuses_a_bus_it_overloads(tmp_path: Path) -> None:
     from sam_codegen.build import generate
-    from sam_codegen.model.diagnostics import SpecError
 
     lines: list[str] = []
     generate(_minimal(tmp_path / "ok", "10"), report=lines.append)
@@ -255,14 +255,6 @@ def _spec_with(tmp_path: Path, old: str, new: str) -> Path:
     spec = tmp_path / "minimal.yaml"
     spec.write_text(text.replace(old, new, 1))
     return spec
-
-
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
 
 
 LAYOUT = "  all_dronecan: {description: Everything on DroneCAN., protocol: dronecan}"
@@ -292,7 +284,7 @@ def test_a_wrong_bus_is_a_spec_error_at_its_key(name: str, tmp_path: Path) -> No
     base = (REPO / "tests" / "specs" / "minimal.yaml").read_text()
     line = base[: base.index("devices:")].count("\n") + 1
     spec = _spec_with(tmp_path, "devices:\n", text + "devices:\n")
-    assert _errors(spec) == [e.format(line=line) for e in errors]
+    assert spec_errors(spec) == [e.format(line=line) for e in errors]
 
 
 def test_the_spec_sets_the_bus_and_a_layout_its_own(tmp_path: Path) -> None:
@@ -314,7 +306,7 @@ def test_bus_none_has_no_budget(tmp_path: Path) -> None:
     from sam_codegen.build import generate
 
     spec = _spec_with(tmp_path, "type: buoy.Level.0.1, rate_hz: 10}", "type: buoy.Level.0.1, rate_hz: 100000}")
-    assert _errors(spec) and "needs" in _errors(spec)[0]  # 100 kHz on one bus: refused ...
+    assert spec_errors(spec) and "needs" in spec_errors(spec)[0]  # 100 kHz on one bus: refused ...
     text = spec.read_text().replace("devices:\n", "bus: none\ndevices:\n", 1)
     spec.write_text(text)
     lines: list[str] = []
@@ -329,7 +321,7 @@ def test_the_overload_of_a_named_layout_is_reported_at_its_bus(tmp_path: Path) -
     assert "{type: buoy.Status, rate_hz: 2}" in v0
     spec.write_text(v0.replace(LAYOUT, changed, 1).replace("{type: buoy.Status, rate_hz: 2}",
                                                            "{type: buoy.Status, rate_hz: 200}", 1))
-    errors = _errors(spec)
+    errors = spec_errors(spec)
     lines = spec.read_text().splitlines()
     line = lines.index(changed) + 1
     column = changed.index("bus: {") + len("bus: ") + 1

@@ -23,11 +23,11 @@ from typing import Any
 
 import pydsdl
 import pytest
+from helpers.spec_errors import spec_errors
 
 from sam_codegen.build import MARKER, generate
 from sam_codegen.cli import main
 from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.model.diagnostics import SpecError
 from sam_codegen.validate.resolve import validate
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -37,14 +37,6 @@ TRACTOR_TEXT = TRACTOR.read_text(encoding="utf-8")
 
 needs_pycyphal = pytest.mark.skipif(importlib.util.find_spec("pycyphal") is None,
                                     reason="pycyphal is not installed (pip extra 'runtime')")
-
-
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
 
 
 def _variant(tmp_path: Path, *changes: tuple[str, str]) -> Path:
@@ -59,7 +51,7 @@ def _variant(tmp_path: Path, *changes: tuple[str, str]) -> Path:
 
 
 def test_tractor_spec_is_valid() -> None:
-    assert _errors(TRACTOR) == []
+    assert spec_errors(TRACTOR) == []
 
 
 # ---- 5: narrow signed integer arrays -----------------------------------------------------------------------
@@ -160,14 +152,14 @@ def test_the_support_fix_applies_once_and_only_to_what_it_knows(tmp_path: Path) 
 
 def test_uavcan_to_ros_table_must_cover_every_value_or_have_a_default(tmp_path: Path) -> None:
     path = _variant(tmp_path, ("{0: 0, 1: 1, 2: 2, 3: 3, 7: -1, default: -1}", "{0: 0, 1: 1, 2: 2, 3: 3, 7: -1}"))
-    assert _errors(path) == [
+    assert spec_errors(path) == [
         "tractor.yaml:100:9: error: mapping 'hitch_status', field 'state': the table has no entry for 3 of the 8 "
         "values of uint3 (4, 5, 6); a message carrying one would be dropped (expected an entry for each value, or "
         "`default: <ROS value>` for the values it does not list)",
     ]
     complete = _variant(tmp_path, ("{0: 0, 1: 1, 2: 2, 3: 3, 7: -1, default: -1}",
                                    "{0: 0, 1: 1, 2: 2, 3: 3, 4: -1, 5: -1, 6: -1, 7: -1}"))
-    assert _errors(complete) == []
+    assert spec_errors(complete) == []
 
 
 def test_a_ros_to_uavcan_table_need_not_list_every_ros_value() -> None:
@@ -219,7 +211,7 @@ def test_a_failed_derive_from_adds_no_errors_about_its_fields(tmp_path: Path) ->
     hitch_command:
 """),
     )
-    assert _errors(path) == [
+    assert spec_errors(path) == [
         "tractor.yaml:19:3: error: cannot derive tractor_msgs/StatusCopy from tractor.hitch.Status.1.0: field "
         "'sections': a tractor.hitch.Section.1.0[3] field cannot be derived automatically; declare the ROS message "
         "by hand",
@@ -229,7 +221,7 @@ def test_a_failed_derive_from_adds_no_errors_about_its_fields(tmp_path: Path) ->
 def test_an_unknown_field_type_is_reported_once(tmp_path: Path) -> None:
     path = _variant(tmp_path, ('type: "tractor.hitch.Section.1.0[3]"', 'type: "tractor.hitch.Sektion.1.0[3]"'),
                     ("      ignore: [", "      ignore: [\"sections[0]\", "))
-    assert _errors(path) == [
+    assert spec_errors(path) == [
         "tractor.yaml:59:9: error: unknown DSDL type 'tractor.hitch.Sektion.1.0' in DSDL type "
         "tractor.hitch.Status.1.0 (expected a type of this spec or of CYPHAL_PATH (uavcan.*, reg.*))",
     ]
@@ -256,7 +248,7 @@ def test_an_output_folder_problem_is_not_a_spec_error(tmp_path: Path, capsys: py
 
 def test_coverage_is_per_element(tmp_path: Path) -> None:
     path = _variant(tmp_path, ('      ignore: ["sections[1]", "sections[2].open"]\n', ""))
-    assert _errors(path) == [
+    assert spec_errors(path) == [
         "tractor.yaml:91:5: error: required field left unmapped: UAVCAN field 'sections[1]' "
         "(tractor.hitch.Section.1.0) of tractor.hitch.Status.1.0 is neither mapped nor ignored in mapping "
         "'hitch_status' (expected a `ros_field: sections[1]` line or `sections[1]` in ignore)",
@@ -265,13 +257,13 @@ def test_coverage_is_per_element(tmp_path: Path) -> None:
         "`ros_field: sections[2].open` line or `sections[2].open` in ignore)",
     ]
     path = _variant(tmp_path, ("      uavcan_values:\n        sections[1].open: true\n", ""))
-    assert _errors(path) == [
+    assert spec_errors(path) == [
         "tractor.yaml:107:5: error: required field left unmapped: UAVCAN field 'sections[1].open' (bool) of "
         "tractor.hitch.Command.1.0 gets no value in mapping 'hitch_command' (expected a `ros_field: "
         "sections[1].open` line or an entry in uavcan_values)",
     ]
     path = _variant(tmp_path, ("        right_rate: sections[2].rate", "        right_rate: sections[3].rate"))
-    assert _errors(path) == [
+    assert spec_errors(path) == [
         "tractor.yaml:105:9: error: mapping 'hitch_status', field 'right_rate': sections[3]: index out of range, "
         "sections has 3 elements",
     ]
@@ -282,7 +274,7 @@ def test_a_whole_element_may_be_ignored_while_another_is_mapped(tmp_path: Path) 
     path = _variant(tmp_path, ('      ignore: ["sections[1]", "sections[2].open"]',
                                '      ignore: ["sections[1]", "sections[2]"]'),
                     ("        right_rate: sections[2].rate\n", "        right_rate: {value: 0}\n"))
-    assert _errors(path) == []
+    assert spec_errors(path) == []
 
 
 # ---- 10: void padding --------------------------------------------------------------------------------------

@@ -13,24 +13,16 @@ from pathlib import Path
 
 import pytest
 from broken_cases import ROUTING_CASES, Case
+from helpers.spec_errors import spec_errors
 
 from sam_codegen.build import build
 from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.model.diagnostics import SpecError
 from sam_codegen.validate.resolve import Resolved, validate
 from sam_codegen.validate.routing import routed_node_ids
 
 SPECS = Path(__file__).parents[1] / "specs"
 TRAWLER = SPECS / "seiner.yaml"
 BASE = TRAWLER.read_text(encoding="utf-8")
-
-
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +38,7 @@ def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_base_spec_is_valid() -> None:
-    assert _errors(TRAWLER) == []
+    assert spec_errors(TRAWLER) == []
 
 
 @pytest.mark.parametrize("case", ROUTING_CASES, ids=lambda c: c.name)
@@ -54,7 +46,7 @@ def test_broken_spec(case: Case, tmp_path: Path) -> None:
     assert BASE.count(case.old) == 1, f"case {case.name} no longer applies to seiner.yaml"
     path = tmp_path / "seiner.yaml"
     path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
-    assert _errors(path) == list(case.errors)
+    assert spec_errors(path) == list(case.errors)
 
 
 def test_any_node_reaches_every_device_with_the_port(resolved: Resolved) -> None:
@@ -97,7 +89,7 @@ def test_a_select_field_published_in_minimal_v0(tmp_path: Path) -> None:
     assert base.count(old) == 1
     path = tmp_path / "minimal_v0.yaml"
     path.write_text(base.replace(old, "        data: pump_id\n      ignore: [timestamp, level_mm]"), encoding="utf-8")
-    assert _errors(path) == []
+    assert spec_errors(path) == []
 
 
 def test_generated_tables_say_any_node(generated: Path) -> None:

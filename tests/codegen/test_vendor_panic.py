@@ -13,11 +13,11 @@ from pathlib import Path
 
 import pytest
 from broken_cases import TRAWLER_CASES, Case
+from helpers.spec_errors import spec_errors
 
 from sam_codegen.catalogs.dronecan import DRONECAN_ROOTS, V0Catalog, in_namespaces
 from sam_codegen.frontend.loader import load_spec_file, parse_spec
 from sam_codegen.frontend.yaml_source import load_yaml
-from sam_codegen.model.diagnostics import SpecError
 from sam_codegen.model.spec import Spec
 from sam_codegen.validate.resolve import validate
 
@@ -27,14 +27,6 @@ BASE = TRAWLER.read_text(encoding="utf-8")
 MINIMAL = "spec_version: 1\nvehicle: {name: t}\nros: {package: t_msgs}\n"
 
 pytest.importorskip("dronecan")  # the standard definitions: the dronecan package's
-
-
-def _errors(path: Path) -> list[str]:
-    try:
-        validate(load_spec_file(path))
-    except SpecError as exc:
-        return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
-    return []
 
 
 def _spec(text: str) -> Spec:
@@ -48,11 +40,11 @@ def _with(tmp_path: Path, *edits: tuple[str, str]) -> list[str]:
         text = text.replace(old, new, 1)
     path = tmp_path / "trawler_v0.yaml"
     path.write_text(text, encoding="utf-8")
-    return _errors(path)
+    return spec_errors(path)
 
 
 def test_trawler_spec_is_valid() -> None:
-    assert _errors(TRAWLER) == []
+    assert spec_errors(TRAWLER) == []
 
 
 @pytest.mark.parametrize("case", TRAWLER_CASES, ids=lambda c: c.name)
