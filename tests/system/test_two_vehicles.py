@@ -277,6 +277,13 @@ def test_two_vehicles_fly_side_by_side_and_no_message_crosses(tmp_path: Path) ->
         assert frames and all(f.startswith(("sam1/", "sam2/")) for f in frames), sorted(frames)
         assert {f.split("/")[0] for f in frames} == {"sam1", "sam2"}
         assert statuses and all(s.startswith(("sam1/", "sam2/")) for s in statuses), sorted(statuses)
+        # the DroneCAN duties too: each bridge's services and Panic topics under its own namespace, none global
+        services = {name for name, _ in probe.node.get_service_names_and_types()}
+        topics = {name for name, _ in probe.node.get_topic_names_and_types()}
+        for v in ("sam1", "sam2"):
+            assert f"/{v}/uavcan_ros_bridge/imu/get_node_info" in services, sorted(services)
+            assert f"/{v}/uavcan_ros_bridge/panic" in topics, sorted(topics)
+        assert not [s for s in services if s.startswith("/uavcan_ros_bridge/")], sorted(services)
         for p in procs.values():
             assert "Traceback" not in p.stderr_tail(400), f"{p.name}:\n{p.stderr_tail(40)}"
     finally:

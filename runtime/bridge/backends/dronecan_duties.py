@@ -94,13 +94,13 @@ class DroneCanDuties:
         self._loop = asyncio.get_running_loop()
         base = self.ros.name
         node = Node(f"{base}_dronecan_duties", namespace=self.ros.node.get_namespace(),
-                                 context=self.ros.context)
+                    context=self.ros.context)
         for nid, name in sorted(self.devices.items()):
-            node.create_service(Trigger, f"/{base}/{name}/get_node_info", _service(self._get_node_info, nid))
-            node.create_service(Trigger, f"/{base}/{name}/restart", _service(self._restart, nid))
+            node.create_service(Trigger, f"{base}/{name}/get_node_info", _service(self._get_node_info, nid))
+            node.create_service(Trigger, f"{base}/{name}/restart", _service(self._restart, nid))
         if self.panic:
-            self._panic_pub = node.create_publisher(String, f"/{base}/panic_received", 10)
-            node.create_subscription(String, f"/{base}/panic", self._on_ros_panic, 10)
+            self._panic_pub = node.create_publisher(String, f"{base}/panic_received", 10)
+            node.create_subscription(String, f"{base}/panic", self._on_ros_panic, 10)
         executor = SingleThreadedExecutor(context=self.ros.context)
         self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-dronecan-duties",
                                    "dronecan_duties_error", "DroneCAN duties")
