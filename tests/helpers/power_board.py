@@ -1,16 +1,20 @@
 """The power board of tests/specs/power_v0.yaml (node 30) in its own process: a plain ``dronecan`` node that knows
 the spec's own types the way the runtime gives them to dronecan (sam_runtime.dronecan_io.types.ensure_types).
 
-python power_board.py --generated DIR --iface mcast-lo:<bus>:<port> --start-file F
+python power_board.py --generated DIR --iface mcast-lo:<bus>:<port> --start-file F [--namespace power]
+    [--node-id 30] [--panic TEXT]
 
-Prints ``READY``; once F exists, broadcasts one power.ConsumedChargeArray (timestamp 1 700 000 000.25 s, circuits
-1..15 with charge circuit * 0.5 Ah) and one with no element, printing ``PUBLISHED``. On SIGTERM or when
-``--max-life`` runs out: ``SUMMARY {}``, exit 0.
+Prints ``READY {...}`` with the array's data type id and the type dronecan decodes that id as; once F exists,
+broadcasts one <namespace>.ConsumedChargeArray (timestamp 1 700 000 000.25 s, circuits 1..15 with charge
+circuit * 0.5 Ah) and one with no element, then (with ``--panic``) one uavcan.protocol.Panic with that reason_text,
+printing ``PUBLISHED``. (tests/specs/lolo_v0.yaml has the same types under lolo.power, its array at vendor id
+20100.) On SIGTERM or when ``--max-life`` runs out: ``SUMMARY {}``, exit 0.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import signal
 import sys
 import threading
@@ -27,6 +31,9 @@ def main() -> int:
     p.add_argument("--iface", required=True)
     p.add_argument("--start-file", required=True)
     p.add_argument("--max-life", type=float, default=120.0)
+    p.add_argument("--namespace", default="power", help="the namespace of the spec's ConsumedCharge types")
+    p.add_argument("--node-id", type=int, default=BOARD_ID)
+    p.add_argument("--panic", help="also broadcast one Panic with this reason_text")
     args = p.parse_args()
 
     import dronecan
@@ -36,15 +43,17 @@ def main() -> int:
     from sam_runtime.genpkg import GeneratedPackage
 
     ensure_types(GeneratedPackage(Path(args.generated)))
-    array = dronecan.TYPENAMES["power.ConsumedChargeArray"]
-    charge = dronecan.TYPENAMES["power.ConsumedCharge"]
+    array = dronecan.TYPENAMES[f"{args.namespace}.ConsumedChargeArray"]
+    charge = dronecan.TYPENAMES[f"{args.namespace}.ConsumedCharge"]
     stamp = dronecan.TYPENAMES["uavcan.Timestamp"]
     spec = parse_iface(args.iface)
-    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=BOARD_ID,
+    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=args.node_id,
                               node_status_interval=0.5, mode=0)
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    print("READY", flush=True)
+    decoded_as = dronecan.DATATYPES.get((array.default_dtid, array.kind))
+    print("READY " + json.dumps({"data_type_id": array.default_dtid,
+                                 "decoded_as": decoded_as.full_name if decoded_as is not None else None}), flush=True)
     published = False
     end = time.monotonic() + args.max_life
     try:
@@ -56,6 +65,9 @@ def main() -> int:
                                      charges=[charge(circuit_id=c, charge=c * 0.5) for c in range(1, 16)]))
                 node.spin(0.01)
                 node.broadcast(array(timestamp=stamp(usec=USEC + 1_000_000), charges=[]))
+                if args.panic is not None:
+                    node.spin(0.01)
+                    node.broadcast(dronecan.uavcan.protocol.Panic(reason_text=args.panic.encode()))
                 print("PUBLISHED", flush=True)
     finally:
         node.close()
