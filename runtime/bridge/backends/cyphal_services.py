@@ -64,7 +64,7 @@ class CyphalServices(ServiceMappingsRos):
         key = (m.name, nid)
         client = self._clients.get(key)
         if client is None:
-            client = node.presentation.make_client(self._types[m.name], nid, m.data_type_id)
+            client = node.presentation.make_client(self._types[m.name], service_id=m.data_type_id, server_node_id=nid)
             client.response_timeout = m.timeout_s
             self._clients[key] = client
         return client
