@@ -9,22 +9,19 @@ checked as on DroneCAN (validate.services); every error has its position and not
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Any
 
 from sam_codegen.model.spec import ServiceMapping
 from sam_codegen.model.types import RosType
-
-if TYPE_CHECKING:
-    from sam_codegen.validate.services import ResolvedServiceMapping, ServiceValidator
 
 __all__ = ["CYPHAL_SERVICE_IDS", "resolve_cyphal_mapping"]
 
 CYPHAL_SERVICE_IDS = range(0, 512)
 
 
-def resolve_cyphal_mapping(v: ServiceValidator, m: ServiceMapping, what: str) -> ResolvedServiceMapping | None:
-    from sam_codegen.validate.services import ResolvedServiceMapping
-
+def resolve_cyphal_mapping(v: Any, m: ServiceMapping, what: str) -> tuple[Any, list[Any], list[Any], int] | None:
+    """`v`: the ServiceValidator (spec, dsdl, error, bad, links). Returns the srv, the request and response links
+    and the service id, or None after reporting why."""
     s = v.spec
     srv = s.services.get(m.type)
     if srv is None:
@@ -65,4 +62,4 @@ def resolve_cyphal_mapping(v: ServiceValidator, m: ServiceMapping, what: str) ->
     links = v.links(m, what, srv, request.fields, response.fields, m.data_type)
     if links is None:
         return None
-    return ResolvedServiceMapping(m, srv, None, links[0], links[1], m.data_type, service_id)
+    return srv, links[0], links[1], service_id

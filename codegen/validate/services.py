@@ -30,6 +30,7 @@ from sam_codegen.model.types import (
     DsdlType,
     RosType,
 )
+from sam_codegen.validate.cyphal_services import resolve_cyphal_mapping
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
 __all__ = ["ResolvedServiceMapping", "ServiceLink", "ServiceValidator"]
@@ -201,13 +202,14 @@ class ServiceValidator:
     def resolve_mapping(self, m: ServiceMapping, what: str) -> ResolvedServiceMapping | None:
         s = self.spec
         if m.protocol == "cyphal":
-            from sam_codegen.validate.cyphal_services import resolve_cyphal_mapping
-
             self.nested = self.dsdl.get
             try:
-                return resolve_cyphal_mapping(self, m, what)
+                found = resolve_cyphal_mapping(self, m, what)
             finally:
                 self.nested = self.catalog.get
+            if found is None:
+                return None
+            return ResolvedServiceMapping(m, found[0], None, found[1], found[2], m.data_type, found[3])
         if m.service_id is not None:
             self.error(m.pos, f"{what} has a `service_id`, which only Cyphal service mappings take",
                        "the DroneCAN type's data type id (no service_id), or protocol: cyphal")
