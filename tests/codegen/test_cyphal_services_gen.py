@@ -1,5 +1,5 @@
 """Cyphal service mappings in the generated output (issue 19): tests/specs/auv_cyphal_services.yaml's table
-(``python/lolo_bridge/services.py``) that the runtime's CyphalServices interprets, and the interface reference."""
+(``python/ran_bridge/services.py``) that the runtime's CyphalServices interprets, and the interface reference."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ SPEC = Path(__file__).parents[1] / "specs" / "auv_cyphal_services.yaml"
 
 def _table() -> dict[str, Any]:
     namespace: dict[str, Any] = {}
-    source = generate(SPEC)["python/lolo_bridge/services.py"]
+    source = generate(SPEC)["python/ran_bridge/services.py"]
     exec(compile(source, "services.py", "exec"), namespace)  # standard library only
     return {m.name: m for m in namespace["SERVICE_MAPPINGS"]}
 
@@ -21,7 +21,7 @@ def _table() -> dict[str, Any]:
 def test_the_table_has_the_protocol_service_ids_and_links() -> None:
     table = _table()
     limits, info = table["set_charge_limits"], table["get_node_info"]
-    assert (limits.protocol, limits.data_type, limits.data_type_id) == ("cyphal", "lolo.power.SetChargeLimits.1.0",
+    assert (limits.protocol, limits.data_type, limits.data_type_id) == ("cyphal", "ran.power.SetChargeLimits.1.0",
                                                                         200)
     assert (info.protocol, info.data_type, info.data_type_id) == ("cyphal", "uavcan.node.GetInfo.1.0", 430)
     assert limits.device == "charger" and limits.timeout_s == 0.5 and info.destination_field == "node_id"
@@ -37,6 +37,6 @@ def test_the_table_has_the_protocol_service_ids_and_links() -> None:
 
 def test_docs_name_the_cyphal_service_id() -> None:
     md = generate(SPEC)["docs/interfaces.md"]
-    assert ("- Service: `/charger/set_limits` (`lolo_msgs/srv/SetChargeLimits`) → `lolo.power.SetChargeLimits.1.0` "
+    assert ("- Service: `/charger/set_limits` (`ran_msgs/srv/SetChargeLimits`) → `ran.power.SetChargeLimits.1.0` "
             "(Cyphal service id 200) to node 31 (charger), timeout 0.5 s") in md
     assert "`uavcan.node.GetInfo.1.0` (Cyphal service id 430) to the node named by the request's node\\_id" in md

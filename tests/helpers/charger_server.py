@@ -1,6 +1,6 @@
-"""A Cyphal charger serving the spec's service lolo.power.SetChargeLimits.1.0 (tests/specs/auv_cyphal_services.yaml,
+"""A Cyphal charger serving the spec's service ran.power.SetChargeLimits.1.0 (tests/specs/auv_cyphal_services.yaml,
 service id 200) over Cyphal/UDP, with pycyphal only (no part of the bridge); as a pycyphal application node it also
-answers the standard uavcan.node.GetInfo.1.0 (its name: org.lolo.charger).
+answers the standard uavcan.node.GetInfo.1.0 (its name: org.ran.charger).
 
 python charger_server.py --generated DIR --node-id 31 --service-id 200 --late 1.5 [--iface 127.0.0.1]
 
@@ -25,8 +25,8 @@ async def run(args: argparse.Namespace) -> None:
     from sam_runtime.genpkg import GeneratedPackage
 
     GeneratedPackage(args.generated).compile_dsdl()
-    dtype = dsdl_class("lolo.power.SetChargeLimits.1.0")
-    node = make_node("org.lolo.charger", args.node_id, "udp", iface=args.iface)
+    dtype = dsdl_class("ran.power.SetChargeLimits.1.0")
+    node = make_node("org.ran.charger", args.node_id, "udp", iface=args.iface)
     server = node.presentation.get_server(dtype, args.service_id)
 
     async def handle(request: Any, _meta: Any) -> Any:

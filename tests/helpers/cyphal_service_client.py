@@ -32,7 +32,7 @@ def main() -> int:
 
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
-    from lolo_msgs.srv import GetNodeInfo, SetChargeLimits
+    from ran_msgs.srv import GetNodeInfo, SetChargeLimits
     from rclpy.executors import SingleThreadedExecutor
 
     rclpy.init()

@@ -1,5 +1,5 @@
 """Service mappings on Cyphal across processes (issue 19): a plain pycyphal charger serving the spec's
-lolo.power.SetChargeLimits.1.0 at service id 200 (tests/helpers/charger_server.py, Cyphal/UDP on 127.0.0.1, with
+ran.power.SetChargeLimits.1.0 at service id 200 (tests/helpers/charger_server.py, Cyphal/UDP on 127.0.0.1, with
 GetInfo as every pycyphal application node), the bridge of tests/specs/auv_cyphal_services.yaml, and an
 independent rclpy client (tests/helpers/cyphal_service_client.py).
 
@@ -79,7 +79,7 @@ def test_an_unanswered_call_fails_after_the_timeout_and_its_late_answer_is_count
 
 def test_standard_get_info_of_the_node_the_request_names(run: dict[str, Any]) -> None:
     info, missing = run["info"]
-    assert info["success"] is True and info["name"] == "org.lolo.charger" and info["message"] == ""
+    assert info["success"] is True and info["name"] == "org.ran.charger" and info["message"] == ""
     assert missing["success"] is False and missing["name"] == ""
     assert missing["message"] == "node 99 did not answer within 1 s"
 
