@@ -1533,7 +1533,8 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      timeout: 0.5',
         '      timeout: 0.5\n      protocol: cyphal',
         (
-            "auv_services.yaml:99:7: error: service mapping 'update_battery': service mappings run on DroneCAN only so far (expected dronecan)",
+            "auv_services.yaml:93:5: error: Cyphal type 'lolo.power.UpdateBattery' of service mapping 'update_battery' is not a Cyphal service type of dsdl_types or CYPHAL_PATH (expected a service type by its versioned name, e.g. uavcan.node.GetInfo.1.0)",
+            "auv_services.yaml:93:5: error: destination node id 30 of service mapping 'update_battery' is not a Cyphal device (expected the node id of a device with Cyphal ports)",
         ),
     ),
     Case(
@@ -1549,7 +1550,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      timeout: 0.5',
         '      timeout: 0.5\n      retries: 3',
         (
-            "auv_services.yaml:99:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values)",
+            "auv_services.yaml:99:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values, service_id)",
         ),
     ),
     Case(
@@ -1638,6 +1639,41 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      service: /bridge/get_node_info',
         (
             "auv_services.yaml:118:5: error: service /bridge/get_node_info of service mapping 'restart_node' is already served by service mapping 'get_node_info' (expected one mapping per ROS service)",
+        ),
+    ),
+    Case(
+        'svc_cyphal_no_service_id',
+        '      data_type: lolo.power.UpdateBattery\n',
+        '      protocol: cyphal\n      data_type: lolo.power.SetChargeLimits.1.0\n',
+        (
+            "auv_services.yaml:93:5: error: destination node id 30 of service mapping 'update_battery' is not a Cyphal device (expected the node id of a device with Cyphal ports)",
+            "auv_services.yaml:93:5: error: service mapping 'update_battery' needs a `service_id`: lolo.power.SetChargeLimits.1.0 has no fixed port id (expected a service id, 0..511)",
+        ),
+    ),
+    Case(
+        'svc_cyphal_service_id_range',
+        '      data_type: lolo.power.UpdateBattery\n',
+        '      protocol: cyphal\n      service_id: 600\n      data_type: lolo.power.SetChargeLimits.1.0\n',
+        (
+            "auv_services.yaml:93:5: error: destination node id 30 of service mapping 'update_battery' is not a Cyphal device (expected the node id of a device with Cyphal ports)",
+            "auv_services.yaml:93:5: error: service id 600 of service mapping 'update_battery' is not a Cyphal service id (expected 0..511)",
+        ),
+    ),
+    Case(
+        'svc_cyphal_message_type',
+        '      data_type: lolo.power.UpdateBattery\n',
+        '      protocol: cyphal\n      data_type: uavcan.node.Heartbeat.1.0\n',
+        (
+            "auv_services.yaml:93:5: error: Cyphal type 'uavcan.node.Heartbeat.1.0' of service mapping 'update_battery' is a message type (expected a service type by its versioned name, e.g. uavcan.node.GetInfo.1.0)",
+            "auv_services.yaml:93:5: error: destination node id 30 of service mapping 'update_battery' is not a Cyphal device (expected the node id of a device with Cyphal ports)",
+        ),
+    ),
+    Case(
+        'svc_service_id_on_dronecan',
+        '      timeout: 0.5',
+        '      timeout: 0.5\n      service_id: 200',
+        (
+            "auv_services.yaml:93:5: error: service mapping 'update_battery' has a `service_id`, which only Cyphal service mappings take (expected the DroneCAN type's data type id (no service_id), or protocol: cyphal)",
         ),
     ),
 )

@@ -65,6 +65,23 @@ def _to_struct(composite: pydsdl.CompositeType) -> DsdlStruct:
                       layout=layout if len(fields) < len(layout) else [])
 
 
+def read_service(name: str, roots: list[Path]) -> tuple[DsdlStruct, DsdlStruct, int | None] | None:
+    """A standard Cyphal service type's request and response (named `<name>.Request`/`.Response`) and its fixed
+    port id; None when `name` is no service type under `roots`."""
+    try:
+        path = dsdl_file_for(name, roots)
+    except ValueError:
+        return None
+    if path is None:
+        return None
+    root = roots[[r.name for r in roots].index(name.split(".")[0])]
+    direct, _ = pydsdl.read_files([path], [root], roots)
+    service = next((t for t in direct if isinstance(t, pydsdl.ServiceType)), None)
+    if service is None:
+        return None
+    return _to_struct(service.request_type), _to_struct(service.response_type), service.fixed_port_id
+
+
 class DsdlCatalog:
     """Looks DSDL composite types up by versioned full name: the spec's own first, then CYPHAL_PATH."""
 
@@ -85,6 +102,14 @@ class DsdlCatalog:
         if name not in self._cache:
             self._load(name)
         return self._cache.get(name)
+
+    def service(self, name: str) -> tuple[DsdlStruct, DsdlStruct, int | None] | None:
+        """A Cyphal service type's request, response and fixed port id: the spec's own (no fixed port id) or a
+        standard one."""
+        own = self._spec.dsdl_services.get(name)
+        if own is not None:
+            return own.request, own.response, None
+        return read_service(name, self.roots)
 
     def _load(self, name: str) -> None:
         self._cache[name] = None

@@ -16,7 +16,7 @@ __all__ = ["DEFAULT_TIMEOUT_S", "parse_service_mapping"]
 
 DEFAULT_TIMEOUT_S = 1.0  # dronecan's own default request timeout
 _KEYS = ("service", "type", "data_type", "protocol", "destination_node_id", "timeout", "request", "response",
-         "uavcan_values")
+         "uavcan_values", "service_id")
 
 
 def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -> ServiceMapping | None:
@@ -27,8 +27,7 @@ def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -
     protocol = r.get("protocol", str, "dronecan")
     if protocol not in PROTOCOLS:
         diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
-    elif protocol != "dronecan":
-        diag.error(r.key_pos("protocol"), f"{what}: service mappings run on DroneCAN only so far", "dronecan")
+    service_id = r.get("service_id", int, None)
     timeout = DEFAULT_TIMEOUT_S
     if r.node("timeout") is not None:
         value = number(r.node("timeout"), f"'timeout' of {what}", diag)
@@ -55,4 +54,4 @@ def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -
     field = destination if isinstance(destination, str) else None
     return ServiceMapping(name, service, type_.replace("/srv/", "/"), data_type,
                           0 if field is not None else int(destination), timeout, links["request"], links["response"],
-                          uavcan_values, protocol, pos, field)
+                          uavcan_values, protocol, pos, field, service_id)

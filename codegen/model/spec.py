@@ -438,6 +438,8 @@ class ServiceMapping:
     # The ROS request field that names the node to ask (`destination_node_id: node_id`, e.g. GetNodeInfo of any
     # node); None: always destination_node_id.
     destination_field: str | None = None
+    # Cyphal: the service id (`service_id`); None: the standard type's fixed port id
+    service_id: int | None = None
 
 
 @dataclass(frozen=True)

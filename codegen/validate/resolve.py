@@ -359,7 +359,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     publishers = v.check_devices()
     dronecan = DronecanValidator(spec, v0, v.diag, v.mapping_validator(v0, publishers))
     dronecan.check_types()
-    services = ServiceValidator(spec, ros, v0, v.diag)
+    services = ServiceValidator(spec, ros, v0, v.diag, dsdl)
     srv_types = services.check_srv_types()
     services.check_v0_service_types()
     dronecan.check_devices()

@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import SERVICE_ID_MAX, VENDOR_SERVICE_IDS, V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import Field, FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
+from sam_codegen.model.spec import DsdlStruct, Field, FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import (
     ROS_FIELD_NAME,
     ROS_FLOAT_BITS,
@@ -28,6 +30,7 @@ from sam_codegen.model.types import (
     DsdlType,
     RosType,
 )
+from sam_codegen.validate.cyphal_services import resolve_cyphal_mapping
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
 __all__ = ["ResolvedServiceMapping", "ServiceLink", "ServiceValidator"]
@@ -57,9 +60,11 @@ class ServiceLink:
 class ResolvedServiceMapping:
     mapping: ServiceMapping
     srv: RosService
-    struct: V0Struct  # signed: its data type id and signature
+    struct: V0Struct | None  # DroneCAN: signed, its data type id and signature; None on Cyphal
     request: list[ServiceLink] = field(default_factory=list)  # every UAVCAN request field
     response: list[ServiceLink] = field(default_factory=list)  # the ROS response fields it sets
+    data_type: str = ""  # the UAVCAN service type's full name (Cyphal: with its version)
+    service_id: int = 0  # DroneCAN: the data type id; Cyphal: the service id
 
 
 def _ros_kind(t: RosType) -> str | None:
@@ -78,13 +83,16 @@ def _ros_kind(t: RosType) -> str | None:
 
 def _v0_kind(t: DsdlType) -> str | None:
     if t.array:
-        return "text" if t.kind in ("uint", "byte") and t.bits == 8 else None
+        return "text" if t.kind in ("uint", "byte", "utf8") and t.bits == 8 else None
     return {"int": "int", "uint": "int", "float": "float", "bool": "bool"}.get(t.kind)
 
 
 class ServiceValidator:
-    def __init__(self, spec: Spec, ros: RosCatalog, catalog: V0Catalog, diag: Diagnostics) -> None:
+    def __init__(self, spec: Spec, ros: RosCatalog, catalog: V0Catalog, diag: Diagnostics,
+                 dsdl: DsdlCatalog | None = None) -> None:
         self.spec, self.ros, self.catalog, self.diag = spec, ros, catalog, diag
+        self.dsdl = dsdl if dsdl is not None else DsdlCatalog(spec)  # Cyphal service mappings' types
+        self.nested: Callable[[str], DsdlStruct | None] = catalog.get  # a nested type by name: the mapping's protocol's
         self.bad: set[str] = set()  # srv and v0 service types reported broken
 
     def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
@@ -193,6 +201,18 @@ class ServiceValidator:
 
     def resolve_mapping(self, m: ServiceMapping, what: str) -> ResolvedServiceMapping | None:
         s = self.spec
+        if m.protocol == "cyphal":
+            self.nested = self.dsdl.get
+            try:
+                found = resolve_cyphal_mapping(self, m, what)
+            finally:
+                self.nested = self.catalog.get
+            if found is None:
+                return None
+            return ResolvedServiceMapping(m, found[0], None, found[1], found[2], m.data_type, found[3])
+        if m.service_id is not None:
+            self.error(m.pos, f"{what} has a `service_id`, which only Cyphal service mappings take",
+                       "the DroneCAN type's data type id (no service_id), or protocol: cyphal")
         srv = s.services.get(m.type)
         if srv is None:
             self.error(m.pos, f"unknown service type {m.type!r} of {what}", "a type of `services` (pkg/Name)")
@@ -218,10 +238,18 @@ class ServiceValidator:
             return None
         signed = self.catalog.signed(struct.name)
         assert signed is not None
+        links = self.links(m, what, srv, struct.fields, struct.response, struct.name)
+        if links is None:
+            return None
+        return ResolvedServiceMapping(m, srv, signed, links[0], links[1], signed.name, signed.data_type_id or 0)
+
+    def links(self, m: ServiceMapping, what: str, srv: RosService, request_fields: list[Field],
+              response_fields: list[Field], type_name: str) -> tuple[list[ServiceLink], list[ServiceLink]] | None:
+        """The request links (every UAVCAN request field, in order) and the response links of a mapping."""
         ros_req = {f.name: f for f in srv.request}
         ros_res = {f.name: f for f in srv.response}
-        uav_req = {f.name: f for f in struct.fields}
-        uav_res = {f.name: f for f in struct.response}
+        uav_req = {f.name: f for f in request_fields if f.name}
+        uav_res = {f.name: f for f in response_fields if f.name}
         request: dict[str, ServiceLink] = {}
         ok = True
         for link in m.request:
@@ -237,7 +265,7 @@ class ServiceValidator:
             f = uav_req.get(name)
             if f is None:
                 self.error(m.pos, f"uavcan_values of {what} name {name!r}, not a field of the request of "
-                           f"{struct.name}", ", ".join(uav_req) or "none: the request is empty")
+                           f"{type_name}", ", ".join(uav_req) or "none: the request is empty")
                 ok = False
                 continue
             assert isinstance(f.type, DsdlType)
@@ -246,14 +274,15 @@ class ServiceValidator:
                 self.error(m.pos, f"uavcan value {name!r} of {what} is not a number or bool field ({f.type})")
                 ok = False
                 continue
-            check_dsdl_value(self.diag, f.type, value, m.pos, f"uavcan value {name!r} of {what}", v0=True)
+            check_dsdl_value(self.diag, f.type, value, m.pos, f"uavcan value {name!r} of {what}",
+                             v0=m.protocol != "cyphal")
             if name in request:
                 self.error(m.pos, f"{what} writes UAVCAN request field {name!r} twice")
                 ok = False
             request[name] = ServiceLink(name, None, kind, value)
         missing = [n for n in uav_req if n not in request]
         if missing and ok:  # not after a broken line: its field would be reported again
-            self.error(m.pos, f"{what} leaves request fields of {struct.name} without a value: {', '.join(missing)}",
+            self.error(m.pos, f"{what} leaves request fields of {type_name} without a value: {', '.join(missing)}",
                        "a `request` line or a `uavcan_values` entry for each")
             ok = False
         response: list[ServiceLink] = []
@@ -268,7 +297,7 @@ class ServiceValidator:
                 response.append(found)
         if not ok:
             return None
-        return ResolvedServiceMapping(m, srv, signed, [request[n] for n in uav_req], response)
+        return [request[n] for n in uav_req], response
 
     def link(self, link: FieldLink, what: str, part: str, ros: dict, uavcan: dict, to_uavcan: bool
              ) -> ServiceLink | None:
@@ -339,6 +368,6 @@ class ServiceValidator:
             t = found.type if found is not None else None
             if not isinstance(t, DsdlType) or t.kind != "composite" or t.array or not t.composite:
                 return None
-            inner = self.catalog.get(t.composite)
+            inner = self.nested(t.composite)
             found = inner.field(name) if inner is not None else None
         return found

@@ -12,8 +12,10 @@ from typing import Any
 from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend, BridgeConfigError
 from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
+from sam_runtime.bridge.backends.cyphal_services import CyphalServices
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
 from sam_runtime.bridge.backends.dronecan_services import DroneCanServices
+from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import sync_message
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
@@ -162,7 +164,7 @@ class Bridge:
         self.outbound: Outbound | None = None
         self.reporter: Reporter | None = None
         self.duties: Any = None  # DroneCAN: sam_runtime.bridge.backends.dronecan_duties
-        self.services: DroneCanServices | None = None  # DroneCAN: the spec's service mappings
+        self.services: ServiceMappingsRos | None = None  # the spec's service mappings of this protocol
 
     @property
     def name(self) -> str:
@@ -255,10 +257,20 @@ class Bridge:
             self.duties.attach()
             services = self.gen.services()
             served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
-                      if m.destination_node_id in sel.devices or m.destination_field is not None]
+                      if getattr(m, "protocol", "dronecan") == "dronecan"
+                      and (m.destination_node_id in sel.devices or m.destination_field is not None)]
             if served:
                 self.services = DroneCanServices(lifetime, backend, self.ros, served,
                                                  diagnostics_period=self._diagnostics_period)
+                self.services.attach()
+        else:
+            services = self.gen.services()
+            served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
+                      if getattr(m, "protocol", "dronecan") == "cyphal"
+                      and (m.destination_node_id in sel.devices or m.destination_field is not None)]
+            if served:
+                self.services = CyphalServices(lifetime, backend, self.ros, served,
+                                               diagnostics_period=self._diagnostics_period)
                 self.services.attach()
         self.time_sync = self._time_sync(sel.protocol)
         inbound.on_stamp = self.time_sync.on_stamp

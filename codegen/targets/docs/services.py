@@ -67,7 +67,8 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
                   "conversion": _conversion(link, False)} for link in rm.response]
         mappings.append({
             "name": m.name, "service": m.service, "srv": f"{rm.srv.package}/srv/{rm.srv.name}",
-            "data_type": rm.struct.name, "data_type_id": rm.struct.data_type_id, "destination": destination,
+            "data_type": rm.data_type, "data_type_id": rm.service_id, "protocol": m.protocol,
+            "destination": destination,
             "timeout": f"{m.timeout_s:g} s", "failure": failure, "rows": rows,
         })
     return {"services": {"srvs": srvs, "v0": v0, "cyphal": cyphal, "mappings": mappings}

@@ -1,5 +1,6 @@
 """The bridge's service mappings as data: ``python/<vehicle>_bridge/services.py`` (standard library only), for a
-spec with `bridge.service_mappings`. The runtime (sam_runtime.bridge.backends.dronecan_services) converts a ROS
+spec with `bridge.service_mappings`. The runtime (sam_runtime.bridge.backends.dronecan_services and
+cyphal_services, by each mapping's `protocol`) converts a ROS
 request into the UAVCAN request and the UAVCAN response back with these links, each field by one rule: numbers
 scaled (target = (source - offset) / scale to UAVCAN, source * scale + offset back), rounded half to even into an
 integer and saturated to the target's range; bools as bools; a string as the bytes of a uint8 array, cut at its
@@ -52,8 +53,9 @@ def emit(resolved: Resolved) -> dict[str, str]:
         mappings.append({
             "name": py_str(m.name), "service": py_str(m.service), "ros_module": py_str(f"{srv.package}.srv"),
             "ros_class": py_str(srv.name), "ros_type": py_str(f"{srv.package}/srv/{srv.name}"),
-            "data_type": py_str(rm.struct.name), "data_type_id": rm.struct.data_type_id,
-            "signature": f"0x{rm.struct.signature:016X}", "destination_node_id": m.destination_node_id,
+            "data_type": py_str(rm.data_type), "data_type_id": rm.service_id,
+            "signature": f"0x{rm.struct.signature:016X}" if rm.struct is not None else "0",
+            "protocol": py_str(m.protocol), "destination_node_id": m.destination_node_id,
             "device": py_str(by_id[m.destination_node_id].name if m.destination_field is None else ""),
             "destination_field": py_str(m.destination_field) if m.destination_field is not None else "None",
             "timeout_s": py_number(m.timeout_s),

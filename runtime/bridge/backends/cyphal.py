@@ -223,6 +223,11 @@ class CyphalBackend(Backend):
     def describe(self) -> str:
         return self.transport_config.describe()
 
+    @property
+    def node(self) -> Any:
+        """The pycyphal node while the link is open (None before and between reopenings); the loop's thread only."""
+        return self._node
+
     # -------------------------------------------------------------------------------------------- declarations
     def subscribe(self, name: str, port_id: int, dtype: Any, handler: Callable[[Any, int | None, int, float], None],
                   *, raw: bool = False) -> Inlet:

@@ -98,11 +98,11 @@ def test_late_and_duplicate_responses_are_counted_and_dropped(monkeypatch: Any) 
     part = _part()
     node = _Node(part)
     part.backend.node = node
-    from sam_runtime.bridge.backends import dronecan_services as mod
+    from sam_runtime.bridge.backends import service_mappings as mod
 
-    calls = [mod._Call(), mod._Call()]
-    part._send(MAPPING, 30, {"command": 1}, calls[0])
-    part._send(MAPPING, 30, {"command": 1}, calls[1])
+    calls = [mod.Call(), mod.Call()]
+    part.send(MAPPING, 30, {"command": 1}, calls[0])
+    part.send(MAPPING, 30, {"command": 1}, calls[1])
     assert [c.key for c in calls] == [(201, 30, 0), (201, 30, 1)]
     node.callbacks[0](None)  # the first times out
     assert calls[0].reason == "timeout" and calls[0].done.is_set()
@@ -130,9 +130,9 @@ def test_a_failed_call_says_so_in_the_response() -> None:
 
 
 def test_link_down_fails_the_call() -> None:
-    from sam_runtime.bridge.backends import dronecan_services as mod
+    from sam_runtime.bridge.backends import service_mappings as mod
 
     part = _part()
-    call = mod._Call()
-    part._send(MAPPING, 30, {}, call)  # backend.node is None
+    call = mod.Call()
+    part.send(MAPPING, 30, {}, call)  # backend.node is None
     assert call.done.is_set() and call.reason == "link_down" and call.failure == "the DroneCAN link is down"

@@ -1,0 +1,302 @@
+"""The ROS side of the bridge's service mappings, whatever the protocol (issue 19): each ROS service of
+``services.py`` (generated from the spec's ``bridge.service_mappings``) answered by a request to its device, which a
+protocol's subclass sends (``dronecan_services``, ``cyphal_services``).
+
+Threads: the ROS services live on a ROS node of their own, served by a MultiThreadedExecutor with a reentrant
+callback group (max(4, 2 per mapping) threads: more calls at once wait for a free one), so one slow device holds
+one executor thread for at most its mapping's timeout and never another call, the bridge's topics (another
+executor) or its UAVCAN loop. A call converts the ROS request (in that thread), hands it to the asyncio loop's
+thread, which owns the UAVCAN node (``call_soon_threadsafe`` of the subclass's ``send``), and waits for the
+response or the timeout; the subclass ends the :class:`Call` in the loop's thread (values or a failure).
+
+The caller learns of a failure (no answer within ``timeout_s``, the link down, a request that could not be sent)
+by the response: the srv's default values, with its bool ``success`` False and its string ``message`` the reason
+when the srv has those fields (std_srvs' convention; the ROS client never waits forever). Every call is counted per
+mapping: ``calls``, ``answered``, ``timeouts``, ``failed.<reason>``, ``saturated.<field>``, and the responses that
+reach no waiting call (``late_responses``, ``duplicate_responses``, ``malformed_responses``, counted by the
+subclass). The counters are published once a second, and at once after a failure, on /diagnostics as
+``<bridge>/service/<name>`` (WARN for 10 s after a failure or a bad response), and are in the bridge's
+``stats()["services"]``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import collections
+import importlib
+import logging
+import math
+import threading
+import time
+from collections.abc import Sequence
+from typing import Any
+
+from sam_runtime.bridge.backends.spin_thread import SpinThread
+from sam_runtime.bridge.lifetime import Lifetime
+
+__all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "to_uavcan"]
+
+WARN_AFTER_PROBLEM_S = 10.0
+_EXECUTOR_THREADS = 4
+
+
+def _number(link: Any, value: float, towards_uavcan: bool, saturated: list[str]) -> Any:
+    """One number by a link's rule (scale/offset, rounding, saturation); ``saturated`` gets the target's name when
+    the value had to be limited."""
+    if link.scale is not None or link.offset is not None:
+        scale = 1.0 if link.scale is None else link.scale
+        offset = 0.0 if link.offset is None else link.offset
+        value = (value - offset) / scale if towards_uavcan else value * scale + offset
+    if link.kind == "bool":
+        return bool(value)
+    if link.kind == "int":
+        if math.isnan(value):
+            saturated.append(link.target)
+            return 0
+        if value < link.lo or value > link.hi:
+            saturated.append(link.target)
+            value = min(max(value, link.lo), link.hi)
+        return round(value)
+    value = float(value)
+    if math.isfinite(value) and not link.lo <= value <= link.hi:
+        saturated.append(link.target)
+        value = min(max(value, link.lo), link.hi)
+    return value
+
+
+def _convert(links: Sequence[Any], source: Any, towards_uavcan: bool, saturated: list[str]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for link in links:
+        raw = link.value
+        if link.source is not None:  # a response's source may be nested: "status.uptime_sec"
+            raw = source
+            for name in link.source.split("."):
+                raw = getattr(raw, name)
+        if link.kind == "text":
+            if towards_uavcan:
+                data = str(raw).encode()
+                if len(data) > link.hi:
+                    saturated.append(link.target)
+                out[link.target] = data[: int(link.hi)]
+            else:
+                text = bytes(int(b) for b in raw).decode(errors="replace") if not isinstance(raw, str) else raw
+                if math.isfinite(link.hi) and len(text) > link.hi:
+                    saturated.append(link.target)
+                    text = text[: int(link.hi)]
+                out[link.target] = text
+        else:
+            out[link.target] = _number(link, float(raw), towards_uavcan, saturated)
+    return out
+
+
+def to_uavcan(mapping: Any, request: Any, saturated: list[str]) -> dict[str, Any]:
+    """The UAVCAN request's fields from a ROS request (every field of the request).
+
+    >>> from types import SimpleNamespace as S
+    >>> link = S(target="level", source="percent", kind="int", value=None, scale=0.5, offset=None, lo=0, hi=255)
+    >>> sat: list[str] = []
+    >>> to_uavcan(S(request=(link,)), S(percent=200.0), sat), sat
+    ({'level': 255}, ['level'])
+    """
+    return _convert(mapping.request, request, True, saturated)
+
+
+def from_uavcan(mapping: Any, response: Any, saturated: list[str]) -> dict[str, Any]:
+    """The ROS response's fields from a UAVCAN response (the linked ones).
+
+    >>> from types import SimpleNamespace as S
+    >>> link = S(target="ok", source="success", kind="bool", value=None, scale=None, offset=None, lo=0, hi=1)
+    >>> from_uavcan(S(response=(link,)), S(success=1), [])
+    {'ok': True}
+    """
+    return _convert(mapping.response, response, False, saturated)
+
+
+class Call:
+    """One call in flight: filled in the loop's thread, read by the waiting service thread."""
+
+    def __init__(self) -> None:
+        self.done = threading.Event()
+        self.values: dict[str, Any] | None = None
+        self.failure: str | None = None  # the reason, for the caller and the counters
+        self.reason: str = ""  # the counter key of a failure
+        self.key: tuple[int, int, int] | None = None  # (data type id, device, transfer id) once sent
+
+
+class MappingStats:
+    def __init__(self, mapping: Any) -> None:
+        self.mapping = mapping
+        self.counts: collections.Counter[str] = collections.Counter()
+        self.last_problem: float | None = None
+        self.latency_ms_last: float | None = None
+        self.latency_ms_max: float = 0.0
+
+    def problem(self, key: str, n: int = 1) -> None:
+        self.counts[key] += n
+        self.last_problem = time.monotonic()
+
+
+class ServiceMappingsRos:
+    """The protocol-independent part. Subclasses set ``protocol``, ``node_ids`` (the valid destination node ids)
+    and implement ``send`` (the loop's thread: the request out, ``call`` ended by its response or its timeout).
+
+    :param backend: the bridge's backend.
+    :param ros: the bridge's RosSide (its context and name).
+    :param mappings: the generated ``services.SERVICE_MAPPINGS`` this protocol serves."""
+
+    protocol = "UAVCAN"
+    node_ids = range(1, 128)
+
+    def __init__(self, lifetime: Lifetime, backend: Any, ros: Any, mappings: Sequence[Any], *,
+                 diagnostics_period: float = 1.0) -> None:
+        self.lifetime, self.backend, self.ros = lifetime, backend, ros
+        self.mappings = list(mappings)
+        self.diagnostics_period = float(diagnostics_period)
+        self._lock = threading.Lock()
+        self.stats = {m.name: MappingStats(m) for m in self.mappings}
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._spinner: SpinThread | None = None  # the services' node on its executor thread
+        self._diag_pub: Any = None
+
+    def send(self, m: Any, nid: int, values: dict[str, Any], call: Call) -> None:
+        raise NotImplementedError
+
+    def attach(self) -> None:
+        self.lifetime.add_hooks(f"{self.protocol} service mappings", start=self._start, close=self._close)
+
+    def count(self, m: Any, key: str, n: int = 1, problem: bool = True) -> None:
+        """Add to a mapping's counter (any thread)."""
+        with self._lock:
+            if problem:
+                self.stats[m.name].problem(key, n)
+            else:
+                self.stats[m.name].counts[key] += n
+
+    # ------------------------------------------------------------------------------------------------ ROS side
+    def _start(self) -> None:
+        from rclpy.callback_groups import ReentrantCallbackGroup
+        from rclpy.executors import MultiThreadedExecutor
+        from rclpy.node import Node
+
+        self._loop = asyncio.get_running_loop()
+        base = self.ros.name
+        node = Node(f"{base}_services", context=self.ros.context)
+        group = ReentrantCallbackGroup()
+        for m in self.mappings:
+            srv_type = getattr(importlib.import_module(m.ros_module), m.ros_class)
+            node.create_service(srv_type, m.service, self._callback(m), callback_group=group)
+        if self.diagnostics_period > 0:
+            from diagnostic_msgs.msg import DiagnosticArray
+
+            self._diag_pub = node.create_publisher(DiagnosticArray, "/diagnostics", 10)
+            node.create_timer(self.diagnostics_period, self.publish_diagnostics, callback_group=group)
+        threads = max(_EXECUTOR_THREADS, 2 * len(self.mappings))  # two calls in flight per mapping at least
+        executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
+        self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-services",
+                                   "service_executor_error", "service mappings")
+        self._spinner.start()
+
+    def _close(self) -> None:
+        if self._spinner is not None:
+            self._spinner.close()
+
+    def _callback(self, m: Any) -> Any:
+        return lambda request, response: self.serve(m, request, response)
+
+    def serve(self, m: Any, request: Any, response: Any) -> Any:
+        """A ROS call of mapping ``m`` (an executor thread): the device's answer in ``response``, or the failure."""
+        st = self.stats[m.name]
+        with self._lock:
+            st.counts["calls"] += 1
+        saturated: list[str] = []
+        try:
+            values = to_uavcan(m, request, saturated)
+        except Exception as ex:  # a value the conversion cannot take (a bug: the spec's types are checked)
+            return self._fail(m, response, "convert_error", f"the request cannot be converted: {ex}")
+        nid = m.destination_node_id
+        if m.destination_field is not None:
+            nid = int(getattr(request, m.destination_field))
+            if nid not in self.node_ids:
+                return self._fail(m, response, "bad_node_id", f"{nid} is not a {self.protocol} node id "
+                                  f"({self.node_ids.start}..{self.node_ids.stop - 1})")
+        call = Call()
+        loop = self._loop
+        if loop is None or loop.is_closed() or self.lifetime.closed:
+            return self._fail(m, response, "not_running", "the bridge is not running")
+        started = time.monotonic()
+        loop.call_soon_threadsafe(self.send, m, nid, values, call)
+        # the protocol's own timeout ends the call; the margin only guards against a stalled loop.
+        if not call.done.wait(m.timeout_s + 2.0):
+            call.failure, call.reason = f"the bridge's loop did not answer within {m.timeout_s + 2.0:.1f} s", "stalled"
+        with self._lock:
+            for name in saturated:
+                st.counts[f"saturated.{name}"] += 1
+        if call.failure is not None or call.values is None:
+            return self._fail(m, response, call.reason or "failed", call.failure or "no answer", nid)
+        for name, value in call.values.items():
+            setattr(response, name, value)
+        with self._lock:
+            st.counts["answered"] += 1
+            st.latency_ms_last = round((time.monotonic() - started) * 1000.0, 3)
+            st.latency_ms_max = max(st.latency_ms_max, st.latency_ms_last)
+        return response
+
+    def _fail(self, m: Any, response: Any, reason: str, text: str, nid: int | None = None) -> Any:
+        st = self.stats[m.name]
+        with self._lock:
+            st.problem("timeouts" if reason == "timeout" else f"failed.{reason}")
+        self.lifetime.rlog.note((f"service {m.name}", reason), logging.WARNING, "service %s (%s, node %d): %s",
+                                m.service, m.data_type, m.destination_node_id if nid is None else nid, text)
+        if m.success_field is not None:
+            setattr(response, m.success_field, False)
+        if m.message_field is not None:
+            setattr(response, m.message_field, text)
+        self.publish_diagnostics()
+        return response
+
+    # ------------------------------------------------------------------------------------------------ reports
+    def snapshot(self) -> dict[str, Any]:
+        now = time.monotonic()
+        out: dict[str, Any] = {}
+        with self._lock:
+            for name, st in self.stats.items():
+                m = st.mapping
+                out[name] = {
+                    "service": m.service, "ros_type": m.ros_type, "data_type": m.data_type,
+                    "data_type_id": m.data_type_id, "destination_node_id": m.destination_node_id,
+                    "device": m.device, "destination_field": m.destination_field, "timeout_s": m.timeout_s,
+                    **{k: st.counts.get(k, 0) for k in ("calls", "answered", "timeouts", "late_responses",
+                                                         "duplicate_responses", "malformed_responses")},
+                    **{k: v for k, v in sorted(st.counts.items()) if "." in k},
+                    "latency_ms_last": st.latency_ms_last, "latency_ms_max": st.latency_ms_max,
+                    "warn": st.last_problem is not None and now - st.last_problem < WARN_AFTER_PROBLEM_S,
+                }
+        return out
+
+    def diagnostics_message(self) -> Any:
+        from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+
+        array = DiagnosticArray()
+        array.header.stamp = self.ros.clock.now().to_msg()
+        for name, entry in self.snapshot().items():
+            status = DiagnosticStatus()
+            status.name = f"{self.ros.name}/service/{name}"
+            status.hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
+                                  else f"the node of the request's {entry['destination_field']}")
+            status.level = DiagnosticStatus.WARN if entry["warn"] else DiagnosticStatus.OK
+            status.message = (f"{entry['answered']}/{entry['calls']} answered, {entry['timeouts']} timed out"
+                              + (" (a recent failure or bad response)" if entry["warn"] else ""))
+            status.values = [KeyValue(key=k, value=str(v)) for k, v in entry.items() if k != "warn"]
+            array.status.append(status)
+        return array
+
+    def publish_diagnostics(self) -> None:
+        """Never raises (the timer and after a failure; rclpy's publish is thread-safe)."""
+        if self._diag_pub is None or self.lifetime.closed:
+            return
+        try:
+            self._diag_pub.publish(self.diagnostics_message())
+        except Exception as ex:
+            self.lifetime.errors["service_diagnostics_error"] += 1
+            self.lifetime.rlog.note(("service", "diagnostics"), logging.ERROR, "service diagnostics: %s: %s",
+                                    type(ex).__name__, ex)

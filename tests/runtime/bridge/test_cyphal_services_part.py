@@ -1,0 +1,109 @@
+"""The Cyphal side of the service mappings (runtime/bridge/backends/cyphal_services.py) without a bus: a fake
+pycyphal node and client. A call ends with the converted response, a timeout (the client's None) or link_down; the
+clients' counts of unexpected and undecodable responses become late_responses and malformed_responses; the clients
+are made again on a new node (a reopened link)."""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from types import SimpleNamespace as NS
+from typing import Any
+
+import pytest
+
+from sam_runtime.bridge.backends import cyphal_services
+from sam_runtime.bridge.backends.service_mappings import Call
+from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.common.rate_log import RateLimitedLog
+
+
+class _Type:
+    class Request:
+        low_percent = 0
+
+    Response = NS
+
+
+MAPPING = NS(
+    name="limits", service="/charger/set_limits", ros_type="p/srv/Limits", data_type="ran.power.Limits.1.0",
+    data_type_id=200, destination_node_id=31, device="charger", destination_field=None, timeout_s=0.5,
+    request=(NS(target="low_percent", source="low", kind="int", value=None, scale=None, offset=None, lo=0, hi=255),),
+    response=(NS(target="reason", source="reason", kind="text", value=None, scale=None, offset=None,
+                 lo=float("-inf"), hi=float("inf")),),
+    success_field="success", message_field="message",
+)
+
+
+class _Client:
+    def __init__(self, answers: list[Any]) -> None:
+        self.answers, self.requests, self.response_timeout = answers, [], 0.0
+        self.stats = NS(unexpected_responses=0, deserialization_failures=0)
+
+    async def call(self, request: Any) -> Any:
+        self.requests.append(request)
+        return self.answers.pop(0)
+
+    def sample_statistics(self) -> Any:
+        return self.stats
+
+
+class _Node:
+    def __init__(self, answers: list[Any]) -> None:
+        self.clients: list[tuple[int, int, _Client]] = []
+        self.answers = answers
+        self.presentation = NS(make_client=self.make_client)
+
+    def make_client(self, dtype: Any, service_id: int, server_node_id: int) -> _Client:
+        client = _Client(self.answers)
+        self.clients.append((service_id, server_node_id, client))
+        return client
+
+
+@pytest.fixture
+def part(monkeypatch: pytest.MonkeyPatch) -> cyphal_services.CyphalServices:
+    monkeypatch.setattr(cyphal_services, "dsdl_class", lambda name: _Type)
+    lifetime = Lifetime("bridge", RateLimitedLog(logging.getLogger("test"), 10.0))
+    return cyphal_services.CyphalServices(lifetime, NS(node=None), NS(name="bridge"), [MAPPING],
+                                          diagnostics_period=0)
+
+
+def _run(part: cyphal_services.CyphalServices, values: dict[str, Any]) -> Call:
+    async def go() -> Call:
+        call = Call()
+        part.send(MAPPING, 31, values, call)
+        while not call.done.is_set():
+            await asyncio.sleep(0)
+        return call
+
+    return asyncio.run(go())
+
+
+def test_answer_timeout_and_link_down(part: cyphal_services.CyphalServices) -> None:
+    call = _run(part, {"low_percent": 20})
+    assert call.reason == "link_down" and call.failure == "the Cyphal link is down"
+    node = _Node([(NS(reason=b"ok"), None), None])
+    part.backend.node = node
+    call = _run(part, {"low_percent": 20})
+    assert call.failure is None and call.values == {"reason": "ok"}
+    service_id, nid, client = node.clients[0]
+    assert (service_id, nid, client.response_timeout) == (200, 31, 0.5)  # by keyword: service id, then node
+    assert client.requests[0].low_percent == 20
+    call = _run(part, {"low_percent": 0})
+    assert call.reason == "timeout" and call.failure == "node 31 (charger) did not answer within 0.5 s"
+    assert len(node.clients) == 1  # one client per (mapping, node)
+
+
+def test_unexpected_and_undecodable_responses_are_counted(part: cyphal_services.CyphalServices) -> None:
+    node = _Node([(NS(reason=b""), None), (NS(reason=b""), None)])
+    part.backend.node = node
+    _run(part, {"low_percent": 1})
+    client = node.clients[0][2]
+    client.stats = NS(unexpected_responses=2, deserialization_failures=1)
+    part.poll_statistics()
+    part.poll_statistics()  # counted once
+    counts = part.snapshot()["limits"]
+    assert counts["late_responses"] == 2 and counts["malformed_responses"] == 1 and counts["warn"] is True
+    part.backend.node = _Node([(NS(reason=b""), None)])  # the link reopened: a new node, new clients
+    _run(part, {"low_percent": 1})
+    assert len(part.backend.node.clients) == 1
