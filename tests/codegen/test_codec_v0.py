@@ -43,7 +43,8 @@ ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml",
          "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",
          "trawler_v0": ROOT / "tests" / "specs" / "trawler_v0.yaml",
-         "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml"}
+         "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml",
+         "power_v0": ROOT / "tests" / "specs" / "power_v0.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
@@ -301,7 +302,7 @@ if not WORKER:
         generated = tmp_path / "generated"  # built afresh: the codecs of the generator as it is
         build(SPECS[spec], generated)
         packages = ros_packages_in_order(ROOT / "generated" / "ros")  # SAM's messages (others: installed)
-        if spec == "relay":  # and relay.yaml's own (its LightsCommand mapping takes a relay_msgs/Led)
+        if spec in ("relay", "power_v0"):  # and the spec's own (relay's LightsCommand takes a relay_msgs/Led)
             packages = [*packages, *ros_packages_in_order(generated / "ros")]
         prefix = built_prefix(packages)
         config = {"spec": str(SPECS[spec]), "generated": str(generated)}
