@@ -44,7 +44,8 @@ SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "sp
          "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",
          "trawler_v0": ROOT / "tests" / "specs" / "trawler_v0.yaml",
          "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml",
-         "power_v0": ROOT / "tests" / "specs" / "power_v0.yaml"}
+         "power_v0": ROOT / "tests" / "specs" / "power_v0.yaml",
+         "power_prefix_v0": ROOT / "tests" / "specs" / "power_prefix_v0.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
@@ -302,7 +303,7 @@ if not WORKER:
         generated = tmp_path / "generated"  # built afresh: the codecs of the generator as it is
         build(SPECS[spec], generated)
         packages = ros_packages_in_order(ROOT / "generated" / "ros")  # SAM's messages (others: installed)
-        if spec in ("relay", "power_v0"):  # and the spec's own (relay's LightsCommand takes a relay_msgs/Led)
+        if spec in ("relay", "power_v0", "power_prefix_v0"):  # and the spec's own messages (relay_msgs, power_msgs)
             packages = [*packages, *ros_packages_in_order(generated / "ros")]
         prefix = built_prefix(packages)
         config = {"spec": str(SPECS[spec]), "generated": str(generated)}

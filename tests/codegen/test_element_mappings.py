@@ -3,8 +3,10 @@
 In this process: the spec is valid, each POWER_CASES row of tests/broken_cases.py gives its exact errors, a Cyphal
 mapping with `each` (tests/specs/barge.yaml with HoldState.tags <- Manifest.history) generates element functions in
 convert.py, the plan holds an ElementMapping with the array's length rule,
-the docs word the element fields, and the wire codec module leaves element mappings to the object converters
-(OBJECT_ONLY says why; the runtime's warning, or the offline bridge's error, quotes it).
+the docs word the element fields, the DroneCAN wire codec converts power_v0's element mappings (cut and saturation
+counted as the object converter counts them; an element type a record cannot hold stays on the object converters)
+and the Cyphal one leaves them to the object converters (OBJECT_ONLY says why; the runtime's warning, or the offline
+bridge's error, quotes it).
 
 In a child process with the spec's ROS package built (hypothesis, dronecan's transport and rclpy's serialization as
 the oracles): ConsumedChargeArray -> ConsumedCharges gives every element's values and the message's header in every

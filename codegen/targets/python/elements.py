@@ -13,6 +13,9 @@ The mapping's own function calls it once per element:
   the message rejected, then the elements are converted; a fixed array is cut the same way, or padded with default
   elements after the conversion (counted once either way).
 
+The DroneCAN wire codec emits the same functions on records instead of objects: its Construction's
+`element_scope(em, step, base)` gives the element emitter its readers and signatures (targets.wire.v0_elements).
+
 The functions are collected in ConvertModule.extra_functions, which the module emitters append after the mappings'
 own functions (the registry indexes those by position).
 """

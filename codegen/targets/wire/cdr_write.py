@@ -23,7 +23,9 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
 - ``cdr_writer(message, values, lookup, names, consts)`` -> ``(lines, expr)``: statements and the final expression
   of the CDR bytes (header included). ``values`` maps leaf paths to Python expressions; a whole-array path takes a
   list expression (``byte`` arrays: a list of 1-byte ``bytes``, as rclpy keeps them), a string path a ``str``
-  expression. A leaf without a value gets the field's default, as the ROS message class has it (``ros_default``).
+  expression; a sequence of messages a list of records, tuples of the element's leaves in ``flatten`` order (prim and
+  string leaves only; cdr_reader reads a sequence of messages wanted at its own path into the same records).
+  A leaf without a value gets the field's default, as the ROS message class has it (``ros_default``).
   Literal expressions (``py_literal``: numbers, strings, True/False, ``_NAN``, ``_INF``) are packed at generation
   time.
 - ``cdr_reader(message, wanted, lookup, names, consts, buf)`` -> ``(lines, locals)``: statements that check the CDR

@@ -11,6 +11,10 @@ objects) and cdr_read from the CDR (V0CdrReader); the tree of values the convert
 to cdr_write (ROS) or v0_write (DroneCAN) instead (DroneCanWire). The checks, saturation, stats keys, tables and
 stamps are the same typed statements, rendered by the same templates/python/statements.j2.
 
+Element mappings (arrays of composites, targets.python.elements) get element functions on records (v0_elements):
+a v0 array of composites as v0_read's records, a ROS sequence of messages as cdr_read's / cdr_write's tuples of
+leaves; element types a record cannot hold stay in OBJECT_ONLY with the reason.
+
 Where the object path refuses a payload, the codec raises WireError: where dronecan's decoding raises (see
 v0_read), and where a decoded array reaches a ROS sequence beyond its bound (rclpy refuses to serialize it). A ROS
 fixed array gets the first elements of a longer one, as rclpy serializes it.

@@ -15,7 +15,9 @@ API (used by codec_v0)
 ---------------------------
 - ``V0Node(fields)``: a composite's values, field name -> expression (a list expression for a whole array),
   ``V0Node`` or ``V0Items``; ``V0Items(items)``: an array's elements one by one (their number known at generation
-  time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default.
+  time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default. A
+  dynamic array of composites may be a list expression of records (tuples of the element's fields, as v0_read gives
+  them) when ``record_fields`` allows it: every field a scalar number of byte-multiple width.
 - ``v0_writer(struct, node, layout, consts)`` -> ``(lines, expr)``: statements and the expression of the payload.
 - ``HELPERS``: the source of the helpers the generated code calls (``_f16``, ``_f16t``, ``_clamp``, ``_trunc``).
 """
