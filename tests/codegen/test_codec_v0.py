@@ -11,7 +11,8 @@ In this process (no ROS needed):
 
 In a child process with SAM's ROS package (as tests/test_v0_converters.py does it; the spec's own v0 types added by
 sam_runtime.dronecan_io.types.ensure_types, never dronecan.load_dsdl), hypothesis property tests for every DroneCAN
-mapping of SAM's spec and of tests/specs/{ferry,minimal_v0,buoy_v0,trawler_v0,seiner,relay}.yaml:
+mapping of SAM's spec and of the tests/specs of SPECS (ferry, minimal_v0, buoy_v0, trawler_v0, seiner, relay, power_v0,
+power_prefix_v0, lolo_v0):
 
 (a) random dronecan messages -> dronecan's bytes (``Transfer(payload=obj).payload``) -> ``<m>_wire_to_ros`` gives
     the CDR of ``<m>_to_ros`` (NaN-aware), its stamp, the same counts, and ``WIRE_MATCHES`` agrees with ``MATCHES``;
@@ -43,10 +44,10 @@ ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml",
          "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",
          "trawler_v0": ROOT / "tests" / "specs" / "trawler_v0.yaml",
-         "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml"}
-# Specs whose codec module is only generated and linted here: lolo_v0's element mapping (charges) has no codec, so
-# the ROS child's every-mapping-has-both-codecs check does not apply (tests/system/test_lolo_dronecan.py runs it).
-LINT_SPECS = {**SPECS, "lolo_v0": ROOT / "tests" / "specs" / "lolo_v0.yaml"}
+         "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml",
+         "power_v0": ROOT / "tests" / "specs" / "power_v0.yaml",
+         "power_prefix_v0": ROOT / "tests" / "specs" / "power_prefix_v0.yaml",
+         "lolo_v0": ROOT / "tests" / "specs" / "lolo_v0.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
@@ -247,7 +248,7 @@ if not WORKER:
     def modules() -> dict[str, dict[str, str]]:
         from sam_codegen.targets.wire import codec_v0 as emit_codec_v0
 
-        return {spec: emit_codec_v0.emit(validate(load_spec_file(path))) for spec, path in LINT_SPECS.items()}
+        return {spec: emit_codec_v0.emit(validate(load_spec_file(path))) for spec, path in SPECS.items()}
 
     def test_golden_codec(modules: dict[str, dict[str, str]]) -> None:
         """SAM's codec_v0.py, byte for byte (tests/test_v0_dsdl.py compares it with the converters' golden;
@@ -256,21 +257,21 @@ if not WORKER:
         assert text == (GOLDEN / "python" / "sam_bridge" / "codec_v0.py.golden").read_text(encoding="utf-8"), \
             "run tests/test_v0_dsdl.py with SAM_UPDATE_GOLDEN=1 after an intended change"
 
-    @pytest.mark.parametrize("spec", sorted(LINT_SPECS))
+    @pytest.mark.parametrize("spec", sorted(SPECS))
     def test_codec_is_lint_clean_deterministic_and_standard_library_only(
             spec: str, modules: dict[str, dict[str, str]], tmp_path: Path) -> None:
         from sam_codegen.targets.python import convert as emit_python
         from sam_codegen.targets.wire import codec_v0 as emit_codec_v0
 
         files = modules[spec]
-        assert files == emit_codec_v0.emit(validate(load_spec_file(LINT_SPECS[spec])))
+        assert files == emit_codec_v0.emit(validate(load_spec_file(SPECS[spec])))
         (path, text), = files.items()
         compile(text, path, "exec")
         target = tmp_path / path
         target.parent.mkdir(parents=True)
         target.write_text(text, encoding="utf-8")
         (target.parent / "__init__.py").write_text("", encoding="utf-8")
-        support = emit_python.emit(validate(load_spec_file(LINT_SPECS[spec])))  # codec_v0 imports conversion_support
+        support = emit_python.emit(validate(load_spec_file(SPECS[spec])))  # codec_v0 imports conversion_support
         (target.parent / "conversion_support.py").write_text(
             support[path.replace("codec_v0.py", "conversion_support.py")], encoding="utf-8")
         ruff = shutil.which("ruff") or str(Path(sys.executable).with_name("ruff"))
@@ -304,7 +305,7 @@ if not WORKER:
         generated = tmp_path / "generated"  # built afresh: the codecs of the generator as it is
         build(SPECS[spec], generated)
         packages = ros_packages_in_order(ROOT / "generated" / "ros")  # SAM's messages (others: installed)
-        if spec == "relay":  # and relay.yaml's own (its LightsCommand mapping takes a relay_msgs/Led)
+        if spec in ("relay", "power_v0", "power_prefix_v0", "lolo_v0"):  # and the spec's own messages (relay_msgs...)
             packages = [*packages, *ros_packages_in_order(generated / "ros")]
         prefix = built_prefix(packages)
         config = {"spec": str(SPECS[spec]), "generated": str(generated)}

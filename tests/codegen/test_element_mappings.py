@@ -3,8 +3,10 @@
 In this process: the spec is valid, each POWER_CASES row of tests/broken_cases.py gives its exact errors, a Cyphal
 mapping with `each` (tests/specs/barge.yaml with HoldState.tags <- Manifest.history) generates element functions in
 convert.py, the plan holds an ElementMapping with the array's length rule,
-the docs word the element fields, and the wire codec module leaves element mappings to the object converters
-(OBJECT_ONLY says why; the runtime's warning, or the offline bridge's error, quotes it).
+the docs word the element fields, the DroneCAN wire codec converts power_v0's element mappings (cut and saturation
+counted as the object converter counts them; an element type a record cannot hold stays on the object converters)
+and the Cyphal one leaves them to the object converters (OBJECT_ONLY says why; the runtime's warning, or the offline
+bridge's error, quotes it).
 
 In a child process with the spec's ROS package built (hypothesis, dronecan's transport and rclpy's serialization as
 the oracles): ConsumedChargeArray -> ConsumedCharges gives every element's values and the message's header in every
@@ -147,9 +149,60 @@ if not WORKER and not CYPHAL_WORKER:
             in docs
         assert "each element's header: the message's stamp and frame id" in docs
         codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
+        registry = codec.split("CODECS:")[1]
+        assert "'charges': (charges_wire_to_ros, charges_ros_to_wire)" in registry
+        assert "'actuators': (actuators_wire_to_ros, actuators_ros_to_wire)" in registry
+        assert "OBJECT_ONLY" not in codec
+
+    def test_elements_a_record_cannot_hold_stay_on_the_object_path(tmp_path: Path) -> None:
+        """An element type with a bool (not a byte-multiple number): no DroneCAN codec, OBJECT_ONLY says why."""
+        from sam_codegen.build import build
+
+        spec = tmp_path / "power_v0.yaml"
+        text = BASE.replace("      - {name: charge, type: float32}\n",
+                            "      - {name: charge, type: float32}\n      - {name: ok, type: bool}\n", 1)
+        text = text.replace("            charge: charge\n    actuators:",
+                            "            charge: charge\n          ignore: [ok]\n    actuators:", 1)
+        assert text.count("ignore: [ok]") == 1 and text.count("name: ok") == 1
+        spec.write_text(text, encoding="utf-8")
+        build(spec, tmp_path / "generated")
+        codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
         registry, object_only = codec.split("CODECS:")[1].split("OBJECT_ONLY:")
-        assert "'charges'" not in registry and "'actuators'" not in registry  # no wire codec yet
-        assert "'charges': 'arrays of composites converted element by element'," in object_only
+        assert "'charges'" not in registry and "'actuators'" in registry
+        assert ("'charges': \"arrays of composites converted element by element: charges's element type holds other "
+                "than numbers of byte-multiple width\"," in object_only)
+
+    def test_the_codec_cuts_and_saturates_as_counted(tmp_path: Path) -> None:
+        """ROS Command[20] -> ArrayCommand: cut to 15 (counted once), a value beyond float16 saturated (counted per
+        element under commands[].command_value); dronecan's bytes of the same message. And back: the elements."""
+        dronecan = pytest.importorskip("dronecan")
+        import struct
+
+        from sam_codegen.build import build
+
+        build(SPEC, tmp_path / "generated")
+        sys.path.insert(0, str(tmp_path / "generated" / "python"))
+        try:
+            codec = importlib.import_module("power_bridge.codec_v0")
+        finally:
+            sys.path.pop(0)
+            for name in [m for m in sys.modules if m.startswith("power_bridge")]:
+                del sys.modules[name]
+        values = [float(i) for i in range(18)] + [1e6, -1e6]
+        values[3] = 1e6
+        cdr = b"\0\1\0\0" + struct.pack("<I", 20) + b"".join(struct.pack("<BBxxf", i, 1, v)
+                                                          for i, v in enumerate(values))
+        stats = codec.ConversionStats()
+        payload = codec.CODECS["actuators"][1](cdr, stats)
+        assert dict(stats.saturated) == {"actuators.commands": 1, "actuators.commands[].command_value": 1}
+        msg = dronecan.uavcan.equipment.actuator.ArrayCommand(commands=[
+            dronecan.uavcan.equipment.actuator.Command(actuator_id=i, command_type=1,
+                                                       command_value=min(v, 65504.0))
+            for i, v in enumerate(values[:15])])
+        assert payload == bytes(dronecan.transport.Transfer(payload=msg).payload)
+        back, stamp = codec.CODECS["actuators"][0](payload, 5, codec.ConversionStats())
+        assert stamp == -1 and struct.unpack_from("<I", back, 4) == (15,) and len(back) == 8 + 15 * 8
+        assert struct.unpack_from("<BBxxf", back, 8 + 3 * 8) == (3, 1, 65504.0)
 
     def test_the_runtime_says_why_a_mapping_has_no_codec() -> None:
         from types import SimpleNamespace
@@ -175,6 +228,7 @@ if not WORKER and not CYPHAL_WORKER:
         build(SPEC, tmp_path / "generated")
         produced = {
             "convert_v0.py.golden": (tmp_path / "generated" / "python" / "power_bridge" / "convert_v0.py"),
+            "codec_v0.py.golden": (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py"),
             "interfaces.md.golden": tmp_path / "generated" / "docs" / "interfaces.md",
         }
         for name, path in produced.items():

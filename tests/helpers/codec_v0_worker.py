@@ -212,7 +212,8 @@ if WORKER:
 
     def ros_value(t: RosType, rng: random.Random) -> Any:
         if t.array:
-            n = t.capacity if t.array == "fixed" else rng.choice([0, 1, 2, 3, rng.randint(0, t.capacity or 12)])
+            # (an unbounded sequence up to 20: beyond a UAVCAN array of 15 it converts into, the cut is counted)
+            n = t.capacity if t.array == "fixed" else rng.choice([0, 1, 2, 3, rng.randint(0, t.capacity or 20)])
             return [ros_value(t.element, rng) for _ in range(n or 0)]
         if t.is_primitive:
             return ros_scalar(t.base, rng)

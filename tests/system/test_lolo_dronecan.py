@@ -17,9 +17,8 @@ bus; ROS probes (tests/helpers/ros_probe.py) listen and publish. Each pattern's 
 - Panic (class 9): the board's Panic on /panic_in; /panic_out broadcast as Panic to the relays, cut to 7 bytes and
   counted.
 
-The bridge starts on its default wire path: the element mapping (charges) has no wire codec, so the whole bridge
-runs the object converters and says why (the wire codecs of the other patterns are run by test_relay_e2e.py,
-test_routing_dronecan.py and test_trawler_dronecan.py). Every wait is on a condition (counts the bridge, the
+The bridge starts on its default wire path, the generated wire codecs: every mapping of this spec has one, the
+element mapping (charges) included. Every wait is on a condition (counts the bridge, the
 simulator or the probe report), never a fixed sleep.
 """
 
@@ -230,7 +229,6 @@ def test_panic_mapped_onto_the_specs_topics(run: dict[str, Any]) -> None:
     assert m["panic_in"]["published"] == 1 and m["panic_in"]["dropped"] == {}
 
 
-def test_the_bridge_runs_the_object_converters_and_says_why(run: dict[str, Any]) -> None:
-    assert ("the generated package has no wire codecs for charges (arrays of composites converted element by "
-            "element): using the object converters") in run["bridge_log"], run["bridge_log"]
-    assert "wire=object" in run["bridge_log"], run["bridge_log"]
+def test_the_bridge_runs_every_mapping_on_the_wire_codecs(run: dict[str, Any]) -> None:
+    assert "no wire codecs" not in run["bridge_log"], run["bridge_log"]
+    assert "wire=codec" in run["bridge_log"], run["bridge_log"]

@@ -13,12 +13,16 @@ The mapping's own function calls it once per element:
   the message rejected, then the elements are converted; a fixed array is cut the same way, or padded with default
   elements after the conversion (counted once either way).
 
+The DroneCAN wire codec emits the same functions on records instead of objects: its Construction's
+`element_scope(em, step, base)` gives the element emitter its readers and signatures (targets.wire.v0_elements).
+
 The functions are collected in ConvertModule.extra_functions, which the module emitters append after the mappings'
 own functions (the registry indexes those by position).
 """
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -72,10 +76,15 @@ def _functions(em: Any, s: Step) -> str:
         return base
     assert s.elements is not None
     saved = dict(module.lengths)
-    sub = type(em)(module, s.elements, type(em.uavcan)(), type(em.ros)(),
-                   _ElementSignatures(base, module.ros_aliases[s.elements.ros_message.full_name]))
-    sub.name = identifier(f"{em.name}_{s.ros}")  # module table names; the stats keys are the plan's
-    module.extra_functions.append((sub.to_ros(), sub.to_uavcan()))
+    # the wire codecs give their own readers and signatures (elements as records: targets.wire.v0_elements)
+    hook = getattr(module.build, "element_scope", None)
+    scope = hook(em, s, base) if hook is not None else nullcontext((
+        type(em.uavcan)(), type(em.ros)(),
+        _ElementSignatures(base, module.ros_aliases[s.elements.ros_message.full_name])))
+    with scope as (uavcan, ros, signatures):
+        sub = type(em)(module, s.elements, uavcan, ros, signatures)
+        sub.name = identifier(f"{em.name}_{s.ros}")  # module table names; the stats keys are the plan's
+        module.extra_functions.append((sub.to_ros(), sub.to_uavcan()))
     module.lengths = saved
     return base
 

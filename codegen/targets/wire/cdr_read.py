@@ -186,20 +186,29 @@ class _Reader:
         self.open_segment()
 
     def read_msgseq(self, leaf: Leaf) -> None:
-        """A sequence of messages (or strings) is checked and skipped element by element: nothing reads into one."""
-        if any(p[:len(leaf.path)] == leaf.path for p in self.wanted):
+        """A sequence of messages (or strings) is checked element by element: skipped, or read whole (wanted at its
+        own path) into a list of records, each a tuple of the element's leaves in `flatten` order (prim and string
+        leaves only: an element message with arrays is not read into one)."""
+        whole = leaf.path in self.wanted and leaf.message is not None
+        if not whole and any(p[:len(leaf.path)] == leaf.path for p in self.wanted):
             raise NotImplementedError(f"{leaf.path}: reading into a sequence of messages")
         count = self.count(leaf, "count")
         off = self.dynamic()
-        inner = _Reader(self.lookup, self.names, self.consts, self.buf, set(), self.size, off)
+        leaves = flatten(leaf.message, self.lookup) if leaf.message is not None else [Leaf("string", leaf.path)]
+        if whole and any(x.kind not in ("prim", "string") for x in leaves):
+            raise NotImplementedError(f"{leaf.path}: reading a sequence of messages that hold arrays")
+        wanted = {x.path for x in leaves} if whole else set()
+        inner = _Reader(self.lookup, self.names, self.consts, self.buf, wanted, self.size, off)
         inner.phase = Phase(1, 0)  # an element starts wherever the one before ended
         inner.open_segment()
-        if leaf.message is None:
-            inner.read_string(Leaf("string", leaf.path))
-        else:
-            inner.read(flatten(leaf.message, self.lookup))
+        inner.read(leaves)
         inner.close_segment()
         inner.dynamic()
+        target = self.want(leaf.path, leaf.path[-1][0])
+        if target is not None:
+            record = ", ".join(inner.found[x.path] for x in leaves) + ("," if len(leaves) == 1 else "")
+            self.lines.append(f"{target} = []")
+            inner.lines.append(f"{target}.append(({record}))")
         self.lines.append(f"for _ in range({count}):")
         self.lines.extend("    " + line for line in inner.lines or ["pass"])
         self.phase.unknown()

@@ -23,7 +23,9 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
 - ``cdr_writer(message, values, lookup, names, consts)`` -> ``(lines, expr)``: statements and the final expression
   of the CDR bytes (header included). ``values`` maps leaf paths to Python expressions; a whole-array path takes a
   list expression (``byte`` arrays: a list of 1-byte ``bytes``, as rclpy keeps them), a string path a ``str``
-  expression. A leaf without a value gets the field's default, as the ROS message class has it (``ros_default``).
+  expression; a sequence of messages a list of records, tuples of the element's leaves in ``flatten`` order (prim and
+  string leaves only; cdr_reader reads a sequence of messages wanted at its own path into the same records).
+  A leaf without a value gets the field's default, as the ROS message class has it (``ros_default``).
   Literal expressions (``py_literal``: numbers, strings, True/False, ``_NAN``, ``_INF``) are packed at generation
   time.
 - ``cdr_reader(message, wanted, lookup, names, consts, buf)`` -> ``(lines, locals)``: statements that check the CDR
@@ -267,11 +269,34 @@ class _Writer:
         self.phase.unknown(min(size, 4))
 
     def write_msgseq(self, leaf: Leaf) -> None:
-        if leaf.path in self.values:
-            raise NotImplementedError(f"{leaf.path}: a sequence of messages is written empty only")
+        """Empty, or from a list of records (tuples of the element's leaves in `flatten` order, prim and string
+        leaves only), each element written as a message at the offset the one before it ends."""
+        expr = self.values.get(leaf.path)
         self.align(4)
-        self.run.add("I", "0", 0)
-        self.phase.advance(4)
+        if expr is None:
+            self.run.add("I", "0", 0)
+            self.phase.advance(4)
+            return
+        if leaf.message is None:
+            raise NotImplementedError(f"{leaf.path}: a sequence of strings is written empty only")
+        leaves = flatten(leaf.message, self.lookup)
+        if any(x.kind not in ("prim", "string") for x in leaves):
+            raise NotImplementedError(f"{leaf.path}: a sequence of messages that hold arrays is written empty only")
+        self.used.add(leaf.path)
+        self.flush()
+        seq, record = self.names.new(leaf.path[-1][0]), self.names.new("record")
+        self.lines.append(f"{seq} = {expr}")
+        self.emit(f"{self.consts.struct('<I')}.pack(len({seq}))")
+        buf = self.need_buffer()
+        inner = _Writer(self.lookup, self.names, self.consts,
+                        {x.path: f"{record}[{i}]" for i, x in enumerate(leaves)})
+        inner.buf = buf
+        inner.phase.unknown()  # an element starts wherever the one before ended
+        inner.write(leaves)
+        inner.flush()
+        self.lines.append(f"for {record} in {seq}:")
+        self.lines.extend("    " + line for line in inner.lines)
+        self.phase.unknown()
 
 
 def _lit(value: float) -> str:

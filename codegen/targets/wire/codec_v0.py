@@ -11,6 +11,10 @@ objects) and cdr_read from the CDR (V0CdrReader); the tree of values the convert
 to cdr_write (ROS) or v0_write (DroneCAN) instead (DroneCanWire). The checks, saturation, stats keys, tables and
 stamps are the same typed statements, rendered by the same templates/python/statements.j2.
 
+Element mappings (arrays of composites, targets.python.elements) get element functions on records (v0_elements):
+a v0 array of composites as v0_read's records, a ROS sequence of messages as cdr_read's / cdr_write's tuples of
+leaves; element types a record cannot hold stay in OBJECT_ONLY with the reason.
+
 Where the object path refuses a payload, the codec raises WireError: where dronecan's decoding raises (see
 v0_read), and where a decoded array reaches a ROS sequence beyond its bound (rclpy refuses to serialize it). A ROS
 fixed array gets the first elements of a longer one, as rclpy serializes it.
@@ -19,6 +23,9 @@ fixed array gets the first elements of a longer one, as rclpy serializes it.
 from __future__ import annotations
 
 import ast
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -35,6 +42,13 @@ from sam_codegen.targets.python.names import LocalNames, ros_aliases
 from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_writer
 from sam_codegen.targets.wire.code import Constants
 from sam_codegen.targets.wire.codec import WireCtorNode, WireSignatures, stamp_ns, wrap_body
+from sam_codegen.targets.wire.v0_elements import (
+    ElementSignatures,
+    RecordCdrReader,
+    RecordV0Reader,
+    element_record,
+    unsupported,
+)
 from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
 from sam_codegen.targets.wire.v0_read import WirePath, v0_reader
 from sam_codegen.targets.wire.v0_write import HELPERS, V0Items, V0Node, v0_writer
@@ -54,6 +68,18 @@ class DroneCanWire:
 
     def __init__(self, resolved: Resolved, consts: Constants, layout: V0Layout) -> None:
         self.resolved, self.consts, self.layout = resolved, consts, layout
+        self.records = False  # in an element function: records in and out (v0_elements)
+
+    @contextmanager
+    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> Iterator[tuple[Any, Any, Any]]:
+        """The readers and signatures of an element mapping's functions (targets.python.elements), which take
+        and return records."""
+        assert s.elements is not None
+        self.records = True
+        try:
+            yield RecordV0Reader(s.elements), RecordCdrReader(self.resolved.ros.get), ElementSignatures(base)
+        finally:
+            self.records = False
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return "Any"
@@ -77,6 +103,14 @@ class DroneCanWire:
 
     def format_return(self, module: ConvertModule, root: CtorNode, names: LocalNames) -> list[str]:
         assert isinstance(root, WireCtorNode)
+        if self.records:
+            leaves: dict[tuple, str] = {}
+            if isinstance(root.of, V0Struct):
+                node = _v0_node(root)
+                leaves = {((name, None),): value for name, value in node.fields.items() if value is not None}
+            else:
+                _ros_values(root, (), leaves, [])
+            return [f"return {element_record(root.of, leaves, self.resolved.ros.get, _default_literal)}"]
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
             return _lines([*lines, f"return {expr}"])
@@ -88,6 +122,14 @@ class DroneCanWire:
         return _lines([*checks, *lines, f"return {expr}, {stamp_ns(root.of, values)}"])
 
 
+
+
+def _default_literal(leaf: Any) -> str:
+    """A ROS leaf's default as an expression (an element record's leaf nothing sets)."""
+    value = leaf.default if leaf.kind == "prim" else leaf.default or ""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "_NAN" if math.isnan(value) else "_INF" if value > 0 else "-_INF"
+    return repr(value)
 
 
 def _lines(lines: list[str]) -> list[str]:
@@ -317,14 +359,17 @@ def _context(resolved: Resolved) -> dict[str, Any]:
     assert resolved.dronecan is not None
     build = DroneCanWire(resolved, consts, V0Layout(resolved.dronecan.get))
     module = ConvertModule(resolved, build, ros_aliases=ros_aliases(resolved, resolved.dronecan_mappings))
-    # Element mappings (arrays of composites, targets.python.elements) have no wire codec yet: a bridge that has
-    # one runs on the object converters (the runtime falls back when CODECS lacks a mapping).
-    mappings = [rm for rm in resolved.dronecan_mappings if not has_elements(rm)]
+    # Element mappings (arrays of composites, targets.python.elements) whose elements a record cannot hold have no
+    # wire codec (v0_elements.unsupported): a bridge that has one runs on the object converters (the runtime falls
+    # back when CODECS lacks a mapping).
+    object_only = {rm.mapping.name: why for rm in resolved.dronecan_mappings if has_elements(rm)
+                   and (why := unsupported(rm, build.layout, resolved.ros.get)) is not None}
+    mappings = [rm for rm in resolved.dronecan_mappings if rm.mapping.name not in object_only]
     module.module_names = (
         {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
         | {f"_wire_matches_{rm.mapping.name}" for rm in mappings}
         | {"CODECS", "WIRE_MATCHES", "WireError", "ConversionStats", "Callable", "Any", "payload", "cdr",
-           "_NAN", "_INF", "_item", "_struct", "_array", "_ZEROS", "_support"}
+           "_NAN", "_INF", "_item", "_struct", "_array", "_ZEROS", "_support", "src"}
     )
     signatures = WireSignatures(": payload -> (CDR, stamp in ns).", ": CDR -> payload.")
     functions, predicates = [], []
@@ -332,14 +377,14 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         emitter = MappingEmitter(module, rm, V0WireReader(build, rm), V0CdrReader(build), signatures)
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
         predicates.append((rm.mapping.name, wire_matches(emitter, build)))
+    functions.extend(module.extra_functions)  # element mappings' functions, after the registry's
     return {
         "uses_array": "array" in consts.imports,
         "tables": module.tables,
         "functions": functions,
         "matches": predicates,
         "mappings": [rm.mapping.name for rm in mappings],
-        "object_only": [(rm.mapping.name, "arrays of composites converted element by element")
-                        for rm in resolved.dronecan_mappings if has_elements(rm)],
+        "object_only": list(object_only.items()),
         "constants": consts.lines(),
         "prelude": MODULE_PRELUDE,
         "helpers": HELPERS.strip("\n").splitlines(),

@@ -15,7 +15,9 @@ API (used by codec_v0)
 ---------------------------
 - ``V0Node(fields)``: a composite's values, field name -> expression (a list expression for a whole array),
   ``V0Node`` or ``V0Items``; ``V0Items(items)``: an array's elements one by one (their number known at generation
-  time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default.
+  time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default. A
+  dynamic array of composites may be a list expression of records (tuples of the element's fields, as v0_read gives
+  them) when ``record_fields`` allows it: every field a scalar number of byte-multiple width.
 - ``v0_writer(struct, node, layout, consts)`` -> ``(lines, expr)``: statements and the expression of the payload.
 - ``HELPERS``: the source of the helpers the generated code calls (``_f16``, ``_f16t``, ``_clamp``, ``_trunc``).
 """
@@ -33,7 +35,7 @@ from sam_codegen.targets.wire.code import NO_VALUE as _NO
 from sam_codegen.targets.wire.code import Constants, literal_value, runs_of
 from sam_codegen.targets.wire.v0_layout import V0Layout, length_bits, merge_pads, struct_code, tag_bits
 
-__all__ = ["HELPERS", "V0Items", "V0Node", "f16_bits", "v0_writer"]
+__all__ = ["HELPERS", "V0Items", "V0Node", "f16_bits", "record_fields", "v0_writer"]
 
 FLOAT_MAX = {16: 65504.0, 32: 3.40282346638528859812e38, 64: 1.79769313486231570815e308}  # dronecan's ranges
 
@@ -125,6 +127,25 @@ class _List:
     t: DsdlType  # element type
     expr: str
     prefix: int  # length prefix bits (0: tail array)
+    record: tuple[DsdlType, ...] = ()  # composite elements: records, the types of their fields (see record_fields)
+
+    @property
+    def bits(self) -> int:
+        return sum(t.bits for t in self.record) if self.record else self.t.bits
+
+
+def record_fields(layout: V0Layout, t: DsdlType) -> tuple[DsdlType, ...] | None:
+    """The field types of a composite element written from a record (a tuple of its fields, as v0_read gives them):
+    when every field is a scalar number of byte-multiple width (one struct code per field), else None."""
+    if t.kind != "composite":
+        return None
+    s = layout.struct(t)
+    types = tuple(f.type for f in s.declared_fields)
+    if s.union or not types or any(
+            not isinstance(x, DsdlType) or x.array or x.kind not in ("int", "uint", "float") or struct_code(x) is None
+            or not f.name for x, f in zip(types, s.declared_fields, strict=True)):
+        return None
+    return types  # type: ignore[return-value]
 
 
 def _flatten(layout: V0Layout, t: DsdlType, value: Any, tao: bool, out: list[_Atom | _List]) -> None:
@@ -141,9 +162,13 @@ def _flatten(layout: V0Layout, t: DsdlType, value: Any, tao: bool, out: list[_At
         tao_mode = layout.tao_mode(t, tao)
         prefix = 0 if tao_mode else length_bits(t.capacity or 0)
         if isinstance(value, str):
+            record: tuple[DsdlType, ...] = ()
             if t.element.kind == "composite":
-                raise NotImplementedError(f"{t}: an array of composites from a list expression")
-            out.append(_List(t.element, value, prefix))
+                found = record_fields(layout, t.element)
+                if found is None:
+                    raise NotImplementedError(f"{t}: an array of composites of other than byte-multiple numbers")
+                record = found
+            out.append(_List(t.element, value, prefix, record))
             return
         items = value.items if isinstance(value, V0Items) else []
         if prefix:
@@ -385,7 +410,16 @@ class _Writer:
         t = d.t
         items = self.name(d.expr)
         code = struct_code(t) if t.kind != "bool" else None
-        if code is not None:
+        if d.record:  # records of byte-multiple numbers: their bytes are their stream bits
+            code = "record"
+            codes = "".join("H" if x.kind == "float" and x.bits == 16 else str(struct_code(x)) for x in d.record)
+            args = [f"_clamp(_r[{i}], {FLOAT_MAX[x.bits]!r})" if x.kind == "float" and x.bits > 16 and not x.truncated
+                    else self.struct_arg(x, f"_r[{i}]") for i, x in enumerate(d.record)]  # (no statement: in a list)
+            data = f"b''.join([{self.consts.struct('<' + codes)}.pack({', '.join(args)}) for _r in {items}])"
+            if not self.acc and not d.prefix:
+                self.parts.append(data)
+                return
+        elif code is not None:
             if t.kind == "uint" and t.bits == 8 and not t.truncated:
                 data = f"bytes({items})"
             else:
@@ -409,10 +443,10 @@ class _Writer:
             self.lines.append(f"for x in {items}:")
             self.lines.extend(f"    {line}" for line in [*body, f"_a = _a << {t.bits} | {bits}"])
         if not self.nb_dyn:
-            self.lines.append(f"_nb = {self.nb} + {d.prefix} + len({items}) * {t.bits}")
+            self.lines.append(f"_nb = {self.nb} + {d.prefix} + len({items}) * {d.bits}")
             self.nb_dyn, self.nb = True, 0
         else:
-            self.lines.append(f"_nb += {self.nb + d.prefix} + len({items}) * {t.bits}")
+            self.lines.append(f"_nb += {self.nb + d.prefix} + len({items}) * {d.bits}")
             self.nb = 0
 
     def start_acc(self) -> None:

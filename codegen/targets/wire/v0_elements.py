@@ -1,0 +1,121 @@
+"""Element mappings (arrays of composites converted element by element, targets.python.elements) in the DroneCAN
+wire codec: the element functions read and return records instead of objects.
+
+The element functions are targets.python.elements' (the same MappingEmitter, plan, checks and stats keys), emitted
+in an `element_scope` of DroneCanWire that gives them these readers and signatures:
+
+- UAVCAN -> ROS: `src` is a record of the element type as v0_read decodes an array of composites (a tuple of its
+  fields, void padding left out: record_index); the result is a tuple of the ROS element's leaves in cdr_layout's
+  `flatten` order (every leaf, defaults included), which cdr_write writes as one element of the sequence;
+- ROS -> UAVCAN: `src` is such a tuple, as cdr_read reads a sequence of messages; the result is a record of the
+  element type (its fields in record order, defaults included), which v0_write writes as one array element.
+
+What a record cannot hold, `unsupported` names (the mapping stays on the object converters, OBJECT_ONLY says
+why): an element type with other than scalar numbers of byte-multiple width (v0_write packs records with struct), a
+ROS element message holding arrays (its leaves are numbers, bools and strings only).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sam_codegen.model.spec import RosMessage, V0Struct
+from sam_codegen.model.types import DsdlType
+from sam_codegen.render.pysource import typed_literal
+from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
+from sam_codegen.targets.python.mapping_v0 import bind_required_elements
+from sam_codegen.targets.python.module import FunctionDraft
+from sam_codegen.targets.python.names import LocalNames
+from sam_codegen.targets.wire.cdr_layout import flatten
+from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
+from sam_codegen.targets.wire.v0_write import record_fields
+from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
+
+__all__ = ["ElementSignatures", "RecordCdrReader", "RecordV0Reader", "element_record", "unsupported"]
+
+
+def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | None:
+    """Why the element mappings of `rm` have no wire codec (None: they have one)."""
+    for s in rm.steps:
+        if s.kind != "elements":
+            continue
+        assert s.elements is not None and s.uavcan_type is not None
+        if record_fields(layout, s.uavcan_type.element) is None:
+            return (f"arrays of composites converted element by element: {s.uavcan}'s element type holds other than "
+                    "numbers of byte-multiple width")
+        if any(leaf.kind not in ("prim", "string") for leaf in flatten(s.elements.ros_message, lookup)):
+            return f"arrays of composites converted element by element: {s.ros}'s element message holds arrays"
+    return None
+
+
+class ElementSignatures:
+    """`_<mapping>_<ros array>_item_to_ros(src, receive_ns, stats)` and `..._item_to_uavcan(src, stats)`: records."""
+
+    def __init__(self, base: str) -> None:
+        self.base = base
+
+    def to_ros(self, em: MappingEmitter) -> FunctionDraft:
+        rm = em.rm
+        return FunctionDraft(f"{self.base}_to_ros", ["src: tuple", "receive_ns: int", "stats: Any"], "tuple | None",
+                             [f"One element of {rm.mapping.name}, UAVCAN -> ROS (records; receive_ns: the "
+                              "message's stamp).", "", f"{rm.dsdl_struct.name} -> {rm.ros_message.full_name}"])
+
+    def to_uavcan(self, em: MappingEmitter) -> FunctionDraft:
+        rm = em.rm
+        return FunctionDraft(f"{self.base}_to_uavcan", ["src: tuple", "stats: Any"], "tuple | None",
+                             [f"One element of {rm.mapping.name}, ROS -> UAVCAN (records).", "",
+                              f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"])
+
+
+class RecordV0Reader:
+    """The UAVCAN side of an element: `src`, a record of the element type (its scalar fields by position)."""
+
+    def __init__(self, rm: ResolvedMapping) -> None:
+        self.rm = rm
+        self.items: dict[tuple, str] = {}
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> dict[tuple, str]:
+        return bind_required_elements(self, em, fn, names, steps)
+
+    def access(self, path: tuple) -> str:
+        assert len(path) == 1 and path[0][1] is None, path  # the element's fields are scalars (unsupported)
+        return f"src[{record_index(self.rm.dsdl_struct, path[0][0])}]"  # type: ignore[arg-type]
+
+    def as_list(self, expr: str) -> str:
+        return f"list({expr})"
+
+    def item_field(self, item_path: tuple, name: str) -> str:
+        raise AssertionError("an element of scalars has no items (unsupported)")
+
+
+class RecordCdrReader:
+    """The ROS side of an element: `src`, a tuple of the element message's leaves in flatten order."""
+
+    def __init__(self, lookup: Any) -> None:
+        self.lookup = lookup
+
+    def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> RosReads:
+        index = {leaf.path: i for i, leaf in enumerate(flatten(em.rm.ros_message, self.lookup))}
+        return RosReads(lambda path: f"src[{index[tuple(path)]}]",
+                        lambda path: (f"src[{index[(*path, ('sec', None))]}]",
+                                      f"src[{index[(*path, ('nanosec', None))]}]"))
+
+    def array_read(self, expr: str, ros_type: Any) -> str:
+        raise AssertionError("an element message with arrays has no wire codec (unsupported)")
+
+
+def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: Any) -> str:
+    """The record an element function returns: a ROS element's leaves (flatten order) or a v0 element's fields
+    (record order), each the value given or the field's default."""
+    if isinstance(of, RosMessage):
+        items = []
+        for leaf in flatten(of, lookup):
+            if leaf.path in values:
+                items.append(values[leaf.path])
+            else:
+                items.append(default_of(leaf))
+    else:
+        assert isinstance(of, V0Struct)
+        items = [values.get(((f.name, None),), typed_literal(0, "float" if f.type.kind == "float" else f.type.kind))
+                 for f in of.declared_fields if f.name and isinstance(f.type, DsdlType)]
+    return f"({', '.join(items)}{',' if len(items) == 1 else ''})"
