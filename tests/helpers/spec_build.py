@@ -15,6 +15,7 @@ import shutil
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -56,3 +57,17 @@ def built_spec(name: str) -> BuiltSpec:
     gen_dir = generated_spec(name)
     prefix = built_prefix([GeneratedPackage(gen_dir).ros_package_dir()])
     return BuiltSpec(SPECS / f"{name}.yaml", gen_dir, prefix)
+
+
+def forget_generated(gen: Any) -> None:
+    """Take a generated package (a GeneratedPackage) out of this process again: its modules and its sys.path entry.
+
+    A test that imports a spec's package into the pytest process calls it when done, so that a later test may
+    import another build of the same vehicle (a user project under tmp_path): GeneratedPackage refuses a package
+    that another copy shadows."""
+    python_dir = str(gen.python_dir)
+    for name in [m for m in sys.modules if m.split(".")[0] == gen.package]:
+        if python_dir in str(getattr(sys.modules[name], "__file__", "") or ""):
+            del sys.modules[name]
+    while python_dir in sys.path:
+        sys.path.remove(python_dir)

@@ -4,6 +4,7 @@ broadcast command are its own."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from types import SimpleNamespace
 from typing import Any
 
@@ -11,7 +12,7 @@ import pytest
 
 pytest.importorskip("dronecan")
 
-from helpers.spec_build import generated_spec
+from helpers.spec_build import forget_generated, generated_spec
 
 from sam_runtime.genpkg import GeneratedPackage
 from sam_runtime.sim.dronecan import DroneCanDevices
@@ -21,11 +22,12 @@ RPM = "uavcan.equipment.esc.RPMCommand"
 
 
 @pytest.fixture(scope="module")
-def adapter() -> DroneCanDevices:
-    tables = GeneratedPackage(generated_spec("seiner")).tables()
+def adapter() -> Iterator[DroneCanDevices]:
+    gen = GeneratedPackage(generated_spec("seiner"))
     sim: Any = SimpleNamespace(config=SimpleNamespace(dronecan_iface="mcast-lo:"), bridge_node_id=100, devices=[],
-                               tables=tables)
-    return DroneCanDevices(sim)
+                               tables=gen.tables())
+    yield DroneCanDevices(sim)
+    forget_generated(gen)
 
 
 def _dev(node_id: int, name: str) -> Any:
@@ -53,19 +55,29 @@ def test_each_esc_takes_its_own_element_of_every_shared_command(adapter: DroneCa
     assert taken(31, "esc_stbd") == [["rpm[1]"], ["rpm[1]"]]
 
 
-def _spec_tables(spec: str) -> Any:
-    if spec == "sam":
-        from helpers.runtime_support import generated_or_skip
+@pytest.fixture
+def spec_tables() -> Iterator[Callable[[str], Any]]:
+    """The tables of SAM's generated package or of a tests/specs build; the latter leave the process afterwards."""
+    imported: list[GeneratedPackage] = []
 
-        return generated_or_skip().tables()
-    return GeneratedPackage(generated_spec(spec)).tables()
+    def tables(spec: str) -> Any:
+        if spec == "sam":
+            from helpers.runtime_support import generated_or_skip
+
+            return generated_or_skip().tables()
+        imported.append(GeneratedPackage(generated_spec(spec)))
+        return imported[-1].tables()
+
+    yield tables
+    for gen in imported:
+        forget_generated(gen)
 
 
 @pytest.mark.parametrize("spec", ["sam", "minimal_v0", "buoy_v0", "ferry", "seiner"])
-def test_every_select_routed_mapping_has_a_device_sending_its_values(spec: str) -> None:
+def test_every_select_routed_mapping_has_a_device_sending_its_values(spec: str, spec_tables: Any) -> None:
     """Class 11 for every spec with DroneCAN: each UAVCAN->ROS mapping with `select` is fed by some simulated device
     that sends its values (in turn with the other selections that accept the device), so its topic publishes."""
-    tables = _spec_tables(spec)
+    tables = spec_tables(spec)
     sim: Any = SimpleNamespace(config=SimpleNamespace(dronecan_iface="mcast-lo:"), bridge_node_id=100, devices=[],
                                tables=tables)
     devices = DroneCanDevices(sim)
