@@ -99,7 +99,11 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
     bridge = Bridge(gen, transport=tcfg, wire=args.wire)
     await bridge.start()
     record = Path(args.out).with_suffix(".sim.jsonl")
-    sim = Simulator(gen, SimConfig("can", args.iface, args.mtu, rate_scale=args.rate_scale, record=record))
+    # One shared stamp clock (no per-device clocks to synchronise): this scenario is about bridging over CAN; the
+    # time-sync master and the devices following it are tests/system/test_time_sync.py's (in one process a
+    # loaded loop makes the master's sends imprecise, so synchronising could take any time)
+    sim = Simulator(gen, SimConfig("can", args.iface, args.mtu, rate_scale=args.rate_scale, record=record,
+                                   device_clocks=False))
     await sim.start()
     in_maps = [m for m in tables.MAPPINGS if m.direction == "uavcan_to_ros"]
     in_topics = sorted({m.topic.name for m in in_maps})
@@ -117,8 +121,6 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
         result["devices"] = bridge.stats()["devices"]
         result["parameters"] = check_parameters(bridge)
 
-        # the devices' clocks follow the bridge's (its time-sync master): every stamp is a device's own
-        await wait_for(lambda: sim.synchronised, 20, "the devices' clocks synchronised")
         plan = command_plan(tables, args.commands)
         t0 = time.monotonic()
         sim.start_publishing(duration=args.duration)

@@ -7,7 +7,7 @@ python power_board.py --generated DIR --iface mcast-lo:<bus>:<port> --start-file
 Prints ``READY {...}`` with the array's data type id and the type dronecan decodes that id as; once F exists,
 broadcasts one <namespace>.ConsumedChargeArray (timestamp 1 700 000 000.25 s, circuits 1..15 with charge
 circuit * 0.5 Ah) and one with no element, then (with ``--panic``) one uavcan.protocol.Panic with that reason_text,
-printing ``PUBLISHED``. (tests/specs/lolo_v0.yaml has the same types under lolo.power, its array at vendor id
+printing ``PUBLISHED``. (tests/specs/lolo_v0.yaml has the same types under sabre.power, its array at vendor id
 20100.) On SIGTERM or when ``--max-life`` runs out: ``SUMMARY {}``, exit 0.
 """
 

@@ -1,6 +1,6 @@
 """Issue 17's patterns together, across processes on DroneCAN, with tests/specs/lolo_v0.yaml (an AUV whose firmware
 uses all of them): ``sam-sim`` plays the relays (node 40) and two ESCs (50, 51); helper processes play the power
-board (tests/helpers/power_board.py: node 30, the spec's lolo.power.ConsumedChargeArray at vendor id 20100, and a
+board (tests/helpers/power_board.py: node 30, the spec's sabre.power.ConsumedChargeArray at vendor id 20100, and a
 Panic), the leak sensor (tests/helpers/leak_sensor_peer.py: node 41, positions 100 and others) and ESCs with dynamic
 node ids (tests/helpers/esc_status_peer.py: 77, 78); ``sam-bridge --protocol dronecan`` on a private ``mcast-lo:``
 bus; ROS probes (tests/helpers/ros_probe.py) listen and publish. Each pattern's values are checked where they arrive:
@@ -76,7 +76,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     sim = Proc("sim", runtime_cmd("sim", "--devices", "relays,esc_port,esc_stbd", "--dronecan-iface", iface,
                                   "--record", str(d / "sim.jsonl"), "--report", str(d / "sim.json")), env, d)
     board = Proc("board", helper_cmd("power_board.py", "--generated", gen, "--iface", iface, "--namespace",
-                                     "lolo.power", "--node-id", str(BOARD_ID), "--panic", "FLOOD",
+                                     "sabre.power", "--node-id", str(BOARD_ID), "--panic", "FLOOD",
                                      "--start-file", str(d / "go")), env, d)
     listen = Proc("listen", helper_cmd("ros_probe.py", "listen", "--generated", gen, "--topics", ",".join(IN_TOPICS),
                                        "--out", str(d / "listen.json"), "--record", str(d / "listen.jsonl")), env, d)
@@ -191,7 +191,7 @@ def test_consumed_charge_array_at_vendor_id_20100_reaches_ros_element_by_element
         ({"stamp": stamp, "frame_id": "base_link"}, c, c * 0.5) for c in range(1, 16)]
     assert empty["charges"] == [] and empty["header"]["stamp"] == {"sec": stamp["sec"] + 1,
                                                                    "nanosec": stamp["nanosec"]}
-    assert run["board_ready"] == {"data_type_id": 20100, "decoded_as": "lolo.power.ConsumedChargeArray"}
+    assert run["board_ready"] == {"data_type_id": 20100, "decoded_as": "sabre.power.ConsumedChargeArray"}
     m = run["stats"]["mappings"]["charges"]
     assert m["data_type_id"] == 20100 and m["published"] == 2 and m["dropped"] == {} and m["saturated"] == {}
 
