@@ -19,6 +19,8 @@ without the core declaring anything again.
 - Device health: ``on_device_status(handler)``; the handler gets a :class:`DeviceStatus` for every heartbeat
   (Cyphal ``uavcan.node.Heartbeat``, DroneCAN ``uavcan.protocol.NodeStatus``) of any node. The core keeps the
   records, the offline timeouts and the restarts (``sam_runtime.bridge.health``).
+- Transmission times (the time-sync master's port): ``outlet.want_tx_times()`` before open, then after each
+  publish ``outlet.take_tx_time()`` -> a :class:`~sam_runtime.common.tx_timestamps.TxWindow` or None.
 - Link: ``link_problem()`` says why the link must be reopened (a dead transport), polled by the core.
 - Counters below the bridge (frames and transfers the protocol stack discarded): ``poll_statistics()``, then
   ``inlet.below`` per port.
@@ -32,6 +34,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
+
+from sam_runtime.common.tx_timestamps import TxWindow
 
 __all__ = ["Backend", "BelowBridge", "BridgeConfigError", "DeviceStatus", "Inlet", "LinkDownError", "Outlet",
            "TransferHandler"]
@@ -115,6 +119,18 @@ class Outlet(abc.ABC):
     @abc.abstractmethod
     async def publish(self, obj: Any) -> bool:
         """Send ``obj``: True when every frame went out within ``send_timeout``."""
+
+    # The time-sync master's port: when its messages left, measured below the bridge where the backend can.
+    tx_times: bool = False
+
+    def want_tx_times(self) -> None:
+        """Measure when each message of this port leaves (from the next open on): :meth:`take_tx_time`."""
+        self.tx_times = True
+
+    def take_tx_time(self) -> TxWindow | None:
+        """When the first frame of the message of the last successful :meth:`publish` left, as the transport or
+        the driver measured it; None when it did not (not asked for, not supported, not measurable that time)."""
+        return None
 
 
 class Backend(abc.ABC):

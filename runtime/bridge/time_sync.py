@@ -5,11 +5,22 @@ and the watch on the devices' stamps (:class:`StampWatch`), protocol-agnostic (t
 - Master (both protocols' algorithm, Cyphal ``uavcan.time.Synchronization.1.0`` and DroneCAN
   ``uavcan.protocol.GlobalTimeSync``): every ``period_s`` one message whose field is the time at which the previous
   one was transmitted, in the bridge's ROS clock (``ros.receive_ns``: the clock the bridge stamps receive times and
-  rclpy its messages with), so that the devices' stamps become ROS time. The transmission time is the middle of
-  the send call (the frame reaches the OS inside it; the stacks give no transmission timestamp through the
-  backend's port); a send that took longer than MAX_TX_SPAN_NS (the loop held up, the send waited) gives no
-  usable time: the next message says 0 (counted ``imprecise``), so the slaves keep their offset instead of
-  adopting a wrong one. The field is 0 for the first message, after a failed or imprecise send or a link down, and
+  rclpy its messages with), so that the devices' stamps become ROS time.
+  The transmission time, best first (``tx_time`` in the snapshot counts which one each message had):
+  ``kernel`` (Cyphal/UDP: the kernel's software transmission timestamp of the session's socket, taken in the
+  network device's transmit routine: exact to the microsecond, whatever held the loop up before or after);
+  ``driver`` (DroneCAN on ``mcast-lo:``: the bounds of the driver's send system call, some 10 us);
+  ``send_call`` where below the bridge nothing measures it (Cyphal/CAN, other DroneCAN drivers): the bounds of the
+  publish call, during which the frame left, on a loaded loop including the loop's lag (the call awaits).
+  Each gives a window [earliest, latest]; the message carries its middle, so the time carried is wrong by at most
+  half the window. A window wider than the accepted span gives no time (counted ``imprecise``; the next message
+  says 0, so the slaves keep their offset instead of adopting a wrong one): for ``kernel`` and ``driver``
+  MAX_TX_SPAN_NS (1 ms); for ``send_call`` twice the median of the last SPAN_WINDOW send-call spans, at least
+  MAX_TX_SPAN_NS and at most MAX_SEND_CALL_SPAN_NS (4 ms): an idle loop's outliers are refused, a loaded loop
+  whose every send takes a few ms still synchronises. Invariant: a message never carries a time more than
+  MAX_TX_ERROR_NS (half of MAX_SEND_CALL_SPAN_NS: 2 ms; 0.5 ms with ``kernel`` or ``driver`` times, 0 with
+  ``kernel``) from the transmission of the previous message.
+  The field is 0 for the first message, after a failed or imprecise send or a link down, and
   when the previous transmission is more than ``max_interval_s`` old (the types' rule): a slave then starts its
   chain again.
   Runs on the asyncio loop (the protocol stacks are not thread-safe); a failed send is counted
@@ -28,6 +39,7 @@ and the watch on the devices' stamps (:class:`StampWatch`), protocol-agnostic (t
 from __future__ import annotations
 
 import asyncio
+import collections
 import logging
 import statistics
 import threading
@@ -40,11 +52,16 @@ from typing import Any
 from sam_runtime.bridge.backend import Outlet
 from sam_runtime.bridge.lifetime import Lifetime
 
-__all__ = ["DEFAULT_TIME_SYNC_PERIOD_S", "ERROR_WINDOW", "OFF_LIMIT_S", "StampWatch", "TimeSyncMaster"]
+__all__ = ["DEFAULT_TIME_SYNC_PERIOD_S", "ERROR_WINDOW", "MAX_SEND_CALL_SPAN_NS", "MAX_TX_ERROR_NS", "MAX_TX_SPAN_NS",
+           "OFF_LIMIT_S", "StampWatch", "TimeSyncMaster"]
 
 DEFAULT_TIME_SYNC_PERIOD_S = 0.5  # as the spec's default (sam_codegen.frontend.time_sync)
 ERROR_WINDOW = 64
-MAX_TX_SPAN_NS = 1_000_000  # a send that took longer gives no transmission time
+MAX_TX_SPAN_NS = 1_000_000  # a measured window (kernel, driver) wider than this gives no transmission time
+MAX_SEND_CALL_SPAN_NS = 4_000_000  # nor ever a send call longer than this
+MAX_TX_ERROR_NS = MAX_SEND_CALL_SPAN_NS // 2  # the most a carried time can be off (the middle of the window)
+SPAN_WINDOW = 16  # the recent send-call spans judged against
+SPAN_FACTOR = 2  # a send call longer than this many times their median is refused
 OFF_LIMIT_S = 1.0
 
 
@@ -59,13 +76,17 @@ class TimeSyncMaster:
         self.period_s, self.max_interval_s, self.label = float(period_s), float(max_interval_s), label
         self.sent = 0
         self.failed = 0
-        self.imprecise = 0  # sent, but the next message says 0: the send took longer than MAX_TX_SPAN_NS
+        self.imprecise = 0  # sent, but the next message says 0: its transmission window was too wide
+        self.tx_sources: collections.Counter[str] = collections.Counter()  # transmission times by source
+        self._spans: deque[int] = deque(maxlen=SPAN_WINDOW)  # the last send-call spans
+        self._last_span_ns: int | None = None
         self._prev_us = 0
         self._prev_mono: float | None = None
         self._last_sent_mono: float | None = None
         self._task: asyncio.Task[None] | None = None
 
     def attach(self) -> None:
+        self.outlet.want_tx_times()  # before the link opens: the backend measures from its first open
         self.lifetime.add_hooks(f"{self.label} master", start=self._start, close=self._close)
 
     def _start(self) -> None:
@@ -115,17 +136,43 @@ class TimeSyncMaster:
         after_ns = self.clock_ns()
         self._last_sent_mono = time.monotonic()
         self.sent += 1
-        if after_ns - before_ns > MAX_TX_SPAN_NS:  # held up: when the frame left is not known well enough
+        window = self._window(before_ns, after_ns)
+        if window is None:  # held up: when the frame left is not known well enough
             self.imprecise += 1
             self._prev_us, self._prev_mono = 0, None
         else:
-            self._prev_us, self._prev_mono = (before_ns + after_ns) // 2000, self._last_sent_mono
+            self._prev_us, self._prev_mono = window // 1000, self._last_sent_mono
         return True
+
+    def _window(self, before_ns: int, after_ns: int) -> int | None:
+        """The transmission time of the message just sent (the bridge's clock, ns): the middle of the window
+        measured below the bridge or else of the send call; None when the window is too wide."""
+        tx = self.outlet.take_tx_time()
+        if tx is not None:
+            # the window is CLOCK_REALTIME: to the bridge's clock (the same one unless ROS time is simulated)
+            shift = self.clock_ns() - time.time_ns()
+            source, lo, hi, limit = tx.source, tx.earliest_ns + shift, tx.latest_ns + shift, MAX_TX_SPAN_NS
+        else:
+            source, lo, hi = "send_call", before_ns, after_ns
+            self._spans.append(hi - lo)
+            typical = statistics.median(self._spans)
+            limit = min(MAX_SEND_CALL_SPAN_NS, max(MAX_TX_SPAN_NS, int(SPAN_FACTOR * typical)))
+        span = hi - lo
+        self._last_span_ns = span
+        if not 0 <= span <= limit:
+            self.tx_sources[f"{source}_refused"] += 1
+            return None
+        self.tx_sources[source] += 1
+        return (lo + hi) // 2
 
     def snapshot(self) -> dict[str, Any]:
         age = None if self._last_sent_mono is None else round(time.monotonic() - self._last_sent_mono, 3)
+        spans = sorted(self._spans)
         return {"message": self.label, "period_s": self.period_s, "sent": self.sent, "failed": self.failed,
-                "imprecise": self.imprecise, "last_sent_age_s": age}
+                "imprecise": self.imprecise, "last_sent_age_s": age, "tx_time": dict(sorted(self.tx_sources.items())),
+                "tx_span_us": {"last": None if self._last_span_ns is None else round(self._last_span_ns / 1000, 1),
+                               **({"send_call_median": round(statistics.median(spans) / 1000, 1),
+                                   "send_call_max": round(spans[-1] / 1000, 1)} if spans else {})}}
 
 
 @dataclass

@@ -17,6 +17,9 @@ An :class:`Acceptance` filter (a CAN controller's acceptance filter: the service
 the broadcasts of some data types) drops every other frame in the kernel, so a node that listens to little (a
 simulated sensor) is not woken by every frame of the bus. The kernel counts the datagrams a socket filter drops
 together with those it drops for a full buffer: under an acceptance filter ``rx_overflow`` is not counted.
+
+Each frame sent leaves its transmission window, the bounds of its send system call (``last_tx_ns``, with the
+count ``frames_sent``): the time-sync master's transmission time on this bus.
 """
 
 from __future__ import annotations
@@ -110,6 +113,9 @@ class LoopbackMulticastDriver(AbstractDriver):
         # acceptance filter drops are counted there too, indistinguishably.
         self._count_drops = _kernel_drops(self._rx) is not None and not (accept and self.kernel_self_filter)
         self._sent = 0
+        # When the last frame was handed to the kernel: the system call's bounds (CLOCK_REALTIME, time.time_ns), so
+        # that a time-sync master knows when its frame left however late its caller reads it.
+        self.last_tx_ns: tuple[int, int] | None = None
         self._overflow_reported = 0
         self._poll = select.poll()
         self._poll.register(self._rx.fileno(), select.POLLIN)
@@ -168,8 +174,11 @@ class LoopbackMulticastDriver(AbstractDriver):
 
     def send_frame(self, frame: CANFrame) -> None:
         self._check_open()
+        packet = encode_packet(frame)
         try:
-            self._tx.send(encode_packet(frame))
+            before = time.time_ns()
+            self._tx.send(packet)
+            after = time.time_ns()
         except (TimeoutError, BlockingIOError) as ex:
             self.drops.add(DropReason.TX_FAILED, detail=f"socket full for the send timeout: {ex}")
             raise TxQueueFullError(f"{self!r}: could not send within {self._tx.gettimeout()} s") from ex
@@ -179,7 +188,12 @@ class LoopbackMulticastDriver(AbstractDriver):
             self.drops.add(DropReason.TX_FAILED, detail=str(ex))
             raise TxQueueFullError(f"{self!r}: {ex}") from ex
         self._sent += 1
+        self.last_tx_ns = (before, after)
         self._tx_hook(frame)
+
+    @property
+    def frames_sent(self) -> int:
+        return self._sent
 
     def _count_overflow(self) -> None:
         kernel_drops = _kernel_drops(self._rx)

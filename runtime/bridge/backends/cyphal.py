@@ -12,6 +12,10 @@ device status events, pycyphal's per-subject counters, and the signs of a dead t
   reopenings; increments are logged at a bounded rate.
 - A dead transport: the CAN media close themselves for good on unrecoverable OS errors (the transport then only
   raises ResourceClosedError); a publish that finds its port closed says so too.
+- Transmission times (a port that ``want_tx_times``, the time-sync master's): on Cyphal/UDP the kernel's software
+  transmission timestamp of the session's socket (sam_runtime.common.tx_timestamps), read after every publish; on
+  CAN none (pycyphal's feedback through python-can without hardware loopback is the time its send coroutine
+  resumed, no better than the master's own measure), so the master measures the send.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from __future__ import annotations
 import collections
 import logging
 import os
+import socket
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -37,6 +42,7 @@ from sam_runtime.bridge.backend import (
 from sam_runtime.bridge.backends.cyphal_wire import RawReceiver, RawSender
 from sam_runtime.bridge.counters import log
 from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.tx_timestamps import KernelTxStamps, TxWindow
 from sam_runtime.cyphal_io.ports import PortConfigError, register_environment, register_node_id, resolve_subject
 from sam_runtime.cyphal_io.transport import aclose, make_node, make_transport, transport_from_env
 
@@ -174,6 +180,8 @@ class _Publication(Outlet):
         self.send_timeout = SEND_TIMEOUT_S
         self.publisher: Any = None  # a pycyphal Publisher, or on the wire path a RawSender with its session open
         self.raw_sender = RawSender() if raw else None
+        self.stamps: KernelTxStamps | None = None  # the kernel's transmission times (want_tx_times, UDP)
+        self._last_tx: TxWindow | None = None
 
     @property
     def ready(self) -> bool:
@@ -189,11 +197,24 @@ class _Publication(Outlet):
             sender = self.raw_sender
             if sender is not None and pub is sender:
                 return await sender.send(obj, self.send_timeout)
-            return bool(await pub.publish(obj))
+            self._last_tx = None
+            stamps = self.stamps
+            if stamps is None:
+                return bool(await pub.publish(obj))
+            try:
+                ok = bool(await pub.publish(obj))
+            finally:
+                window = stamps.take()  # after every attempt: the next take sees the next send's only
+            self._last_tx = window if ok else None
+            return ok
         except pycyphal.transport.ResourceClosedError as ex:
             if self.publisher is pub:  # not replaced by a reopened one meanwhile: the transport is gone
                 self._backend.suspect(f"publish on {self.port_id}: {type(ex).__name__}: {ex}")
             raise
+
+    def take_tx_time(self) -> TxWindow | None:
+        window, self._last_tx = self._last_tx, None
+        return window
 
 
 class CyphalBackend(Backend):
@@ -308,6 +329,10 @@ class CyphalBackend(Backend):
                 p = node.presentation.make_publisher(pub.dtype, pub.port_id)
                 p.send_timeout = pub.send_timeout
                 pub.publisher = p
+                pub.stamps = None
+                if pub.tx_times:  # Cyphal/UDP: the kernel's transmission timestamps of the session's socket
+                    sock = getattr(p.transport_session, "socket", None)
+                    pub.stamps = KernelTxStamps.attach(sock) if isinstance(sock, socket.socket) else None
             for sub in self._subs:
                 sub.port_id = resolve_subject(node.registry, "sub", sub.name, sub.dtype, sub.spec_id)
                 sub.seen, sub.refused = {}, 0

@@ -11,7 +11,10 @@ Wired to the spec by the composition root (``Bridge(layout=..., protocol="dronec
   ``load_dsdl`` replaces every type object: a handler registered on an old one never fires); its data type id must
   be the port id the spec gives;
 - publications: ``node.broadcast`` (v0 commands carry no destination either; the ESC index or actuator id is in
-  the message), sent before publish returns;
+  the message), sent before publish returns; a port that ``want_tx_times`` (the time-sync master's) gets the
+  driver's transmission window of its frame where the driver measures one (sam_runtime.dronecan_io's ``mcast-lo:``
+  driver: the bounds of its send system call), else none (the master measures the broadcast call, which does not
+  wait: no loop lag in it);
 - device health: every ``uavcan.protocol.NodeStatus`` as a DeviceStatus (OK, WARNING, ERROR, CRITICAL; its
   OFFLINE_TIMEOUT_MS is 3000 like Cyphal's heartbeat timeout);
 - the link: a closed driver (its socket failed) or a send that raised DriverError asks for a reopen;
@@ -40,6 +43,7 @@ from sam_runtime.bridge.backend import (
 )
 from sam_runtime.bridge.counters import log
 from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.tx_timestamps import TxWindow
 from sam_runtime.dronecan_io import DropReason, IfaceError, NodeLoop, close_node
 from sam_runtime.dronecan_io import make_node as default_make_node
 from sam_runtime.dronecan_io.wire import TransferTaps, broadcast_payload
@@ -122,6 +126,7 @@ class _Publication(Outlet):
         self.send_timeout = 0.1  # the loopback driver's; a broadcast is sent (or raises) before it returns
         self.raw = False
         self.crc_base = 0  # the wire path: the data type's CRC seed, from dronecan's type at each open
+        self._last_tx: TxWindow | None = None
 
     @property
     def ready(self) -> bool:
@@ -133,11 +138,18 @@ class _Publication(Outlet):
         node = self._backend.node
         if node is None:
             raise LinkDownError(self.port_name)
+        self._last_tx = None
+        driver: Any = _driver(node) if self.tx_times else None
+        sent = getattr(driver, "frames_sent", None)
         try:
             if self.raw:
                 broadcast_payload(node, self.spec_id, self.crc_base, obj)
             else:
                 node.broadcast(obj)
+            if sent is not None and driver.frames_sent == sent + 1 and driver.last_tx_ns is not None:
+                # one frame, sent by this broadcast (the driver is used in this thread only): the driver's window
+                earliest, latest = driver.last_tx_ns
+                self._last_tx = TxWindow(earliest, latest, "driver")
         except TxQueueFullError:
             raise  # the bus is full: counted by the core, the next one goes
         except DriverError as ex:
@@ -145,6 +157,15 @@ class _Publication(Outlet):
                 self._backend.suspect(f"broadcast on {self.port_id}: {type(ex).__name__}: {ex}")
             raise
         return True
+
+    def take_tx_time(self) -> TxWindow | None:
+        window, self._last_tx = self._last_tx, None
+        return window
+
+
+def _driver(node: Any) -> Any:
+    """The CAN driver under the node's FrameGate."""
+    return getattr(node.can_driver, "inner", node.can_driver)
 
 
 class DroneCanBackend(Backend):

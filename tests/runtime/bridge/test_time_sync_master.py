@@ -1,20 +1,23 @@
 """The bridge's time-sync master and stamp watch (sam_runtime.bridge.time_sync) with a fake port and a fake clock:
-each message carries the previous one's transmission time (the middle of its send), 0 first, after a failure, a
-link down, a send that took too long, or a previous transmission older than the protocol allows; the watch counts
+each message carries the previous one's transmission time (the transport's when it gives one, else the middle of
+the send call), 0 first, after a failure, a link down, a send that took too long (judged against the recent
+ones), or a previous transmission older than the protocol allows; the watch counts
 unknown (== receive time) and off stamps per device and reports the error; /diagnostics shows both."""
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import time
 from typing import Any
 
 import pytest
 
 from sam_runtime.bridge.diagnostics import Naming, diagnostic_array
 from sam_runtime.bridge.lifetime import Lifetime
-from sam_runtime.bridge.time_sync import StampWatch, TimeSyncMaster
+from sam_runtime.bridge.time_sync import MAX_SEND_CALL_SPAN_NS, MAX_TX_SPAN_NS, StampWatch, TimeSyncMaster
 from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.tx_timestamps import TxWindow
 
 
 class FakeOutlet:
@@ -22,13 +25,31 @@ class FakeOutlet:
 
     def __init__(self, clock: FakeClock) -> None:
         self.clock, self.ready, self.sent, self.fail, self.send_ns = clock, True, [], False, 100_000
+        self.tx_times = False
+        # a transmission window measured below the bridge: (offset from the call's start, width) or None
+        self.below: tuple[int, int] | None = None
+        self._window: TxWindow | None = None
+
+    def want_tx_times(self) -> None:
+        self.tx_times = True
 
     async def publish(self, obj: Any) -> bool:
+        start = self.clock.ns
         self.clock.ns += self.send_ns  # the send takes this long
+        self._window = None
         if self.fail:
             raise OSError("bus off")
         self.sent.append(obj)
+        if self.below is not None:
+            at, width = self.below
+            # CLOCK_REALTIME, as the transports give it: the fake ROS clock is this far from it
+            shift = self.clock.ns - time.time_ns()
+            self._window = TxWindow(start + at - shift, start + at + width - shift, "kernel")
         return True
+
+    def take_tx_time(self) -> TxWindow | None:
+        window, self._window = self._window, None
+        return window
 
 
 class FakeClock:
@@ -44,6 +65,7 @@ def _master(max_interval_s: float = 1.0) -> tuple[TimeSyncMaster, FakeOutlet, Fa
     outlet = FakeOutlet(clock)
     lifetime = Lifetime("b", RateLimitedLog(logging.getLogger("test"), 10.0))
     master = TimeSyncMaster(lifetime, outlet, lambda us: us, clock, 0.5, max_interval_s, "sync")  # type: ignore[arg-type]
+    master.attach()
     return master, outlet, clock, lifetime
 
 
@@ -70,6 +92,59 @@ def test_each_message_carries_the_previous_transmission_time() -> None:
         outlet.send_ns = 100_000
         assert await master.tick() and outlet.sent[-1] == 0
         assert master.imprecise == 1 and master.failed == 1 and lifetime.errors["time_sync_error"] == 1
+
+    asyncio.run(go())
+
+
+def test_the_transports_window_wins_over_a_held_up_send_call() -> None:
+    """A send call held up 30 ms (a loaded loop) whose frame the kernel timestamped 12 us into it: the kernel's time
+    is carried, exact; a measured window wider than MAX_TX_SPAN_NS gives none."""
+    master, outlet, clock, _ = _master()
+    assert outlet.tx_times  # asked for before the link opens
+
+    async def go() -> None:
+        outlet.send_ns, outlet.below = 30_000_000, (12_000, 0)
+        start = clock.ns
+        assert await master.tick() and await master.tick()
+        # the clocks' shift is read twice: within a few microseconds
+        assert abs(outlet.sent[1] - (start + 12_000) // 1000) <= 50, (outlet.sent[1], start)
+        outlet.below = (10_000, MAX_TX_SPAN_NS + 1)  # the driver's send system call preempted for long
+        assert await master.tick()
+        outlet.below = (12_000, 0)
+        assert await master.tick() and outlet.sent[-1] == 0
+        assert master.imprecise == 1
+        assert master.snapshot()["tx_time"] == {"kernel": 3, "kernel_refused": 1}
+
+    asyncio.run(go())
+
+
+def test_send_call_spans_are_judged_against_the_recent_ones() -> None:
+    """Without a transport's time: an idle loop's outlier is refused (1.5 ms when sends take 0.1 ms), a loaded
+    loop whose every send takes 3 ms is accepted (the middle: at most 1.5 ms off), nothing beyond
+    MAX_SEND_CALL_SPAN_NS however slow every send is."""
+    master, outlet, clock, _ = _master()
+
+    async def go() -> None:
+        for _ in range(8):
+            assert await master.tick()
+        assert master.imprecise == 0
+        outlet.send_ns = 1_500_000
+        assert await master.tick()
+        outlet.send_ns = 100_000
+        assert await master.tick() and outlet.sent[-1] == 0 and master.imprecise == 1
+        outlet.send_ns = 3_000_000  # a loaded loop: after a few such sends they are the norm
+        for _ in range(16):
+            await master.tick()
+        before = master.imprecise
+        start = clock.ns
+        assert await master.tick() and await master.tick()
+        assert master.imprecise == before and outlet.sent[-1] == (start + 1_500_000) // 1000
+        outlet.send_ns = MAX_SEND_CALL_SPAN_NS + 1_000  # every send too slow: never a time
+        for _ in range(20):
+            assert await master.tick()
+        assert outlet.sent[-19:] == [0] * 19 and master.imprecise == before + 20
+        snap = master.snapshot()
+        assert snap["tx_span_us"]["send_call_median"] == (MAX_SEND_CALL_SPAN_NS + 1_000) / 1000
 
     asyncio.run(go())
 
