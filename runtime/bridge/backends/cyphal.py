@@ -14,8 +14,9 @@ device status events, pycyphal's per-subject counters, and the signs of a dead t
   raises ResourceClosedError); a publish that finds its port closed says so too.
 - Transmission times (a port that ``want_tx_times``, the time-sync master's): on Cyphal/UDP the kernel's software
   transmission timestamp of the session's socket (sam_runtime.common.tx_timestamps), read after every publish; on
-  CAN none (pycyphal's feedback through python-can without hardware loopback is the time its send coroutine
-  resumed, no better than the master's own measure), so the master measures the send.
+  CAN through python-can the bounds of the media's transmit thread's send call (sam_runtime.cyphal_io.can_tx_times;
+  pycyphal's own feedback there is the time its send coroutine resumed on the loop); else (SocketCAN media) none,
+  and the master measures the send call.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from sam_runtime.bridge.backends.cyphal_wire import RawReceiver, RawSender
 from sam_runtime.bridge.counters import log
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.tx_timestamps import KernelTxStamps, TxWindow
+from sam_runtime.cyphal_io.can_tx_times import CanTxTimes
 from sam_runtime.cyphal_io.ports import PortConfigError, register_environment, register_node_id, resolve_subject
 from sam_runtime.cyphal_io.transport import aclose, make_node, make_transport, transport_from_env
 
@@ -181,6 +183,7 @@ class _Publication(Outlet):
         self.publisher: Any = None  # a pycyphal Publisher, or on the wire path a RawSender with its session open
         self.raw_sender = RawSender() if raw else None
         self.stamps: KernelTxStamps | None = None  # the kernel's transmission times (want_tx_times, UDP)
+        self.can_times: CanTxTimes | None = None  # python-can's transmit thread's (want_tx_times, CAN)
         self._last_tx: TxWindow | None = None
 
     @property
@@ -198,7 +201,12 @@ class _Publication(Outlet):
             if sender is not None and pub is sender:
                 return await sender.send(obj, self.send_timeout)
             self._last_tx = None
-            stamps = self.stamps
+            stamps, can_times = self.stamps, self.can_times
+            if can_times is not None:
+                count = can_times.count
+                ok = bool(await pub.publish(obj))
+                self._last_tx = can_times.take(count) if ok else None
+                return ok
             if stamps is None:
                 return bool(await pub.publish(obj))
             try:
@@ -329,10 +337,12 @@ class CyphalBackend(Backend):
                 p = node.presentation.make_publisher(pub.dtype, pub.port_id)
                 p.send_timeout = pub.send_timeout
                 pub.publisher = p
-                pub.stamps = None
+                pub.stamps = pub.can_times = None
                 if pub.tx_times:  # Cyphal/UDP: the kernel's transmission timestamps of the session's socket
                     sock = getattr(p.transport_session, "socket", None)
                     pub.stamps = KernelTxStamps.attach(sock) if isinstance(sock, socket.socket) else None
+                    if pub.stamps is None:  # Cyphal/CAN through python-can: its transmit thread's
+                        pub.can_times = CanTxTimes.attach(transport, pub.port_id, self.node_id)
             for sub in self._subs:
                 sub.port_id = resolve_subject(node.registry, "sub", sub.name, sub.dtype, sub.spec_id)
                 sub.seen, sub.refused = {}, 0
