@@ -151,7 +151,9 @@ def time_sync_status(ts: Mapping[str, Any], naming: Naming, status_cls: Any, kv:
         running = age is not None and age <= 3 * master["period_s"]
         values.update({"master": "running" if running else "not sending", "master.message": master["message"],
                        "master.period_s": master["period_s"], "master.sent": master["sent"],
-                       "master.failed": master["failed"]})
+                       "master.failed": master["failed"], "master.imprecise": master["imprecise"]})
+        if master.get("tx_time"):  # where its transmission times came from (sam_runtime.bridge.time_sync)
+            values["master.tx_time"] = ", ".join(f"{k}={v}" for k, v in master["tx_time"].items())
         if not running:
             level = 2
             problems.append("the master is not sending")

@@ -233,6 +233,7 @@ class StampWatch:
             if errs:
                 ordered = sorted(errs)
                 entry["error_ms"] = {"median": round(statistics.median(ordered) * 1e-6, 3),
+                                     "p95": round(ordered[min(len(ordered) - 1, (95 * len(ordered)) // 100)] * 1e-6, 3),
                                      "min": round(ordered[0] * 1e-6, 3), "max": round(ordered[-1] * 1e-6, 3),
                                      "last": round(errs[-1] * 1e-6, 3), "n": len(errs)}
             devices[self.devices.get(nid, f"node_{nid}")] = entry

@@ -189,7 +189,7 @@ def test_diagnostics_status_of_the_time_sync() -> None:
                    "link": {"up": True, "state": "up", "outages": 0, "down_s": 0.0}},
         "mappings": {}, "devices": {},
         "time_sync": {"master": {"message": "m", "period_s": 0.5, "sent": 9, "failed": 0, "imprecise": 1,
-                                 "last_sent_age_s": 0.2},
+                                 "last_sent_age_s": 0.2, "tx_time": {"kernel": 8, "kernel_refused": 1}},
                       "devices": {"imu": {"node_id": 11, "synchronised": True, "stamps_known": 5,
                                           "stamps_unknown": 2, "stamps_off": 0,
                                           "error_ms": {"median": 1.5, "min": 1.0, "max": 2.0, "last": 1.2,
@@ -202,6 +202,7 @@ def test_diagnostics_status_of_the_time_sync() -> None:
     values = {kv.key: kv.value for kv in st.values}
     assert st.level == b"\x01" and "not synchronised: gps" in st.message
     assert values["master"] == "running" and values["imu.error_ms.median"] == "1.5"
+    assert values["master.imprecise"] == "1" and values["master.tx_time"] == "kernel=8, kernel_refused=1"
     assert values["gps.stamps_unknown"] == "3"
     snap["time_sync"]["master"]["last_sent_age_s"] = 5.0
     st = next(s for s in diagnostic_array(snap, Naming("br", "cyphal", "C", "p"), None).status
