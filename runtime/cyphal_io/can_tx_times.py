@@ -50,7 +50,7 @@ class CanTxTimes:
 
     @classmethod
     def attach(cls, transport: Any, subject_id: int, node_id: int) -> CanTxTimes | None:
-        media = getattr(transport, "_maybe_media", None)
+        media: Any = getattr(transport, "_maybe_media", None)
         bus = getattr(media, "_bus", None)
         if bus is None or not callable(getattr(bus, "send", None)):
             return None
