@@ -129,7 +129,8 @@ class Outlet(abc.ABC):
 
     def take_tx_time(self) -> TxWindow | None:
         """When the first frame of the message of the last successful :meth:`publish` left, as the transport or
-        the driver measured it; None when it did not (not asked for, not supported, not measurable that time)."""
+        the driver measured it; None when it did not (not asked for, not supported, not measurable that time).
+        Called once, before the next publish (a transport may report the time after publish returned)."""
         return None
 
 

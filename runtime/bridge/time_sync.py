@@ -6,20 +6,23 @@ and the watch on the devices' stamps (:class:`StampWatch`), protocol-agnostic (t
   ``uavcan.protocol.GlobalTimeSync``): every ``period_s`` one message whose field is the time at which the previous
   one was transmitted, in the bridge's ROS clock (``ros.receive_ns``: the clock the bridge stamps receive times and
   rclpy its messages with), so that the devices' stamps become ROS time.
-  The transmission time, best first (``tx_time`` in the snapshot counts which one each message had):
-  ``kernel`` (Cyphal/UDP: the kernel's software transmission timestamp of the session's socket, taken in the
-  network device's transmit routine: exact to the microsecond, whatever held the loop up before or after);
-  ``driver`` (DroneCAN on ``mcast-lo:``: the bounds of the driver's send system call, some 10 us);
-  ``send_call`` where below the bridge nothing measures it (Cyphal/CAN, other DroneCAN drivers): the bounds of the
-  publish call, during which the frame left, on a loaded loop including the loop's lag (the call awaits).
-  Each gives a window [earliest, latest]; the message carries its middle, so the time carried is wrong by at most
-  half the window. A window wider than the accepted span gives no time (counted ``imprecise``; the next message
-  says 0, so the slaves keep their offset instead of adopting a wrong one): for ``kernel`` and ``driver``
-  MAX_TX_SPAN_NS (1 ms); for ``send_call`` twice the median of the last SPAN_WINDOW send-call spans, at least
-  MAX_TX_SPAN_NS and at most MAX_SEND_CALL_SPAN_NS (4 ms): an idle loop's outliers are refused, a loaded loop
-  whose every send takes a few ms still synchronises. Invariant: a message never carries a time more than
-  MAX_TX_ERROR_NS (half of MAX_SEND_CALL_SPAN_NS: 2 ms; 0.5 ms with ``kernel`` or ``driver`` times, 0 with
-  ``kernel``) from the transmission of the previous message.
+  The transmission time, measured where a held-up asyncio loop cannot delay it (``tx_time`` in the snapshot
+  counts where each message's came from):
+  ``kernel``: Cyphal/UDP, the kernel's software transmission timestamp of the session's socket (exact);
+  ``can_thread``: Cyphal/CAN through python-can, the bounds of the send call in pycyphal's transmit thread
+  (sam_runtime.cyphal_io.can_tx_times, some 10-60 us);
+  ``driver``: DroneCAN on ``mcast-lo:``, the bounds of the driver's send system call (some 10 us);
+  ``send_call`` where nothing below the bridge measures it (SocketCAN media, other DroneCAN drivers): the bounds
+  of the publish call, during which the frame left (on a loaded loop including the loop's lag: the call awaits).
+  Each is a window [earliest, latest], read when the next message is built (a transport may report a
+  transmission after the send returned: a real interface's queue); the message carries its middle, so the time
+  carried is off by at most half the window. A window wider than its limit gives no time (counted ``imprecise``
+  and ``<source>_refused``; the next message says 0, so the slaves keep their offset instead of adopting a wrong
+  one). The limit of a measured window is MAX_TX_SPAN_NS (1 ms); of a send call, twice the median of the last
+  SPAN_WINDOW send calls, at least MAX_TX_SPAN_NS and at most MAX_SEND_CALL_SPAN_NS (4 ms): an idle loop's
+  outliers are refused, a loop whose every send takes a few ms still synchronises.
+  Invariant (the bound): a message never carries a time more than MAX_TX_ERROR_NS (2 ms) from the previous
+  message's transmission; with a measured window 0.5 ms, with the kernel's 0.
   The field is 0 for the first message, after a failed or imprecise send or a link down, and
   when the previous transmission is more than ``max_interval_s`` old (the types' rule): a slave then starts its
   chain again.
@@ -76,11 +79,11 @@ class TimeSyncMaster:
         self.period_s, self.max_interval_s, self.label = float(period_s), float(max_interval_s), label
         self.sent = 0
         self.failed = 0
-        self.imprecise = 0  # sent, but the next message says 0: its transmission window was too wide
+        self.imprecise = 0  # sent, but the next message says 0: its transmission window was too wide (counted then)
         self.tx_sources: collections.Counter[str] = collections.Counter()  # transmission times by source
         self._spans: deque[int] = deque(maxlen=SPAN_WINDOW)  # the last send-call spans
         self._last_span_ns: int | None = None
-        self._prev_us = 0
+        self._pending: tuple[int, int] | None = None  # the last message sent, its send call's bounds
         self._prev_mono: float | None = None
         self._last_sent_mono: float | None = None
         self._task: asyncio.Task[None] | None = None
@@ -114,11 +117,12 @@ class TimeSyncMaster:
     async def tick(self) -> bool:
         """Send one message; True when it went out."""
         if not self.outlet.ready:
-            self._prev_us, self._prev_mono = 0, None
+            self._pending = None
             return False
         mono = time.monotonic()
-        fresh = self._prev_mono is not None and mono - self._prev_mono <= self.max_interval_s
-        obj = self.make(self._prev_us if fresh else 0)
+        prev_us = self._previous_us()
+        fresh = prev_us is not None and self._prev_mono is not None and mono - self._prev_mono <= self.max_interval_s
+        obj = self.make(prev_us if fresh and prev_us is not None else 0)
         before_ns = self.clock_ns()
         try:
             ok = await self.outlet.publish(obj)
@@ -131,22 +135,28 @@ class TimeSyncMaster:
         if not ok:
             self.failed += 1
             self.lifetime.errors["time_sync_error"] += 1
-            self._prev_us, self._prev_mono = 0, None
             return False
         after_ns = self.clock_ns()
-        self._last_sent_mono = time.monotonic()
+        self._last_sent_mono = self._prev_mono = time.monotonic()
         self.sent += 1
-        window = self._window(before_ns, after_ns)
-        if window is None:  # held up: when the frame left is not known well enough
-            self.imprecise += 1
-            self._prev_us, self._prev_mono = 0, None
-        else:
-            self._prev_us, self._prev_mono = window // 1000, self._last_sent_mono
+        self._pending = (before_ns, after_ns)  # its time is read at the next tick (a transport may report late)
         return True
 
+    def _previous_us(self) -> int | None:
+        """The transmission time of the last message sent [us], None when there was none (the first, after a
+        failure or a link down) or it is not known well enough (counted ``imprecise``)."""
+        pending, self._pending = self._pending, None
+        if pending is None:
+            return None
+        window = self._window(*pending)
+        if window is None:  # held up: when the frame left is not known well enough
+            self.imprecise += 1
+            return None
+        return window // 1000
+
     def _window(self, before_ns: int, after_ns: int) -> int | None:
-        """The transmission time of the message just sent (the bridge's clock, ns): the middle of the window
-        measured below the bridge or else of the send call; None when the window is too wide."""
+        """The transmission time of the last message (the bridge's clock, ns): the middle of the window measured
+        below the bridge or else of its send call (``before_ns``, ``after_ns``); None when the window is too wide."""
         tx = self.outlet.take_tx_time()
         if tx is not None:
             # the window is CLOCK_REALTIME: to the bridge's clock (the same one unless ROS time is simulated)

@@ -184,7 +184,7 @@ class _Publication(Outlet):
         self.raw_sender = RawSender() if raw else None
         self.stamps: KernelTxStamps | None = None  # the kernel's transmission times (want_tx_times, UDP)
         self.can_times: CanTxTimes | None = None  # python-can's transmit thread's (want_tx_times, CAN)
-        self._last_tx: TxWindow | None = None
+        self._last_tx: Callable[[], TxWindow | None] | None = None  # how to read the last message's time
 
     @property
     def ready(self) -> bool:
@@ -205,15 +205,19 @@ class _Publication(Outlet):
             if can_times is not None:
                 count = can_times.count
                 ok = bool(await pub.publish(obj))
-                self._last_tx = can_times.take(count) if ok else None
+                if ok:  # read when asked: by then the transmit thread has certainly noted it
+                    self._last_tx = lambda: can_times.take(count)
                 return ok
             if stamps is None:
                 return bool(await pub.publish(obj))
+            ok = False
             try:
                 ok = bool(await pub.publish(obj))
             finally:
-                window = stamps.take()  # after every attempt: the next take sees the next send's only
-            self._last_tx = window if ok else None
+                if ok:  # read when asked: by then the kernel has certainly reported it (a NIC's queue)
+                    self._last_tx = stamps.take
+                else:
+                    stamps.take()  # what a failed attempt left: the next take sees the next send's only
             return ok
         except pycyphal.transport.ResourceClosedError as ex:
             if self.publisher is pub:  # not replaced by a reopened one meanwhile: the transport is gone
@@ -221,8 +225,8 @@ class _Publication(Outlet):
             raise
 
     def take_tx_time(self) -> TxWindow | None:
-        window, self._last_tx = self._last_tx, None
-        return window
+        read, self._last_tx = self._last_tx, None
+        return None if read is None else read()
 
 
 class CyphalBackend(Backend):
