@@ -19,7 +19,9 @@ simulated sensor) is not woken by every frame of the bus. The kernel counts the 
 together with those it drops for a full buffer: under an acceptance filter ``rx_overflow`` is not counted.
 
 Each frame sent leaves its transmission window, the bounds of its send system call (``last_tx_ns``, with the
-count ``frames_sent``): the time-sync master's transmission time on this bus.
+count ``frames_sent``): the time-sync master's transmission time on this bus. Each frame received is stamped with
+the time the kernel received it (``SO_TIMESTAMPNS``; ``ts_monotonic`` and ``ts_real``), not the time a possibly
+held-up loop read it: a time-sync slave's reception time.
 """
 
 from __future__ import annotations
@@ -91,6 +93,10 @@ class LoopbackMulticastDriver(AbstractDriver):
             mreq = socket.inet_aton(self.group) + socket.inet_aton(LOOPBACK_ADDRESS)
             self._rx.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, mreq)
             self._rx.setblocking(False)
+            try:  # when each datagram arrived, not when it is read (Linux; elsewhere the reading time)
+                self._rx.setsockopt(socket.SOL_SOCKET, _SO_TIMESTAMPNS, 1)
+            except OSError:
+                pass
 
             self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(LOOPBACK_ADDRESS))
             self._tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
@@ -141,7 +147,7 @@ class LoopbackMulticastDriver(AbstractDriver):
         deadline = None if timeout is None else time.monotonic() + max(timeout, 0.0)
         while True:
             try:
-                data, source = self._rx.recvfrom(_RECV_SIZE)
+                data, ancdata, _flags, source = self._rx.recvmsg(_RECV_SIZE, _ANC_SIZE)
             except BlockingIOError:
                 if self._count_drops:
                     self._count_overflow()
@@ -159,6 +165,12 @@ class LoopbackMulticastDriver(AbstractDriver):
             if self.accept is not None and not self.kernel_self_filter and not (
                     frame.extended and self.accept.accepts(frame.id)):
                 continue  # what the kernel filter would have dropped
+            for level, kind, cdata in ancdata:
+                if level == socket.SOL_SOCKET and kind == _SO_TIMESTAMPNS and len(cdata) >= _TIMESPEC.size:
+                    sec, nsec = _TIMESPEC.unpack_from(cdata)
+                    arrived_ns = sec * 1_000_000_000 + nsec
+                    frame.ts_real = arrived_ns * 1e-9
+                    frame.ts_monotonic = time.monotonic() - (time.time_ns() - arrived_ns) * 1e-9
             self._rx_hook(frame)
             return frame
 
@@ -225,6 +237,9 @@ class LoopbackMulticastDriver(AbstractDriver):
 
 
 _SO_ATTACH_FILTER = 26  # Linux; not exported by the socket module
+_SO_TIMESTAMPNS = 35  # Linux; also the cmsg type SCM_TIMESTAMPNS
+_TIMESPEC = struct.Struct("qq")
+_ANC_SIZE = 64  # room for one struct timespec message
 _SO_MEMINFO = 55  # Linux >= 4.12: u32[SK_MEMINFO_VARS]
 _MEMINFO = struct.Struct("9I")
 _SK_MEMINFO_DROPS = 8
