@@ -17,6 +17,10 @@ wrong offset). The median includes the queueing of a loaded machine: MEDIAN_ERRO
 bound 200 times below the smallest initial offset (5 s). The convergence is waited for (a condition polled with a
 deadline), so a stall on a loaded machine (a sync message held up: the slaves lag until the next adjustment, 0.5 s
 later) delays the verdict instead of failing it. The figures print what was measured.
+
+Each protocol runs idle and loaded: LOAD_PER_CORE processes per core burn CPU beside the bridge and the simulator
+for the whole run (at the same niceness). The bounds are the same; the master's transmission times must come from
+below the bridge (the kernel's on Cyphal/UDP, the driver's on DroneCAN mcast-lo), never from its send calls.
 """
 
 from __future__ import annotations
