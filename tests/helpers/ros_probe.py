@@ -53,35 +53,59 @@ def to_plain(msg: Any) -> Any:
     return msg
 
 
-class ThreadedProbe:
-    """An rclpy node in its own context, spun in a thread: subscribes to bridged topics (each message goes to
-    ``on_message``), publishes commands; the in-process scenarios extend it."""
+class SpunNode:
+    """An rclpy node in a context of its own (and a domain of its own, if given), spun by a daemon thread from
+    `start_spinning` (called once its subscriptions exist) until `close`: the base of the tests' in-process probes."""
+
+    def __init__(self, node_name: str, domain: int | None = None) -> None:
+        import rclpy
+        from rclpy.node import Node
+        from rclpy.signals import SignalHandlerOptions
+
+        self.ctx = rclpy.Context()
+        domain_arg = {} if domain is None else {"domain_id": domain}
+        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO, **domain_arg)
+        self.node = Node(node_name, context=self.ctx)
+
+    def start_spinning(self, thread_name: str | None = None) -> None:
+        import threading
+
+        from rclpy.executors import SingleThreadedExecutor
+
+        self.ex = SingleThreadedExecutor(context=self.ctx)
+        self.ex.add_node(self.node)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._spin, name=thread_name, daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        while not self._stop.is_set():
+            self.ex.spin_once(timeout_sec=0.05)
+
+    def close(self, join_timeout_s: float = 5.0) -> None:
+        self._stop.set()
+        self._thread.join(timeout=join_timeout_s)
+        self.ex.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        self.ctx.shutdown()
+
+
+class ThreadedProbe(SpunNode):
+    """A SpunNode that subscribes to bridged topics (each message goes to ``on_message``) and publishes commands;
+    the in-process scenarios extend it."""
 
     node_name = "test_probe"
 
     def __init__(self, gen: Any, in_topics: list[str], out_topics: list[str], depth: int = 1000) -> None:
-        import threading
-
-        import rclpy
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.signals import SignalHandlerOptions
-
         info = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node(self.node_name, context=self.ctx)
+        super().__init__(self.node_name)
         self.setup()
         for t in in_topics:
             self.node.create_subscription(gen.ros_class(info[t]), t, lambda msg, t=t: self.on_message(t, msg),
                                           topic_qos(info[t], depth))
         self.classes = {t: gen.ros_class(info[t]) for t in out_topics}
         self.pubs = {t: self.node.create_publisher(self.classes[t], t, topic_qos(info[t], depth)) for t in out_topics}
-        self.ex = SingleThreadedExecutor(context=self.ctx)
-        self.ex.add_node(self.node)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
+        self.start_spinning()
 
     def setup(self) -> None:
         """Extra state and subscriptions, before the topics are subscribed."""
@@ -89,22 +113,26 @@ class ThreadedProbe:
     def on_message(self, topic: str, msg: Any) -> None:
         raise NotImplementedError
 
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.ex.spin_once(timeout_sec=0.05)
-
     def publish(self, topic: str, values: dict[str, Any]) -> None:
         msg = self.classes[topic]()
         for k, v in values.items():
             setattr(msg, k, v)
         self.pubs[topic].publish(msg)
 
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.ex.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
+
+class DroneCanTopics:
+    """A generated package as ThreadedProbe reads it, with the DroneCAN mappings' topics (it reads MAPPINGS)."""
+
+    def __init__(self, gen: Any) -> None:
+        self.gen = gen
+
+    def tables(self) -> Any:
+        from types import SimpleNamespace
+
+        return SimpleNamespace(MAPPINGS=self.gen.tables().DRONECAN_MAPPINGS)
+
+    def ros_class(self, topic: Any) -> Any:
+        return self.gen.ros_class(topic)
 
 
 def _tables_and_classes(generated: Path, topics: list[str]) -> tuple[dict[str, type], dict[str, Any]]:
