@@ -402,10 +402,149 @@ def _build(spec: Path, gen_dir: Path, say: Any) -> None:
     say(f"generated {gen_dir} from {spec}: " + (f"{len(stale.lines())} file(s) updated" if stale else "up to date"))
 
 
-def run(opts: RunOptions) -> int:
-    def say(text: str) -> None:
-        print(text, flush=True)
+def _say(text: str) -> None:
+    print(text, flush=True)
 
+
+@dataclass(frozen=True)
+class _Prepared:
+    """What the run starts from: generated/ up to date, its ROS package installed, its DSDL compiled."""
+
+    gen_dir: Path
+    state: Path  # the project's .sam-codegen-cache
+    gen: GeneratedPackage
+    prefix: Path  # where the generated ROS package is installed
+
+
+def _prepare(opts: RunOptions, say: Any) -> _Prepared | int:
+    """Steps 1-3 of the run (build, ROS package, DSDL); an exit code where one fails (said, never raised)."""
+    try:
+        ws = _workspace(opts)
+        gen_dir = ws.generated
+        if opts.build:
+            _build(ws.spec, gen_dir, say)
+        state = ensure_state_dir(ws)
+        gen = GeneratedPackage(gen_dir, opts.package)
+        prefix = ensure_ros_package(gen, opts.ros_prefix, log=say, build_root=state / "ros-build")
+        importlib.invalidate_caches()  # a package installed just now into this venv
+        gen.compile_dsdl()
+    except SpecError as ex:
+        say(f"sam-run: the spec is invalid:\n{ex}")
+        return 1
+    except (WorkspaceError, CyphalPathError, GeneratedPackageError, DsdlCompileError) as ex:
+        say(f"sam-run: {ex}")
+        return 1
+    except RosBuildError as ex:
+        say(f"sam-run: building the generated ROS packages failed: {ex}")
+        return 1
+    return _Prepared(gen_dir, state, gen, prefix)
+
+
+def _children_env(opts: RunOptions, prefix: Path, gen_dir: Path,
+                  old_handlers: Mapping[signal.Signals, Any]) -> dict[str, str]:
+    """The children's environment; first, if the ROS prefix is a separate one not yet on LD_LIBRARY_PATH, this
+    process continues as a new one that has it (os.execve, with the signal handlers it found put back)."""
+    env = ros_runtime_env(prefix) if prefix != Path(sys.prefix).absolute() else dict(os.environ)
+    ld_path = os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep)
+    if str(prefix / "lib") not in ld_path and opts.argv is not None:
+        # The ROS type support libraries of a separate prefix are found only through LD_LIBRARY_PATH,
+        # which the loader reads at process start: continue in a process that has it (built already).
+        for sig, h in old_handlers.items():
+            signal.signal(sig, h)
+        sys.stdout.flush()
+        os.execve(sys.executable, [sys.executable, "-m", "sam_runtime.cli", "run", *opts.argv, "--no-build",
+                                   "--generated", str(gen_dir)], env)
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "LOCALHOST"
+    env["PYTHONUNBUFFERED"] = "1"
+    env.setdefault("SAM_GENERATED_DIR", str(gen_dir))
+    return env
+
+
+def _start_children(children: list[_Child], opts: RunOptions, gen_dir: Path, tables: Any, hosted: list[str],
+                    env: Mapping[str, str], log_dir: Path, truth: Path) -> None:
+    """Step 4: the simulator, a bridge per protocol in use, the recorder and the node host, each appended to
+    `children` as soon as it runs (the caller stops whatever was started, even if a later start fails)."""
+    common = ["--generated", str(gen_dir), "--transport", "udp", "--iface", opts.iface,
+              "--dronecan-iface", opts.dronecan_iface, *(["--layout", opts.layout] if opts.layout else [])]
+    if opts.package:
+        common += ["--package", opts.package]
+    py = [sys.executable, "-m", "sam_runtime.cli"]
+    ns_args = opts.namespace.argv() if opts.namespace is not None else []
+    children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth),
+                                   *ns_args[:2]],
+                           env, log_dir / "sim.log"))
+    layout = opts.layout or tables.DEFAULT_LAYOUT
+    protocols = protocols_in_use(tables, layout)
+    for proto in protocols if len(protocols) > 1 else [None]:
+        name = "bridge" if proto is None else f"bridge_{proto}"
+        children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire, *ns_args,
+                                      *(["--protocol", proto] if proto else [])], env, log_dir / f"{name}.log"))
+    if opts.record is not None:
+        children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
+                                            "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
+                                            *ns_args[:2],
+                                            *(["--layout", opts.layout] if opts.layout else []),
+                                            *(["--package", opts.package] if opts.package else [])],
+                               env, log_dir / "recorder.log"))
+    if hosted:
+        gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
+        children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or []), *ns_args], env,
+                               log_dir / "nodes.log"))
+
+
+def _show_live(live: LiveView, children: list[_Child], tables: Any, opts: RunOptions, stop_reason: list[str],
+               say: Any) -> int:
+    """Step 5 until a stop reason comes (a signal handler, --duration, a child that died: exit code 1).
+    Returns the exit code."""
+    exit_code = 0
+    tty = sys.stdout.isatty() and not opts.plain
+    started = time.monotonic()
+    next_draw = started
+    refresh = opts.refresh_s if tty else 1.0
+    while not stop_reason:
+        elapsed = time.monotonic() - started
+        if opts.duration is not None and elapsed >= opts.duration:
+            stop_reason.append("duration")
+            break
+        dead = [c for c in children if not c.alive()]
+        if dead:
+            for c in dead:
+                say(f"sam-run: {c.name} exited with code {c.proc.returncode}; its log ({c.log}):\n{c.tail()}")
+            exit_code = 1
+            stop_reason.append("child exited")
+            break
+        live.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
+        if time.monotonic() >= next_draw:
+            next_draw += refresh
+            header = (f"{tables.VEHICLE} bridge run  t={elapsed:6.1f} s  "
+                      + "  ".join(f"{c.name} pid {c.proc.pid}" for c in children)
+                      + ("" if opts.duration is None else f"  (stops at {opts.duration:.0f} s)")
+                      + ("  Ctrl-C to stop" if tty else ""))
+            lines = live.table(header)
+            if tty:
+                cols = shutil.get_terminal_size((120, 40)).columns
+                sys.stdout.write("\x1b[H\x1b[2J" + "\n".join(line[:cols] for line in lines) + "\n")
+                sys.stdout.flush()
+            else:
+                say("\n".join(lines) + "\n")
+    return exit_code
+
+
+def _report_stopped(children: list[_Child], codes: Mapping[str, int | None], exit_code: int,
+                    stop_reason: list[str], say: Any) -> None:
+    """Step 6's words: a child that stopped badly (unless the run already said why it ended), and the logs."""
+    with contextlib.suppress(OSError):  # the terminal may be gone (SIGHUP): reporting must not fail the stop
+        for c in children:
+            rc = codes[c.name]
+            if rc not in (0, None, -signal.SIGTERM) and exit_code == 0 and (
+                    not stop_reason or stop_reason[0] != "child exited"):
+                say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
+        if children:
+            say("logs: " + ", ".join(str(c.log) for c in children))
+
+
+def run(opts: RunOptions) -> int:
+    say = _say
     stop_reason: list[str] = []
 
     def on_signal(signum: int, _frame: Any) -> None:
@@ -422,46 +561,14 @@ def run(opts: RunOptions) -> int:
     live: LiveView | None = None
     exit_code = 0
     try:
-        try:
-            ws = _workspace(opts)
-            gen_dir = ws.generated
-            if opts.build:
-                _build(ws.spec, gen_dir, say)
-            state = ensure_state_dir(ws)
-            gen = GeneratedPackage(gen_dir, opts.package)
-            prefix = ensure_ros_package(gen, opts.ros_prefix, log=say, build_root=state / "ros-build")
-            importlib.invalidate_caches()  # a package installed just now into this venv
-            gen.compile_dsdl()
-        except SpecError as ex:
-            say(f"sam-run: the spec is invalid:\n{ex}")
-            return 1
-        except (WorkspaceError, CyphalPathError, GeneratedPackageError, DsdlCompileError) as ex:
-            say(f"sam-run: {ex}")
-            return 1
-        except RosBuildError as ex:
-            say(f"sam-run: building the generated ROS packages failed: {ex}")
-            return 1
+        prepared = _prepare(opts, say)
+        if isinstance(prepared, int):
+            return prepared
+        gen_dir, gen = prepared.gen_dir, prepared.gen
         if stop_reason:
             return 0
-        env = ros_runtime_env(prefix) if prefix != Path(sys.prefix).absolute() else dict(os.environ)
-        ld_path = os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep)
-        if str(prefix / "lib") not in ld_path and opts.argv is not None:
-            # The ROS type support libraries of a separate prefix are found only through LD_LIBRARY_PATH,
-            # which the loader reads at process start: continue in a process that has it (built already).
-            for sig, h in old_handlers.items():
-                signal.signal(sig, h)
-            sys.stdout.flush()
-            os.execve(sys.executable, [sys.executable, "-m", "sam_runtime.cli", "run", *opts.argv, "--no-build",
-                                       "--generated", str(gen_dir)], env)
-        env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE") or "LOCALHOST"
-        env["PYTHONUNBUFFERED"] = "1"
-        env.setdefault("SAM_GENERATED_DIR", str(gen_dir))
-        log_dir = (opts.log_dir or state / "run-logs").resolve()
-        common = ["--generated", str(gen_dir), "--transport", "udp", "--iface", opts.iface,
-                  "--dronecan-iface", opts.dronecan_iface, *(["--layout", opts.layout] if opts.layout else [])]
-        if opts.package:
-            common += ["--package", opts.package]
-        py = [sys.executable, "-m", "sam_runtime.cli"]
+        env = _children_env(opts, prepared.prefix, gen_dir, old_handlers)
+        log_dir = (opts.log_dir or prepared.state / "run-logs").resolve()
         tables = gen.tables()
         hosted = implemented(tables) if opts.nodes else []
         missing = unimplemented(tables)
@@ -469,62 +576,13 @@ def run(opts: RunOptions) -> int:
             say(f"no implementation for node(s) {', '.join(missing)} of the spec"
                 + (f"; hosting {', '.join(hosted)}" if hosted else "; demo commands move the actuators"))
         truth = (opts.truth_file or log_dir / "truth.json").resolve()
-        ns_args = opts.namespace.argv() if opts.namespace is not None else []
-        children.append(_Child("sim", [*py, "sim", *common, *(opts.sim_args or []), "--truth-file", str(truth),
-                                       *ns_args[:2]],
-                               env, log_dir / "sim.log"))
-        layout = opts.layout or tables.DEFAULT_LAYOUT
-        protocols = protocols_in_use(tables, layout)
-        for proto in protocols if len(protocols) > 1 else [None]:
-            name = "bridge" if proto is None else f"bridge_{proto}"
-            children.append(_Child(name, [*py, "bridge", *common, "--wire", opts.wire, *ns_args,
-                                          *(["--protocol", proto] if proto else [])], env, log_dir / f"{name}.log"))
-        if opts.record is not None:
-            children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
-                                                "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
-                                                *ns_args[:2],
-                                                *(["--layout", opts.layout] if opts.layout else []),
-                                                *(["--package", opts.package] if opts.package else [])],
-                                   env, log_dir / "recorder.log"))
-        if hosted:
-            gen_args = ["--generated", str(gen_dir)] + (["--package", opts.package] if opts.package else [])
-            children.append(_Child("nodes", [*py, "nodes", *gen_args, *(opts.node_args or []), *ns_args], env,
-                                   log_dir / "nodes.log"))
+        _start_children(children, opts, gen_dir, tables, hosted, env, log_dir, truth)
         live = LiveView(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
-                               truth_file=truth, namespace=opts.namespace)
-
-        tty = sys.stdout.isatty() and not opts.plain
+                        truth_file=truth, namespace=opts.namespace)
         started = time.monotonic()
-        next_draw = started
-        refresh = opts.refresh_s if tty else 1.0
-        while not stop_reason:
-            elapsed = time.monotonic() - started
-            if opts.duration is not None and elapsed >= opts.duration:
-                stop_reason.append("duration")
-                break
-            dead = [c for c in children if not c.alive()]
-            if dead:
-                for c in dead:
-                    say(f"sam-run: {c.name} exited with code {c.proc.returncode}; its log ({c.log}):\n{c.tail()}")
-                exit_code = 1
-                stop_reason.append("child exited")
-                break
-            live.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
-            if time.monotonic() >= next_draw:
-                next_draw += refresh
-                header = (f"{tables.VEHICLE} bridge run  t={elapsed:6.1f} s  "
-                          + "  ".join(f"{c.name} pid {c.proc.pid}" for c in children)
-                          + ("" if opts.duration is None else f"  (stops at {opts.duration:.0f} s)")
-                          + ("  Ctrl-C to stop" if tty else ""))
-                lines = live.table(header)
-                if tty:
-                    cols = shutil.get_terminal_size((120, 40)).columns
-                    sys.stdout.write("\x1b[H\x1b[2J" + "\n".join(line[:cols] for line in lines) + "\n")
-                    sys.stdout.flush()
-                else:
-                    say("\n".join(lines) + "\n")
+        exit_code = _show_live(live, children, tables, opts, stop_reason, say)
         final = live.table(f"final ({stop_reason[0] if stop_reason else 'stopped'}) after "
-                              f"{time.monotonic() - started:.1f} s")
+                           f"{time.monotonic() - started:.1f} s")
         say("\n".join(final))
     finally:
         # Our handlers stay in place until the children are stopped: a second Ctrl-C must not cut the stop short.
@@ -534,14 +592,7 @@ def run(opts: RunOptions) -> int:
         if live is not None:
             with contextlib.suppress(Exception):  # the children are stopped already; nothing else depends on it
                 live.close()
-        with contextlib.suppress(OSError):  # the terminal may be gone (SIGHUP): reporting must not fail the stop
-            for c in children:
-                rc = codes[c.name]
-                if rc not in (0, None, -signal.SIGTERM) and exit_code == 0 and (
-                        not stop_reason or stop_reason[0] != "child exited"):
-                    say(f"sam-run: {c.name} stopped with exit code {rc}; log: {c.log}")
-            if children:
-                say("logs: " + ", ".join(str(c.log) for c in children))
+        _report_stopped(children, codes, exit_code, stop_reason, say)
     if opts.record is not None and opts.record.is_file():  # the recorder has stopped: its file is whole
         report_picture(opts.record, gen_dir, say)
     return exit_code
