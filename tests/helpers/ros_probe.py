@@ -22,6 +22,7 @@ import math
 import signal
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -268,6 +269,20 @@ def publish(args: argparse.Namespace) -> int:
     node.destroy_node()
     rclpy.shutdown()
     return 0
+
+
+def listen_cmd(generated: Path | str, topics: Sequence[str], out: Path, record: Path | None = None,
+               diagnostics: bool = False) -> list[str]:
+    """The command line of `listen` (this script in a process of its own), for the tests that start it."""
+    return [sys.executable, str(Path(__file__).resolve()), "listen", "--generated", str(generated),
+            "--topics", ",".join(topics), "--out", str(out), *(["--record", str(record)] if record else []),
+            *(["--diagnostics"] if diagnostics else [])]
+
+
+def publish_cmd(generated: Path | str, plan: Path, out: Path) -> list[str]:
+    """The command line of `publish`, for the tests that start it."""
+    return [sys.executable, str(Path(__file__).resolve()), "publish", "--generated", str(generated),
+            "--plan", str(plan), "--out", str(out)]
 
 
 def main() -> int:

@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import pytest
 
@@ -33,24 +33,14 @@ from helpers.runtime_support import (
     cyphal_udp_lock,
     domain_id,
     generated_or_skip,
+    poll_until,
     ros_prefix_for,
     runtime_cmd,
 )
 
-T = TypeVar("T")
+wait_for = poll_until  # (the scenario tests' name for it)
 START_TIMEOUT_S = 90.0  # three Python processes compiling nothing (the DSDL cache is warm) on a loaded machine
 WORLD_TIMEOUT_S = 45.0  # world -> base_link: discovery, the first GPS fix, SLAM's first correction
-
-
-def wait_for(fn: Callable[[], T], timeout: float, what: str, interval: float = 0.05) -> T:
-    deadline = time.monotonic() + timeout
-    while True:
-        value = fn()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
-        time.sleep(interval)
 
 
 # ============================================================================================ truth

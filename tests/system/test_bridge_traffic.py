@@ -20,11 +20,10 @@ from __future__ import annotations
 
 import sys
 import threading
-import time
 from collections.abc import Callable
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import pytest
 
@@ -33,13 +32,13 @@ pytest.importorskip("rclpy")
 
 from helpers.ros_probe import SpunNode
 from helpers.runtime_support import Proc, child_env, cyphal_udp_lock, domain_id, runtime_cmd
+from helpers.runtime_support import poll_until as wait_for
 from helpers.spec_build import generated_spec
 
 from sam_runtime.bridge.rate_limit import most_in
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
-T = TypeVar("T")
 BRIDGE = "weir_bridge"
 LEVEL_RATE_HZ = 4.0  # tests/specs/weir.yaml
 START_TIMEOUT_S = 90.0
@@ -47,16 +46,6 @@ START_TIMEOUT_S = 90.0
 # neighbours may look that much closer than the interval. One message of slack covers it.
 STAMP_SLACK = 1
 
-
-def wait_for(fn: Callable[[], T], timeout: float, what: str) -> T:
-    deadline = time.monotonic() + timeout
-    while True:
-        value = fn()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
-        time.sleep(0.05)
 
 
 class TrafficProbe(SpunNode):
