@@ -40,6 +40,7 @@ from sam_codegen.model.spec import (
     ParameterRule,
     RosMessage,
     RosPackageInfo,
+    RosService,
     Spec,
     Topic,
     Transform,
@@ -73,10 +74,60 @@ def parse_spec(root: YNode, file: str) -> Spec:
                    "topics_message"))
     cyphal = Reader(top.node("cyphal") or YMap(top.pos), "cyphal", diag, ("root_namespace",))
     package = ros.get("package", str) or ""
-    info = RosPackageInfo(package, ros.get("version", str, "0.1.0"), text_of(ros, "description"),
+    info = _package_info(ros, package)
+    external_messages, messages = _ros_messages(top, package, diag)
+    dsdl_types, dsdl_services = _dsdl_types(top, diag)
+    frames: dict[str, Frame] = {}
+    for key, pos, node in map_items(top.node("frames"), "frames", diag):
+        frames[key] = parse_frame(key, pos, node, diag)
+    transforms = _transforms(top, diag)
+    declared_topics = _declared_topics(top, diag)  # their effective QoS comes once the bridge is read
+    parameters: dict[str, Parameter] = {}
+    for key, pos, node in map_items(top.node("parameters"), "parameters", diag):
+        parameter = parse_parameter(key, pos, node, diag)
+        if parameter is not None:
+            parameters[key] = parameter
+    parameter_rules = _parameter_rules(top, diag)
+    dronecan_types: dict[str, V0Struct] = {}
+    for key, pos, node in map_items(top.node("dronecan_types"), "dronecan_types", diag):
+        dronecan_types[key] = parse_dronecan_type(key, pos, node, diag)
+    devices = {key: parse_device(key, pos, node, diag)
+               for key, pos, node in map_items(top.node("devices"), "devices", diag)}
+    layouts = {key: parse_layout(key, pos, node, diag)
+               for key, pos, node in map_items(top.node("layouts"), "layouts", diag)}
+    bridge = _bridge(top.node("bridge"), diag)
+    nodes: dict[str, Node] = {}
+    for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
+        nodes[key] = parse_node(key, pos, node, diag)
+    bridged = {m.topic for m in bridge.all_mappings if m.direction == UAVCAN_TO_ROS} if bridge is not None else set()
+    declared_topics += implied_tf_topics({t.name: t for t in declared_topics}, nodes, frames)
+    topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
+    bus = parse_bus(top.node("bus"), "bus", diag)
+    namespaces = str_list(top.node("dronecan_namespaces"), "dronecan_namespaces", diag) \
+        if top.node("dronecan_namespaces") is not None else None
+    services = _ros_services(top, package, diag)
+    diag.check()
+    return Spec(
+        file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
+        cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
+        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus,
+        dronecan_namespaces=tuple(n for n, _ in namespaces) if namespaces is not None else None,
+        dronecan_namespaces_pos=tuple(p for _, p in namespaces) if namespaces is not None else (),
+        services=services, dsdl_services=dsdl_services,
+    )
+
+
+def _package_info(ros: Reader, package: str) -> RosPackageInfo:
+    """The `ros` section: the spec's own ROS package."""
+    return RosPackageInfo(package, ros.get("version", str, "0.1.0"), text_of(ros, "description"),
                           ros.get("maintainer", str, "maintainer"),
                           ros.get("maintainer_email", str, "maintainer@example.org"), ros.get("license", str, "MIT"),
                           ros.get("topics_message", str, None), ros.key_pos("topics_message"))
+
+
+def _ros_messages(top: Reader, package: str,
+                  diag: Diagnostics) -> tuple[dict[str, RosMessage], dict[str, RosMessage]]:
+    """`external_messages` (pkg/Name) and `messages` (bare names, of the spec's package), by full name."""
     external_messages: dict[str, RosMessage] = {}
     for key, pos, node in map_items(top.node("external_messages"), "external_messages", diag):
         if "/" not in key:
@@ -91,6 +142,11 @@ def parse_spec(root: YNode, file: str) -> Spec:
             continue
         message = parse_ros_message(key, pos, node, package, False, diag)
         messages[message.full_name] = message
+    return external_messages, messages
+
+
+def _dsdl_types(top: Reader, diag: Diagnostics) -> tuple[dict[str, DsdlStruct], dict[str, DsdlService]]:
+    """`dsdl_types`: the structures, and the service types (an entry with a request or a response)."""
     dsdl_types: dict[str, DsdlStruct] = {}
     dsdl_services: dict[str, DsdlService] = {}
     for key, pos, node in map_items(top.node("dsdl_types"), "dsdl_types", diag):
@@ -98,15 +154,21 @@ def parse_spec(root: YNode, file: str) -> Spec:
             dsdl_services[key] = parse_dsdl_service(key, pos, node, diag)  # a service type
             continue
         dsdl_types[key] = parse_dsdl_struct(key, pos, node, diag)
-    frames: dict[str, Frame] = {}
-    for key, pos, node in map_items(top.node("frames"), "frames", diag):
-        frames[key] = parse_frame(key, pos, node, diag)
+    return dsdl_types, dsdl_services
+
+
+def _transforms(top: Reader, diag: Diagnostics) -> list[Transform]:
     transforms: list[Transform] = []
     for item in seq_items(top.node("transforms"), "transforms", diag):
         r = Reader(item, "a transform", diag, ("parent", "child", "publisher", "description"))
         parent, child, publisher = r.get("parent", str), r.get("child", str), r.get("publisher", str)
         if parent and child and publisher:
             transforms.append(Transform(parent, child, publisher, text_of(r, "description"), item.pos))
+    return transforms
+
+
+def _declared_topics(top: Reader, diag: Diagnostics) -> list[Topic]:
+    """`topics` as declared (a topic declared twice is an error), each with its declared QoS only."""
     topics_node = top.node("topics")
     if isinstance(topics_node, YMap):
         for key, pos, again in topics_node.duplicates:
@@ -116,7 +178,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
             diag.error(pos, f"topic {key!r} is declared twice (first at line {topics_node.key_pos[key].line}"
                        + (f", types {' and '.join(map(str, types))}" if types else "")
                        + "): two types on one topic", "one type per topic; give the second its own topic")
-    declared_topics: list[Topic] = []  # their effective QoS comes once the bridge is read
+    declared_topics: list[Topic] = []
     for key, pos, node in map_items(topics_node, "topics", diag, duplicates=False):
         r = Reader(node, f"topic {key!r}", diag, ("type", "description", "section", "qos", "published_by"))
         type_ = r.get("type", str)
@@ -128,11 +190,10 @@ def parse_spec(root: YNode, file: str) -> Spec:
                                          str(r.get("section", (str, float, int), "")), pos, qos,
                                          qos_node.pos if qos_node is not None else pos,
                                          external_publisher=external, external_pos=external_pos))
-    parameters: dict[str, Parameter] = {}
-    for key, pos, node in map_items(top.node("parameters"), "parameters", diag):
-        parameter = parse_parameter(key, pos, node, diag)
-        if parameter is not None:
-            parameters[key] = parameter
+    return declared_topics
+
+
+def _parameter_rules(top: Reader, diag: Diagnostics) -> list[ParameterRule]:
     parameter_rules: list[ParameterRule] = []
     for item in seq_items(top.node("parameter_rules"), "parameter_rules", diag):
         r = Reader(item, "a parameter rule", diag, ("left", "op", "right", "description"))
@@ -141,60 +202,44 @@ def parse_spec(root: YNode, file: str) -> Spec:
             diag.error(r.key_pos("op"), f"parameter rule operator {op!r} is unknown", "<, <=, > or >=")
         elif left and op and right:
             parameter_rules.append(ParameterRule(left, op, right, text_of(r, "description"), item.pos))
-    dronecan_types: dict[str, V0Struct] = {}
-    for key, pos, node in map_items(top.node("dronecan_types"), "dronecan_types", diag):
-        dronecan_types[key] = parse_dronecan_type(key, pos, node, diag)
-    devices = {key: parse_device(key, pos, node, diag)
-               for key, pos, node in map_items(top.node("devices"), "devices", diag)}
-    layouts = {key: parse_layout(key, pos, node, diag)
-               for key, pos, node in map_items(top.node("layouts"), "layouts", diag)}
-    bridge_node = top.node("bridge")
-    bridge = None
-    if bridge_node is not None:
-        r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty",
-                                                 "service_mappings", "time_sync"))
-        name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
-        mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
-        for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
-            what = "bridge mappings" if protocol == "cyphal" else "bridge dronecan_mappings"
-            for key, pos, node in map_items(r.node(key_), what, diag):
-                mapping = parse_mapping(key, pos, node, diag, protocol)
-                if mapping is not None:
-                    mappings[protocol].append(mapping)
-        for protocol, protocol_mappings in mappings.items():
-            check_enable_services(protocol_mappings, protocol, diag)
-        service_mappings = [m for key, pos, node in map_items(r.node("service_mappings"), "bridge service_mappings",
-                                                              diag)
-                            for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]
-        bridge = Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
-                        service_mappings=service_mappings,
-                        time_sync=parse_time_sync(r.node("time_sync"), "bridge time_sync", diag),
-                        panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"))
-    nodes: dict[str, Node] = {}
-    for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
-        nodes[key] = parse_node(key, pos, node, diag)
-    bridged = {m.topic for m in bridge.all_mappings if m.direction == UAVCAN_TO_ROS} if bridge is not None else set()
-    declared_topics += implied_tf_topics({t.name: t for t in declared_topics}, nodes, frames)
-    topics = {topic.name: _with_effective_qos(topic, bridged) for topic in declared_topics}
-    bus = parse_bus(top.node("bus"), "bus", diag)
-    namespaces = str_list(top.node("dronecan_namespaces"), "dronecan_namespaces", diag) \
-        if top.node("dronecan_namespaces") is not None else None
-    services = {}
+    return parameter_rules
+
+
+def _bridge(bridge_node: YNode | None, diag: Diagnostics) -> Bridge | None:
+    """The `bridge` section (None without one): its Cyphal and DroneCAN mappings, service mappings, time sync."""
+    if bridge_node is None:
+        return None
+    r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty",
+                                             "service_mappings", "time_sync"))
+    name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
+    mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
+    for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
+        what = "bridge mappings" if protocol == "cyphal" else "bridge dronecan_mappings"
+        for key, pos, node in map_items(r.node(key_), what, diag):
+            mapping = parse_mapping(key, pos, node, diag, protocol)
+            if mapping is not None:
+                mappings[protocol].append(mapping)
+    for protocol, protocol_mappings in mappings.items():
+        check_enable_services(protocol_mappings, protocol, diag)
+    service_mappings = [m for key, pos, node in map_items(r.node("service_mappings"), "bridge service_mappings",
+                                                          diag)
+                        for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]
+    return Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
+                  service_mappings=service_mappings,
+                  time_sync=parse_time_sync(r.node("time_sync"), "bridge time_sync", diag),
+                  panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"))
+
+
+def _ros_services(top: Reader, package: str, diag: Diagnostics) -> dict[str, RosService]:
+    """`services`: the spec's own .srv types (bare names, of the spec's package), by full name."""
+    services: dict[str, RosService] = {}
     for key, pos, node in map_items(top.node("services"), "services", diag):
         if "/" in key:
             diag.error(pos, f"service type {key!r} is declared in package {package}: give its bare name", "Name")
             continue
         srv = parse_ros_service(key, pos, node, package, diag)
         services[srv.full_name] = srv
-    diag.check()
-    return Spec(
-        file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
-        cyphal.get("root_namespace", str) or "", external_messages, messages, dsdl_types, frames, transforms, topics,
-        parameters, parameter_rules, devices, bridge, nodes, dronecan_types, layouts, bus,
-        dronecan_namespaces=tuple(n for n, _ in namespaces) if namespaces is not None else None,
-        dronecan_namespaces_pos=tuple(p for _, p in namespaces) if namespaces is not None else (),
-        services=services, dsdl_services=dsdl_services,
-    )
+    return services
 
 
 def _with_effective_qos(topic: Topic, bridged: set[str]) -> Topic:

@@ -1,6 +1,6 @@
 """Demo values for any ROS message, built from the message's own field types (issue 11, defect 4).
 
-The live view's demo publisher (main_job.job.LiveView) sweeps the command topics of a spec that has no nodes of its
+The demo publisher of main_job.live_view.LiveView sweeps the command topics of a spec that has no nodes of its
 own. Its values come from each field's rosidl type (``SLOT_TYPES``), never from a guess on the type's name: a
 fixed-size array gets a sequence of exactly its size, a bounded sequence at most its bound, an integer a value inside
 its width, a bool a bool, a byte a one-byte ``bytes``, a string a ``str``, a nested message (or a sequence of them) its

@@ -1,4 +1,4 @@
-"""The main job's view of the vehicle and its mission (beside the topic/device table of sam_runtime.main_job.job), for a
+"""The main job's view of the vehicle and its mission (beside the topic/device table of main_job.live_view), for a
 spec whose nodes are hosted: where the vehicle is, where it goes and what the nodes say.
 
 - The vehicle: position, depth and heading from world -> base_link (/tf, as the nodes see it), the depth from

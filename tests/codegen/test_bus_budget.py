@@ -318,9 +318,9 @@ def test_the_overload_of_a_named_layout_is_reported_at_its_bus(tmp_path: Path) -
     v0 = (REPO / "tests" / "specs" / "buoy_v0.yaml").read_text()
     spec = tmp_path / "buoy_v0.yaml"
     changed = LAYOUT[:-1] + ", bus: {bitrate: 10000}}"
-    assert "{type: buoy.Status, rate_hz: 2}" in v0
-    spec.write_text(v0.replace(LAYOUT, changed, 1).replace("{type: buoy.Status, rate_hz: 2}",
-                                                           "{type: buoy.Status, rate_hz: 200}", 1))
+    assert "{type: spar.Status, rate_hz: 2}" in v0
+    spec.write_text(v0.replace(LAYOUT, changed, 1).replace("{type: spar.Status, rate_hz: 2}",
+                                                           "{type: spar.Status, rate_hz: 200}", 1))
     errors = spec_errors(spec)
     lines = spec.read_text().splitlines()
     line = lines.index(changed) + 1

@@ -50,7 +50,7 @@ def test_generated_packages_build_with_colcon(tmp_path: Path) -> None:
     src = tmp_path / "ws" / "src"
     packages = [*ros_packages_in_order(REPO / "generated" / "ros"),
                 *ros_packages_in_order(skiff / "generated" / "ros")]
-    assert {"sam_msgs", "skiff_msgs"} <= {p.name for p in packages}
+    assert {"sam_msgs", "dinghy_msgs"} <= {p.name for p in packages}
     for package in packages:
         shutil.copytree(package, src / package.name)
 

@@ -1,5 +1,5 @@
 """The conversion plan is the one place a link's conversion is decided: the converters' statements and the
-interface reference's wording both follow from its operations (codegen/conversion_plan.py)."""
+interface reference's wording both follow from its operations (codegen/conversion_plan/)."""
 
 from __future__ import annotations
 

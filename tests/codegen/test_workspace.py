@@ -124,8 +124,8 @@ def test_cli_acts_on_the_project_where_it_runs(project: Path, monkeypatch: pytes
     assert main(["build"]) == 0
     assert "updated" in capsys.readouterr().out
     generated = project / "generated"
-    assert (generated / "ros" / "skiff_msgs" / "package.xml").is_file()
-    assert (generated / "python" / "skiff_bridge" / "tables.py").is_file()
+    assert (generated / "ros" / "dinghy_msgs" / "package.xml").is_file()
+    assert (generated / "python" / "dinghy_bridge" / "tables.py").is_file()
     assert main(["build", "--check"]) == 0
 
     # The user edits their spec: the check sees it, a build takes it.
@@ -133,7 +133,7 @@ def test_cli_acts_on_the_project_where_it_runs(project: Path, monkeypatch: pytes
     spec.write_text(spec.read_text().replace("rate_hz: 10}", "rate_hz: 20}"))
     capsys.readouterr()
     assert main(["build", "--check"]) == 1
-    assert "python/skiff_bridge/tables.py" in capsys.readouterr().err
+    assert "python/dinghy_bridge/tables.py" in capsys.readouterr().err
     assert main(["build"]) == 0
     assert main(["build", "--check"]) == 0
     assert _tree(REPO / "generated") == mine
@@ -229,16 +229,16 @@ def test_ros_install_builds_every_generated_package(project: Path, tmp_path: Pat
 
     monkeypatch.chdir(project)
     assert main(["build"]) == 0
-    _package(project / "generated" / "ros" / "aa_extra_msgs", "aa_extra_msgs", "skiff_msgs")
+    _package(project / "generated" / "ros" / "aa_extra_msgs", "aa_extra_msgs", "dinghy_msgs")
     built: list[tuple[str, Path, Path]] = []
     monkeypatch.setattr(ros_build, "build_ros_package",
                         lambda pkg, build, prefix, **_: built.append((Path(pkg).name, Path(build), Path(prefix))))
     assert main(["ros-install", "--prefix", str(tmp_path / "prefix")]) == 0
     state = project / ".sam-codegen-cache"
-    assert built == [("skiff_msgs", state / "ros-build" / "skiff_msgs", tmp_path / "prefix"),
+    assert built == [("dinghy_msgs", state / "ros-build" / "dinghy_msgs", tmp_path / "prefix"),
                      ("aa_extra_msgs", state / "ros-build" / "aa_extra_msgs", tmp_path / "prefix")]
     assert (state / ".gitignore").read_text().splitlines()[-1] == "*"
-    assert "skiff_msgs, aa_extra_msgs installed into" in capsys.readouterr().out
+    assert "dinghy_msgs, aa_extra_msgs installed into" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------------------- CYPHAL_PATH

@@ -27,28 +27,16 @@ def main() -> int:
     p.add_argument("--max-life", type=float, default=60.0)
     args = p.parse_args()
     import dronecan
+    from plain_dronecan_node import broadcast_paced, loopback_node, wait_until_heard
 
-    from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
-
-    spec = parse_iface(args.iface)
-    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=args.node_id,
-                              node_status_interval=0.5, mode=0)
-    seen: set[int] = set()
-    node.add_handler(dronecan.uavcan.protocol.NodeStatus, lambda e: seen.add(e.transfer.source_node_id))
+    node = loopback_node(args.iface, args.node_id)
     end = time.monotonic() + args.max_life
-    sent = 0
     try:
-        while args.wait_for not in seen:
-            if time.monotonic() > end:
-                print(f"TIMEOUT waiting for node {args.wait_for}", flush=True)
-                return 1
-            node.spin(0.05)
-        while sent < args.count and time.monotonic() < end:
-            node.broadcast(dronecan.uavcan.equipment.esc.Status(esc_index=args.esc_index, rpm=args.rpm,
-                                                                temperature=300.0))
-            sent += 1
-            node.spin(1.0 / args.rate)
-        node.spin(0.2)  # the last frames out
+        if not wait_until_heard(node, args.wait_for, end):
+            return 1
+        sent = broadcast_paced(node, (dronecan.uavcan.equipment.esc.Status(esc_index=args.esc_index, rpm=args.rpm,
+                                                                           temperature=300.0)
+                                      for _ in range(args.count)), args.rate, end)
     finally:
         node.close()
     print(f"PUBLISHED {sent}", flush=True)

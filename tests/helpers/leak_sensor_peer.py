@@ -12,6 +12,7 @@ Waits until node ``--wait-for`` (the bridge) is heard, broadcasts one uavcan.equ
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 
@@ -27,29 +28,17 @@ def main() -> int:
     p.add_argument("--max-life", type=float, default=60.0)
     args = p.parse_args()
     import dronecan
-
-    from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
+    from plain_dronecan_node import broadcast_paced, loopback_node, wait_until_heard
 
     positions = [float(v) for v in args.positions.split(",")]
-    spec = parse_iface(args.iface)
-    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=args.node_id,
-                              node_status_interval=0.5, mode=0)
-    seen: set[int] = set()
-    node.add_handler(dronecan.uavcan.protocol.NodeStatus, lambda e: seen.add(e.transfer.source_node_id))
-    end = time.monotonic() + args.max_life
-    sent = 0
+    node = loopback_node(args.iface, args.node_id)
     try:
-        while args.wait_for not in seen:
-            if time.monotonic() > end:
-                print(f"TIMEOUT waiting for node {args.wait_for}", flush=True)
-                return 1
-            node.spin(0.05)
-        for position in positions:
-            node.broadcast(dronecan.uavcan.equipment.actuator.Status(actuator_id=args.actuator_id,
-                                                                     position=position))
-            sent += 1
-            node.spin(1.0 / args.rate)
-        node.spin(0.2)  # the last frames out
+        if not wait_until_heard(node, args.wait_for, time.monotonic() + args.max_life):
+            return 1
+        # (--max-life bounds the wait only: the few positions always go out)
+        sent = broadcast_paced(node, (dronecan.uavcan.equipment.actuator.Status(actuator_id=args.actuator_id,
+                                                                                position=position)
+                                      for position in positions), args.rate, math.inf)
     finally:
         node.close()
     print(f"PUBLISHED {sent}", flush=True)

@@ -15,11 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
-import threading
-import time
-from pathlib import Path
 
 BOARD_ID = 30
 USEC = 1_700_000_000_250_000
@@ -36,41 +32,29 @@ def main() -> int:
     p.add_argument("--panic", help="also broadcast one Panic with this reason_text")
     args = p.parse_args()
 
-    import dronecan
+    from plain_dronecan_node import loopback_node, serve, stop_on_sigterm, with_spec_types
 
-    from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
-    from sam_runtime.dronecan_io.types import ensure_types
-    from sam_runtime.genpkg import GeneratedPackage
-
-    ensure_types(GeneratedPackage(Path(args.generated)))
+    dronecan = with_spec_types(args.generated)
     array = dronecan.TYPENAMES[f"{args.namespace}.ConsumedChargeArray"]
     charge = dronecan.TYPENAMES[f"{args.namespace}.ConsumedCharge"]
     stamp = dronecan.TYPENAMES["uavcan.Timestamp"]
-    spec = parse_iface(args.iface)
-    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=args.node_id,
-                              node_status_interval=0.5, mode=0)
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    node = loopback_node(args.iface, args.node_id)
+    stop = stop_on_sigterm()
     decoded_as = dronecan.DATATYPES.get((array.default_dtid, array.kind))
     print("READY " + json.dumps({"data_type_id": array.default_dtid,
                                  "decoded_as": decoded_as.full_name if decoded_as is not None else None}), flush=True)
-    published = False
-    end = time.monotonic() + args.max_life
-    try:
-        while not stop.is_set() and time.monotonic() < end:
-            node.spin(0.05)
-            if not published and Path(args.start_file).exists():
-                published = True
-                node.broadcast(array(timestamp=stamp(usec=USEC),
-                                     charges=[charge(circuit_id=c, charge=c * 0.5) for c in range(1, 16)]))
-                node.spin(0.01)
-                node.broadcast(array(timestamp=stamp(usec=USEC + 1_000_000), charges=[]))
-                if args.panic is not None:
-                    node.spin(0.01)
-                    node.broadcast(dronecan.uavcan.protocol.Panic(reason_text=args.panic.encode()))
-                print("PUBLISHED", flush=True)
-    finally:
-        node.close()
+
+    def publish() -> None:
+        node.broadcast(array(timestamp=stamp(usec=USEC),
+                             charges=[charge(circuit_id=c, charge=c * 0.5) for c in range(1, 16)]))
+        node.spin(0.01)
+        node.broadcast(array(timestamp=stamp(usec=USEC + 1_000_000), charges=[]))
+        if args.panic is not None:
+            node.spin(0.01)
+            node.broadcast(dronecan.uavcan.protocol.Panic(reason_text=args.panic.encode()))
+        print("PUBLISHED", flush=True)
+
+    serve(node, stop, args.max_life, args.start_file, publish)
     print("SUMMARY {}", flush=True)
     return 0
 

@@ -22,6 +22,7 @@ import math
 import signal
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -53,35 +54,59 @@ def to_plain(msg: Any) -> Any:
     return msg
 
 
-class ThreadedProbe:
-    """An rclpy node in its own context, spun in a thread: subscribes to bridged topics (each message goes to
-    ``on_message``), publishes commands; the in-process scenarios extend it."""
+class SpunNode:
+    """An rclpy node in a context of its own (and a domain of its own, if given), spun by a daemon thread from
+    `start_spinning` (called once its subscriptions exist) until `close`: the base of the tests' in-process probes."""
+
+    def __init__(self, node_name: str, domain: int | None = None) -> None:
+        import rclpy
+        from rclpy.node import Node
+        from rclpy.signals import SignalHandlerOptions
+
+        self.ctx = rclpy.Context()
+        domain_arg = {} if domain is None else {"domain_id": domain}
+        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO, **domain_arg)
+        self.node = Node(node_name, context=self.ctx)
+
+    def start_spinning(self, thread_name: str | None = None) -> None:
+        import threading
+
+        from rclpy.executors import SingleThreadedExecutor
+
+        self.ex = SingleThreadedExecutor(context=self.ctx)
+        self.ex.add_node(self.node)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._spin, name=thread_name, daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        while not self._stop.is_set():
+            self.ex.spin_once(timeout_sec=0.05)
+
+    def close(self, join_timeout_s: float = 5.0) -> None:
+        self._stop.set()
+        self._thread.join(timeout=join_timeout_s)
+        self.ex.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        self.ctx.shutdown()
+
+
+class ThreadedProbe(SpunNode):
+    """A SpunNode that subscribes to bridged topics (each message goes to ``on_message``) and publishes commands;
+    the in-process scenarios extend it."""
 
     node_name = "test_probe"
 
     def __init__(self, gen: Any, in_topics: list[str], out_topics: list[str], depth: int = 1000) -> None:
-        import threading
-
-        import rclpy
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.signals import SignalHandlerOptions
-
         info = {m.topic.name: m.topic for m in gen.tables().MAPPINGS}
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node(self.node_name, context=self.ctx)
+        super().__init__(self.node_name)
         self.setup()
         for t in in_topics:
             self.node.create_subscription(gen.ros_class(info[t]), t, lambda msg, t=t: self.on_message(t, msg),
                                           topic_qos(info[t], depth))
         self.classes = {t: gen.ros_class(info[t]) for t in out_topics}
         self.pubs = {t: self.node.create_publisher(self.classes[t], t, topic_qos(info[t], depth)) for t in out_topics}
-        self.ex = SingleThreadedExecutor(context=self.ctx)
-        self.ex.add_node(self.node)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
+        self.start_spinning()
 
     def setup(self) -> None:
         """Extra state and subscriptions, before the topics are subscribed."""
@@ -89,22 +114,26 @@ class ThreadedProbe:
     def on_message(self, topic: str, msg: Any) -> None:
         raise NotImplementedError
 
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.ex.spin_once(timeout_sec=0.05)
-
     def publish(self, topic: str, values: dict[str, Any]) -> None:
         msg = self.classes[topic]()
         for k, v in values.items():
             setattr(msg, k, v)
         self.pubs[topic].publish(msg)
 
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.ex.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
+
+class DroneCanTopics:
+    """A generated package as ThreadedProbe reads it, with the DroneCAN mappings' topics (it reads MAPPINGS)."""
+
+    def __init__(self, gen: Any) -> None:
+        self.gen = gen
+
+    def tables(self) -> Any:
+        from types import SimpleNamespace
+
+        return SimpleNamespace(MAPPINGS=self.gen.tables().DRONECAN_MAPPINGS)
+
+    def ros_class(self, topic: Any) -> Any:
+        return self.gen.ros_class(topic)
 
 
 def _tables_and_classes(generated: Path, topics: list[str]) -> tuple[dict[str, type], dict[str, Any]]:
@@ -240,6 +269,20 @@ def publish(args: argparse.Namespace) -> int:
     node.destroy_node()
     rclpy.shutdown()
     return 0
+
+
+def listen_cmd(generated: Path | str, topics: Sequence[str], out: Path, record: Path | None = None,
+               diagnostics: bool = False) -> list[str]:
+    """The command line of `listen` (this script in a process of its own), for the tests that start it."""
+    return [sys.executable, str(Path(__file__).resolve()), "listen", "--generated", str(generated),
+            "--topics", ",".join(topics), "--out", str(out), *(["--record", str(record)] if record else []),
+            *(["--diagnostics"] if diagnostics else [])]
+
+
+def publish_cmd(generated: Path | str, plan: Path, out: Path) -> list[str]:
+    """The command line of `publish`, for the tests that start it."""
+    return [sys.executable, str(Path(__file__).resolve()), "publish", "--generated", str(generated),
+            "--plan", str(plan), "--out", str(out)]
 
 
 def main() -> int:

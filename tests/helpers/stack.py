@@ -22,34 +22,25 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import pytest
 
+from helpers.ros_probe import SpunNode
 from helpers.runtime_support import (
     Proc,
     child_env,
     cyphal_udp_lock,
     domain_id,
     generated_or_skip,
+    poll_until,
     ros_prefix_for,
     runtime_cmd,
 )
 
-T = TypeVar("T")
+wait_for = poll_until  # (the scenario tests' name for it)
 START_TIMEOUT_S = 90.0  # three Python processes compiling nothing (the DSDL cache is warm) on a loaded machine
 WORLD_TIMEOUT_S = 45.0  # world -> base_link: discovery, the first GPS fix, SLAM's first correction
-
-
-def wait_for(fn: Callable[[], T], timeout: float, what: str, interval: float = 0.05) -> T:
-    deadline = time.monotonic() + timeout
-    while True:
-        value = fn()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
-        time.sleep(interval)
 
 
 # ============================================================================================ truth
@@ -116,26 +107,20 @@ class Records:
     buoyancy: list[tuple[int, float]] = field(default_factory=list)
 
 
-class Probe:
+class Probe(SpunNode):
     """An rclpy node of the test in its own context and domain, spun by a thread."""
 
     def __init__(self, domain: int) -> None:
-        import rclpy
         from diagnostic_msgs.msg import DiagnosticArray
         from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Path as PathMsg
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.signals import SignalHandlerOptions
         from sam_msgs.msg import Abort, HeadingStamped, PercentStamped, ThrusterRPMs
         from tf2_msgs.msg import TFMessage
 
         from sam_runtime.node_support import qos_profile
         from sam_runtime.tf_buffer import TfBuffer
 
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, domain_id=domain, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node("scenario_probe", context=self.ctx)
+        super().__init__("scenario_probe", domain)
         self.tf = TfBuffer(cache_time_s=30.0)
         self.rec = Records()
         self._lock = threading.Lock()
@@ -156,15 +141,7 @@ class Probe:
         self.heading_pub = n.create_publisher(HeadingStamped, "/nav_heading", qos_profile("reliable", "volatile", 10))
         self.plan_pub = n.create_publisher(PathMsg, "/global_plan", qos_profile("reliable", "volatile", 10))
         self._clients: dict[str, Any] = {}
-        self.ex = SingleThreadedExecutor(context=self.ctx)
-        self.ex.add_node(n)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, name="probe", daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.ex.spin_once(timeout_sec=0.05)
+        self.start_spinning("probe")
 
     # ---------------------------------------------------------------------------------- callbacks
     def _on_tf(self, msg: Any, static: bool) -> None:
@@ -321,13 +298,6 @@ class Probe:
         wait_for(future.done, timeout, f"the answer of /{node}/set_parameters")
         result = future.result().results[0]
         return bool(result.successful), str(result.reason)
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.ex.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
 
 
 # ============================================================================================ the stack

@@ -14,11 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
-import threading
-import time
-from pathlib import Path
 from typing import Any
 
 PANEL_ID = 30
@@ -32,20 +28,13 @@ def main() -> int:
     p.add_argument("--max-life", type=float, default=120.0)
     args = p.parse_args()
 
-    import dronecan
+    from plain_dronecan_node import loopback_node, serve, stop_on_sigterm, with_spec_types
 
-    from sam_runtime.dronecan_io import LoopbackMulticastDriver, parse_iface
-    from sam_runtime.dronecan_io.types import ensure_types
-    from sam_runtime.genpkg import GeneratedPackage
-
-    ensure_types(GeneratedPackage(Path(args.generated)))
+    dronecan = with_spec_types(args.generated)
     switch = dronecan.TYPENAMES["trawler.io.Switch"]
     panic = dronecan.TYPENAMES["uavcan.protocol.Panic"]
-    spec = parse_iface(args.iface)
-    node = dronecan.node.Node(LoopbackMulticastDriver(spec.bus, spec.port), node_id=PANEL_ID,
-                              node_status_interval=0.5, mode=0)
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    node = loopback_node(args.iface, PANEL_ID)
+    stop = stop_on_sigterm()
     received: list[dict[str, Any]] = []
 
     def on_message(e: Any) -> None:
@@ -65,21 +54,16 @@ def main() -> int:
     decoded_as = dronecan.DATATYPES.get((20100, switch.kind))
     print("READY " + json.dumps({"node_id": PANEL_ID,
                                  "20100": decoded_as.full_name if decoded_as is not None else None}), flush=True)
-    published = False
-    end = time.monotonic() + args.max_life
-    try:
-        while not stop.is_set() and time.monotonic() < end:
-            node.spin(0.05)
-            if not published and Path(args.start_file).exists():
-                published = True
-                for k in range(5):
-                    node.broadcast(switch(switch_id=1, level=100 * k + 7, flags=k))
-                    node.spin(0.01)
-                node.broadcast(switch(switch_id=3, level=5, flags=0))
-                node.broadcast(panic(reason_text=b"LEAK"))
-                print("PUBLISHED", flush=True)
-    finally:
-        node.close()
+
+    def publish() -> None:
+        for k in range(5):
+            node.broadcast(switch(switch_id=1, level=100 * k + 7, flags=k))
+            node.spin(0.01)
+        node.broadcast(switch(switch_id=3, level=5, flags=0))
+        node.broadcast(panic(reason_text=b"LEAK"))
+        print("PUBLISHED", flush=True)
+
+    serve(node, stop, args.max_life, args.start_file, publish)
     print("SUMMARY " + json.dumps({"received": received}), flush=True)
     return 0
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from helpers.runtime_support import REPO, TEST_ROS_PREFIX
 
 SKIFF_SPEC = REPO / "tests" / "specs" / "skiff.yaml"
-# skiff_msgs goes into the runtime tests' prefix too, stamped with its sources' hash, so a later session reuses it.
+# dinghy_msgs goes into the runtime tests' prefix too, stamped with its sources' hash, so a later session reuses it.
 TEST_ROS_BUILD = REPO / ".cache" / "ros-test-build"
 
 
@@ -22,7 +22,7 @@ def make_project(root: Path) -> Path:
 
 
 def built_project(root: Path) -> tuple[Path, Path]:
-    """A skiff project with generated/ built and skiff_msgs installed: (project, ROS prefix)."""
+    """A skiff project with generated/ built and dinghy_msgs installed: (project, ROS prefix)."""
     from sam_codegen.build import build
     from sam_runtime.genpkg import GeneratedPackage, ensure_ros_package
 

@@ -20,25 +20,25 @@ from __future__ import annotations
 
 import sys
 import threading
-import time
 from collections.abc import Callable
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import pytest
 
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
+from helpers.ros_probe import SpunNode
 from helpers.runtime_support import Proc, child_env, cyphal_udp_lock, domain_id, runtime_cmd
+from helpers.runtime_support import poll_until as wait_for
 from helpers.spec_build import generated_spec
 
 from sam_runtime.bridge.rate_limit import most_in
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
-T = TypeVar("T")
 BRIDGE = "weir_bridge"
 LEVEL_RATE_HZ = 4.0  # tests/specs/weir.yaml
 START_TIMEOUT_S = 90.0
@@ -47,34 +47,19 @@ START_TIMEOUT_S = 90.0
 STAMP_SLACK = 1
 
 
-def wait_for(fn: Callable[[], T], timeout: float, what: str) -> T:
-    deadline = time.monotonic() + timeout
-    while True:
-        value = fn()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
-        time.sleep(0.05)
 
-
-class TrafficProbe:
+class TrafficProbe(SpunNode):
     """The test's rclpy node: /level and /level_raw with their DDS source timestamps, the bridge's mapping statuses
     from /diagnostics with their stamps, a /gate publisher, SetBool clients."""
 
     def __init__(self, domain: int) -> None:
-        import rclpy
         from diagnostic_msgs.msg import DiagnosticArray
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.signals import SignalHandlerOptions
         from std_msgs.msg import Int32, UInt8
 
         from sam_runtime.node_support import qos_profile
 
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, domain_id=domain, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = n = Node("traffic_probe", context=self.ctx)
+        super().__init__("traffic_probe", domain)
+        n = self.node
         self.lock = threading.Lock()
         self.stamps: dict[str, list[int]] = {"/level": [], "/level_raw": []}  # DDS source timestamps, ns
         self.statuses: dict[str, list[tuple[int, dict[str, str], int, str]]] = {}  # (stamp ns, values, level, msg)
@@ -84,15 +69,7 @@ class TrafficProbe:
         n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, qos_profile("reliable", "volatile",
                                                                                             200))
         self.gate = n.create_publisher(UInt8, "/gate", qos_profile("reliable", "volatile", 50))
-        self.executor = SingleThreadedExecutor(context=self.ctx)
-        self.executor.add_node(n)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, name="traffic-probe", daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.executor.spin_once(timeout_sec=0.05)
+        self.start_spinning("traffic-probe")
 
     def _on_level(self, topic: str) -> Callable[[Any, Any], None]:
         def on_message(msg: Any, info: Any) -> None:
@@ -131,12 +108,8 @@ class TrafficProbe:
         wait_for(future.done, 10, f"the answer of {service}")
         return future.result()
 
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=2)
-        self.executor.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
+    def close(self, join_timeout_s: float = 2.0) -> None:
+        super().close(join_timeout_s)
 
 
 def _count(values: dict[str, str] | None, key: str) -> int:

@@ -31,6 +31,7 @@ import pytest
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
+from helpers.ros_probe import listen_cmd, publish_cmd
 from helpers.runtime_support import (
     Proc,
     child_env,
@@ -92,9 +93,7 @@ def _sensor_run(gen: Any, d: Path, env: dict[str, str], in_maps: list[Any], topi
     bridge = Proc("bridge", runtime_cmd("bridge", *udp, "--stats-file", str(d / "bridge.json")), env, d)
     sim = Proc("sim", runtime_cmd("sim", *udp, "--start-file", str(d / "go"), "--duration", str(WINDOW_S),
                                   "--record", str(d / "sim.jsonl"), "--report", str(d / "sim.json")), env, d)
-    probe = Proc("probe", helper_cmd("ros_probe.py", "listen", "--generated", str(gen.root), "--topics",
-                                     ",".join(topics), "--out", str(d / "probe.json"), "--record",
-                                     str(d / "probe.jsonl"), "--diagnostics"), env, d)
+    probe = Proc("probe", listen_cmd(gen.root, topics, d / "probe.json", d / "probe.jsonl", diagnostics=True), env, d)
     try:
         bridge.wait_line("READY", 60)
         sim.wait_line("READY", 60)
@@ -303,8 +302,7 @@ def _command_run(gen: Any, d: Path, env: dict[str, str], bridge_env: dict[str, s
     try:
         bridge.wait_line("READY", 60)
         sim.wait_line("READY", 60)
-        pub = Proc("publisher", helper_cmd("ros_probe.py", "publish", "--generated", str(gen.root), "--plan",
-                                           str(d / "plan.json"), "--out", str(d / "pub.json")), env, d)
+        pub = Proc("publisher", publish_cmd(gen.root, d / "plan.json", d / "pub.json"), env, d)
         procs.append(pub)
         pub.wait_line("DONE", 60)
         want = {m.port.subject_id: len(plan[m.topic.name]) for m in tables.MAPPINGS

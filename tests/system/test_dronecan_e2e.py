@@ -15,12 +15,12 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
+from helpers.ros_probe import listen_cmd
 from helpers.runtime_support import (
     Proc,
     child_env,
     domain_id,
     generated_or_skip,
-    helper_cmd,
     poll_until,
     read_json,
     ros_prefix_for,
@@ -59,8 +59,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     bridge = Proc("bridge", runtime_cmd("bridge", *dc, "--stats-file", str(d / "bridge.json")), env, d)
     sim = Proc("sim", runtime_cmd("sim", *dc, "--start-file", str(d / "go"), "--duration", str(WINDOW_S),
                                   "--report", str(d / "sim.json")), env, d)
-    probe = Proc("probe", helper_cmd("ros_probe.py", "listen", "--generated", str(gen.root), "--topics",
-                                     ",".join(topics), "--out", str(d / "probe.json")), env, d)
+    probe = Proc("probe", listen_cmd(gen.root, topics, d / "probe.json"), env, d)
     try:
         bridge.wait_line("READY", 90)
         sim.wait_line("READY", 90)

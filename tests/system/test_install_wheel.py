@@ -4,7 +4,7 @@ repository. build, validate, ros-install, sim, bridge and run work there; what t
 the user's cache directory, never in the install; without the [runtime] extra or without the Cyphal standard types
 each runtime command ends with one clear line.
 
-About 3-4 minutes: the two installs come from pip's cache, ros-install builds skiff_msgs with CMake.
+About 3-4 minutes: the two installs come from pip's cache, ros-install builds dinghy_msgs with CMake.
 """
 
 from __future__ import annotations
@@ -153,7 +153,7 @@ def test_installed_wheel_in_a_user_project(wheel: Wheel) -> None:
 
     assert "spec/interfaces.yaml is valid" in _run([sam, "validate"], cwd=work, env=env).stdout
     assert _run([sam, "build"], cwd=work, env=env).stdout.startswith(f"sam-codegen: {project / 'generated'} updated")
-    assert (project / "generated" / "ros" / "skiff_msgs" / "package.xml").is_file()
+    assert (project / "generated" / "ros" / "dinghy_msgs" / "package.xml").is_file()
     _run([sam, "build", "--check"], cwd=work, env=env)
 
     # No Cyphal standard types anywhere (an installed wheel has no development default): one clear error.
@@ -175,9 +175,9 @@ def test_installed_wheel_in_a_user_project(wheel: Wheel) -> None:
     _run([python, "-m", "pip", "install", "-q", f"{wheel.path}[runtime,rosbuild]"], cwd=root, env=env,
          timeout=INSTALL_TIMEOUT_S)
     out = _run([sam, "ros-install"], cwd=work, env=env, timeout=STEP_TIMEOUT_S).stdout
-    assert f"skiff_msgs installed into {venv}" in out
-    assert (venv / "share" / "skiff_msgs" / "package.xml").is_file()
-    assert (project / ".sam-codegen-cache" / "ros-build" / "skiff_msgs" / "CMakeCache.txt").is_file()
+    assert f"dinghy_msgs installed into {venv}" in out
+    assert (venv / "share" / "dinghy_msgs" / "package.xml").is_file()
+    assert (project / ".sam-codegen-cache" / "ros-build" / "dinghy_msgs" / "CMakeCache.txt").is_file()
 
     with cyphal_udp_lock():
         # The bridge and the devices, each found its generated/ from the working directory.
@@ -188,7 +188,7 @@ def test_installed_wheel_in_a_user_project(wheel: Wheel) -> None:
                                       cwd=work, env=env, stdout=fh, stderr=subprocess.STDOUT, text=True,
                                       start_new_session=True)
         try:
-            _wait_for_line(bridge_out, bridge, "READY bridge skiff_bridge", 180)
+            _wait_for_line(bridge_out, bridge, "READY bridge dinghy_bridge", 180)
             sim = _run([sam, "sim", "--duration", "3", "--report", report], cwd=work, env=env, timeout=180)
             assert "READY sim devices=2" in sim.stdout
             published = {name: sum(d["published"].values()) for name, d in read_json(report)["devices"].items()}
@@ -206,7 +206,7 @@ def test_installed_wheel_in_a_user_project(wheel: Wheel) -> None:
                 os.killpg(bridge.pid, signal.SIGKILL)
                 bridge.wait(timeout=10)
 
-        # The main job: build (up to date), the installed skiff_msgs, sim and bridge, and what flows.
+        # The main job: build (up to date), the installed dinghy_msgs, sim and bridge, and what flows.
         proc = _run([sam, "run", "--duration", "8", "--plain"], cwd=work, env=env, timeout=STEP_TIMEOUT_S)
         counts = _final_counts(proc.stdout)
         assert counts["/depth"] > 0 and counts["/pump/volume"] > 0, proc.stdout[-3000:]

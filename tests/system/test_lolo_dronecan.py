@@ -34,6 +34,7 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
+from helpers.ros_probe import listen_cmd, publish_cmd
 from helpers.runtime_support import (
     Proc,
     child_env,
@@ -78,8 +79,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     board = Proc("board", helper_cmd("power_board.py", "--generated", gen, "--iface", iface, "--namespace",
                                      "sabre.power", "--node-id", str(BOARD_ID), "--panic", "FLOOD",
                                      "--start-file", str(d / "go")), env, d)
-    listen = Proc("listen", helper_cmd("ros_probe.py", "listen", "--generated", gen, "--topics", ",".join(IN_TOPICS),
-                                       "--out", str(d / "listen.json"), "--record", str(d / "listen.jsonl")), env, d)
+    listen = Proc("listen", listen_cmd(gen, IN_TOPICS, d / "listen.json", d / "listen.jsonl"), env, d)
     (d / "plan.json").write_text(json.dumps({"rate_hz": 10, "topics": COMMANDS}))
     procs = [listen, board, sim, bridge]
     try:
@@ -93,8 +93,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                                    ("leak", "charges", "esc0_status", "esc1_status", "panic_in"))
 
         poll_until(ready, 60, "the bridge matching the probe")
-        publish = Proc("publish", helper_cmd("ros_probe.py", "publish", "--generated", gen, "--plan",
-                                             str(d / "plan.json"), "--out", str(d / "publish.json")), env, d)
+        publish = Proc("publish", publish_cmd(gen, d / "plan.json", d / "publish.json"), env, d)
         procs.append(publish)
         assert publish.wait(90) == 0, publish.stderr_tail()
 

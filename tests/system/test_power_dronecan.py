@@ -48,23 +48,11 @@ if not WORKER:
         assert " passed" in proc.stdout and " skipped" not in proc.stdout and " failed" not in proc.stdout, report
 
 if WORKER:
-    from types import SimpleNamespace
-
     from helpers.dronecan_support import private_iface
-    from helpers.ros_probe import ThreadedProbe
+    from helpers.ros_probe import DroneCanTopics, ThreadedProbe
     from helpers.runtime_support import Proc, child_env, helper_cmd, load_records, poll_until, read_json, runtime_cmd
 
     GENERATED = Path(json.loads(WORKER)["generated"])
-
-    class _DroneCanTopics:
-        def __init__(self, gen: Any) -> None:
-            self.gen = gen
-
-        def tables(self) -> Any:
-            return SimpleNamespace(MAPPINGS=self.gen.tables().DRONECAN_MAPPINGS)
-
-        def ros_class(self, topic: Any) -> Any:
-            return self.gen.ros_class(topic)
 
     class Probe(ThreadedProbe):
         node_name = "test_power_probe"
@@ -94,7 +82,7 @@ if WORKER:
         probe = None
         out: dict[str, Any] = {}
         try:
-            probe = Probe(_DroneCanTopics(gen), ["/power/charges"], ["/actuators"])
+            probe = Probe(DroneCanTopics(gen), ["/power/charges"], ["/actuators"])
             board.wait_line("READY", 60)
             bridge.wait_line("READY", 90)
             sim.wait_line("READY", 90)

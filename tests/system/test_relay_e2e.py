@@ -23,12 +23,12 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
+from helpers.ros_probe import listen_cmd, publish_cmd
 from helpers.runtime_support import (
     Proc,
     child_env,
     cyphal_udp_lock,
     domain_id,
-    helper_cmd,
     poll_until,
     read_json,
     runtime_cmd,
@@ -56,9 +56,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                                         str(d / "bridge.json")), env, d)
     sim = Proc("sim", runtime_cmd("sim", *dc, "--devices", DEVICES, "--report", str(d / "sim.json"),
                                   "--record", str(d / "sim.jsonl")), env, d)
-    listen = Proc("listen", helper_cmd("ros_probe.py", "listen", "--generated", str(b.generated), "--topics",
-                                       "/leak", "--out", str(d / "listen.json"), "--record",
-                                       str(d / "leak.jsonl")), env, d)
+    listen = Proc("listen", listen_cmd(b.generated, ["/leak"], d / "listen.json", d / "leak.jsonl"), env, d)
     publish = None
     try:
         bridge.wait_line("READY", 120)
@@ -66,8 +64,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         listen.wait_line("READY", 60)
         poll_until(lambda: (read_json(d / "listen.json") or {}).get("counts", {}).get("/leak", 0) >= 5, 60,
                    "leak flags at the probe")
-        publish = Proc("publish", helper_cmd("ros_probe.py", "publish", "--generated", str(b.generated), "--plan",
-                                             str(d / "plan.json"), "--out", str(d / "publish.json")), env, d)
+        publish = Proc("publish", publish_cmd(b.generated, d / "plan.json", d / "publish.json"), env, d)
         assert publish.wait(90) == 0, publish.stderr_tail()
 
         def commands_sent() -> bool:
@@ -128,9 +125,8 @@ def cyphal_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                                             str(d / "bridge.json")), env, d)
         sim = Proc("sim", runtime_cmd("sim", *udp, "--devices", "hull,rail", "--report", str(d / "sim.json"),
                                       "--record", str(d / "sim.jsonl")), env, d)
-        listen = Proc("listen", helper_cmd("ros_probe.py", "listen", "--generated", str(b.generated), "--topics",
-                                           "/hull_leak,/hull_depth", "--out", str(d / "listen.json"), "--record",
-                                           str(d / "hull.jsonl")), env, d)
+        listen = Proc("listen", listen_cmd(b.generated, ["/hull_leak", "/hull_depth"], d / "listen.json",
+                                           d / "hull.jsonl"), env, d)
         publish = None
         try:
             bridge.wait_line("READY", 120)
@@ -138,8 +134,7 @@ def cyphal_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             listen.wait_line("READY", 60)
             poll_until(lambda: min((read_json(d / "listen.json") or {}).get("counts", {"": 0}).values()) >= 5, 60,
                        "hull messages at the probe")
-            publish = Proc("publish", helper_cmd("ros_probe.py", "publish", "--generated", str(b.generated),
-                                                 "--plan", str(d / "plan.json"), "--out", str(d / "publish.json")),
+            publish = Proc("publish", publish_cmd(b.generated, d / "plan.json", d / "publish.json"),
                            env, d)
             assert publish.wait(90) == 0, publish.stderr_tail()
             poll_until(lambda: (read_json(d / "bridge.json") or {}).get("mappings", {}).get("rail", {}).get(

@@ -15,6 +15,7 @@ import pytest
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
+from helpers.ros_probe import listen_cmd
 from helpers.runtime_support import (
     Proc,
     child_env,
@@ -43,8 +44,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                                             str(d / "bridge.json")), env, d)
         sim = Proc("sim", runtime_cmd("sim", *UDP, "--devices", "winch", "--start-file", str(d / "go"),
                                       "--duration", "3", "--report", str(d / "sim.json")), env, d)
-        probe = Proc("probe", helper_cmd("ros_probe.py", "listen", "--generated", str(gen), "--topics",
-                                         "/winch/tension", "--out", str(d / "probe.json")), env, d)
+        probe = Proc("probe", listen_cmd(gen, ["/winch/tension"], d / "probe.json"), env, d)
         procs = [probe, sim, bridge]
         try:
             bridge.wait_line("READY", 90)

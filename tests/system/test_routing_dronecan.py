@@ -25,6 +25,7 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
+from helpers.ros_probe import listen_cmd, publish_cmd
 from helpers.runtime_support import (
     Proc,
     child_env,
@@ -64,9 +65,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     sim = Proc("sim", runtime_cmd("sim", "--devices", SIM_DEVICES, "--dronecan-iface", iface, "--start-file",
                                   str(d / "go"), "--duration", str(WINDOW_S), "--report", str(d / "sim.json")),
                env, d)
-    probe = Proc("probe", helper_cmd("ros_probe.py", "listen", "--generated", str(gen), "--topics",
-                                     ",".join(IN_TOPICS), "--out", str(d / "probe.json"), "--record",
-                                     str(d / "probe.jsonl"), "--diagnostics"), env, d)
+    probe = Proc("probe", listen_cmd(gen, IN_TOPICS, d / "probe.json", d / "probe.jsonl", diagnostics=True), env, d)
     (d / "plan.json").write_text(json.dumps({"rate_hz": 20, "topics": COMMANDS}))
     procs = [probe, bridge, sim]
     try:
@@ -85,8 +84,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
         poll_until(ready, 30, "the bridge matching the probe and hearing every device")
         # The commands first (the devices take commands as soon as their nodes are up), then the broadcasts.
-        publisher = Proc("publisher", helper_cmd("ros_probe.py", "publish", "--generated", str(gen), "--plan",
-                                                 str(d / "plan.json"), "--out", str(d / "sent.json")), env, d)
+        publisher = Proc("publisher", publish_cmd(gen, d / "plan.json", d / "sent.json"), env, d)
         procs.append(publisher)
         publisher.wait_line("DONE", 60)
         assert publisher.wait(20) == 0, publisher.stderr_tail()

@@ -22,7 +22,6 @@ import json
 import signal
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
 
 import pytest
@@ -31,7 +30,7 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
-from helpers.ros_probe import ThreadedProbe
+from helpers.ros_probe import DroneCanTopics, ThreadedProbe
 from helpers.runtime_support import (
     Proc,
     child_env,
@@ -50,19 +49,6 @@ SPECS = Path(__file__).parents[1] / "specs"
 BRIDGE_ID, PANEL_ID, RELAY_ID = 100, 30, 31
 BRIDGE = "trawler_bridge"
 LEVELS = [7, 107, 207, 307, 407]
-
-
-class _DroneCanTopics:
-    """The generated package as ThreadedProbe reads it, with the DroneCAN mappings' topics (it reads MAPPINGS)."""
-
-    def __init__(self, gen: Any) -> None:
-        self.gen = gen
-
-    def tables(self) -> Any:
-        return SimpleNamespace(MAPPINGS=self.gen.tables().DRONECAN_MAPPINGS)
-
-    def ros_class(self, topic: Any) -> Any:
-        return self.gen.ros_class(topic)
 
 
 class Probe(ThreadedProbe):
@@ -133,7 +119,7 @@ def _scenario(d: Path, generated: Path, wire: str, domain: str, both: bool) -> d
         with pytest.MonkeyPatch.context() as mp:
             mp.setenv("ROS_DOMAIN_ID", domain)
             mp.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-            probe = Probe(_DroneCanTopics(gen), ["/panel_level", "/panic_in"], ["/relay_level", "/panic_out"])
+            probe = Probe(DroneCanTopics(gen), ["/panel_level", "/panic_in"], ["/relay_level", "/panic_out"])
             probe.watch_builtin()
         out["panel_ready"] = json.loads(panel.wait_line("READY ", 60).split(" ", 1)[1])
         bridge.wait_line("READY", 90)

@@ -37,6 +37,7 @@ pytest.importorskip("rclpy")
 pytest.importorskip("dronecan")
 
 from helpers.dronecan_support import private_iface
+from helpers.ros_probe import SpunNode
 from helpers.runtime_support import (
     Proc,
     child_env,
@@ -80,17 +81,13 @@ def relative_spec(tmp: Path) -> Path:
     return out
 
 
-class Probe:
+class Probe(SpunNode):
     """An rclpy node of the test on the shared domain: both namespaces' topics, the global names, /tf, /diagnostics."""
 
     def __init__(self, domain: int) -> None:
-        import rclpy
         from diagnostic_msgs.msg import DiagnosticArray
         from geometry_msgs.msg import PoseStamped
         from nav_msgs.msg import Path as PathMsg
-        from rclpy.executors import SingleThreadedExecutor
-        from rclpy.node import Node
-        from rclpy.signals import SignalHandlerOptions
         from sam_msgs.msg import ThrusterRPMs
         from sensor_msgs.msg import Imu, NavSatFix
         from tf2_msgs.msg import TFMessage
@@ -98,9 +95,8 @@ class Probe:
         from sam_runtime.node_support import qos_profile
         from sam_runtime.tf_buffer import TfBuffer
 
-        self.ctx = rclpy.Context()
-        rclpy.init(args=[], context=self.ctx, domain_id=domain, signal_handler_options=SignalHandlerOptions.NO)
-        self.node = n = Node("two_vehicle_probe", context=self.ctx)
+        super().__init__("two_vehicle_probe", domain)
+        n = self.node
         self.tf = TfBuffer(cache_time_s=30.0)
         self.lock = threading.Lock()
         self.got: dict[str, list[Any]] = defaultdict(list)  # fully qualified topic -> summaries
@@ -132,15 +128,7 @@ class Probe:
             n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, qos_profile("reliable", "volatile",
                                                                                                  200)),
         ]
-        self.ex = SingleThreadedExecutor(context=self.ctx)
-        self.ex.add_node(n)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, name="probe", daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self.ex.spin_once(timeout_sec=0.05)
+        self.start_spinning("probe")
 
     def _keep(self, topic: str, summary: Any) -> None:
         with self.lock:
@@ -169,13 +157,6 @@ class Probe:
             return self.tf.lookup(f"{prefix}world", f"{prefix}base_link", now_ns=time.time_ns(), max_age_s=3.0)
         except TfError:
             return None
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=5)
-        self.ex.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        self.ctx.shutdown()
 
 
 def _truth(path: Path) -> list[dict[str, Any]]:
