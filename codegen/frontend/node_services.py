@@ -7,7 +7,7 @@ GetTransportStats of any device, by the node id in the request, on the protocol 
         restart_node: false                # off
         get_transport_stats: {}            # on, the defaults
 
-Each duty is `false` (off), `true` or a mapping (on) with optional `service` (a ROS name; relative names resolve
+`node_services: false` turns all three off. Each duty is `false` (off), `true` or a mapping (on) with optional `service` (a ROS name; relative names resolve
 under the run's namespace; default `uavcan_<duty>`), `type` (a srv of the spec's `services`, bare or pkg/Name;
 default `<package>/Uavcan<Duty>`) and `timeout` (seconds, 0 < t <= 60, default 1).
 
@@ -64,6 +64,9 @@ DEFAULT_SRVS: dict[str, tuple[str, str, list[tuple[str, str, str]]]] = {
 def parse_node_services(node: YNode | None, bridge_pos: Pos, package: str, diag: Diagnostics) -> list[NodeService]:
     """The three duties, in :data:`DUTIES` order; absent keys (or an absent section) are on with the defaults."""
     entries: dict[str, YNode] = {}
+    if isinstance(node, YScalar) and node.value is False:  # `node_services: false`: every duty off
+        return [NodeService(d, False, f"uavcan_{d}", f"{package}/{DEFAULT_SRVS[d][0]}", _DEFAULT_TIMEOUT_S, node.pos)
+                for d in DUTIES]
     if node is not None:
         r = Reader(node, "bridge node_services", diag, DUTIES)
         entries = {d: n for d in DUTIES if (n := r.node(d)) is not None}

@@ -92,7 +92,7 @@ def resolve_node_services(spec: Spec, diag: Diagnostics, signed: object) -> list
     """`signed`: the V0Catalog's ``signed`` (a DroneCAN type's data type id and signature)."""
     if spec.bridge is None:
         return []
-    taken = {m.service: m.name for m in spec.bridge.service_mappings}
+    taken = {m.service: f"service mapping {m.name!r}" for m in spec.bridge.service_mappings}
     out: list[ResolvedServiceMapping] = []
     for ns in spec.bridge.node_services:
         if not ns.enabled:
@@ -142,8 +142,8 @@ def _response_fields(ns: NodeService, srv: RosService, what: str, diag: Diagnost
         assert isinstance(f.type, RosType)
         if not _fits(kind, f.type):
             diag.error(f.pos if f.pos.line else ns.type_pos,
-                       f"response field {f.name!r} ({f.type}) of {srv.full_name} cannot take the {what}'s "
-                       f"{name}", _EXPECTED[kind])
+                       f"response field {f.name!r} ({f.type}) of {srv.full_name} cannot hold {name} of {what}",
+                       _EXPECTED[kind])
             ok = False
             continue
         found.append(f.name)

@@ -103,8 +103,16 @@ def test_docs_list_the_services() -> None:
     assert "| response | — | `void7` | — |" in section
 
 
-def test_specs_without_services_have_no_services_output() -> None:
-    files = generate(Path(__file__).parents[1] / "specs" / "minimal_v0.yaml")
+def test_specs_without_services_have_no_services_output(tmp_path: Path) -> None:
+    """A spec without services and with the device duties off (`node_services: false`) has no services output; by
+    default it has the duties' srvs and their mappings only."""
+    base = Path(__file__).parents[1] / "specs" / "minimal_v0.yaml"
+    files = generate(base)
+    assert sorted(p for p in files if "/srv/" in p) == [
+        f"ros/skiff_msgs/srv/Uavcan{n}.srv" for n in ("GetNodeInfo", "GetTransportStats", "RestartNode")]
+    spec = tmp_path / "minimal_v0.yaml"
+    spec.write_text(base.read_text().replace("bridge:\n", "bridge:\n  node_services: false\n", 1))
+    files = generate(spec)
     assert "\n## Services\n" not in files["docs/interfaces.md"]
     assert not any(p.endswith("/services.py") or "/srv/" in p for p in files)
 
