@@ -7,9 +7,10 @@ GetTransportStats of any device, by the node id in the request, on the protocol 
         restart_node: false                # off
         get_transport_stats: {}            # on, the defaults
 
-`node_services: false` turns all three off. Each duty is `false` (off), `true` or a mapping (on) with optional `service` (a ROS name; relative names resolve
-under the run's namespace; default `uavcan_<duty>`), `type` (a srv of the spec's `services`, bare or pkg/Name;
-default `<package>/Uavcan<Duty>`) and `timeout` (seconds, 0 < t <= 60, default 1).
+`node_services: false` turns all three off. Each duty is `false` (off), `true` or a mapping (on) with optional
+`service` (a ROS name; relative names resolve under the run's namespace; default `uavcan_<duty>`), `type` (a srv of
+the spec's `services`, bare or pkg/Name; default `<package>/Uavcan<Duty>`) and `timeout` (seconds, 0 < t <= 60,
+default 1).
 
 Invariants: structure only here (validate.node_services checks the names, the srv's fields and builds the service
 mappings the runtime serves). The default srv types (:data:`DEFAULT_SRVS`) are added to the spec's services when a

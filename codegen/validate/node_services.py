@@ -21,9 +21,11 @@ mapping's name can take it); its service name is unique among the service mappin
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from sam_codegen.model.diagnostics import Diagnostics
 from sam_codegen.model.ros_names import ros_name_problem
-from sam_codegen.model.spec import NodeService, RosService, ServiceMapping, Spec
+from sam_codegen.model.spec import NodeService, RosService, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import ROS_INT_RANGES, RosType
 from sam_codegen.validate.services import ResolvedServiceMapping, ServiceLink
 
@@ -88,7 +90,8 @@ def _duty_protocols(spec: Spec) -> list[str]:
     return [p for p in ("dronecan", "cyphal") if p in found]
 
 
-def resolve_node_services(spec: Spec, diag: Diagnostics, signed: object) -> list[ResolvedServiceMapping]:
+def resolve_node_services(spec: Spec, diag: Diagnostics, signed: Callable[[str], V0Struct | None]
+                          ) -> list[ResolvedServiceMapping]:
     """`signed`: the V0Catalog's ``signed`` (a DroneCAN type's data type id and signature)."""
     if spec.bridge is None:
         return []
@@ -151,11 +154,11 @@ def _response_fields(ns: NodeService, srv: RosService, what: str, diag: Diagnost
 
 
 def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
-             signed: object) -> ResolvedServiceMapping | None:
+             signed: Callable[[str], V0Struct | None]) -> ResolvedServiceMapping | None:
     data_type, service_id = DUTY_TYPES[(ns.duty, protocol)]
     struct = None
     if protocol == "dronecan":
-        struct = signed(data_type)  # type: ignore[operator]
+        struct = signed(data_type)
         if struct is None:  # the standard definitions could not be read: reported by the catalog
             return None
         service_id = struct.data_type_id
