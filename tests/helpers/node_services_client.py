@@ -6,9 +6,9 @@ python node_services_client.py --package lolo_msgs --device 30 --not-device 99 -
 
 Calls, in order: get_node_info of the device and of a node that is no device; get_transport_stats of the device
 until its counters have grown past the first answer's (each call is itself a transfer both ways; polled, with a
-deadline); restart_node of the device (once its uptime is 2 s or more), then get_node_info until the device's
-uptime went below the one it had before the restart (the reboot seen; polled, with a deadline). Every response
-(all its fields) goes to the JSON.
+deadline); restart_node of the device (once its uptime is 2 s or more), then get_node_info and
+get_transport_stats until the device's uptime or its transfer count went below the one it had before the restart
+(the reboot seen; polled every 0.1 s, with a deadline). Every response (all its fields) goes to the JSON.
 """
 
 from __future__ import annotations
@@ -59,12 +59,19 @@ def main() -> int:
             if time.monotonic() > end:
                 raise SystemExit(f"{client.srv_name} never returned")
         r = future.result()
-        return {f: (list(v) if not isinstance(v, (bool, int, float, str)) else v)
+        return {f: ([int(b) for b in v] if not isinstance(v, (bool, int, float, str)) else v)
                 for f in r.get_fields_and_field_types() for v in [getattr(r, f)]}
 
-    result: dict[str, Any] = {"services": {d: c.srv_name for d, c in clients.items()}}
+    result: dict[str, Any] = {}
     try:
         result["info"] = call("get_node_info", args.device)
+        # where the bridge serves the duties, as the ROS graph has them (the srv types of its package)
+        while True:  # (discovery: until the three are there, or the deadline)
+            result["services"] = sorted(f"{name} {types[0]}" for name, types in node.get_service_names_and_types()
+                                        if any("/srv/Uavcan" in t for t in types))
+            if len(result["services"]) >= 3 or time.monotonic() > end:
+                break
+            executor.spin_once(timeout_sec=0.05)
         result["info_not_device"] = call("get_node_info", args.not_device)
         result["stats_not_device"] = call("get_transport_stats", args.not_device)
         first = call("get_transport_stats", args.device)
@@ -82,14 +89,26 @@ def main() -> int:
             if time.monotonic() > end:
                 raise SystemExit(f"the device's uptime stayed at {before['uptime_sec']}")
         result["before_restart"] = before
+        last_stats = call("get_transport_stats", args.device)
+        result["stats_before_restart"] = last_stats
         result["restart"] = call("restart_node", args.device)
-        after = []
-        while time.monotonic() < end:
-            info = call("get_node_info", args.device)
-            after.append(info)
-            if info["success"] and info["uptime_sec"] < before["uptime_sec"]:
-                break
+        # The reboot seen: the node's uptime went down (DroneCAN's GetNodeInfo carries its own), or its transport
+        # counters started again (Cyphal: GetInfo has no uptime, and the bridge's heartbeat record may not see the
+        # new node's first heartbeats, which reuse transfer ids that pycyphal takes for duplicates for 2 s).
+        after: list[dict[str, Any]] = []
         result["after_restart"] = after
+        while time.monotonic() < end:
+            info, stats = call("get_node_info", args.device), call("get_transport_stats", args.device)
+            after.append({"info": info, "stats": stats})
+            if info["success"] and info["uptime_sec"] < before["uptime_sec"]:
+                result["rebooted_by"] = "uptime"
+                break
+            if stats["success"] and stats["transfers_tx"] < last_stats["transfers_tx"]:
+                result["rebooted_by"] = "transfers_tx"
+                break
+            pause = time.monotonic() + 0.1  # a poll interval, not a verdict
+            while time.monotonic() < pause:
+                executor.spin_once(timeout_sec=0.1)
     finally:
         with open(args.out, "w") as fh:
             json.dump(result, fh)
