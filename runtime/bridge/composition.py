@@ -285,6 +285,7 @@ class Bridge:
     def _duty_options(self, services: ServiceMappingsRos) -> None:
         """The device duties (bridge.node_services) answer for this bridge's devices; in a mixed layout two bridges
         share the namespace, so their duty services take the protocol as a suffix (uavcan_get_node_info_cyphal)."""
+        services.status_prefix = self.namespace.status_name(self.name)  # (a namespaced run's statuses say so)
         services.devices = dict(self.selection.devices)
         services.health = self.health
         services.duty_suffix = f"_{self.selection.protocol}" if self.selection.shared else ""

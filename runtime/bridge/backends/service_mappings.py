@@ -9,6 +9,10 @@ executor) or its UAVCAN loop. A call converts the ROS request (in that thread), 
 thread, which owns the UAVCAN node (``call_soon_threadsafe`` of the subclass's ``send``), and waits for the
 response or the timeout; the subclass ends the :class:`Call` in the loop's thread (values or a failure).
 
+A device duty (a mapping with ``duty``, of the spec's ``bridge.node_services``) whose srv type is not installed (a
+spec whose ROS package was not built, its other interfaces all standard) is not served: logged once, counted as the
+bridge's ``service_type_missing``, ``served: false`` in its stats; a mapping the spec declares needs its type.
+
 The caller learns of a failure (no answer within ``timeout_s``, the link down, a request that could not be sent)
 by the response: the srv's default values, with its bool ``success`` False and its string ``message`` the reason
 when the srv has those fields (std_srvs' convention; the ROS client never waits forever). Every call is counted per
@@ -32,6 +36,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sam_runtime.bridge.backends.spin_thread import SpinThread
+from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "to_uavcan"]
@@ -175,6 +180,8 @@ class ServiceMappingsRos:
         self.devices: dict[int, str] = {}
         self.duty_suffix = ""
         self.health: Any = None
+        self.unserved: set[str] = set()  # duties whose srv type is not installed
+        self.status_prefix = ros.name  # /diagnostics names: the bridge's, with its namespace (composition sets it)
 
     def send(self, m: Any, nid: int, values: dict[str, Any], call: Call) -> None:
         raise NotImplementedError
@@ -202,7 +209,18 @@ class ServiceMappingsRos:
         node = Node(f"{base}_services", namespace=self.ros.node.get_namespace(), context=self.ros.context)
         group = ReentrantCallbackGroup()
         for m in self.mappings:
-            srv_type = getattr(importlib.import_module(m.ros_module), m.ros_class)
+            try:
+                srv_type = getattr(importlib.import_module(m.ros_module), m.ros_class)
+            except (ImportError, AttributeError) as ex:
+                if getattr(m, "duty", None) is None:
+                    raise  # a mapping the spec declares: its package must be there
+                # a built-in duty of a spec whose ROS package is not built (its other interfaces are standard):
+                # the bridge runs without it, and says so
+                self.unserved.add(m.name)
+                self.lifetime.errors["service_type_missing"] += 1
+                log.warning("the device duty %s (%s) is not served: %s is not installed (%s; build the spec's ROS "
+                            "package: sam-codegen ros-install)", m.duty, self.service_name(m), m.ros_type, ex)
+                continue
             node.create_service(srv_type, self.service_name(m), self._callback(m), callback_group=group)
         if self.diagnostics_period > 0:
             from diagnostic_msgs.msg import DiagnosticArray
@@ -296,6 +314,7 @@ class ServiceMappingsRos:
                                                          "duplicate_responses", "malformed_responses")},
                     **{k: v for k, v in sorted(st.counts.items()) if "." in k},
                     "latency_ms_last": st.latency_ms_last, "latency_ms_max": st.latency_ms_max,
+                    "served": name not in self.unserved,
                     "warn": st.last_problem is not None and now - st.last_problem < WARN_AFTER_PROBLEM_S,
                 }
         return out
@@ -307,7 +326,7 @@ class ServiceMappingsRos:
         array.header.stamp = self.ros.clock.now().to_msg()
         for name, entry in self.snapshot().items():
             status = DiagnosticStatus()
-            status.name = f"{self.ros.name}/service/{name}"
+            status.name = f"{self.status_prefix}/service/{name}"
             status.hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
                                   else f"the node of the request's {entry['destination_field']}")
             status.level = DiagnosticStatus.WARN if entry["warn"] else DiagnosticStatus.OK
