@@ -69,6 +69,8 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
             destination = f"node {m.destination_node_id}" + (f" ({device.name})" if device else "")
         names = {f.name: str(f.type) for f in rm.srv.response}
         failure = [n for n, t in (("success", "bool"), ("message", "string")) if names.get(n) == t]
+        if m.duty is not None and not failure and names.get("ok") == "bool":  # a duty's srv may say `ok`
+            failure = ["ok"]
         rows = [{"ros": link.source or "", "arrow": "→", "uavcan": link.target,
                  "conversion": _conversion(link, True)} for link in rm.request]
         rows += [{"ros": link.target, "arrow": "←", "uavcan": link.source or "",
@@ -78,6 +80,7 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
             "data_type": rm.data_type, "data_type_id": rm.service_id, "protocol": m.protocol,
             "destination": destination,
             "timeout": f"{m.timeout_s:g} s", "failure": failure, "rows": rows,
+            "duty": m.duty, "protocol_label": "Cyphal" if m.protocol == "cyphal" else "DroneCAN",
         })
     return {"services": {"srvs": srvs, "v0": v0, "cyphal": cyphal, "mappings": mappings}
             if srvs or v0 or cyphal or mappings else None}
