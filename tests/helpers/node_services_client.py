@@ -62,6 +62,12 @@ def main() -> int:
         return {f: ([int(b) for b in v] if not isinstance(v, (bool, int, float, str)) else v)
                 for f in r.get_fields_and_field_types() for v in [getattr(r, f)]}
 
+    def wait(seconds: float) -> None:
+        """A poll interval (spinning), not a verdict."""
+        pause = time.monotonic() + seconds
+        while time.monotonic() < pause:
+            executor.spin_once(timeout_sec=seconds)
+
     result: dict[str, Any] = {}
     try:
         result["info"] = call("get_node_info", args.device)
@@ -85,6 +91,7 @@ def main() -> int:
         result["restart_not_device"] = call("restart_node", args.not_device)
         before = call("get_node_info", args.device)
         while not before["success"] or before["uptime_sec"] < 2:  # up long enough that a reboot shows
+            wait(0.1)
             before = call("get_node_info", args.device)
             if time.monotonic() > end:
                 raise SystemExit(f"the device's uptime stayed at {before['uptime_sec']}")
@@ -106,9 +113,7 @@ def main() -> int:
             if stats["success"] and stats["transfers_tx"] < last_stats["transfers_tx"]:
                 result["rebooted_by"] = "transfers_tx"
                 break
-            pause = time.monotonic() + 0.1  # a poll interval, not a verdict
-            while time.monotonic() < pause:
-                executor.spin_once(timeout_sec=0.1)
+            wait(0.1)
     finally:
         with open(args.out, "w") as fh:
             json.dump(result, fh)
