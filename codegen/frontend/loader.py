@@ -13,6 +13,7 @@ from pathlib import Path
 
 from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mapping
 from sam_codegen.frontend.bus import parse_bus
+from sam_codegen.frontend.node_services import parse_node_services, with_duty_srvs
 from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.services import parse_service_mapping
@@ -95,7 +96,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
                for key, pos, node in map_items(top.node("devices"), "devices", diag)}
     layouts = {key: parse_layout(key, pos, node, diag)
                for key, pos, node in map_items(top.node("layouts"), "layouts", diag)}
-    bridge = _bridge(top.node("bridge"), diag)
+    bridge = _bridge(top.node("bridge"), package, diag)
     nodes: dict[str, Node] = {}
     for key, pos, node in map_items(top.node("nodes"), "nodes", diag):
         nodes[key] = parse_node(key, pos, node, diag)
@@ -106,6 +107,7 @@ def parse_spec(root: YNode, file: str) -> Spec:
     namespaces = str_list(top.node("dronecan_namespaces"), "dronecan_namespaces", diag) \
         if top.node("dronecan_namespaces") is not None else None
     services = _ros_services(top, package, diag)
+    services = with_duty_srvs(services, bridge, package)  # the device duties' default srvs (frontend.node_services)
     diag.check()
     return Spec(
         file, vehicle.get("name", str) or "", text_of(vehicle, "description"), info,
@@ -205,12 +207,12 @@ def _parameter_rules(top: Reader, diag: Diagnostics) -> list[ParameterRule]:
     return parameter_rules
 
 
-def _bridge(bridge_node: YNode | None, diag: Diagnostics) -> Bridge | None:
+def _bridge(bridge_node: YNode | None, package: str, diag: Diagnostics) -> Bridge | None:
     """The `bridge` section (None without one): its Cyphal and DroneCAN mappings, service mappings, time sync."""
     if bridge_node is None:
         return None
     r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty",
-                                             "service_mappings", "time_sync"))
+                                             "service_mappings", "time_sync", "node_services"))
     name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
     mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
     for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
@@ -227,7 +229,8 @@ def _bridge(bridge_node: YNode | None, diag: Diagnostics) -> Bridge | None:
     return Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
                   service_mappings=service_mappings,
                   time_sync=parse_time_sync(r.node("time_sync"), "bridge time_sync", diag),
-                  panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"))
+                  panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"),
+                  node_services=parse_node_services(r.node("node_services"), bridge_node.pos, package, diag))
 
 
 def _ros_services(top: Reader, package: str, diag: Diagnostics) -> dict[str, RosService]:

@@ -440,6 +440,24 @@ class ServiceMapping:
     destination_field: str | None = None
     # Cyphal: the service id (`service_id`); None: the standard type's fixed port id
     service_id: int | None = None
+    # a device duty of `bridge.node_services` (get_node_info...): any device of the bridge's protocol, by node id
+    duty: str | None = None
+
+
+@dataclass(frozen=True)
+class NodeService:
+    """One device duty of `bridge.node_services` (frontend.node_services): `duty` is get_node_info, restart_node or
+    get_transport_stats; off (`false`) when not `enabled`; `service` the ROS name as written; `type` the srv
+    (pkg/Name): the spec's own by `type:`, else the default the tool generates (`<package>/UavcanGetNodeInfo`...)."""
+
+    duty: str
+    enabled: bool
+    service: str
+    type: str
+    timeout_s: float = 1.0
+    pos: Pos = NOWHERE
+    type_pos: Pos = NOWHERE
+    type_given: bool = False  # `type:` written (else the default name, which the spec may declare itself)
 
 
 @dataclass(frozen=True)
@@ -464,6 +482,7 @@ class Bridge:
     panic_duty_pos: Pos = NOWHERE
     service_mappings: list[ServiceMapping] = field(default_factory=list)
     time_sync: TimeSync = field(default_factory=TimeSync)
+    node_services: list[NodeService] = field(default_factory=list)  # the device duties (all three by default)
 
     @property
     def all_mappings(self) -> list[Mapping]:

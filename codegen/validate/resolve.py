@@ -33,6 +33,7 @@ from sam_codegen.validate.bus_budget import check_bus_budgets
 from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
+from sam_codegen.validate.node_services import resolve_node_services
 from sam_codegen.validate.nodes import check_nodes
 from sam_codegen.validate.panic_duty import check_panic_duty
 from sam_codegen.validate.routing import check_routing
@@ -368,6 +369,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     check_panic_duty(spec, v.diag)
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
     service_mappings = services.resolve_mappings()
+    service_mappings += resolve_node_services(spec, v.diag, v0.signed)  # the device duties (validate.node_services)
     check_routing(spec, v.diag)  # `any` node ids, `shares_data_type` (validate.routing)
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")

@@ -71,8 +71,9 @@ class Bridge:
         :mod:`.layout`); default: the layout's only protocol.
     :param dronecan_iface: the DroneCAN interface (sam_runtime.dronecan_io: ``mcast-lo:`` between processes on this
         machine, ``socketcan:can0``, ``slcan:/dev/ttyACM0``).
-    :param dronecan_services: the DroneCAN node duties of :mod:`.backends.dronecan_duties` (GetNodeInfo and
-        RestartNode of the devices as ROS services, Panic both ways; options ``time_sync`` and ``dna_server``).
+    :param dronecan_services: the DroneCAN node duties of :mod:`.backends.dronecan_duties` (Panic both ways;
+        options ``time_sync`` and ``dna_server``; the devices' GetNodeInfo, RestartNode and GetTransportStats are
+        the typed services of the spec's ``bridge.node_services``, served with the service mappings).
     :param wire: ``codec`` (default): the generated wire codecs, from the UAVCAN payload bytes straight to the ROS
         message's CDR and back, with raw ROS publishers and subscriptions and the backend's transport-level ports;
         ``object``: the object converters between the protocol library's message objects and ROS messages (the
@@ -262,6 +263,7 @@ class Bridge:
             if served:
                 self.services = DroneCanServices(lifetime, backend, self.ros, served,
                                                  diagnostics_period=self._diagnostics_period)
+                self._duty_options(self.services)
                 self.services.attach()
         else:
             services = self.gen.services()
@@ -271,6 +273,7 @@ class Bridge:
             if served:
                 self.services = CyphalServices(lifetime, backend, self.ros, served,
                                                diagnostics_period=self._diagnostics_period)
+                self._duty_options(self.services)
                 self.services.attach()
         self.time_sync = self._time_sync(sel.protocol)
         inbound.on_stamp = self.time_sync.on_stamp
@@ -278,6 +281,14 @@ class Bridge:
         link.attach()
         reporter.attach()
         self.ros.attach_spinner()
+
+    def _duty_options(self, services: ServiceMappingsRos) -> None:
+        """The device duties (bridge.node_services) answer for this bridge's devices; in a mixed layout two bridges
+        share the namespace, so their duty services take the protocol as a suffix (uavcan_get_node_info_cyphal)."""
+        services.status_prefix = self.namespace.status_name(self.name)  # (a namespaced run's statuses say so)
+        services.devices = dict(self.selection.devices)
+        services.health = self.health
+        services.duty_suffix = f"_{self.selection.protocol}" if self.selection.shared else ""
 
     def _time_sync(self, protocol: str) -> StampWatch:
         """The time-sync master (advertised before the link opens; its task starts after it) and the stamp watch."""

@@ -1,5 +1,7 @@
 """The simulator's Cyphal adapter: a pycyphal node per device (heartbeats from the start), a publisher per published
-port, a subscriber per command subject; generic values from sam_runtime.sim.devices, records as transmitted.
+port, a subscriber per command subject; generic values from sam_runtime.sim.devices, records as transmitted. Each
+node answers GetInfo (pycyphal's), ExecuteCommand COMMAND_RESTART (a reboot: power off and on, as DroneCAN's
+RestartNode) and GetTransportStatistics (its transport sessions' counts).
 (The DroneCAN one is sam_runtime.sim.dronecan; the schedule, physics and counters are sam_runtime.sim.simulator's.)"""
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from sam_runtime.sim.time_sync import CYPHAL_MAX_INTERVAL_S
 __all__ = ["CyphalDevices"]
 
 _log = logging.getLogger("sam_runtime.sim.simulator")
+_RESTART_DELAY_S = 0.1  # a restart waits this long, so that its ExecuteCommand response goes out first
 
 
 class CyphalDevices:
@@ -25,6 +28,7 @@ class CyphalDevices:
 
     def __init__(self, sim: DeviceHost) -> None:
         self.sim = sim
+        self._restarts: set[asyncio.Task[None]] = set()
 
     def prepare(self) -> None:
         self.sim.gen.compile_dsdl()
@@ -49,6 +53,7 @@ class CyphalDevices:
         else:
             dev.node = make_node(name, dev.info.node_id, cfg.kind, iface=cfg.iface, mtu=cfg.mtu)
         dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+        self._serve_duties(dev)
         for sp in dev.subs:
             sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
             sp.subscriber.receive_in_background(
@@ -64,6 +69,40 @@ class CyphalDevices:
                 lambda msg, tr, dev=dev: self.sim.on_time_sync(
                     dev, int(tr.source_node_id if tr.source_node_id is not None else 0xFFFF), int(tr.transfer_id),
                     int(msg.previous_transmission_timestamp_microsecond), int(tr.timestamp.monotonic_ns)))
+
+    def _serve_duties(self, dev: SimDevice) -> None:
+        """ExecuteCommand.1.1 (COMMAND_RESTART: a reboot, as DroneCAN's RestartNode; other commands: bad command)
+        and GetTransportStatistics.0.1 (the transport's sessions' transfers and errors); GetInfo is pycyphal's."""
+        import uavcan.node
+
+        node = dev.node
+        execute = uavcan.node.ExecuteCommand_1_1
+
+        async def on_command(request: Any, meta: Any) -> Any:
+            if request.command != execute.Request.COMMAND_RESTART:
+                return execute.Response(status=execute.Response.STATUS_BAD_COMMAND)
+            _log.info("%s: restart requested by node %s: rebooting", dev.info.name, meta.client_node_id)
+            # after the response is out: the reboot closes this node
+            asyncio.get_running_loop().call_later(_RESTART_DELAY_S, self._restart, dev)
+            return execute.Response(status=execute.Response.STATUS_SUCCESS)
+
+        async def on_stats(_request: Any, _meta: Any) -> Any:
+            transport = node.presentation.transport
+            out = [s.sample_statistics() for s in transport.output_sessions]
+            into = [s.sample_statistics() for s in transport.input_sessions]
+            stats = uavcan.node.IOStatistics_0_1(num_emitted=sum(int(st.transfers) for st in out),
+                                                 num_received=sum(int(st.transfers) for st in into),
+                                                 num_errored=sum(int(st.errors) for st in out + into))
+            return uavcan.node.GetTransportStatistics_0_1.Response(transfer_statistics=stats)
+
+        node.get_server(execute).serve_in_background(on_command)
+        node.get_server(uavcan.node.GetTransportStatistics_0_1).serve_in_background(on_stats)
+
+    def _restart(self, dev: SimDevice) -> None:
+        task = asyncio.get_running_loop().create_task(self.sim.restart(dev.info.name),
+                                                      name=f"sim-restart-{dev.info.name}")
+        self._restarts.add(task)
+        task.add_done_callback(self._restarts.discard)
 
     def sync_params(self, dev: SimDevice) -> tuple[float, int]:
         return CYPHAL_MAX_INTERVAL_S, int(dev.node.presentation.transport.protocol_parameters.transfer_id_modulo)

@@ -5,8 +5,9 @@ that its layout puts on DroneCAN.
 - One ``dronecan`` node per device (the node id of ``DRONECAN_DEVICES``, 1..125) on ``SimConfig.dronecan_iface``
   (an interface URI of :mod:`sam_runtime.dronecan_io`, ``mcast-lo:`` by default), run in the simulator's asyncio
   loop by a :class:`~sam_runtime.dronecan_io.NodeLoop`: NodeStatus once a second (health OK, mode OPERATIONAL, its
-  uptime), GetNodeInfo (``org.<vehicle>.sim.<device>``, answered by dronecan) and RestartNode (the magic number:
-  a real reboot, as ``power_off`` + ``power_on``: a new node whose uptime starts at 0).
+  uptime), GetNodeInfo (``org.<vehicle>.sim.<device>``, answered by dronecan), RestartNode (the magic number:
+  a real reboot, as ``power_off`` + ``power_on``: a new node whose uptime starts at 0) and GetTransportStats (the
+  node's transfers out and in, counted by a transfer hook; its errors: the transfers its loop dropped).
 - On ``mcast-lo:`` each node has the acceptance filter of a CAN controller (in the kernel: the service transfers
   addressed to it and the broadcasts it subscribes to), so a sensor is not woken by every frame of the bus.
 - Broadcasts: each v0 port on the simulator's publish loop (same schedule as the Cyphal ports), its values from
@@ -58,6 +59,7 @@ __all__ = ["DroneCanDevices", "ensure_types", "type_problems"]
 _log = logging.getLogger("sam_runtime.sim.simulator")
 NODE_STATUS_INTERVAL_S = 1.0
 RESTART_NODE = "uavcan.protocol.RestartNode"
+TRANSPORT_STATS = "uavcan.protocol.GetTransportStats"
 TIME_SYNC = "uavcan.protocol.GlobalTimeSync"
 
 
@@ -219,6 +221,10 @@ class DroneCanDevices:
             loop = NodeLoop(node, logger=_log, log_interval=self.sim.config.log_interval)
             node.add_handler(None, self._message_handler(dev))
             loop.add_handler(dronecan.TYPENAMES[RESTART_NODE], self._restart_handler(dev))
+            counts = {"tx": 0, "rx": 0}  # this node's transfers (the hook sees each one, both ways)
+            node.add_transfer_hook(lambda transfer: counts.__setitem__(
+                transfer.direction, counts.get(transfer.direction, 0) + 1))
+            loop.add_handler(dronecan.TYPENAMES[TRANSPORT_STATS], self._stats_handler(counts, loop))
             loop.start()
         except BaseException:
             gate.close()
@@ -253,6 +259,16 @@ class DroneCanDevices:
                 raise HandlerError(f"{dev.info.name}: {type(ex).__name__}: {ex}") from ex
 
         return on_transfer
+
+    def _stats_handler(self, counts: dict[str, int], loop: NodeLoop) -> Any:
+        import dronecan
+
+        def on_stats(event: Any) -> Any:
+            # the transfers the node sent and received; its errors are what its loop dropped (CRC, toggle, ...)
+            return dronecan.TYPENAMES[TRANSPORT_STATS].Response(
+                transfers_tx=counts.get("tx", 0), transfers_rx=counts.get("rx", 0), transfer_errors=loop.drops.total)
+
+        return on_stats
 
     def _restart_handler(self, dev: SimDevice) -> Any:
         import dronecan

@@ -301,16 +301,21 @@ def test_broken_msg_raises_ros_build_error(tmp_path: Path) -> None:
 
 
 def test_a_package_without_messages_is_not_built(tmp_path: Path) -> None:
-    """A spec whose ROS side uses upstream messages only (the ferry) generates its own package empty: rosidl would
-    refuse it ("called without any interface files"), so ros-install leaves it out and says so."""
+    """A spec whose ROS side uses upstream messages only (the ferry, its device duties off: their default srvs would
+    be the package's) generates its own package empty: rosidl would refuse it ("called without any interface
+    files"), so ros-install leaves it out and says so."""
     from sam_codegen.cli import main
     from sam_codegen.frontend.loader import load_spec_file
     from sam_codegen.project.ros_install import has_interfaces
     from sam_codegen.targets.ros import emit
     from sam_codegen.validate.resolve import validate
 
-    resolved = validate(load_spec_file(Path(__file__).parents[1] / "specs" / "ferry.yaml"))
-    assert not resolved.messages
+    ferry = (Path(__file__).parents[1] / "specs" / "ferry.yaml").read_text(encoding="utf-8")
+    assert ferry.count("bridge:\n") == 1
+    spec = tmp_path / "ferry.yaml"
+    spec.write_text(ferry.replace("bridge:\n", "bridge:\n  node_services: false\n"), encoding="utf-8")
+    resolved = validate(load_spec_file(spec))
+    assert not resolved.messages and not resolved.services
     for rel, text in emit(resolved).items():
         (tmp_path / "generated" / rel).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / "generated" / rel).write_text(text)

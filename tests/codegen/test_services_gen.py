@@ -1,6 +1,7 @@
 """Service types (issue 19): the spec's DroneCAN service types come out as v0 DSDL that dronecan's own parser reads
 with the same id, kind, fields and signature as the generator computed; the spec's `services` come out as .srv
-files listed in the package's CMakeLists, which rosidl builds and rclpy imports and serializes."""
+files listed in the package's CMakeLists, which rosidl builds and rclpy imports and serializes (with the device
+duties' default srvs, UavcanGetNodeInfo...)."""
 
 from __future__ import annotations
 
@@ -65,8 +66,15 @@ _SRV_SCRIPT = textwrap.dedent(
     request = UpdateBattery.Request(command=1, charge_percent=42.5)
     back = deserialize_message(serialize_message(request), UpdateBattery.Request)
     response = UpdateBattery.Response()
+    from lolo_msgs.srv import UavcanGetNodeInfo, UavcanGetTransportStats, UavcanRestartNode
+
+    info = deserialize_message(serialize_message(UavcanGetNodeInfo.Request(node_id=300)), UavcanGetNodeInfo.Request)
+    stats = UavcanGetTransportStats.Response(transfers_tx=2**63)
+    stats = deserialize_message(serialize_message(stats), UavcanGetTransportStats.Response)
     print("RESULT " + json.dumps({"command": back.command, "charge": back.charge_percent,
-                                  "success": response.success, "status": response.status}))
+                                  "success": response.success, "status": response.status,
+                                  "duties": [info.node_id, len(UavcanGetNodeInfo.Response().unique_id),
+                                             stats.transfers_tx, UavcanRestartNode.Response().success]}))
     """
 )
 
@@ -85,7 +93,7 @@ def test_srv_builds_with_rosidl_and_imports(tmp_path: Path) -> None:
     lines = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
     assert lines, proc.stdout + proc.stderr
     assert json.loads(lines[-1].removeprefix("RESULT ")) == {"command": 1, "charge": 42.5, "success": False,
-                                                            "status": 0}
+                                                            "status": 0, "duties": [300, 16, 2**63, False]}
 
 
 def test_docs_list_the_services() -> None:
@@ -103,8 +111,16 @@ def test_docs_list_the_services() -> None:
     assert "| response | — | `void7` | — |" in section
 
 
-def test_specs_without_services_have_no_services_output() -> None:
-    files = generate(Path(__file__).parents[1] / "specs" / "minimal_v0.yaml")
+def test_specs_without_services_have_no_services_output(tmp_path: Path) -> None:
+    """A spec without services and with the device duties off (`node_services: false`) has no services output; by
+    default it has the duties' srvs and their mappings only."""
+    base = Path(__file__).parents[1] / "specs" / "minimal_v0.yaml"
+    files = generate(base)
+    assert sorted(p for p in files if "/srv/" in p) == [
+        f"ros/skiff_msgs/srv/Uavcan{n}.srv" for n in ("GetNodeInfo", "GetTransportStats", "RestartNode")]
+    spec = tmp_path / "minimal_v0.yaml"
+    spec.write_text(base.read_text().replace("bridge:\n", "bridge:\n  node_services: false\n", 1))
+    files = generate(spec)
     assert "\n## Services\n" not in files["docs/interfaces.md"]
     assert not any(p.endswith("/services.py") or "/srv/" in p for p in files)
 

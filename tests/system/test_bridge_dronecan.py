@@ -8,14 +8,14 @@ itself, not the project's receive path) on a private loopback bus, and a ROS pro
   elements;
 - esc.Status of both ESCs routed by source node and ``esc_index``; a Status no mapping selects is counted
   (``unselected``), never silent;
-- the node duties: a device's GetNodeInfo as a ROS service, RestartNode refused by a device that does not answer,
-  Panic both ways, the GlobalTimeSync master.
+- the node duties: a device's GetNodeInfo as the typed service uavcan_get_node_info (bridge.node_services), a
+  restart_node to a device that does not answer RestartNode fails clearly, Panic both ways, the GlobalTimeSync
+  master.
 """
 
 from __future__ import annotations
 
 import asyncio
-import json
 import time
 from typing import Any
 
@@ -49,13 +49,14 @@ class Probe(ThreadedProbe):
     def on_message(self, topic: str, msg: Any) -> None:
         self.messages.setdefault(topic, []).append(msg)
 
-    def call(self, service: str, timeout: float = 10.0) -> Any:
-        from std_srvs.srv import Trigger
+    def call(self, service: str, srv_name: str, node_id: int, timeout: float = 10.0) -> Any:
+        import importlib
 
-        client = self.node.create_client(Trigger, service)
+        srv = getattr(importlib.import_module("sam_msgs.srv"), srv_name)
+        client = self.node.create_client(srv, service)
         if not client.wait_for_service(timeout_sec=timeout):
             raise AssertionError(f"no service {service}")
-        future = client.call_async(Trigger.Request())
+        future = client.call_async(srv.Request(node_id=node_id))
         deadline = time.monotonic() + timeout
         while not future.done() and time.monotonic() < deadline:
             time.sleep(0.02)
@@ -125,8 +126,8 @@ async def _scenario(gen: Any, iface: str, wire: str) -> dict[str, Any]:
                     and len(listener.got("uavcan.equipment.actuator.ArrayCommand")) >= 2, 10, "the commands")
 
         # Duties.
-        out["info"] = await asyncio.to_thread(probe.call, f"/{BRIDGE}/imu/get_node_info")
-        out["restart"] = await asyncio.to_thread(probe.call, f"/{BRIDGE}/thruster_1/restart")
+        out["info"] = await asyncio.to_thread(probe.call, "/uavcan_get_node_info", "UavcanGetNodeInfo", IMU_ID)
+        out["restart"] = await asyncio.to_thread(probe.call, "/uavcan_restart_node", "UavcanRestartNode", ESC1_ID)
         await until(lambda: _ready(probe.panic_pub), 10, "the bridge's panic subscription")
         probe.panic_pub.publish(__import__("std_msgs.msg", fromlist=["String"]).String(data="ROS-ABORT"))
         stranger.broadcast(dronecan.TYPENAMES["uavcan.protocol.Panic"](reason_text=b"LEAK"))
@@ -192,7 +193,7 @@ def test_commands_reach_a_plain_listener_with_index_id_and_saturation(run: dict[
 
 def test_node_duties(run: dict[str, Any]) -> None:
     info = run["info"]
-    assert info.success and json.loads(info.message)["name"] == "org.test.peer11"
+    assert info.success and info.name == "org.test.peer11" and info.message == ""
     restart = run["restart"]  # the plain node does not serve RestartNode: a clear refusal, no hang
     assert not restart.success and "did not answer" in restart.message
     assert [p for p in run["panic_bus"] if p[0] == BRIDGE_ID] == [(BRIDGE_ID, b"ROS-ABO")] * 3

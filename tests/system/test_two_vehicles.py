@@ -262,9 +262,9 @@ def test_two_vehicles_fly_side_by_side_and_no_message_crosses(tmp_path: Path) ->
         services = {name for name, _ in probe.node.get_service_names_and_types()}
         topics = {name for name, _ in probe.node.get_topic_names_and_types()}
         for v in ("sam1", "sam2"):
-            assert f"/{v}/uavcan_ros_bridge/imu/get_node_info" in services, sorted(services)
+            assert f"/{v}/uavcan_get_node_info" in services, sorted(services)  # bridge.node_services
             assert f"/{v}/uavcan_ros_bridge/panic" in topics, sorted(topics)
-        assert not [s for s in services if s.startswith("/uavcan_ros_bridge/")], sorted(services)
+        assert not [s for s in services if s.startswith(("/uavcan_ros_bridge/", "/uavcan_get"))], sorted(services)
         for p in procs.values():
             assert "Traceback" not in p.stderr_tail(400), f"{p.name}:\n{p.stderr_tail(40)}"
     finally:

@@ -17,16 +17,24 @@ def _conversion(link: ServiceLink, towards_uavcan: bool) -> str:
     if link.source is None:
         return f"the constant {link.value!r}"
     parts = []
+    if link.source.startswith("heartbeat."):  # a device duty on Cyphal (validate.node_services)
+        parts.append("from the node's last Heartbeat the bridge heard (0 if none)")
     if link.scale is not None or link.offset is not None:
         scale = 1.0 if link.scale is None else link.scale
         offset = 0.0 if link.offset is None else link.offset
         parts.append(f"(ROS - {offset:g}) / {scale:g}" if towards_uavcan else f"UAVCAN × {scale:g} + {offset:g}")
     if link.kind == "int":
-        parts.append(f"rounded, saturated to [{link.lo:.0f}, {link.hi:.0f}]")
+        # (an int bound exactly: a uint64's maximum is no float)
+        lo, hi = (str(b) if isinstance(b, int) else f"{b:.0f}" for b in (link.lo, link.hi))
+        parts.append(f"rounded, saturated to [{lo}, {hi}]")
     elif link.kind == "text":
         parts.append("UTF-8 bytes" + (f", cut at {link.hi:g}" if towards_uavcan else ""))
     elif link.kind == "bool":
         parts.append("non-zero is true")
+    elif link.kind == "ok_if_zero":
+        parts.append("true when 0 (success)")
+    elif link.kind == "bytes":
+        parts.append("the bytes as they are")
     elif math.isfinite(link.hi):
         parts.append(f"saturated to ±{link.hi:g}")
     return "; ".join(parts) or "as is"
@@ -61,6 +69,8 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
             destination = f"node {m.destination_node_id}" + (f" ({device.name})" if device else "")
         names = {f.name: str(f.type) for f in rm.srv.response}
         failure = [n for n, t in (("success", "bool"), ("message", "string")) if names.get(n) == t]
+        if m.duty is not None and not failure and names.get("ok") == "bool":  # a duty's srv may say `ok`
+            failure = ["ok"]
         rows = [{"ros": link.source or "", "arrow": "→", "uavcan": link.target,
                  "conversion": _conversion(link, True)} for link in rm.request]
         rows += [{"ros": link.target, "arrow": "←", "uavcan": link.source or "",
@@ -70,6 +80,7 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
             "data_type": rm.data_type, "data_type_id": rm.service_id, "protocol": m.protocol,
             "destination": destination,
             "timeout": f"{m.timeout_s:g} s", "failure": failure, "rows": rows,
+            "duty": m.duty, "protocol_label": "Cyphal" if m.protocol == "cyphal" else "DroneCAN",
         })
     return {"services": {"srvs": srvs, "v0": v0, "cyphal": cyphal, "mappings": mappings}
             if srvs or v0 or cyphal or mappings else None}

@@ -49,13 +49,16 @@ def emit(resolved: Resolved) -> dict[str, str]:
         # The fields that tell the caller of a failure (timeout, link down): a bool `success` set False and a
         # string `message` with the reason, when the srv has them (std_srvs' convention).
         success = response_names.get("success")
+        if m.duty is not None and success is None:  # a duty's srv may say `ok` (SMARC's UavcanRestartNode)
+            success = response_names.get("ok")
         message = response_names.get("message")
         mappings.append({
             "name": py_str(m.name), "service": py_str(m.service), "ros_module": py_str(f"{srv.package}.srv"),
             "ros_class": py_str(srv.name), "ros_type": py_str(f"{srv.package}/srv/{srv.name}"),
             "data_type": py_str(rm.data_type), "data_type_id": rm.service_id,
             "signature": f"0x{rm.struct.signature:016X}" if rm.struct is not None else "0",
-            "protocol": py_str(m.protocol), "destination_node_id": m.destination_node_id,
+            "protocol": py_str(m.protocol), "duty": py_str(m.duty) if m.duty is not None else "None",
+            "destination_node_id": m.destination_node_id,
             "device": py_str(by_id[m.destination_node_id].name if m.destination_field is None else ""),
             "destination_field": py_str(m.destination_field) if m.destination_field is not None else "None",
             "timeout_s": py_number(m.timeout_s),

@@ -9,7 +9,9 @@ matches a response to its request by transfer id and drops the others, counting 
 waiting request (after its call timed out, or a second one) is ``unexpected_responses`` in pycyphal's client
 statistics, counted here as ``late_responses`` (pycyphal does not tell late from duplicate), and a response it could
 not deserialize is ``deserialization_failures``, counted as ``malformed_responses`` (the call then times out). The
-clients' statistics are read in the loop's thread after each call and once a second.
+clients' statistics are read in the loop's thread after each call and once a second. The device duty get_node_info
+(GetInfo, which has no uptime, health, mode or vendor code) takes those from the node's last heartbeat the bridge
+heard (0 when none).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import asyncio
 import importlib
 import logging
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from sam_runtime.bridge.backends.service_mappings import Call, ServiceMappingsRos, from_uavcan
@@ -26,6 +29,32 @@ from sam_runtime.bridge.lifetime import Lifetime
 __all__ = ["CyphalServices", "dsdl_class"]
 
 _POLL_PERIOD_S = 1.0
+# uavcan.node.Health.1.0 and Mode.1.0 by the names the backend's DeviceStatus gives them
+_HEALTH = {"NOMINAL": 0, "ADVISORY": 1, "CAUTION": 2, "WARNING": 3}
+_MODE = {"OPERATIONAL": 0, "INITIALIZATION": 1, "MAINTENANCE": 2, "SOFTWARE_UPDATE": 3}
+
+
+@dataclass(frozen=True)
+class _Heartbeat:
+    uptime_s: int
+    health: int
+    mode: int
+    vssc: int
+
+
+def _code(names: dict[str, int], name: str) -> int:
+    """A health or mode name back to its value (the backend keeps an unknown value as its digits)."""
+    return names.get(name, int(name) if name.isdigit() else 0)
+
+
+class _WithHeartbeat:
+    """A GetInfo response whose links may also read ``heartbeat.<x>`` (the duty get_node_info on Cyphal)."""
+
+    def __init__(self, response: Any, heartbeat: _Heartbeat) -> None:
+        self._response, self.heartbeat = response, heartbeat
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._response, name)
 
 
 def dsdl_class(full_name: str) -> Any:
@@ -101,13 +130,24 @@ class CyphalServices(ServiceMappingsRos):
         else:
             saturated: list[str] = []
             try:
-                call.values = from_uavcan(m, result[0], saturated)
+                answer = result[0] if getattr(m, "duty", None) != "get_node_info" else _WithHeartbeat(
+                    result[0], self.heartbeat(nid))
+                call.values = from_uavcan(m, answer, saturated)
             except Exception as ex:
                 call.failure, call.reason = f"the response cannot be converted: {ex}", "convert_error"
             for name in saturated:
                 self.count(m, f"saturated.{name}", problem=False)
         call.done.set()
         self.poll_statistics()
+
+    def heartbeat(self, nid: int) -> Any:
+        """The node's last heartbeat as numbers (uptime_s, health, mode, vssc; 0 when none was heard): GetInfo
+        has none of them, the duty's srv has them (DroneCAN's GetNodeInfo carries its NodeStatus)."""
+        rec = self.health.records.get(nid) if self.health is not None else None
+        if rec is None:
+            return _Heartbeat(0, 0, 0, 0)
+        st = rec.status
+        return _Heartbeat(int(st.uptime_s), _code(_HEALTH, st.health), _code(_MODE, st.mode), int(st.vssc))
 
     def poll_statistics(self) -> None:
         """The clients' counts of responses that reached no request and of undecodable ones (the loop's thread)."""

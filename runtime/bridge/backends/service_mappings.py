@@ -9,6 +9,10 @@ executor) or its UAVCAN loop. A call converts the ROS request (in that thread), 
 thread, which owns the UAVCAN node (``call_soon_threadsafe`` of the subclass's ``send``), and waits for the
 response or the timeout; the subclass ends the :class:`Call` in the loop's thread (values or a failure).
 
+A device duty (a mapping with ``duty``, of the spec's ``bridge.node_services``) whose srv type is not installed (a
+spec whose ROS package was not built, its other interfaces all standard) is not served: logged once, counted as the
+bridge's ``service_type_missing``, ``served: false`` in its stats; a mapping the spec declares needs its type.
+
 The caller learns of a failure (no answer within ``timeout_s``, the link down, a request that could not be sent)
 by the response: the srv's default values, with its bool ``success`` False and its string ``message`` the reason
 when the srv has those fields (std_srvs' convention; the ROS client never waits forever). Every call is counted per
@@ -32,6 +36,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sam_runtime.bridge.backends.spin_thread import SpinThread
+from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "to_uavcan"]
@@ -72,7 +77,18 @@ def _convert(links: Sequence[Any], source: Any, towards_uavcan: bool, saturated:
             raw = source
             for name in link.source.split("."):
                 raw = getattr(raw, name)
-        if link.kind == "text":
+        if link.kind == "bytes":  # a uint8 array as it is (a unique id)
+            out[link.target] = [int(b) for b in raw]
+        elif link.kind == "ok_if_zero":  # a status code: 0 is success
+            out[link.target] = int(raw) == 0
+        elif link.kind == "int" and link.scale is None and link.offset is None and not isinstance(raw, float) \
+                and float(raw).is_integer():  # exact, also beyond 2**53 (a uint64 revision id)
+            value = int(raw)
+            if not link.lo <= value <= link.hi:
+                saturated.append(link.target)
+                value = int(min(max(value, link.lo), link.hi))
+            out[link.target] = value
+        elif link.kind == "text":
             if towards_uavcan:
                 data = str(raw).encode()
                 if len(data) > link.hi:
@@ -157,6 +173,15 @@ class ServiceMappingsRos:
         self._loop: asyncio.AbstractEventLoop | None = None
         self._spinner: SpinThread | None = None  # the services' node on its executor thread
         self._diag_pub: Any = None
+        # The device duties (mappings with a ``duty``) answer for these nodes only (node id -> device name: the
+        # devices the layout puts on this bridge's protocol); ``duty_suffix`` ("_dronecan" in a mixed layout, where
+        # two bridges share one namespace) goes after their service names; ``health`` (the bridge's DeviceHealth)
+        # has each node's last heartbeat. Set by the composition root.
+        self.devices: dict[int, str] = {}
+        self.duty_suffix = ""
+        self.health: Any = None
+        self.unserved: set[str] = set()  # duties whose srv type is not installed
+        self.status_prefix = ros.name  # /diagnostics names: the bridge's, with its namespace (composition sets it)
 
     def send(self, m: Any, nid: int, values: dict[str, Any], call: Call) -> None:
         raise NotImplementedError
@@ -180,11 +205,23 @@ class ServiceMappingsRos:
 
         self._loop = asyncio.get_running_loop()
         base = self.ros.name
-        node = Node(f"{base}_services", context=self.ros.context)
+        # in the bridge's namespace: relative service names (the duties' defaults) resolve where its topics do
+        node = Node(f"{base}_services", namespace=self.ros.node.get_namespace(), context=self.ros.context)
         group = ReentrantCallbackGroup()
         for m in self.mappings:
-            srv_type = getattr(importlib.import_module(m.ros_module), m.ros_class)
-            node.create_service(srv_type, m.service, self._callback(m), callback_group=group)
+            try:
+                srv_type = getattr(importlib.import_module(m.ros_module), m.ros_class)
+            except (ImportError, AttributeError) as ex:
+                if getattr(m, "duty", None) is None:
+                    raise  # a mapping the spec declares: its package must be there
+                # a built-in duty of a spec whose ROS package is not built (its other interfaces are standard):
+                # the bridge runs without it, and says so
+                self.unserved.add(m.name)
+                self.lifetime.errors["service_type_missing"] += 1
+                log.warning("the device duty %s (%s) is not served: %s is not installed (%s; build the spec's ROS "
+                            "package: sam-codegen ros-install)", m.duty, self.service_name(m), m.ros_type, ex)
+                continue
+            node.create_service(srv_type, self.service_name(m), self._callback(m), callback_group=group)
         if self.diagnostics_period > 0:
             from diagnostic_msgs.msg import DiagnosticArray
 
@@ -195,6 +232,10 @@ class ServiceMappingsRos:
         self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-services",
                                    "service_executor_error", "service mappings")
         self._spinner.start()
+
+    def service_name(self, m: Any) -> str:
+        """The ROS name a mapping is served under (a duty's with the layout's protocol suffix)."""
+        return m.service + self.duty_suffix if getattr(m, "duty", None) is not None else m.service
 
     def _close(self) -> None:
         if self._spinner is not None:
@@ -219,6 +260,10 @@ class ServiceMappingsRos:
             if nid not in self.node_ids:
                 return self._fail(m, response, "bad_node_id", f"{nid} is not a {self.protocol} node id "
                                   f"({self.node_ids.start}..{self.node_ids.stop - 1})")
+            if getattr(m, "duty", None) is not None and nid not in self.devices:
+                known = ", ".join(f"{n} ({name})" for n, name in sorted(self.devices.items())) or "none"
+                return self._fail(m, response, "bad_node_id", f"node {nid} is no {self.protocol} device of this "
+                                  f"bridge (its devices: {known})", nid)
         call = Call()
         loop = self._loop
         if loop is None or loop.is_closed() or self.lifetime.closed:
@@ -262,13 +307,14 @@ class ServiceMappingsRos:
             for name, st in self.stats.items():
                 m = st.mapping
                 out[name] = {
-                    "service": m.service, "ros_type": m.ros_type, "data_type": m.data_type,
+                    "service": self.service_name(m), "ros_type": m.ros_type, "data_type": m.data_type,
                     "data_type_id": m.data_type_id, "destination_node_id": m.destination_node_id,
                     "device": m.device, "destination_field": m.destination_field, "timeout_s": m.timeout_s,
                     **{k: st.counts.get(k, 0) for k in ("calls", "answered", "timeouts", "late_responses",
                                                          "duplicate_responses", "malformed_responses")},
                     **{k: v for k, v in sorted(st.counts.items()) if "." in k},
                     "latency_ms_last": st.latency_ms_last, "latency_ms_max": st.latency_ms_max,
+                    "served": name not in self.unserved,
                     "warn": st.last_problem is not None and now - st.last_problem < WARN_AFTER_PROBLEM_S,
                 }
         return out
@@ -280,7 +326,7 @@ class ServiceMappingsRos:
         array.header.stamp = self.ros.clock.now().to_msg()
         for name, entry in self.snapshot().items():
             status = DiagnosticStatus()
-            status.name = f"{self.ros.name}/service/{name}"
+            status.name = f"{self.status_prefix}/service/{name}"
             status.hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
                                   else f"the node of the request's {entry['destination_field']}")
             status.level = DiagnosticStatus.WARN if entry["warn"] else DiagnosticStatus.OK

@@ -107,3 +107,75 @@ def test_unexpected_and_undecodable_responses_are_counted(part: cyphal_services.
     part.backend.node = _Node([(NS(reason=b""), None)])  # the link reopened: a new node, new clients
     _run(part, {"low_percent": 1})
     assert len(part.backend.node.clients) == 1
+
+
+def _link(target: str, source: str | None, kind: str, value: Any = None, hi: float = float("inf")) -> NS:
+    return NS(target=target, source=source, kind=kind, value=value, scale=None, offset=None, lo=0, hi=hi)
+
+
+INFO_DUTY = NS(
+    name="node_services.get_node_info", service="uavcan_get_node_info", ros_type="p/srv/UavcanGetNodeInfo",
+    data_type="uavcan.node.GetInfo.1.0", data_type_id=430, destination_node_id=0, device="",
+    destination_field="node_id", timeout_s=0.5, request=(),
+    response=(_link("success", None, "bool", True), _link("name", "name", "text"),
+              _link("uptime_sec", "heartbeat.uptime_s", "int", hi=2**32 - 1),
+              _link("health", "heartbeat.health", "int", hi=255), _link("mode", "heartbeat.mode", "int", hi=255),
+              _link("software_vcs_revision_id", "software_vcs_revision_id", "int", hi=float(2**64)),
+              _link("unique_id", "unique_id", "bytes")),
+    success_field="success", message_field="message", duty="get_node_info",
+)
+
+
+def test_the_get_node_info_duty_takes_what_get_info_lacks_from_the_heartbeat(monkeypatch: pytest.MonkeyPatch) -> None:
+    """GetInfo has no uptime, health or mode: the node's last heartbeat gives them (0 before any); a uint64 stays
+    exact; the unique id is copied as bytes."""
+    from sam_runtime.bridge.backend import DeviceStatus
+
+    monkeypatch.setattr(cyphal_services, "dsdl_class", lambda name: _Type)
+    lifetime = Lifetime("bridge", RateLimitedLog(logging.getLogger("test"), 10.0))
+    answer = NS(name=b"org.ran.charger", software_vcs_revision_id=2**64 - 3, unique_id=bytes(range(16)))
+    part = cyphal_services.CyphalServices(lifetime, NS(node=_Node([(answer, None), (answer, None)])),
+                                          NS(name="bridge"), [INFO_DUTY], diagnostics_period=0)
+    part.health = NS(records={31: NS(status=DeviceStatus(31, "CAUTION", 1, "MAINTENANCE", 1234, 7))})
+
+    def run(nid: int) -> Call:
+        async def go() -> Call:
+            call = Call()
+            part.send(INFO_DUTY, nid, {}, call)
+            while not call.done.is_set():
+                await asyncio.sleep(0)
+            return call
+
+        return asyncio.run(go())
+
+    values = run(31).values
+    assert values == {"success": True, "name": "org.ran.charger", "uptime_sec": 1234, "health": 2, "mode": 2,
+                      "software_vcs_revision_id": 2**64 - 3, "unique_id": list(range(16))}
+    unheard = run(32).values  # no heartbeat of node 32 heard: zeros
+    assert unheard is not None and (unheard["uptime_sec"], unheard["health"], unheard["mode"]) == (0, 0, 0)
+
+
+@pytest.fixture
+def duty_part(monkeypatch: pytest.MonkeyPatch) -> cyphal_services.CyphalServices:
+    monkeypatch.setattr(cyphal_services, "dsdl_class", lambda name: _Type)
+    lifetime = Lifetime("bridge", RateLimitedLog(logging.getLogger("test"), 10.0))
+    return cyphal_services.CyphalServices(lifetime, NS(node=None), NS(name="bridge"), [INFO_DUTY],
+                                          diagnostics_period=0)
+
+
+def test_a_duty_refuses_a_node_that_is_no_device(duty_part: cyphal_services.CyphalServices) -> None:
+    """A node id of no device of the bridge's protocol: success false and the reason at once, bad_node_id."""
+    part = duty_part
+    part.devices = {31: "charger"}
+    response = part.serve(INFO_DUTY, NS(node_id=99), NS(success=True, message=""))
+    assert response.success is False
+    assert response.message == "node 99 is no Cyphal device of this bridge (its devices: 31 (charger))"
+    assert part.stats[INFO_DUTY.name].counts == {"calls": 1, "failed.bad_node_id": 1}
+
+
+def test_restart_status_zero_is_success() -> None:
+    from sam_runtime.bridge.backends.service_mappings import from_uavcan
+
+    mapping = NS(response=(_link("success", "status", "ok_if_zero"),))
+    assert from_uavcan(mapping, NS(status=0), []) == {"success": True}
+    assert from_uavcan(mapping, NS(status=3), []) == {"success": False}
