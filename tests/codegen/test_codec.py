@@ -43,7 +43,8 @@ from sam_codegen.validate.resolve import validate
 
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {**tc.SPECS, "barge": Path(__file__).resolve().parents[1] / "specs" / "barge.yaml",
-         "relay": Path(__file__).resolve().parents[1] / "specs" / "relay.yaml"}
+         "relay": Path(__file__).resolve().parents[1] / "specs" / "relay.yaml",
+         "dredger": Path(__file__).resolve().parents[1] / "specs" / "dredger.yaml"}
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "python" / "python" / "sam_bridge" / "codec.py.golden"
 UPDATE = os.environ.get("SAM_UPDATE_GOLDEN") == "1"
 WORKER_ENV = "SAM_CODEC_WORKER"
@@ -173,6 +174,8 @@ if not WORKER:
         report = proc.stdout[-12000:] + proc.stderr[-4000:]
         assert proc.returncode == 0, f"worker tests for {spec} failed:\n{report}"
         assert " passed" in proc.stdout and " skipped" not in proc.stdout, report
+        if os.environ.get("SAM_SHOW_WORKER") == "1":
+            print(proc.stdout[-3000:])
 
 
 # ============================================================================================ worker

@@ -23,7 +23,6 @@ fixed array gets the first elements of a longer one, as rclpy serializes it.
 from __future__ import annotations
 
 import ast
-import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -46,6 +45,7 @@ from sam_codegen.targets.wire.v0_elements import (
     ElementSignatures,
     RecordCdrReader,
     RecordV0Reader,
+    default_literal,
     element_record,
     unsupported,
 )
@@ -110,7 +110,7 @@ class DroneCanWire:
                 leaves = {((name, None),): value for name, value in node.fields.items() if value is not None}
             else:
                 _ros_values(root, (), leaves, [])
-            return [f"return {element_record(root.of, leaves, self.resolved.ros.get, _default_literal)}"]
+            return [f"return {element_record(root.of, leaves, self.resolved.ros.get, default_literal)}"]
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
             return _lines([*lines, f"return {expr}"])
@@ -122,14 +122,6 @@ class DroneCanWire:
         return _lines([*checks, *lines, f"return {expr}, {stamp_ns(root.of, values)}"])
 
 
-
-
-def _default_literal(leaf: Any) -> str:
-    """A ROS leaf's default as an expression (an element record's leaf nothing sets)."""
-    value = leaf.default if leaf.kind == "prim" else leaf.default or ""
-    if isinstance(value, float) and not math.isfinite(value):
-        return "_NAN" if math.isnan(value) else "_INF" if value > 0 else "-_INF"
-    return repr(value)
 
 
 def _lines(lines: list[str]) -> list[str]:

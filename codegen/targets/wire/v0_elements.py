@@ -17,9 +17,10 @@ ROS element message holding arrays (its leaves are numbers, bools and strings on
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
-from sam_codegen.model.spec import RosMessage, V0Struct
+from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import DsdlType
 from sam_codegen.render.pysource import typed_literal
 from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
@@ -31,7 +32,8 @@ from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
 from sam_codegen.targets.wire.v0_write import record_fields
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
 
-__all__ = ["ElementSignatures", "RecordCdrReader", "RecordV0Reader", "element_record", "unsupported"]
+__all__ = ["ElementSignatures", "RecordCdrReader", "RecordV0Reader", "default_literal", "element_record",
+           "unsupported"]
 
 
 def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | None:
@@ -104,9 +106,9 @@ class RecordCdrReader:
         raise AssertionError("an element message with arrays has no wire codec (unsupported)")
 
 
-def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: Any) -> str:
-    """The record an element function returns: a ROS element's leaves (flatten order) or a v0 element's fields
-    (record order), each the value given or the field's default."""
+def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: Any = None) -> str:
+    """The record an element function returns: a ROS element's leaves (flatten order) or a v0 or Cyphal element's
+    fields (record order), each the value given or the field's default (`default_of(leaf)` for a ROS leaf)."""
     if isinstance(of, RosMessage):
         items = []
         for leaf in flatten(of, lookup):
@@ -115,7 +117,24 @@ def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: A
             else:
                 items.append(default_of(leaf))
     else:
-        assert isinstance(of, V0Struct)
-        items = [values.get(((f.name, None),), typed_literal(0, "float" if f.type.kind == "float" else f.type.kind))
+        assert isinstance(of, DsdlStruct)
+        items = [values.get(((f.name, None),), _zero(f.type))
                  for f in of.declared_fields if f.name and isinstance(f.type, DsdlType)]
     return f"({', '.join(items)}{',' if len(items) == 1 else ''})"
+
+
+def _zero(t: DsdlType) -> str:
+    """A scalar field's zero as a record holds it (a number or a bool; bytes and utf8 as ints).
+
+    >>> _zero(DsdlType("float", 16)), _zero(DsdlType("bool", 1)), _zero(DsdlType("byte", 8))
+    ('0.0', 'False', '0')
+    """
+    return typed_literal(0, t.kind if t.kind in ("float", "bool") else "int")
+
+
+def default_literal(leaf: Any) -> str:
+    """A ROS leaf's default as an expression (an element record's leaf nothing sets)."""
+    value = leaf.default if leaf.kind == "prim" else leaf.default or ""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "_NAN" if math.isnan(value) else "_INF" if value > 0 else "-_INF"
+    return repr(value)
