@@ -115,8 +115,8 @@ if not WORKER and not CYPHAL_WORKER:
         spec = tmp_path / "spec" / "barge.yaml"
         spec.parent.mkdir()
         text = barge_with_tags().replace("      - {name: checked, type: bool}\n  barge.cargo.Hold.1.0:",
-                                         "      - {name: checked, type: bool}\n      - {name: marks, type: \"uint2[2]\"}"
-                                         "\n  barge.cargo.Hold.1.0:", 1)
+                                         "      - {name: checked, type: bool}\n"
+                                         "      - {name: marks, type: \"uint2[2]\"}\n  barge.cargo.Hold.1.0:", 1)
         text = text.replace("tags: {each: history, fields: {code: code, checked: checked}}",
                             "tags: {each: history, fields: {code: code, checked: checked}, ignore: [marks]}", 1)
         text = text.replace("      ignore: [hold.open, tag.checked, faults]",

@@ -81,7 +81,7 @@ class RecordV0Reader:
 
     def access(self, path: tuple) -> str:
         assert len(path) == 1 and path[0][1] is None, path  # the element's fields are scalars (unsupported)
-        return f"src[{record_index(self.rm.dsdl_struct, path[0][0])}]"  # type: ignore[arg-type]
+        return f"src[{record_index(self.rm.dsdl_struct, path[0][0])}]"
 
     def as_list(self, expr: str) -> str:
         return f"list({expr})"
