@@ -79,6 +79,14 @@ if not WORKER and not CYPHAL_WORKER:
             return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
         return []
 
+    def _registry_and_object_only(spec: Path, tmp_path: Path, codec: str) -> list[str]:
+        """The CODECS and OBJECT_ONLY parts of a codec module built from `spec` (python/<codec>)."""
+        from sam_codegen.build import build
+
+        build(spec, tmp_path / "generated")
+        text = (tmp_path / "generated" / "python" / codec).read_text(encoding="utf-8")
+        return text.split("CODECS:")[1].split("OBJECT_ONLY:")
+
     def test_power_spec_is_valid() -> None:
         assert _errors(SPEC) == []
 
@@ -110,7 +118,6 @@ if not WORKER and not CYPHAL_WORKER:
     def test_cyphal_elements_a_record_cannot_hold_stay_on_the_object_path(tmp_path: Path) -> None:
         """A Cyphal element type holding an array: no codec for its mapping, OBJECT_ONLY says why; the others
         keep theirs."""
-        from sam_codegen.build import build
 
         spec = tmp_path / "spec" / "barge.yaml"
         spec.parent.mkdir()
@@ -126,9 +133,7 @@ if not WORKER and not CYPHAL_WORKER:
         spec.write_text(text, encoding="utf-8")
         assert text.count("marks") == 5
         assert _errors(spec) == []
-        build(spec, tmp_path / "generated")
-        codec = (tmp_path / "generated" / "python" / "barge_bridge" / "codec.py").read_text(encoding="utf-8")
-        registry, object_only = codec.split("CODECS:")[1].split("OBJECT_ONLY:")
+        registry, object_only = _registry_and_object_only(spec, tmp_path, "barge_bridge/codec.py")
         assert "'hold_state'" not in registry and "'hold_order'" in registry
         assert ("'hold_state': \"arrays of composites converted element by element: history's element type holds "
                 "arrays, composites or a union\"," in object_only)
@@ -185,7 +190,6 @@ if not WORKER and not CYPHAL_WORKER:
 
     def test_elements_a_record_cannot_hold_stay_on_the_object_path(tmp_path: Path) -> None:
         """An element type with a bool (not a byte-multiple number): no DroneCAN codec, OBJECT_ONLY says why."""
-        from sam_codegen.build import build
 
         spec = tmp_path / "power_v0.yaml"
         text = BASE.replace("      - {name: charge, type: float32}\n",
@@ -194,9 +198,7 @@ if not WORKER and not CYPHAL_WORKER:
                             "            charge: charge\n          ignore: [ok]\n    actuators:", 1)
         assert text.count("ignore: [ok]") == 1 and text.count("name: ok") == 1
         spec.write_text(text, encoding="utf-8")
-        build(spec, tmp_path / "generated")
-        codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
-        registry, object_only = codec.split("CODECS:")[1].split("OBJECT_ONLY:")
+        registry, object_only = _registry_and_object_only(spec, tmp_path, "power_bridge/codec_v0.py")
         assert "'charges'" not in registry and "'actuators'" in registry
         assert ("'charges': \"arrays of composites converted element by element: charges's element type holds other "
                 "than numbers of byte-multiple width\"," in object_only)

@@ -17,8 +17,7 @@ text. codec.py imports the standard library only.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -33,7 +32,7 @@ from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
 from sam_codegen.targets.wire.cyphal_elements import RecordCyphalReader, unsupported, zero_record
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
-from sam_codegen.targets.wire.v0_elements import ElementSignatures, RecordCdrReader, default_literal, element_record
+from sam_codegen.targets.wire.v0_elements import default_literal, element_record, record_scope
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved
 
@@ -65,16 +64,11 @@ class CyphalWire:
         self.resolved, self.consts = resolved, consts
         self.records = False  # in an element function: records in and out (cyphal_elements)
 
-    @contextmanager
-    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> Iterator[tuple[Any, Any, Any]]:
+    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> AbstractContextManager[tuple[Any, Any, Any]]:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        self.records = True
-        try:
-            yield RecordCyphalReader(s.elements), RecordCdrReader(self.resolved.ros.get), ElementSignatures(base)
-        finally:
-            self.records = False
+        return record_scope(self, RecordCyphalReader(s.elements), self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return struct.name

@@ -23,8 +23,7 @@ fixed array gets the first elements of a longer one, as rclpy serializes it.
 from __future__ import annotations
 
 import ast
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -42,11 +41,10 @@ from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_w
 from sam_codegen.targets.wire.code import Constants
 from sam_codegen.targets.wire.codec import WireCtorNode, WireSignatures, stamp_ns, wrap_body
 from sam_codegen.targets.wire.v0_elements import (
-    ElementSignatures,
-    RecordCdrReader,
     RecordV0Reader,
     default_literal,
     element_record,
+    record_scope,
     unsupported,
 )
 from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
@@ -70,16 +68,11 @@ class DroneCanWire:
         self.resolved, self.consts, self.layout = resolved, consts, layout
         self.records = False  # in an element function: records in and out (v0_elements)
 
-    @contextmanager
-    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> Iterator[tuple[Any, Any, Any]]:
+    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> AbstractContextManager[tuple[Any, Any, Any]]:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        self.records = True
-        try:
-            yield RecordV0Reader(s.elements), RecordCdrReader(self.resolved.ros.get), ElementSignatures(base)
-        finally:
-            self.records = False
+        return record_scope(self, RecordV0Reader(s.elements), self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return "Any"

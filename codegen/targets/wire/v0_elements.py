@@ -10,14 +10,17 @@ in an `element_scope` of DroneCanWire that gives them these readers and signatur
 - ROS -> UAVCAN: `src` is such a tuple, as cdr_read reads a sequence of messages; the result is a record of the
   element type (its fields in record order, defaults included), which v0_write writes as one array element.
 
-What a record cannot hold, `unsupported` names (the mapping stays on the object converters, OBJECT_ONLY says
-why): an element type with other than scalar numbers of byte-multiple width (v0_write packs records with struct), a
-ROS element message holding arrays (its leaves are numbers, bools and strings only).
+The Cyphal codec's element functions share the CDR side, the signatures, the records and `record_scope` with these
+(targets.wire.cyphal_elements). What a v0 record cannot hold, `unsupported` names (the mapping stays on the object
+converters, OBJECT_ONLY says why): an element type with other than scalar numbers of byte-multiple width (v0_write
+packs records with struct), a ROS element message holding arrays (its leaves are numbers, bools and strings only).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from sam_codegen.model.spec import DsdlStruct, RosMessage
@@ -33,7 +36,7 @@ from sam_codegen.targets.wire.v0_write import record_fields
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
 
 __all__ = ["ElementSignatures", "RecordCdrReader", "RecordV0Reader", "default_literal", "element_record",
-           "unsupported"]
+           "record_scope", "unsupported"]
 
 
 def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | None:
@@ -48,6 +51,17 @@ def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | Non
         if any(leaf.kind not in ("prim", "string") for leaf in flatten(s.elements.ros_message, lookup)):
             return f"arrays of composites converted element by element: {s.ros}'s element message holds arrays"
     return None
+
+
+@contextmanager
+def record_scope(build: Any, uavcan: Any, ros_lookup: Any, base: str) -> Iterator[tuple[Any, Any, Any]]:
+    """A wire codec's `element_scope` (targets.python.elements): `build.records` set while the element functions
+    are emitted (their results are records), with `uavcan` as the UAVCAN reader of a record."""
+    build.records = True
+    try:
+        yield uavcan, RecordCdrReader(ros_lookup), ElementSignatures(base)
+    finally:
+        build.records = False
 
 
 class ElementSignatures:
