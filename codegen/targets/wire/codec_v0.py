@@ -103,7 +103,7 @@ class DroneCanWire:
                 leaves = {((name, None),): value for name, value in node.fields.items() if value is not None}
             else:
                 _ros_values(root, (), leaves, [])
-            return [f"return {element_record(root.of, leaves, self.resolved.ros.get, default_literal)}"]
+            return _lines([f"return {element_record(root.of, leaves, self.resolved.ros.get, default_literal)}"])
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
             return _lines([*lines, f"return {expr}"])

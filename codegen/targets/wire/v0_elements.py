@@ -12,8 +12,9 @@ in an `element_scope` of DroneCanWire that gives them these readers and signatur
 
 The Cyphal codec's element functions share the CDR side, the signatures, the records and `record_scope` with these
 (targets.wire.cyphal_elements). What a v0 record cannot hold, `unsupported` names (the mapping stays on the object
-converters, OBJECT_ONLY says why): an element type with other than scalar numbers of byte-multiple width (v0_write
-packs records with struct), a ROS element message holding arrays (its leaves are numbers, bools and strings only).
+converters, OBJECT_ONLY says why): an element type holding arrays, nested composites, a union or a float32/64 among
+bit fields (v0_write packs records of byte-multiple numbers with struct, and shifts bools, integers of any width and
+float16 in as stream bits), a ROS element message holding arrays (its leaves are numbers, bools and strings only).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from sam_codegen.targets.python.module import FunctionDraft
 from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_layout import flatten
 from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
-from sam_codegen.targets.wire.v0_write import record_fields
+from sam_codegen.targets.wire.v0_write import record_bit_fields, record_fields
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
 
 __all__ = ["ElementSignatures", "RecordCdrReader", "RecordV0Reader", "default_literal", "element_record",
@@ -45,9 +46,10 @@ def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | Non
         if s.kind != "elements":
             continue
         assert s.elements is not None and s.uavcan_type is not None
-        if record_fields(layout, s.uavcan_type.element) is None:
-            return (f"arrays of composites converted element by element: {s.uavcan}'s element type holds other than "
-                    "numbers of byte-multiple width")
+        element = s.uavcan_type.element
+        if record_fields(layout, element) is None and record_bit_fields(layout, element) is None:
+            return (f"arrays of composites converted element by element: {s.uavcan}'s element type holds arrays, "
+                    "composites, a union or a float32/64 beside fields of other widths")
         if any(leaf.kind not in ("prim", "string") for leaf in flatten(s.elements.ros_message, lookup)):
             return f"arrays of composites converted element by element: {s.ros}'s element message holds arrays"
     return None
