@@ -3,8 +3,8 @@
 For every Cyphal mapping of six specs (SAM; tests/specs/rover.yaml: odd widths, bool, utf8, arrays, a nested
 composite; tests/specs/tractor.yaml: void padding, int3/5/7 arrays, fixed arrays of composites;
 tests/specs/barge.yaml: nested delimited composites, a variable-length array of them, bool arrays, a standard type
-with padding; tests/relay.yaml: expressions; tests/specs/dredger.yaml: element mappings, arrays of delimited and sealed
-composites of bit fields as records, ROS element messages of mixed alignment), with hypothesis:
+with padding; tests/specs/relay.yaml: expressions; tests/specs/dredger.yaml: element mappings, arrays of delimited and
+sealed composites of bit fields as records, ROS element messages of mixed alignment), with hypothesis:
 
 (a) random pycyphal objects (every field over its whole range) -> pycyphal serialize -> ``m_wire_to_ros`` ->
     rclpy deserialize_message == what the object path gives (pycyphal deserialize, ``m_to_ros``, rclpy), NaN-aware,
