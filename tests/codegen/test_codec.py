@@ -175,8 +175,6 @@ if not WORKER:
         report = proc.stdout[-12000:] + proc.stderr[-4000:]
         assert proc.returncode == 0, f"worker tests for {spec} failed:\n{report}"
         assert " passed" in proc.stdout and " skipped" not in proc.stdout, report
-        if os.environ.get("SAM_SHOW_WORKER") == "1":
-            print(proc.stdout[-3000:])
 
 
 # ============================================================================================ worker
