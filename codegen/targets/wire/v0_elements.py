@@ -12,9 +12,9 @@ in an `element_scope` of DroneCanWire that gives them these readers and signatur
 
 The Cyphal codec's element functions share the CDR side, the signatures, the records and `record_scope` with these
 (targets.wire.cyphal_elements). What a v0 record cannot hold, `unsupported` names (the mapping stays on the object
-converters, OBJECT_ONLY says why): an element type holding arrays, nested composites, a union or a float32/64 among
-bit fields (v0_write packs records of byte-multiple numbers with struct, and shifts bools, integers of any width and
-float16 in as stream bits), a ROS element message holding arrays (its leaves are numbers, bools and strings only).
+converters, OBJECT_ONLY says why): an element type holding arrays, nested composites or a union (v0_write packs
+records of byte-multiple numbers with struct, and shifts other scalar fields in as stream bits), a ROS element message
+holding arrays (its leaves are numbers, bools and strings only).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | Non
         element = s.uavcan_type.element
         if record_fields(layout, element) is None and record_bit_fields(layout, element) is None:
             return (f"arrays of composites converted element by element: {s.uavcan}'s element type holds arrays, "
-                    "composites, a union or a float32/64 beside fields of other widths")
+                    "composites or a union")
         if any(leaf.kind not in ("prim", "string") for leaf in flatten(s.elements.ros_message, lookup)):
             return f"arrays of composites converted element by element: {s.ros}'s element message holds arrays"
     return None

@@ -18,7 +18,7 @@ API (used by codec_v0)
   time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default. A
   dynamic array of composites may be a list expression of records (tuples of the element's fields, as v0_read gives
   them) when ``record_fields`` allows it (every field a scalar number of byte-multiple width: struct packs them) or
-  ``record_bit_fields`` does (bools, integers of any width, float16, void padding: shifted in as stream bits).
+  ``record_bit_fields`` does (any scalars and void padding: shifted in as stream bits).
 - ``v0_writer(struct, node, layout, consts)`` -> ``(lines, expr)``: statements and the expression of the payload.
 - ``HELPERS``: the source of the helpers the generated code calls (``_f16``, ``_f16t``, ``_clamp``, ``_trunc``).
 """
@@ -154,8 +154,8 @@ def record_fields(layout: V0Layout, t: DsdlType) -> tuple[DsdlType, ...] | None:
 
 
 def record_bit_fields(layout: V0Layout, t: DsdlType) -> tuple[tuple[DsdlType, int | None], ...] | None:
-    """The fields of a composite element written from a record as bits: when every field is a bool, an integer of
-    any width, a float16 or void padding (no arrays, composites, unions, wider floats), each field's type and its
+    """The fields of a composite element written from a record as stream bits: when every field is a scalar (a
+    bool, an integer of any width, a float, void padding; no arrays, composites, unions), each field's type and its
     position in the record (None: padding, not in the record); else None."""
     if t.kind != "composite":
         return None
@@ -164,8 +164,7 @@ def record_bit_fields(layout: V0Layout, t: DsdlType) -> tuple[tuple[DsdlType, in
     position = 0
     for f in s.declared_fields:
         x = f.type
-        if s.union or not isinstance(x, DsdlType) or x.array or x.kind not in ("bool", "int", "uint", "float", "void") \
-                or (x.kind == "float" and x.bits != 16):
+        if s.union or not isinstance(x, DsdlType) or x.array or x.kind not in ("bool", "int", "uint", "float", "void"):
             return None
         out.append((x, position if f.name else None))
         position += bool(f.name)
@@ -464,8 +463,8 @@ class _Writer:
             self.lines.append(f"_a = _a << (len({chunk}) << 3) | int.from_bytes({chunk}, 'big')")
         elif d.bit_record:  # records of bit fields: each element's stream bits as one integer
             outer, self.lines = self.lines, []
-            bits = self.combine([("bits", None if i is None else self.stream_bits(x, f"_r[{i}]"), x.bits)
-                                 for x, i in d.bit_record])  # (their temporaries are bound in the loop)
+            bits = self.combine(self.pieces([_Atom(x, None if i is None else f"_r[{i}]") for x, i in d.bit_record]))
+            # (their temporaries are bound in the loop)
             body, self.lines = self.lines, outer
             self.lines.append(f"for _r in {items}:")
             self.lines.extend(f"    {line}" for line in [*body, f"_a = _a << {d.bits} | {bits}"])
