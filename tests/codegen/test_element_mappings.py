@@ -201,7 +201,7 @@ if not WORKER and not CYPHAL_WORKER:
         registry, object_only = _registry_and_object_only(spec, tmp_path, "power_bridge/codec_v0.py")
         assert "'charges'" not in registry and "'actuators'" in registry
         assert ("'charges': \"arrays of composites converted element by element: charges's element type holds "
-                "arrays, composites or a union\"," in object_only)
+                "arrays or a union\"," in object_only)
 
     def test_the_codec_cuts_and_saturates_as_counted(tmp_path: Path) -> None:
         """ROS Command[20] -> ArrayCommand: cut to 15 (counted once), a value beyond float16 saturated (counted per

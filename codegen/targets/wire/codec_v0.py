@@ -72,7 +72,7 @@ class DroneCanWire:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        return record_scope(self, RecordV0Reader(s.elements), self.resolved.ros.get, base)
+        return record_scope(self, RecordV0Reader(s.elements, self.layout.struct), self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return "Any"
@@ -99,11 +99,12 @@ class DroneCanWire:
         if self.records:
             leaves: dict[tuple, str] = {}
             if isinstance(root.of, V0Struct):
-                node = _v0_node(root)
-                leaves = {((name, None),): value for name, value in node.fields.items() if value is not None}
+                _v0_leaves(_v0_node(root), (), leaves)
+                record = element_record(root.of, leaves, self.layout.struct)
             else:
                 _ros_values(root, (), leaves, [])
-            return _lines([f"return {element_record(root.of, leaves, self.resolved.ros.get, default_literal)}"])
+                record = element_record(root.of, leaves, self.resolved.ros.get, default_literal)
+            return _lines([f"return {record}"])
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
             return _lines([*lines, f"return {expr}"])
@@ -115,6 +116,15 @@ class DroneCanWire:
         return _lines([*checks, *lines, f"return {expr}, {stamp_ns(root.of, values)}"])
 
 
+
+
+def _v0_leaves(node: Any, prefix: tuple, out: dict[tuple, str]) -> None:
+    """The expressions of a DroneCAN element's scalars by path (nested composites by their fields'), for its record."""
+    for name, value in node.fields.items():
+        if isinstance(value, V0Node):
+            _v0_leaves(value, (*prefix, (name, None)), out)
+        elif value is not None:
+            out[(*prefix, (name, None))] = value
 
 
 def _lines(lines: list[str]) -> list[str]:

@@ -12,9 +12,9 @@ in an `element_scope` of DroneCanWire that gives them these readers and signatur
 
 The Cyphal codec's element functions share the CDR side, the signatures, the records and `record_scope` with these
 (targets.wire.cyphal_elements). What a v0 record cannot hold, `unsupported` names (the mapping stays on the object
-converters, OBJECT_ONLY says why): an element type holding arrays, nested composites or a union (v0_write packs
-records of byte-multiple numbers with struct, and shifts other scalar fields in as stream bits), a ROS element message
-holding arrays (its leaves are numbers, bools and strings only).
+converters, OBJECT_ONLY says why): an element type holding arrays or a union (v0_write packs records of byte-multiple
+numbers with struct, and shifts other scalar fields, and nested composites of them, in as stream bits), a ROS element
+message holding arrays (its leaves are numbers, bools and strings only).
 """
 
 from __future__ import annotations
@@ -48,8 +48,8 @@ def unsupported(rm: ResolvedMapping, layout: V0Layout, lookup: Any) -> str | Non
         assert s.elements is not None and s.uavcan_type is not None
         element = s.uavcan_type.element
         if record_fields(layout, element) is None and record_bit_fields(layout, element) is None:
-            return (f"arrays of composites converted element by element: {s.uavcan}'s element type holds arrays, "
-                    "composites or a union")
+            return (f"arrays of composites converted element by element: {s.uavcan}'s element type holds arrays "
+                    "or a union")
         if any(leaf.kind not in ("prim", "string") for leaf in flatten(s.elements.ros_message, lookup)):
             return f"arrays of composites converted element by element: {s.ros}'s element message holds arrays"
     return None
@@ -86,18 +86,26 @@ class ElementSignatures:
 
 
 class RecordV0Reader:
-    """The UAVCAN side of an element: `src`, a record of the element type (its scalar fields by position)."""
+    """The UAVCAN side of an element: `src`, a record of the element type (its fields by position, a nested
+    composite a tuple of its own); `struct_of` gives a nested composite's type."""
 
-    def __init__(self, rm: ResolvedMapping) -> None:
-        self.rm = rm
+    def __init__(self, rm: ResolvedMapping, struct_of: Any) -> None:
+        self.rm, self.struct_of = rm, struct_of
         self.items: dict[tuple, str] = {}
 
     def bind(self, em: MappingEmitter, fn: FunctionDraft, names: LocalNames, steps: list[Step]) -> dict[tuple, str]:
         return bind_required_elements(self, em, fn, names, steps)
 
     def access(self, path: tuple) -> str:
-        assert len(path) == 1 and path[0][1] is None, path  # the element's fields are scalars (unsupported)
-        return f"src[{record_index(self.rm.dsdl_struct, path[0][0])}]"
+        struct, text = self.rm.dsdl_struct, "src"
+        for name, index in path:
+            assert index is None, path  # the element's fields are scalars and composites of them (unsupported)
+            text += f"[{record_index(struct, name)}]"
+            f = struct.field(name)
+            assert f is not None and isinstance(f.type, DsdlType)
+            if f.type.kind == "composite":
+                struct = self.struct_of(f.type)
+        return text
 
     def as_list(self, expr: str) -> str:
         return f"list({expr})"
@@ -122,9 +130,10 @@ class RecordCdrReader:
         raise AssertionError("an element message with arrays has no wire codec (unsupported)")
 
 
-def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: Any = None) -> str:
+def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: Any = None, prefix: tuple = ()) -> str:
     """The record an element function returns: a ROS element's leaves (flatten order) or a v0 or Cyphal element's
-    fields (record order), each the value given or the field's default (`default_of(leaf)` for a ROS leaf)."""
+    fields (record order; a nested composite a tuple of its own, its type from `lookup`), each the value given or the
+    field's default (`default_of(leaf)` for a ROS leaf)."""
     if isinstance(of, RosMessage):
         items = []
         for leaf in flatten(of, lookup):
@@ -134,7 +143,8 @@ def element_record(of: Any, values: dict[tuple, str], lookup: Any, default_of: A
                 items.append(default_of(leaf))
     else:
         assert isinstance(of, DsdlStruct)
-        items = [values.get(((f.name, None),), _zero(f.type))
+        items = [element_record(lookup(f.type), values, lookup, default_of, (*prefix, (f.name, None)))
+                 if f.type.kind == "composite" else values.get((*prefix, (f.name, None)), _zero(f.type))
                  for f in of.declared_fields if f.name and isinstance(f.type, DsdlType)]
     return f"({', '.join(items)}{',' if len(items) == 1 else ''})"
 

@@ -18,7 +18,8 @@ API (used by codec_v0)
   time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default. A
   dynamic array of composites may be a list expression of records (tuples of the element's fields, as v0_read gives
   them) when ``record_fields`` allows it (every field a scalar number of byte-multiple width: struct packs them) or
-  ``record_bit_fields`` does (any scalars and void padding: shifted in as stream bits).
+  ``record_bit_fields`` does (any scalars, void padding and composites of them, nested tuples in the record: shifted
+  in as stream bits).
 - ``v0_writer(struct, node, layout, consts)`` -> ``(lines, expr)``: statements and the expression of the payload.
 - ``HELPERS``: the source of the helpers the generated code calls (``_f16``, ``_f16t``, ``_clamp``, ``_trunc``).
 """
@@ -129,8 +130,8 @@ class _List:
     expr: str
     prefix: int  # length prefix bits (0: tail array)
     record: tuple[DsdlType, ...] = ()  # composite elements: records, the types of their fields (see record_fields)
-    # composite elements of bit fields: every declared field's type and its record position (None: void padding)
-    bit_record: tuple[tuple[DsdlType, int | None], ...] = ()
+    # composite elements of bit fields: every scalar's type and where the record holds it (see record_bit_fields)
+    bit_record: tuple[tuple[DsdlType, str | None], ...] = ()
 
     @property
     def bits(self) -> int:
@@ -153,20 +154,30 @@ def record_fields(layout: V0Layout, t: DsdlType) -> tuple[DsdlType, ...] | None:
     return types  # type: ignore[return-value]
 
 
-def record_bit_fields(layout: V0Layout, t: DsdlType) -> tuple[tuple[DsdlType, int | None], ...] | None:
-    """The fields of a composite element written from a record as stream bits: when every field is a scalar (a
-    bool, an integer of any width, a float, void padding; no arrays, composites, unions), each field's type and its
-    position in the record (None: padding, not in the record); else None."""
+def record_bit_fields(layout: V0Layout, t: DsdlType, at: str = "") -> tuple[tuple[DsdlType, str | None], ...] | None:
+    """The scalar fields of a composite element written from a record as stream bits, in wire order: when every field
+    is a scalar (a bool, an integer of any width, a float), void padding or a composite of such fields (no arrays, no
+    unions), each scalar's type and where the record holds it (`[2][0]`: a nested composite is a tuple in its
+    record; None: padding, not in the record); else None."""
     if t.kind != "composite":
         return None
     s = layout.struct(t)
-    out: list[tuple[DsdlType, int | None]] = []
+    if s.union:
+        return None
+    out: list[tuple[DsdlType, str | None]] = []
     position = 0
     for f in s.declared_fields:
         x = f.type
-        if s.union or not isinstance(x, DsdlType) or x.array or x.kind not in ("bool", "int", "uint", "float", "void"):
+        if not isinstance(x, DsdlType) or x.array or x.kind not in ("bool", "int", "uint", "float", "void",
+                                                                    "composite"):
             return None
-        out.append((x, position if f.name else None))
+        if x.kind == "composite":
+            nested = record_bit_fields(layout, x, f"{at}[{position}]")
+            if nested is None:
+                return None
+            out.extend(nested)
+        else:
+            out.append((x, f"{at}[{position}]" if f.name else None))
         position += bool(f.name)
     return tuple(out) if out else None
 
@@ -186,7 +197,7 @@ def _flatten(layout: V0Layout, t: DsdlType, value: Any, tao: bool, out: list[_At
         prefix = 0 if tao_mode else length_bits(t.capacity or 0)
         if isinstance(value, str):
             record: tuple[DsdlType, ...] = ()
-            bit_record: tuple[tuple[DsdlType, int | None], ...] = ()
+            bit_record: tuple[tuple[DsdlType, str | None], ...] = ()
             if t.element.kind == "composite":
                 found = record_fields(layout, t.element)
                 bits_found = record_bit_fields(layout, t.element) if found is None else None
@@ -463,7 +474,7 @@ class _Writer:
             self.lines.append(f"_a = _a << (len({chunk}) << 3) | int.from_bytes({chunk}, 'big')")
         elif d.bit_record:  # records of bit fields: each element's stream bits as one integer
             outer, self.lines = self.lines, []
-            bits = self.combine(self.pieces([_Atom(x, None if i is None else f"_r[{i}]") for x, i in d.bit_record]))
+            bits = self.combine(self.pieces([_Atom(x, None if at is None else f"_r{at}") for x, at in d.bit_record]))
             # (their temporaries are bound in the loop)
             body, self.lines = self.lines, outer
             self.lines.append(f"for _r in {items}:")
