@@ -4,12 +4,12 @@
 valve controller receiving the commands) and ROS probes, under the machine-wide UDP lock:
 
 - UAVCAN -> ROS: every Readings becomes one /pumps message whose PumpReading elements hold what the pumps sent
-  (a uint4, a bool, an int7 and an unaligned float64 among them) and whose element headers carry the message's
-  header: its stamp (from the device's timestamp) and the mapping's frame;
+  (a uint4, a bool, an int7, an unaligned float64 and a nested delimited Health among them) and whose element
+  headers carry the message's header: its stamp (from the device's timestamp) and the mapping's frame;
 - ROS -> UAVCAN: ValveCommands on /valves (a bounded array, `on_out_of_range: reject`) reach the valves in range,
-  with the constant `mode: 2` in every element; more than 4 elements, or a valve id beyond uint6, drop the message,
-  counted; on /valve_pair (a fixed array of 2, saturating) one element is padded with a zero element and three are
-  cut to two, counted once each, a float16 opening saturated and counted.
+  with the constant `mode: 2` and their nested limits in every element; more than 4 elements, or a valve id beyond
+  uint6, drop the message, counted; on /valve_pair (a fixed array of 2, saturating) one element is padded with a
+  zero element and three are cut to two, counted once each, a float16 opening saturated and counted.
 
 The bridge's stats say it ran them on the codec (`wire: codec`), not on the object converters' fallback.
 """
@@ -43,7 +43,8 @@ UDP = ["--transport", "udp", "--iface", "127.0.0.1"]
 
 
 def _valve(valve_id: int, opening: float, speed: float) -> dict[str, Any]:
-    return {"valve_id": valve_id, "opening": opening, "speed": speed, "label": f"v{valve_id}"}
+    return {"valve_id": valve_id, "opening": opening, "speed": speed, "label": f"v{valve_id}",
+            "max_opening": opening / 2, "steps": valve_id % 8}
 
 
 VALVES = [  # /valves: bounded [<=4], reject
@@ -122,7 +123,8 @@ def test_pump_readings_reach_ros_element_by_element(run: dict[str, Any]) -> None
 
     def expected(v: dict[str, Any]) -> list[dict[str, Any]]:
         return [{"pump_id": p["pump_id"], "running": p["running"], "flow": p["flow"], "temp": p["temp"],
-                 "pressure": p["pressure"]} for p in v["pumps"]]
+                 "pressure": p["pressure"], "state": p["health"]["state"], "fault": p["health"]["fault"]}
+                for p in v["pumps"]]
 
     got = [r["msg"] for r in run["got"]]
     assert len(got) >= 5
@@ -130,8 +132,8 @@ def test_pump_readings_reach_ros_element_by_element(run: dict[str, Any]) -> None
         assert msg["pumps"] and all(p["header"] == msg["header"] for p in msg["pumps"]), msg
         assert msg["header"]["frame_id"] == "pump_link"
     values = [expected(v) for v in sent]
-    received = [[{k: p[k] for k in ("pump_id", "running", "flow", "temp", "pressure")} for p in m["pumps"]]
-                for m in got]
+    received = [[{k: p[k] for k in ("pump_id", "running", "flow", "temp", "pressure", "state", "fault")}
+                 for p in m["pumps"]] for m in got]
     assert any(values[i:i + len(received)] == received for i in range(len(values) - len(received) + 1)), \
         (received[:2], values[:2])
 
@@ -143,8 +145,8 @@ def test_valve_commands_reach_the_valves_or_are_dropped_counted(run: dict[str, A
     assert all(r["accepted"] for r in run["records"] if r["dir"] == "rx")
     assert [v["seq"] for v in got] == [0, 3]
     for v, valves in zip(got, (VALVES[0], VALVES[3]), strict=True):
-        assert v["valves"] == [{"valve_id": x["valve_id"], "mode": 2, "opening": x["opening"], "speed": x["speed"]}
-                               for x in valves]
+        assert v["valves"] == [{"valve_id": x["valve_id"], "mode": 2, "opening": x["opening"], "speed": x["speed"],
+                                "limits": {"max_opening": x["max_opening"], "steps": x["steps"]}} for x in valves]
     assert stats["rejected_fields"] == {"valve_commands.valves": 1, "valve_commands.valves[].valve_id": 1}, stats
     assert stats["dropped"] == {"rejected": 2}, stats
 
@@ -153,12 +155,13 @@ def test_valve_pair_padded_cut_and_saturated(run: dict[str, Any]) -> None:
     stats = run["stats"]["mappings"]["valve_pair"]
     assert stats["received"] == stats["published"] == len(PAIR), stats
     got = [r["value"]["valves"] for r in run["records"] if r["dir"] == "rx" and r["subject"] == 802]
-    zero = {"valve_id": 0, "mode": 0, "opening": 0.0, "speed": 0.0}
+    limits = {"max_opening": 1.0, "steps": 7}  # uavcan_values
+    zero = {"valve_id": 0, "mode": 0, "opening": 0.0, "speed": 0.0, "limits": {"max_opening": 0.0, "steps": 0}}
     assert got == [
-        [{"valve_id": 5, "mode": 1, "opening": 0.75, "speed": 1.0}, zero],
-        [{"valve_id": 9, "mode": 1, "opening": 65504.0, "speed": 2.0},
-         {"valve_id": 10, "mode": 1, "opening": 0.5, "speed": 4.0}],
-        [{"valve_id": 12, "mode": 1, "opening": 0.5, "speed": 0.5},
-         {"valve_id": 13, "mode": 1, "opening": 0.25, "speed": 0.75}],
+        [{"valve_id": 5, "mode": 1, "opening": 0.75, "speed": 1.0, "limits": limits}, zero],
+        [{"valve_id": 9, "mode": 1, "opening": 65504.0, "speed": 2.0, "limits": limits},
+         {"valve_id": 10, "mode": 1, "opening": 0.5, "speed": 4.0, "limits": limits}],
+        [{"valve_id": 12, "mode": 1, "opening": 0.5, "speed": 0.5, "limits": limits},
+         {"valve_id": 13, "mode": 1, "opening": 0.25, "speed": 0.75, "limits": limits}],
     ]
     assert stats["saturated"] == {"valve_pair.valves": 2, "valve_pair.valves[].opening": 1}, stats

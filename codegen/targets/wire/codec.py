@@ -30,9 +30,9 @@ from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
 from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft
 from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
-from sam_codegen.targets.wire.cyphal_elements import RecordCyphalReader, unsupported, zero_record
+from sam_codegen.targets.wire.cyphal_elements import unsupported, zero_record
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
-from sam_codegen.targets.wire.v0_elements import default_literal, element_record, record_scope
+from sam_codegen.targets.wire.v0_elements import RecordV0Reader, default_literal, element_record, record_scope
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved
 
@@ -68,7 +68,8 @@ class CyphalWire:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        return record_scope(self, RecordCyphalReader(s.elements), self.resolved.ros.get, base)
+        return record_scope(self, RecordV0Reader(s.elements, lambda t: self.struct(t.composite or "")),
+                            self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return struct.name
@@ -86,14 +87,18 @@ class CyphalWire:
 
     def element_default(self, t: DsdlType | RosType) -> str:
         if isinstance(t, DsdlType) and t.kind == "composite":
-            return zero_record(self.struct(t.composite or ""))  # a fixed array of records padded
+            return zero_record(self.struct(t.composite or ""), self.struct)  # a fixed array of records padded
         return "None"  # an element nobody sets: the writers give the type's default
 
     def format_return(self, module: ConvertModule, root: CtorNode, names: LocalNames) -> list[str]:
         assert isinstance(root, WireCtorNode)
         values = tree_values(root)
         if self.records:
-            return wrap_body([f"return {element_record(root.of, values, self.resolved.ros.get, default_literal)}"])
+            if isinstance(root.of, RosMessage):
+                record = element_record(root.of, values, self.resolved.ros.get, default_literal)
+            else:
+                record = element_record(root.of, values, lambda t: self.struct(t.composite or ""))
+            return wrap_body([f"return {record}"])
         if isinstance(root.of, RosMessage):
             lines, expr = cdr_writer(root.of, values, self.resolved.ros.get, names, self.consts)
             return wrap_body([*lines, f"return {expr}, {stamp_ns(root.of, values)}"])

@@ -384,16 +384,36 @@ class _Reader:
         """One composite of scalar fields appended to the list local `records` as a record: a tuple of its fields
         in declaration order, void padding left out (what the element functions take: targets.wire.v0_elements)."""
         at = (*path[:-1], (path[-1][0], -1))  # the element being read (no index of a real element is negative)
-        fields = [(*at, (f.name, None)) for f in nested.fields]
-        if any(isinstance(f.type, DsdlType) and (f.type.array or f.type.kind == "composite") for f in nested.fields):
-            raise NotImplementedError(f"{path}: records of composites holding arrays or composites")
+        fields = self.record_paths(nested, at)
         self.s.wanted.update(fields)
         self.read_composite(nested, at)
         self.flush()  # the fields' struct runs unpacked before they are gathered
-        values = [self.s.found.pop(f) for f in fields]
+        values = {f: self.s.found.pop(f) for f in fields}
         self.s.wanted.difference_update(fields)
-        self.s.keep.update(values)
-        self.lines.append(f"{records}.append(({', '.join(values)}{',' if len(values) == 1 else ''}))")
+        self.s.keep.update(values.values())
+        self.lines.append(f"{records}.append({self.record_expr(nested, at, values)})")
+
+    def record_paths(self, struct_: DsdlStruct, at: FieldPath) -> list[FieldPath]:
+        """The scalar leaves of a record of `struct_` read at `at` (nested composites: their leaves)."""
+        out: list[FieldPath] = []
+        for f in struct_.fields:
+            t = f.type
+            assert isinstance(t, DsdlType)
+            if t.array or (t.kind == "composite" and struct_of(self.s.lookup, t.composite).union):
+                raise NotImplementedError(f"{struct_.name}: records of composites holding arrays or unions")
+            path = (*at, (f.name, None))
+            out += self.record_paths(struct_of(self.s.lookup, t.composite), path) if t.kind == "composite" else [path]
+        return out
+
+    def record_expr(self, struct_: DsdlStruct, at: FieldPath, values: dict[FieldPath, str]) -> str:
+        """The tuple of a record from its leaves' locals (a nested composite a tuple of its own)."""
+        items = []
+        for f in struct_.fields:
+            t, path = f.type, (*at, (f.name, None))
+            assert isinstance(t, DsdlType)
+            items.append(self.record_expr(struct_of(self.s.lookup, t.composite), path, values)
+                         if t.kind == "composite" else values[path])
+        return f"({', '.join(items)}{',' if len(items) == 1 else ''})"
 
     def loop(self, head: str, off: str, body: Callable[[_Reader], None]) -> None:
         """A block read with its own state from the byte offset local `off`, which it leaves advanced."""

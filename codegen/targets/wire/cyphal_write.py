@@ -296,8 +296,6 @@ class _Writer:
         """An array of composites from a list of records (tuples of their fields in declaration order, void padding
         left out: what the element functions return, targets.wire.v0_elements); a fixed array's list has its
         size, a variable-length one's is within the capacity (the converters cut it before)."""
-        if any(isinstance(f.type, DsdlType) and (f.type.array or f.type.kind == "composite") for f in nested.fields):
-            raise NotImplementedError(f"{nested.name}: records of composites holding arrays or composites")
         local = self.names.new("records")
         self.lines.append(f"{local} = {records}")
         self.align()
@@ -305,14 +303,28 @@ class _Writer:
             self.prim(DsdlType("uint", prefix_bits(t.capacity or 0)), f"len({local})", NO_VALUE)
         self.flush_run()
         record, chunks = self.names.new("record"), self.names.new("chunks")
-        inner = _Writer(self.lookup, self.names, self.consts,
-                        {((f.name, None),): f"{record}[{i}]" for i, f in enumerate(nested.fields)})
+        inner = _Writer(self.lookup, self.names, self.consts, self.record_values(nested, (), record))
         inner.write_composite(nested, ())
         inner.flush_run()
         one = " + ".join(inner.parts) if inner.parts else repr(b"")
         self.lines += [f"{chunks} = []", f"for {record} in {local}:",
                        *(f"    {line}" for line in inner.lines), f"    {chunks}.append({one})"]
         self.parts.append(f"b''.join({chunks})")
+
+    def record_values(self, struct_: DsdlStruct, at: FieldPath, record: str) -> dict[FieldPath, str]:
+        """The writer's values of a record of `struct_` (its scalar leaves; a nested composite a tuple of its own)."""
+        out: dict[FieldPath, str] = {}
+        for i, f in enumerate(struct_.fields):
+            t = f.type
+            assert isinstance(t, DsdlType)
+            if t.array or (t.kind == "composite" and struct_of(self.lookup, t.composite).union):
+                raise NotImplementedError(f"{struct_.name}: records of composites holding arrays or unions")
+            if t.kind == "composite":
+                out.update(self.record_values(struct_of(self.lookup, t.composite), (*at, (f.name, None)),
+                                              f"{record}[{i}]"))
+            else:
+                out[(*at, (f.name, None))] = f"{record}[{i}]"
+        return out
 
     def write_composite(self, nested: DsdlStruct, path: FieldPath | None) -> None:
         self.align()
