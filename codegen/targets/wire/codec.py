@@ -32,7 +32,7 @@ from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
 from sam_codegen.targets.wire.cyphal_elements import unsupported, zero_record
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
-from sam_codegen.targets.wire.v0_elements import RecordV0Reader, default_literal, element_record, record_scope
+from sam_codegen.targets.wire.v0_elements import RecordUavcanReader, default_literal, element_record, record_scope
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved
 
@@ -68,7 +68,7 @@ class CyphalWire:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        return record_scope(self, RecordV0Reader(s.elements, lambda t: self.struct(t.composite or "")),
+        return record_scope(self, RecordUavcanReader(s.elements, lambda t: self.struct(t.composite or "")),
                             self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:

@@ -41,7 +41,7 @@ from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_w
 from sam_codegen.targets.wire.code import Constants
 from sam_codegen.targets.wire.codec import WireCtorNode, WireSignatures, stamp_ns, wrap_body
 from sam_codegen.targets.wire.v0_elements import (
-    RecordV0Reader,
+    RecordUavcanReader,
     default_literal,
     element_record,
     record_scope,
@@ -72,7 +72,7 @@ class DroneCanWire:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        return record_scope(self, RecordV0Reader(s.elements, self.layout.struct), self.resolved.ros.get, base)
+        return record_scope(self, RecordUavcanReader(s.elements, self.layout.struct), self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return "Any"

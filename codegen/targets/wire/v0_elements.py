@@ -36,7 +36,7 @@ from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
 from sam_codegen.targets.wire.v0_write import record_bit_fields, record_fields
 from sam_codegen.validate.mapping_rules import ResolvedMapping, Step
 
-__all__ = ["ElementSignatures", "RecordCdrReader", "RecordV0Reader", "default_literal", "element_record",
+__all__ = ["ElementSignatures", "RecordCdrReader", "RecordUavcanReader", "default_literal", "element_record",
            "record_scope", "unsupported"]
 
 
@@ -85,9 +85,9 @@ class ElementSignatures:
                               f"{rm.ros_message.full_name} -> {rm.dsdl_struct.name}"])
 
 
-class RecordV0Reader:
-    """The UAVCAN side of an element: `src`, a record of the element type (its fields by position, a nested
-    composite a tuple of its own); `struct_of` gives a nested composite's type."""
+class RecordUavcanReader:
+    """The UAVCAN side of an element (both codecs): `src`, a record of the element type (its fields by position, a
+    nested composite a tuple of its own); `struct_of` gives a nested composite's type."""
 
     def __init__(self, rm: ResolvedMapping, struct_of: Any) -> None:
         self.rm, self.struct_of = rm, struct_of
