@@ -318,10 +318,12 @@ class Bridge:
             self.inbound.forget_stamps(nid)
 
     def stats(self) -> dict[str, Any]:
-        """A JSON-serialisable snapshot of every counter, the devices' heartbeats and the bridge itself."""
+        """A JSON-serialisable snapshot of every counter, the devices' heartbeats and the bridge itself (`wire`: the
+        path its mappings run on)."""
         if self.reporter is None:
             raise RuntimeError("start() the bridge first")
         snapshot = self.reporter.snapshot()
+        snapshot["wire"] = self.wire  # the path the mappings run on: "codec", or "object" (chosen, or fallen back)
         if self.services is not None:
             snapshot["services"] = self.services.snapshot()
         return snapshot

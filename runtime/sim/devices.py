@@ -149,6 +149,11 @@ def generic_fill(obj: Any, tt: float, now_us: int, seed: int = 0) -> Any:
                     sub.microsecond = now_us
                 else:
                     generic_fill(sub, tt, now_us, seed + i + 1)
+            elif isinstance(t, pydsdl.VariableLengthArrayType) and isinstance(t.element_type, pydsdl.CompositeType):
+                # a few elements, each filled as a nested composite (arrays of composites mapped element by element)
+                element = pycyphal.dsdl.get_class(t.element_type)
+                setattr(obj, f.name, [generic_fill(element(), tt, now_us, seed + i + 1 + k)
+                                      for k in range(min(t.capacity, 3))])
             elif isinstance(t, pydsdl.ArrayType) and isinstance(t.element_type, pydsdl.PrimitiveType):
                 n = t.capacity if isinstance(t, pydsdl.FixedLengthArrayType) else min(t.capacity, 3)
                 if isinstance(t.element_type, pydsdl.UnsignedIntegerType) and t.element_type.bit_length == 8 \

@@ -1,9 +1,10 @@
 """The generated Cyphal wire codecs (codec.py) against the object path they replace, with the real classes.
 
-For every Cyphal mapping of four specs (SAM; tests/specs/rover.yaml: odd widths, bool, utf8, arrays, a nested
+For every Cyphal mapping of six specs (SAM; tests/specs/rover.yaml: odd widths, bool, utf8, arrays, a nested
 composite; tests/specs/tractor.yaml: void padding, int3/5/7 arrays, fixed arrays of composites;
 tests/specs/barge.yaml: nested delimited composites, a variable-length array of them, bool arrays, a standard type
-with padding), with hypothesis:
+with padding; tests/specs/relay.yaml: expressions; tests/specs/dredger.yaml: element mappings, arrays of delimited and
+sealed composites of bit fields as records, ROS element messages of mixed alignment), with hypothesis:
 
 (a) random pycyphal objects (every field over its whole range) -> pycyphal serialize -> ``m_wire_to_ros`` ->
     rclpy deserialize_message == what the object path gives (pycyphal deserialize, ``m_to_ros``, rclpy), NaN-aware,
@@ -43,7 +44,8 @@ from sam_codegen.validate.resolve import validate
 
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {**tc.SPECS, "barge": Path(__file__).resolve().parents[1] / "specs" / "barge.yaml",
-         "relay": Path(__file__).resolve().parents[1] / "specs" / "relay.yaml"}
+         "relay": Path(__file__).resolve().parents[1] / "specs" / "relay.yaml",
+         "dredger": Path(__file__).resolve().parents[1] / "specs" / "dredger.yaml"}
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "python" / "python" / "sam_bridge" / "codec.py.golden"
 UPDATE = os.environ.get("SAM_UPDATE_GOLDEN") == "1"
 WORKER_ENV = "SAM_CODEC_WORKER"

@@ -12,7 +12,7 @@ In this process (no ROS needed):
 In a child process with SAM's ROS package (as tests/test_v0_converters.py does it; the spec's own v0 types added by
 sam_runtime.dronecan_io.types.ensure_types, never dronecan.load_dsdl), hypothesis property tests for every DroneCAN
 mapping of SAM's spec and of the tests/specs of SPECS (ferry, minimal_v0, buoy_v0, trawler_v0, seiner, relay, power_v0,
-power_prefix_v0, lolo_v0):
+power_prefix_v0, lolo_v0, hopper_v0: element records of bit fields):
 
 (a) random dronecan messages -> dronecan's bytes (``Transfer(payload=obj).payload``) -> ``<m>_wire_to_ros`` gives
     the CDR of ``<m>_to_ros`` (NaN-aware), its stamp, the same counts, and ``WIRE_MATCHES`` agrees with ``MATCHES``;
@@ -47,7 +47,8 @@ SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "sp
          "seiner": ROOT / "tests" / "specs" / "seiner.yaml", "relay": ROOT / "tests" / "specs" / "relay.yaml",
          "power_v0": ROOT / "tests" / "specs" / "power_v0.yaml",
          "power_prefix_v0": ROOT / "tests" / "specs" / "power_prefix_v0.yaml",
-         "lolo_v0": ROOT / "tests" / "specs" / "lolo_v0.yaml"}
+         "lolo_v0": ROOT / "tests" / "specs" / "lolo_v0.yaml",
+         "hopper_v0": ROOT / "tests" / "specs" / "hopper_v0.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)
@@ -305,7 +306,7 @@ if not WORKER:
         generated = tmp_path / "generated"  # built afresh: the codecs of the generator as it is
         build(SPECS[spec], generated)
         packages = ros_packages_in_order(ROOT / "generated" / "ros")  # SAM's messages (others: installed)
-        if spec in ("relay", "power_v0", "power_prefix_v0", "lolo_v0"):  # and the spec's own messages (relay_msgs...)
+        if spec in ("relay", "power_v0", "power_prefix_v0", "lolo_v0", "hopper_v0"):  # and the spec's own messages
             packages = [*packages, *ros_packages_in_order(generated / "ros")]
         prefix = built_prefix(packages)
         config = {"spec": str(SPECS[spec]), "generated": str(generated)}

@@ -5,15 +5,16 @@ mapping with `each` (tests/specs/barge.yaml with HoldState.tags <- Manifest.hist
 convert.py, the plan holds an ElementMapping with the array's length rule,
 the docs word the element fields, the DroneCAN wire codec converts power_v0's element mappings (cut and saturation
 counted as the object converter counts them; an element type a record cannot hold stays on the object converters)
-and the Cyphal one leaves them to the object converters (OBJECT_ONLY says why; the runtime's warning, or the offline
-bridge's error, quotes it).
+and so does the Cyphal one (an element type a record cannot hold stays on the object converters: OBJECT_ONLY says
+why; the runtime's warning, or the offline bridge's error, quotes it).
 
 In a child process with the spec's ROS package built (hypothesis, dronecan's transport and rclpy's serialization as
 the oracles): ConsumedChargeArray -> ConsumedCharges gives every element's values and the message's header in every
 element; Commands -> ArrayCommand gives the first 15 elements (float16 saturated and counted), the cut counted once
 under `actuators.commands`; with on_out_of_range: reject, more than 15 elements or a value beyond float16 drops the
 message, counted. Likewise on Cyphal with pycyphal's compiled classes: Manifest.history (Tag[<=3]) -> HoldState.tags
-and back, the cut beyond 3 and uint24 saturation counted.
+and back, the cut beyond 3 and uint24 saturation counted, by the object converters and by the wire codec (the same
+message, pycyphal's payload bytes, the same counts).
 """
 
 from __future__ import annotations
@@ -78,6 +79,14 @@ if not WORKER and not CYPHAL_WORKER:
             return [str(d).replace(str(path), path.name) for d in exc.diagnostics]
         return []
 
+    def _registry_and_object_only(spec: Path, tmp_path: Path, codec: str) -> list[str]:
+        """The CODECS and OBJECT_ONLY parts of a codec module built from `spec` (python/<codec>)."""
+        from sam_codegen.build import build
+
+        build(spec, tmp_path / "generated")
+        text = (tmp_path / "generated" / "python" / codec).read_text(encoding="utf-8")
+        return text.split("CODECS:")[1].split("OBJECT_ONLY:")
+
     def test_power_spec_is_valid() -> None:
         assert _errors(SPEC) == []
 
@@ -88,8 +97,9 @@ if not WORKER and not CYPHAL_WORKER:
         path.write_text(BASE.replace(case.old, case.new, 1), encoding="utf-8")
         assert _errors(path) == list(case.errors)
 
-    def test_cyphal_element_mapping_generates_object_converters(tmp_path: Path) -> None:
-        """The same construct in a Cyphal mapping: element functions in convert.py, no wire codec (OBJECT_ONLY)."""
+    def test_cyphal_element_mapping_generates_converters_and_codecs(tmp_path: Path) -> None:
+        """The same construct in a Cyphal mapping: element functions in convert.py and, on records, in codec.py
+        (the mapping is in CODECS, nothing in OBJECT_ONLY)."""
         from sam_codegen.build import build
 
         spec = tmp_path / "spec" / "barge.yaml"
@@ -101,8 +111,32 @@ if not WORKER and not CYPHAL_WORKER:
         convert = (python / "convert.py").read_text(encoding="utf-8")
         assert "def _hold_state_tags_item_to_ros(" in convert and "for element in list(src.history):" in convert
         codec = (python / "codec.py").read_text(encoding="utf-8")
-        assert "OBJECT_ONLY: dict[str, str] = {\n    'hold_state': 'arrays of composites converted element by " \
-            "element',\n}" in codec
+        assert "'hold_state': (hold_state_wire_to_ros, hold_state_ros_to_wire)" in codec.split("CODECS:")[1]
+        assert "def _hold_state_tags_item_to_ros(src: tuple, receive_ns: int, stats: Any) -> tuple | None:" in codec
+        assert "for element in list(history):" in codec and "OBJECT_ONLY" not in codec
+
+    def test_cyphal_elements_a_record_cannot_hold_stay_on_the_object_path(tmp_path: Path) -> None:
+        """A Cyphal element type holding an array: no codec for its mapping, OBJECT_ONLY says why; the others
+        keep theirs."""
+
+        spec = tmp_path / "spec" / "barge.yaml"
+        spec.parent.mkdir()
+        text = barge_with_tags().replace("      - {name: checked, type: bool}\n  barge.cargo.Hold.1.0:",
+                                         "      - {name: checked, type: bool}\n"
+                                         "      - {name: marks, type: \"uint2[2]\"}\n  barge.cargo.Hold.1.0:", 1)
+        text = text.replace("tags: {each: history, fields: {code: code, checked: checked}}",
+                            "tags: {each: history, fields: {code: code, checked: checked}, ignore: [marks]}", 1)
+        text = text.replace("      ignore: [hold.open, tag.checked, faults]",
+                            "      ignore: [hold.open, tag.checked, tag.marks, faults]", 1)
+        text = text.replace("        tag.checked: true\n", "        tag.checked: true\n        \"tag.marks[0]\": 1\n"
+                            "        \"tag.marks[1]\": 2\n", 1)
+        spec.write_text(text, encoding="utf-8")
+        assert text.count("marks") == 5
+        assert _errors(spec) == []
+        registry, object_only = _registry_and_object_only(spec, tmp_path, "barge_bridge/codec.py")
+        assert "'hold_state'" not in registry and "'hold_order'" in registry
+        assert ("'hold_state': \"arrays of composites converted element by element: history's element type holds "
+                "arrays or a union\"," in object_only)
 
     def test_plan_holds_the_element_mapping() -> None:
         resolved = validate(load_spec_file(SPEC))
@@ -155,22 +189,19 @@ if not WORKER and not CYPHAL_WORKER:
         assert "OBJECT_ONLY" not in codec
 
     def test_elements_a_record_cannot_hold_stay_on_the_object_path(tmp_path: Path) -> None:
-        """An element type with a bool (not a byte-multiple number): no DroneCAN codec, OBJECT_ONLY says why."""
-        from sam_codegen.build import build
-
+        """An element type holding an array: no DroneCAN codec, OBJECT_ONLY says why (bools and bit-width integers
+        have one: tests/specs/hopper_v0.yaml in tests/codegen/test_codec_v0.py)."""
         spec = tmp_path / "power_v0.yaml"
         text = BASE.replace("      - {name: charge, type: float32}\n",
-                            "      - {name: charge, type: float32}\n      - {name: ok, type: bool}\n", 1)
+                            "      - {name: charge, type: float32}\n      - {name: ok, type: \"bool[2]\"}\n", 1)
         text = text.replace("            charge: charge\n    actuators:",
                             "            charge: charge\n          ignore: [ok]\n    actuators:", 1)
         assert text.count("ignore: [ok]") == 1 and text.count("name: ok") == 1
         spec.write_text(text, encoding="utf-8")
-        build(spec, tmp_path / "generated")
-        codec = (tmp_path / "generated" / "python" / "power_bridge" / "codec_v0.py").read_text(encoding="utf-8")
-        registry, object_only = codec.split("CODECS:")[1].split("OBJECT_ONLY:")
+        registry, object_only = _registry_and_object_only(spec, tmp_path, "power_bridge/codec_v0.py")
         assert "'charges'" not in registry and "'actuators'" in registry
-        assert ("'charges': \"arrays of composites converted element by element: charges's element type holds other "
-                "than numbers of byte-multiple width\"," in object_only)
+        assert ("'charges': \"arrays of composites converted element by element: charges's element type holds "
+                "arrays or a union\"," in object_only)
 
     def test_the_codec_cuts_and_saturates_as_counted(tmp_path: Path) -> None:
         """ROS Command[20] -> ArrayCommand: cut to 15 (counted once), a value beyond float16 saturated (counted per
@@ -306,6 +337,7 @@ if CYPHAL_WORKER:
     sys.path.insert(0, CYPHAL_CONFIG["dsdl"])
     sys.path.insert(0, CYPHAL_CONFIG["python"])
     barge_convert = importlib.import_module("barge_bridge.convert")
+    barge_codec = importlib.import_module("barge_bridge.codec")
     import barge.cargo
     from barge_msgs.msg import HoldState, TagMsg
 
@@ -329,6 +361,12 @@ if CYPHAL_WORKER:
         assert ros is not None, stats.rejected
         ros = deserialize_message(serialize_message(ros), HoldState)
         assert [(t.code, t.checked) for t in ros.tags] == tags
+        # the wire codec: the same message (rclpy leaves its padding bytes unset: compared decoded) and stamp
+        payload = b"".join(bytes(x) for x in pycyphal.dsdl.serialize(manifest))
+        codec_stats = barge_convert.ConversionStats()
+        cdr, stamp = barge_codec.CODECS["hold_state"][0](payload, C_RECEIVE_NS, codec_stats)
+        assert deserialize_message(cdr, HoldState) == ros and stamp == usec * 1000
+        assert not codec_stats.saturated and not codec_stats.rejected and not stats.saturated
 
     @C_SETTINGS
     @given(tags=st.lists(st.tuples(st.integers(0, 2**32 - 1), st.booleans()), max_size=6))
@@ -344,6 +382,11 @@ if CYPHAL_WORKER:
         assert stats.saturated.get("hold_state.tags[].code", 0) == sum(c > 2**24 - 1 for c, _ in kept)
         assert not stats.rejected
         assert np.all(np.asarray([t.code for t in out.history], dtype=np.int64) < 2**24)
+        # the wire codec: pycyphal's bytes of the object converter's result, counted the same (the cut once)
+        codec_stats = barge_convert.ConversionStats()
+        payload = barge_codec.CODECS["hold_state"][1](serialize_message(msg), codec_stats)
+        assert payload == b"".join(bytes(x) for x in pycyphal.dsdl.serialize(out))
+        assert dict(codec_stats.saturated) == dict(stats.saturated) and not codec_stats.rejected
 
 
 if WORKER:

@@ -17,6 +17,7 @@ import os
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 import argparse
+import importlib
 import json
 import math
 import signal
@@ -221,7 +222,16 @@ def listen(args: argparse.Namespace) -> int:
 
 
 def _fill(msg: Any, values: dict[str, Any]) -> Any:
+    """`msg` with `values` set; a dict fills a nested message, a list of dicts a sequence of messages."""
     for k, v in values.items():
+        if isinstance(v, dict):
+            _fill(getattr(msg, k), v)
+            continue
+        if isinstance(v, list) and v and isinstance(v[0], dict):
+            type_name = msg.get_fields_and_field_types()[k]  # sequence<pkg/Name> or pkg/Name[N] / [<=N]
+            package, name = type_name.removeprefix("sequence<").split(">")[0].split(",")[0].split("[")[0].split("/")
+            cls = getattr(importlib.import_module(f"{package}.msg"), name)
+            v = [_fill(cls(), item) for item in v]
         setattr(msg, k, v)
     return msg
 

@@ -17,6 +17,7 @@ text. codec.py imports the standard library only.
 
 from __future__ import annotations
 
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -24,12 +25,14 @@ from typing import Any, ClassVar
 from sam_codegen.model.spec import DsdlStruct, RosMessage
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.render.templating import render
-from sam_codegen.targets.python.elements import has_elements
+from sam_codegen.targets.python.elements import element_function_names, has_elements
 from sam_codegen.targets.python.mapping import MappingEmitter, RosReads
 from sam_codegen.targets.python.module import ArrayNode, ConvertModule, CtorNode, FunctionDraft
 from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
+from sam_codegen.targets.wire.cyphal_elements import unsupported, zero_record
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
+from sam_codegen.targets.wire.v0_elements import RecordUavcanReader, default_literal, element_record, record_scope
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved
 
@@ -59,6 +62,14 @@ class CyphalWire:
 
     def __init__(self, resolved: Resolved, consts: Constants) -> None:
         self.resolved, self.consts = resolved, consts
+        self.records = False  # in an element function: records in and out (cyphal_elements)
+
+    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> AbstractContextManager[tuple[Any, Any, Any]]:
+        """The readers and signatures of an element mapping's functions (targets.python.elements), which take
+        and return records."""
+        assert s.elements is not None
+        return record_scope(self, RecordUavcanReader(s.elements, lambda t: self.struct(t.composite or "")),
+                            self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return struct.name
@@ -75,11 +86,19 @@ class CyphalWire:
         return WireCtorNode(message, [(f.name, f.type) for f in message.fields])
 
     def element_default(self, t: DsdlType | RosType) -> str:
+        if isinstance(t, DsdlType) and t.kind == "composite":
+            return zero_record(self.struct(t.composite or ""), self.struct)  # a fixed array of records padded
         return "None"  # an element nobody sets: the writers give the type's default
 
     def format_return(self, module: ConvertModule, root: CtorNode, names: LocalNames) -> list[str]:
         assert isinstance(root, WireCtorNode)
         values = tree_values(root)
+        if self.records:
+            if isinstance(root.of, RosMessage):
+                record = element_record(root.of, values, self.resolved.ros.get, default_literal)
+            else:
+                record = element_record(root.of, values, lambda t: self.struct(t.composite or ""))
+            return wrap_body([f"return {record}"])
         if isinstance(root.of, RosMessage):
             lines, expr = cdr_writer(root.of, values, self.resolved.ros.get, names, self.consts)
             return wrap_body([*lines, f"return {expr}, {stamp_ns(root.of, values)}"])
@@ -216,17 +235,22 @@ def codec_context(resolved: Resolved) -> dict[str, Any]:
     consts = Constants("_W")
     build = CyphalWire(resolved, consts)
     module = ConvertModule(resolved, build)
-    # Element mappings (arrays of composites, targets.python.elements) have no wire codec yet: a bridge that has
-    # one runs on the object converters (the runtime falls back when CODECS lacks a mapping; OBJECT_ONLY says why).
-    mappings = [rm for rm in resolved.mappings if not has_elements(rm)]
+    # Element mappings (arrays of composites, targets.python.elements) get element functions on records
+    # (cyphal_elements); those whose elements a record cannot hold have no wire codec: a bridge that has one runs
+    # on the object converters (the runtime falls back when CODECS lacks a mapping; OBJECT_ONLY says why).
+    object_only = {rm.mapping.name: why for rm in resolved.mappings if has_elements(rm)
+                   and (why := unsupported(rm, resolved.dsdl.get, resolved.ros.get)) is not None}
+    mappings = [rm for rm in resolved.mappings if rm.mapping.name not in object_only]
     for rm in mappings:
-        module.ros_aliases.setdefault(rm.ros_message.full_name, rm.ros_message.full_name)
+        for message in (rm.ros_message, *(s.elements.ros_message for s in rm.steps if s.elements is not None)):
+            module.ros_aliases.setdefault(message.full_name, message.full_name)
     module.module_names = set(MODULE_NAMES) | {f"{rm.mapping.name}_wire_to_ros" for rm in mappings} \
-        | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings}
+        | {f"{rm.mapping.name}_ros_to_wire" for rm in mappings} | element_function_names(mappings) | {"src"}
     functions = []
     for rm in mappings:
         emitter = MappingEmitter(module, rm, CyphalWireReader(build), CdrReader(resolved, consts), WireSignatures())
         functions.append((emitter.to_ros(), emitter.to_uavcan()))
+    functions.extend(module.extra_functions)  # element mappings' functions, after the registry's
     return {
         "uses_array": "array" in consts.imports,
         "prelude": [*MODULE_PRELUDE, *CYPHAL_PRELUDE],
@@ -234,8 +258,7 @@ def codec_context(resolved: Resolved) -> dict[str, Any]:
         "tables": module.tables,
         "functions": functions,
         "mappings": [rm.mapping.name for rm in mappings],
-        "object_only": [(rm.mapping.name, "arrays of composites converted element by element")
-                        for rm in resolved.mappings if has_elements(rm)],
+        "object_only": list(object_only.items()),
     }
 
 

@@ -23,9 +23,7 @@ fixed array gets the first elements of a longer one, as rclpy serializes it.
 from __future__ import annotations
 
 import ast
-import math
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -43,10 +41,10 @@ from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_w
 from sam_codegen.targets.wire.code import Constants
 from sam_codegen.targets.wire.codec import WireCtorNode, WireSignatures, stamp_ns, wrap_body
 from sam_codegen.targets.wire.v0_elements import (
-    ElementSignatures,
-    RecordCdrReader,
-    RecordV0Reader,
+    RecordUavcanReader,
+    default_literal,
     element_record,
+    record_scope,
     unsupported,
 )
 from sam_codegen.targets.wire.v0_layout import V0Layout, record_index
@@ -70,16 +68,11 @@ class DroneCanWire:
         self.resolved, self.consts, self.layout = resolved, consts, layout
         self.records = False  # in an element function: records in and out (v0_elements)
 
-    @contextmanager
-    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> Iterator[tuple[Any, Any, Any]]:
+    def element_scope(self, em: MappingEmitter, s: Step, base: str) -> AbstractContextManager[tuple[Any, Any, Any]]:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
         and return records."""
         assert s.elements is not None
-        self.records = True
-        try:
-            yield RecordV0Reader(s.elements), RecordCdrReader(self.resolved.ros.get), ElementSignatures(base)
-        finally:
-            self.records = False
+        return record_scope(self, RecordUavcanReader(s.elements, self.layout.struct), self.resolved.ros.get, base)
 
     def dsdl_ref(self, struct: DsdlStruct) -> str:
         return "Any"
@@ -106,11 +99,12 @@ class DroneCanWire:
         if self.records:
             leaves: dict[tuple, str] = {}
             if isinstance(root.of, V0Struct):
-                node = _v0_node(root)
-                leaves = {((name, None),): value for name, value in node.fields.items() if value is not None}
+                _v0_leaves(_v0_node(root), (), leaves)
+                record = element_record(root.of, leaves, self.layout.struct)
             else:
                 _ros_values(root, (), leaves, [])
-            return [f"return {element_record(root.of, leaves, self.resolved.ros.get, _default_literal)}"]
+                record = element_record(root.of, leaves, self.resolved.ros.get, default_literal)
+            return _lines([f"return {record}"])
         if isinstance(root.of, V0Struct):
             lines, expr = v0_writer(root.of, _v0_node(root), self.layout, self.consts)
             return _lines([*lines, f"return {expr}"])
@@ -124,12 +118,13 @@ class DroneCanWire:
 
 
 
-def _default_literal(leaf: Any) -> str:
-    """A ROS leaf's default as an expression (an element record's leaf nothing sets)."""
-    value = leaf.default if leaf.kind == "prim" else leaf.default or ""
-    if isinstance(value, float) and not math.isfinite(value):
-        return "_NAN" if math.isnan(value) else "_INF" if value > 0 else "-_INF"
-    return repr(value)
+def _v0_leaves(node: Any, prefix: tuple, out: dict[tuple, str]) -> None:
+    """The expressions of a DroneCAN element's scalars by path (nested composites by their fields'), for its record."""
+    for name, value in node.fields.items():
+        if isinstance(value, V0Node):
+            _v0_leaves(value, (*prefix, (name, None)), out)
+        elif value is not None:
+            out[(*prefix, (name, None))] = value
 
 
 def _lines(lines: list[str]) -> list[str]:

@@ -72,6 +72,7 @@ class _Shared:
     consts: Constants
     wanted: set[FieldPath]
     found: dict[FieldPath, str] = field(default_factory=dict)
+    keep: set[str] = field(default_factory=set)  # locals read by generated lines (records' fields), kept by prune
 
     def want(self, path: FieldPath | None, hint: str | None = None) -> str | None:
         if path is None or path not in self.wanted:
@@ -265,8 +266,14 @@ class _Reader:
             if not t.array:
                 self.read_composite(nested, path)
             elif t.array == "fixed":
+                records = self.s.want(path, path[-1][0] if path else None)
+                if records is not None:
+                    self.lines.append(f"{records} = []")
                 for i in range(t.capacity or 0):
-                    self.read_composite(nested, None if path is None else elem_path(path, i))
+                    if records is not None:
+                        self.read_record(nested, records, path)  # type: ignore[arg-type]
+                    else:
+                        self.read_composite(nested, None if path is None else elem_path(path, i))
             else:
                 self.read_composite_array(nested, t.capacity or 0, path)
         elif t.array == "fixed":
@@ -357,7 +364,8 @@ class _Reader:
         self.lines.append(f"{off} += {header}")
 
     def read_composite_array(self, nested: DsdlStruct, cap: int, path: FieldPath | None) -> None:
-        if self.s.wants_inside(path):
+        records = self.s.want(path, path[-1][0] if path else None)
+        if records is None and self.s.wants_inside(path):
             raise NotImplementedError(f"{path}: reading into a variable-length array of composites")
         self.align()
         self.close_group()
@@ -365,7 +373,47 @@ class _Reader:
         self.item(UNSIGNED_FORMATS[prefix_bits(cap)], prefix_bits(cap), count)
         off = self.fold()
         self.check_count(count, cap, DsdlType("composite", composite=nested.name, array="bounded", capacity=cap))
-        self.loop(f"for _ in range({count}):", off, lambda r: r.read_composite(nested, None))
+        if records is None:
+            self.loop(f"for _ in range({count}):", off, lambda r: r.read_composite(nested, None))
+            return
+        assert path is not None
+        self.lines.append(f"{records} = []")
+        self.loop(f"for _ in range({count}):", off, lambda r: r.read_record(nested, records, path))
+
+    def read_record(self, nested: DsdlStruct, records: str, path: FieldPath) -> None:
+        """One composite of scalar fields appended to the list local `records` as a record: a tuple of its fields
+        in declaration order, void padding left out (what the element functions take: targets.wire.v0_elements)."""
+        at = (*path[:-1], (path[-1][0], -1))  # the element being read (no index of a real element is negative)
+        fields = self.record_paths(nested, at)
+        self.s.wanted.update(fields)
+        self.read_composite(nested, at)
+        self.flush()  # the fields' struct runs unpacked before they are gathered
+        values = {f: self.s.found.pop(f) for f in fields}
+        self.s.wanted.difference_update(fields)
+        self.s.keep.update(values.values())
+        self.lines.append(f"{records}.append({self.record_expr(nested, at, values)})")
+
+    def record_paths(self, struct_: DsdlStruct, at: FieldPath) -> list[FieldPath]:
+        """The scalar leaves of a record of `struct_` read at `at` (nested composites: their leaves)."""
+        out: list[FieldPath] = []
+        for f in struct_.fields:
+            t = f.type
+            assert isinstance(t, DsdlType)
+            if t.array or (t.kind == "composite" and struct_of(self.s.lookup, t.composite).union):
+                raise NotImplementedError(f"{struct_.name}: records of composites holding arrays or unions")
+            path = (*at, (f.name, None))
+            out += self.record_paths(struct_of(self.s.lookup, t.composite), path) if t.kind == "composite" else [path]
+        return out
+
+    def record_expr(self, struct_: DsdlStruct, at: FieldPath, values: dict[FieldPath, str]) -> str:
+        """The tuple of a record from its leaves' locals (a nested composite a tuple of its own)."""
+        items = []
+        for f in struct_.fields:
+            t, path = f.type, (*at, (f.name, None))
+            assert isinstance(t, DsdlType)
+            items.append(self.record_expr(struct_of(self.s.lookup, t.composite), path, values)
+                         if t.kind == "composite" else values[path])
+        return f"({', '.join(items)}{',' if len(items) == 1 else ''})"
 
     def loop(self, head: str, off: str, body: Callable[[_Reader], None]) -> None:
         """A block read with its own state from the byte offset local `off`, which it leaves advanced."""
@@ -409,7 +457,7 @@ def cyphal_reader(struct_: DsdlStruct, wanted: Iterable[FieldPath], lookup: Look
     missing = shared.wanted - set(shared.found)
     if missing:
         raise ValueError(f"{struct_.name}: no field at {sorted(map(str, missing))}")
-    return prune(r.lines, shared.found.values()), shared.found
+    return prune(r.lines, {*shared.found.values(), *shared.keep}), shared.found
 
 
 def _read_variant(r: _Reader, t: DsdlType) -> None:

@@ -218,6 +218,8 @@ class _Writer:
             expr, _ = self.value(path)
             if not t.array:
                 self.write_composite(nested, path)
+            elif expr is not None and not touches(set(self.values) - {path}, path):
+                self.write_records(nested, t, expr)
             elif t.array == "fixed":
                 for i in range(t.capacity or 0):
                     self.write_composite(nested, None if path is None else elem_path(path, i))
@@ -289,6 +291,40 @@ class _Writer:
             return
         term_expr, _ = self.term_bits(_Term(0, e, "x", NO_VALUE))
         self.lines += [f"for x in {local}:", f"    {self.acc} |= {term_expr} << {q}", f"    {q} += {e.bits}"]
+
+    def write_records(self, nested: DsdlStruct, t: DsdlType, records: str) -> None:
+        """An array of composites from a list of records (tuples of their fields in declaration order, void padding
+        left out: what the element functions return, targets.wire.v0_elements); a fixed array's list has its
+        size, a variable-length one's is within the capacity (the converters cut it before)."""
+        local = self.names.new("records")
+        self.lines.append(f"{local} = {records}")
+        self.align()
+        if t.array == "bounded":
+            self.prim(DsdlType("uint", prefix_bits(t.capacity or 0)), f"len({local})", NO_VALUE)
+        self.flush_run()
+        record, chunks = self.names.new("record"), self.names.new("chunks")
+        inner = _Writer(self.lookup, self.names, self.consts, self.record_values(nested, (), record))
+        inner.write_composite(nested, ())
+        inner.flush_run()
+        one = " + ".join(inner.parts) if inner.parts else repr(b"")
+        self.lines += [f"{chunks} = []", f"for {record} in {local}:",
+                       *(f"    {line}" for line in inner.lines), f"    {chunks}.append({one})"]
+        self.parts.append(f"b''.join({chunks})")
+
+    def record_values(self, struct_: DsdlStruct, at: FieldPath, record: str) -> dict[FieldPath, str]:
+        """The writer's values of a record of `struct_` (its scalar leaves; a nested composite a tuple of its own)."""
+        out: dict[FieldPath, str] = {}
+        for i, f in enumerate(struct_.fields):
+            t = f.type
+            assert isinstance(t, DsdlType)
+            if t.array or (t.kind == "composite" and struct_of(self.lookup, t.composite).union):
+                raise NotImplementedError(f"{struct_.name}: records of composites holding arrays or unions")
+            if t.kind == "composite":
+                out.update(self.record_values(struct_of(self.lookup, t.composite), (*at, (f.name, None)),
+                                              f"{record}[{i}]"))
+            else:
+                out[(*at, (f.name, None))] = f"{record}[{i}]"
+        return out
 
     def write_composite(self, nested: DsdlStruct, path: FieldPath | None) -> None:
         self.align()

@@ -10,7 +10,7 @@ import math
 import re
 from collections.abc import Callable
 
-from sam_codegen.model.spec import V0Struct
+from sam_codegen.model.spec import DsdlStruct, V0Struct
 from sam_codegen.model.types import DsdlType
 
 __all__ = ["V0Layout", "code_is_bytes", "length_bits", "merge_pads", "record_index", "struct_code", "tag_bits"]
@@ -57,7 +57,7 @@ def struct_code(t: DsdlType) -> str | None:
     return None
 
 
-def record_index(struct: V0Struct, name: str) -> int:
+def record_index(struct: DsdlStruct, name: str) -> int:
     """A field's position in the records of `struct` (its fields without void padding)."""
     return [f.name for f in struct.fields].index(name)
 

@@ -17,7 +17,9 @@ API (used by codec_v0)
   ``V0Node`` or ``V0Items``; ``V0Items(items)``: an array's elements one by one (their number known at generation
   time), each an expression, a ``V0Node`` or None for the element's default. Fields not given are default. A
   dynamic array of composites may be a list expression of records (tuples of the element's fields, as v0_read gives
-  them) when ``record_fields`` allows it: every field a scalar number of byte-multiple width.
+  them) when ``record_fields`` allows it (every field a scalar number of byte-multiple width: struct packs them) or
+  ``record_bit_fields`` does (any scalars, void padding and composites of them, nested tuples in the record: shifted
+  in as stream bits).
 - ``v0_writer(struct, node, layout, consts)`` -> ``(lines, expr)``: statements and the expression of the payload.
 - ``HELPERS``: the source of the helpers the generated code calls (``_f16``, ``_f16t``, ``_clamp``, ``_trunc``).
 """
@@ -35,7 +37,7 @@ from sam_codegen.targets.wire.code import NO_VALUE as _NO
 from sam_codegen.targets.wire.code import Constants, literal_value, runs_of
 from sam_codegen.targets.wire.v0_layout import V0Layout, length_bits, merge_pads, struct_code, tag_bits
 
-__all__ = ["HELPERS", "V0Items", "V0Node", "f16_bits", "record_fields", "v0_writer"]
+__all__ = ["HELPERS", "V0Items", "V0Node", "f16_bits", "record_bit_fields", "record_fields", "v0_writer"]
 
 FLOAT_MAX = {16: 65504.0, 32: 3.40282346638528859812e38, 64: 1.79769313486231570815e308}  # dronecan's ranges
 
@@ -128,9 +130,13 @@ class _List:
     expr: str
     prefix: int  # length prefix bits (0: tail array)
     record: tuple[DsdlType, ...] = ()  # composite elements: records, the types of their fields (see record_fields)
+    # composite elements of bit fields: every scalar's type and where the record holds it (see record_bit_fields)
+    bit_record: tuple[tuple[DsdlType, str | None], ...] = ()
 
     @property
     def bits(self) -> int:
+        if self.bit_record:
+            return sum(t.bits for t, _ in self.bit_record)
         return sum(t.bits for t in self.record) if self.record else self.t.bits
 
 
@@ -148,6 +154,34 @@ def record_fields(layout: V0Layout, t: DsdlType) -> tuple[DsdlType, ...] | None:
     return types  # type: ignore[return-value]
 
 
+def record_bit_fields(layout: V0Layout, t: DsdlType, at: str = "") -> tuple[tuple[DsdlType, str | None], ...] | None:
+    """The scalar fields of a composite element written from a record as stream bits, in wire order: when every field
+    is a scalar (a bool, an integer of any width, a float), void padding or a composite of such fields (no arrays, no
+    unions), each scalar's type and where the record holds it (`[2][0]`: a nested composite is a tuple in its
+    record; None: padding, not in the record); else None."""
+    if t.kind != "composite":
+        return None
+    s = layout.struct(t)
+    if s.union:
+        return None
+    out: list[tuple[DsdlType, str | None]] = []
+    position = 0
+    for f in s.declared_fields:
+        x = f.type
+        if not isinstance(x, DsdlType) or x.array or x.kind not in ("bool", "int", "uint", "float", "void",
+                                                                    "composite"):
+            return None
+        if x.kind == "composite":
+            nested = record_bit_fields(layout, x, f"{at}[{position}]")
+            if nested is None:
+                return None
+            out.extend(nested)
+        else:
+            out.append((x, f"{at}[{position}]" if f.name else None))
+        position += bool(f.name)
+    return tuple(out) if out else None
+
+
 def _flatten(layout: V0Layout, t: DsdlType, value: Any, tao: bool, out: list[_Atom | _List]) -> None:
     if t.array == "fixed":
         elem, n = t.element, t.capacity or 0
@@ -163,12 +197,14 @@ def _flatten(layout: V0Layout, t: DsdlType, value: Any, tao: bool, out: list[_At
         prefix = 0 if tao_mode else length_bits(t.capacity or 0)
         if isinstance(value, str):
             record: tuple[DsdlType, ...] = ()
+            bit_record: tuple[tuple[DsdlType, str | None], ...] = ()
             if t.element.kind == "composite":
                 found = record_fields(layout, t.element)
-                if found is None:
-                    raise NotImplementedError(f"{t}: an array of composites of other than byte-multiple numbers")
-                record = found
-            out.append(_List(t.element, value, prefix, record))
+                bits_found = record_bit_fields(layout, t.element) if found is None else None
+                if found is None and bits_found is None:
+                    raise NotImplementedError(f"{t}: an array of composites of other than scalar fields")
+                record, bit_record = found or (), bits_found or ()
+            out.append(_List(t.element, value, prefix, record, bit_record))
             return
         items = value.items if isinstance(value, V0Items) else []
         if prefix:
@@ -436,6 +472,13 @@ class _Writer:
             chunk = self.temp()
             self.lines.append(f"{chunk} = {data}")
             self.lines.append(f"_a = _a << (len({chunk}) << 3) | int.from_bytes({chunk}, 'big')")
+        elif d.bit_record:  # records of bit fields: each element's stream bits as one integer
+            outer, self.lines = self.lines, []
+            bits = self.combine(self.pieces([_Atom(x, None if at is None else f"_r{at}") for x, at in d.bit_record]))
+            # (their temporaries are bound in the loop)
+            body, self.lines = self.lines, outer
+            self.lines.append(f"for _r in {items}:")
+            self.lines.extend(f"    {line}" for line in [*body, f"_a = _a << {d.bits} | {bits}"])
         else:
             outer, self.lines = self.lines, []
             bits = self.stream_bits(t, "x")  # (its temporaries are bound in the loop)
