@@ -14,7 +14,7 @@ The mapping's own function calls it once per element:
   elements after the conversion (counted once either way).
 
 The DroneCAN wire codec emits the same functions on records instead of objects: its Construction's
-`element_scope(em, step, base)` gives the element emitter its readers and signatures (targets.wire.v0_elements).
+`element_scope(em, step, base)` gives the element emitter its readers and signatures (targets.wire.element_records).
 
 The functions are collected in ConvertModule.extra_functions, which the module emitters append after the mappings'
 own functions (the registry indexes those by position).
@@ -76,7 +76,7 @@ def _functions(em: Any, s: Step) -> str:
         return base
     assert s.elements is not None
     saved = dict(module.lengths)
-    # the wire codecs give their own readers and signatures (elements as records: targets.wire.v0_elements)
+    # the wire codecs give their own readers and signatures (elements as records: targets.wire.element_records)
     hook = getattr(module.build, "element_scope", None)
     scope = hook(em, s, base) if hook is not None else nullcontext((
         type(em.uavcan)(), type(em.ros)(),

@@ -32,7 +32,7 @@ from sam_codegen.targets.python.names import LocalNames
 from sam_codegen.targets.wire.cdr_write import LINE_LIMIT, MODULE_PRELUDE, Constants, cdr_reader, cdr_writer, wrap_line
 from sam_codegen.targets.wire.cyphal_elements import unsupported, zero_record
 from sam_codegen.targets.wire.cyphal_read import CYPHAL_PRELUDE, cyphal_reader, cyphal_writer
-from sam_codegen.targets.wire.v0_elements import RecordUavcanReader, default_literal, element_record, record_scope
+from sam_codegen.targets.wire.element_records import RecordUavcanReader, default_literal, element_record, record_scope
 from sam_codegen.validate.mapping_rules import Step
 from sam_codegen.validate.resolve import Resolved
 

@@ -11,7 +11,7 @@ objects) and cdr_read from the CDR (V0CdrReader); the tree of values the convert
 to cdr_write (ROS) or v0_write (DroneCAN) instead (DroneCanWire). The checks, saturation, stats keys, tables and
 stamps are the same typed statements, rendered by the same templates/python/statements.j2.
 
-Element mappings (arrays of composites, targets.python.elements) get element functions on records (v0_elements):
+Element mappings (arrays of composites, targets.python.elements) get element functions on records (element_records):
 a v0 array of composites as v0_read's records, a ROS sequence of messages as cdr_read's / cdr_write's tuples of
 leaves; element types a record cannot hold stay in OBJECT_ONLY with the reason.
 
@@ -40,7 +40,7 @@ from sam_codegen.targets.python.names import LocalNames, ros_aliases
 from sam_codegen.targets.wire.cdr_write import MODULE_PRELUDE, cdr_reader, cdr_writer
 from sam_codegen.targets.wire.code import Constants
 from sam_codegen.targets.wire.codec import WireCtorNode, WireSignatures, stamp_ns, wrap_body
-from sam_codegen.targets.wire.v0_elements import (
+from sam_codegen.targets.wire.element_records import (
     RecordUavcanReader,
     default_literal,
     element_record,
@@ -66,7 +66,7 @@ class DroneCanWire:
 
     def __init__(self, resolved: Resolved, consts: Constants, layout: V0Layout) -> None:
         self.resolved, self.consts, self.layout = resolved, consts, layout
-        self.records = False  # in an element function: records in and out (v0_elements)
+        self.records = False  # in an element function: records in and out (element_records)
 
     def element_scope(self, em: MappingEmitter, s: Step, base: str) -> AbstractContextManager[tuple[Any, Any, Any]]:
         """The readers and signatures of an element mapping's functions (targets.python.elements), which take
@@ -355,7 +355,7 @@ def _context(resolved: Resolved) -> dict[str, Any]:
     build = DroneCanWire(resolved, consts, V0Layout(resolved.dronecan.get))
     module = ConvertModule(resolved, build, ros_aliases=ros_aliases(resolved, resolved.dronecan_mappings))
     # Element mappings (arrays of composites, targets.python.elements) whose elements a record cannot hold have no
-    # wire codec (v0_elements.unsupported): a bridge that has one runs on the object converters (the runtime falls
+    # wire codec (element_records.unsupported): a bridge that has one runs on the object converters (the runtime falls
     # back when CODECS lacks a mapping).
     object_only = {rm.mapping.name: why for rm in resolved.dronecan_mappings if has_elements(rm)
                    and (why := unsupported(rm, build.layout, resolved.ros.get)) is not None}

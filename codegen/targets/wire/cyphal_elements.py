@@ -2,7 +2,7 @@
 wire codec: the element functions read and return records instead of objects, as the DroneCAN codec's do.
 
 The element functions are targets.python.elements' (the same MappingEmitter, plan, checks and stats keys), emitted
-in CyphalWire's `element_scope` with v0_elements' record readers and signatures:
+in CyphalWire's `element_scope` with element_records' record readers and signatures:
 
 - UAVCAN -> ROS: `src` is a record of the element type as cyphal_read decodes a wanted array of composites (a tuple
   of its fields in declaration order, void padding left out, a nested composite a tuple of its own); the result is
@@ -23,7 +23,7 @@ from typing import Any
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType
 from sam_codegen.targets.wire.cdr_layout import flatten
-from sam_codegen.targets.wire.v0_elements import element_record
+from sam_codegen.targets.wire.element_records import element_record
 from sam_codegen.validate.mapping_rules import ResolvedMapping
 
 __all__ = ["unsupported", "zero_record"]

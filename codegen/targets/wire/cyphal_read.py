@@ -382,7 +382,7 @@ class _Reader:
 
     def read_record(self, nested: DsdlStruct, records: str, path: FieldPath) -> None:
         """One composite of scalar fields appended to the list local `records` as a record: a tuple of its fields
-        in declaration order, void padding left out (what the element functions take: targets.wire.v0_elements)."""
+        in declaration order, void padding left out (what the element functions take: targets.wire.element_records)."""
         at = (*path[:-1], (path[-1][0], -1))  # the element being read (no index of a real element is negative)
         fields = self.record_paths(nested, at)
         self.s.wanted.update(fields)

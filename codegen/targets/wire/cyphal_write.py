@@ -294,7 +294,7 @@ class _Writer:
 
     def write_records(self, nested: DsdlStruct, t: DsdlType, records: str) -> None:
         """An array of composites from a list of records (tuples of their fields in declaration order, void padding
-        left out: what the element functions return, targets.wire.v0_elements); a fixed array's list has its
+        left out: what the element functions return, targets.wire.element_records); a fixed array's list has its
         size, a variable-length one's is within the capacity (the converters cut it before)."""
         local = self.names.new("records")
         self.lines.append(f"{local} = {records}")

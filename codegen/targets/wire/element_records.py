@@ -1,5 +1,5 @@
-"""Element mappings (arrays of composites converted element by element, targets.python.elements) in the DroneCAN
-wire codec: the element functions read and return records instead of objects.
+"""Element mappings (arrays of composites converted element by element, targets.python.elements) in the wire
+codecs, DroneCAN's first: the element functions read and return records instead of objects.
 
 The element functions are targets.python.elements' (the same MappingEmitter, plan, checks and stats keys), emitted
 in an `element_scope` of DroneCanWire that gives them these readers and signatures:
