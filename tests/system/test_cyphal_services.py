@@ -1,7 +1,7 @@
 """Service mappings on Cyphal across processes (issue 19): a plain pycyphal charger serving the spec's
 ran.power.SetChargeLimits.1.0 at service id 200 (tests/helpers/charger_server.py, Cyphal/UDP on 127.0.0.1, with
 GetInfo as every pycyphal application node), the bridge of tests/specs/auv_cyphal_services.yaml, and an
-independent rclpy client (tests/helpers/cyphal_service_client.py).
+independent rclpy client (tests/helpers/ros_service_client.py charger).
 
 - an answered call carries the request's fields to the device (float percent -> uint8) and its answer back
   (bool, uint8[] -> string);
@@ -43,7 +43,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                                                 "--stats-file", str(d / "bridge.json")), env, d)
             peer.wait_line("READY", 60)
             bridge.wait_line("READY", 90)
-            client = Proc("client", helper_cmd("cyphal_service_client.py", "--out", str(d / "client.json")), env, d)
+            client = Proc("client", helper_cmd("ros_service_client.py", "--out", str(d / "client.json"),
+                                               "charger"), env, d)
             assert client.wait(120) == 0, client.stderr_tail()
             result = json.loads((d / "client.json").read_text())
             assert bridge.proc.poll() is None, bridge.stderr_tail()  # nothing raised into the bridge

@@ -1,6 +1,6 @@
 """A service mapping across processes (issue 19): a plain dronecan battery management system serving the vendor v0
 service UpdateBattery (tests/helpers/battery_peer.py, on a private loopback bus), the bridge of
-tests/specs/auv_services.yaml, and an independent rclpy client (tests/helpers/service_client.py) calling
+tests/specs/auv_services.yaml, and an independent rclpy client (tests/helpers/ros_service_client.py battery) calling
 /bms/update_battery (lolo_msgs/srv/UpdateBattery).
 
 - an answered call carries the request's fields to the device and its answer back (success, status);
@@ -45,9 +45,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     try:
         peer.wait_line("READY", 60)
         bridge.wait_line("READY", 90)
-        client = Proc("client", helper_cmd("service_client.py", "--service", "/bms/update_battery", "--status",
-                                           "bridge/service/update_battery", "--out", str(d / "client.json"),
-                                           "--duties"), env, d)
+        client = Proc("client", helper_cmd("ros_service_client.py", "--out", str(d / "client.json"), "battery",
+                                           "--service", "/bms/update_battery", "--status",
+                                           "bridge/service/update_battery", "--duties"), env, d)
         assert client.wait(120) == 0, client.stderr_tail()
         result = json.loads((d / "client.json").read_text())
         assert bridge.proc.poll() is None, bridge.stderr_tail()  # nothing raised into the bridge
