@@ -20,7 +20,7 @@ from typing import Any
 import pytest
 
 from helpers.ros_packages import built_prefix, locked
-from helpers.runtime_support import REPO
+from helpers.runtime_support import REPO, child_env, domain_id
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 
@@ -30,6 +30,11 @@ class BuiltSpec:
     spec: Path
     generated: Path  # the generated/ folder of the spec
     prefix: Path  # where its ROS package is installed
+
+    def child_env(self, domain_offset: int) -> dict[str, str]:
+        """The environment of a child process running this spec: its ROS package, a private ROS domain
+        (runtime_support.domain_id), SAM_GENERATED_DIR its generated/ folder."""
+        return child_env(self.prefix, domain_id(domain_offset), {"SAM_GENERATED_DIR": str(self.generated)})
 
 
 def generated_spec(name: str) -> Path:

@@ -13,7 +13,6 @@ independent rclpy client (tests/helpers/ros_service_client.py charger).
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import pytest
@@ -21,7 +20,8 @@ import pytest
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
-from helpers.runtime_support import Proc, child_env, cyphal_udp_lock, domain_id, helper_cmd, read_json, runtime_cmd
+from helpers.runtime_support import cyphal_udp_lock, helper_cmd
+from helpers.service_run import ServiceRun, requests_seen
 from helpers.spec_build import built_spec
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -33,29 +33,16 @@ TIMEOUT_S = 0.5  # set_charge_limits', in auv_cyphal_services.yaml
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     built = built_spec("auv_cyphal_services")
     d = tmp_path_factory.mktemp("cyphal_services")
-    env = child_env(built.prefix, domain_id(63), {"SAM_GENERATED_DIR": str(built.generated)})
-    client = peer = bridge = None
-    with cyphal_udp_lock():
-        try:
-            peer = Proc("peer", helper_cmd("charger_server.py", "--generated", str(built.generated), "--node-id",
-                                           "31", "--late", str(3 * TIMEOUT_S)), env, d)
-            bridge = Proc("bridge", runtime_cmd("bridge", "--transport", "udp", "--iface", "127.0.0.1",
-                                                "--stats-file", str(d / "bridge.json")), env, d)
-            peer.wait_line("READY", 60)
-            bridge.wait_line("READY", 90)
-            client = Proc("client", helper_cmd("ros_service_client.py", "--out", str(d / "client.json"),
-                                               "charger"), env, d)
-            assert client.wait(120) == 0, client.stderr_tail()
-            result = json.loads((d / "client.json").read_text())
-            assert bridge.proc.poll() is None, bridge.stderr_tail()  # nothing raised into the bridge
-        finally:
-            for p in (client, bridge, peer):
-                if p is not None:
-                    p.stop()
-    result["peer"] = [json.loads(line.split(" ", 1)[1]) for line in peer.lines if line.startswith("REQUEST ")]
-    result["bridge_stats"] = read_json(d / "bridge.json")
-    result["bridge_stderr"] = (d / "bridge.stderr").read_text() if (d / "bridge.stderr").exists() else ""
-    return result
+    env = built.child_env(63)
+    with cyphal_udp_lock(), ServiceRun(env, d) as r:
+        peer = r.start("peer", helper_cmd("charger_server.py", "--generated", str(built.generated), "--node-id",
+                                          "31", "--late", str(3 * TIMEOUT_S)))
+        bridge = r.bridge("--transport", "udp", "--iface", "127.0.0.1")
+        peer.wait_line("READY", 60)
+        bridge.wait_line("READY", 90)
+        result = r.client("charger")
+        r.assert_bridge_alive()
+    return result | {"peer": requests_seen(peer)} | r.outcome()
 
 
 def test_an_answered_call_carries_both_ways(run: dict[str, Any]) -> None:
