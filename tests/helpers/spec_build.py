@@ -64,6 +64,14 @@ def built_spec(name: str) -> BuiltSpec:
     return BuiltSpec(SPECS / f"{name}.yaml", gen_dir, prefix)
 
 
+def spec_workdir(tmp_path_factory: pytest.TempPathFactory, name: str, folder: str,
+                 domain_offset: int) -> tuple[BuiltSpec, Path, dict[str, str]]:
+    """The prologue of a system test's module fixture: ``tests/specs/<name>.yaml`` built (built_spec), a fresh
+    folder for its processes' files, and their environment (BuiltSpec.child_env)."""
+    built = built_spec(name)
+    return built, tmp_path_factory.mktemp(folder), built.child_env(domain_offset)
+
+
 def forget_generated(gen: Any) -> None:
     """Take a generated package (a GeneratedPackage) out of this process again: its modules and its sys.path entry.
 

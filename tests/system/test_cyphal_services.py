@@ -22,7 +22,7 @@ pytest.importorskip("rclpy")
 
 from helpers.runtime_support import cyphal_udp_lock, helper_cmd
 from helpers.service_run import ServiceRun, requests_seen
-from helpers.spec_build import built_spec
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -31,9 +31,7 @@ TIMEOUT_S = 0.5  # set_charge_limits', in auv_cyphal_services.yaml
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    built = built_spec("auv_cyphal_services")
-    d = tmp_path_factory.mktemp("cyphal_services")
-    env = built.child_env(63)
+    built, d, env = spec_workdir(tmp_path_factory, "auv_cyphal_services", "cyphal_services", 63)
     with cyphal_udp_lock(), ServiceRun(env, d) as r:
         peer = r.start("peer", helper_cmd("charger_server.py", "--generated", str(built.generated), "--node-id",
                                           "31", "--late", str(3 * TIMEOUT_S)))

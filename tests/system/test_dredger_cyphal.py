@@ -26,7 +26,7 @@ pytest.importorskip("rclpy")
 
 from helpers.bridge_sim_probe import bridge_sim_probe
 from helpers.runtime_support import cyphal_udp_lock, poll_until, read_json
-from helpers.spec_build import built_spec
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -53,9 +53,7 @@ PAIR = [  # /valve_pair: fixed [2], saturate
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    b = built_spec("dredger")
-    d = tmp_path_factory.mktemp("dredger_cyphal")
-    env = b.child_env(97)
+    b, d, env = spec_workdir(tmp_path_factory, "dredger", "dredger_cyphal", 97)
     (d / "plan.json").write_text(json.dumps({"rate_hz": 5, "topics": {
         "/valves": [{"seq": i, "valves": v} for i, v in enumerate(VALVES)],
         "/valve_pair": [{"seq": i, "valves": v} for i, v in enumerate(PAIR)]}}))

@@ -24,7 +24,7 @@ pytest.importorskip("rclpy")
 from helpers.dronecan_support import private_iface
 from helpers.runtime_support import helper_cmd
 from helpers.service_run import ServiceRun, requests_seen
-from helpers.spec_build import built_spec
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -33,9 +33,7 @@ TIMEOUT_S = 0.5  # the mapping's, in auv_services.yaml
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    built = built_spec("auv_services")
-    d = tmp_path_factory.mktemp("dronecan_services")
-    env = built.child_env(61)
+    built, d, env = spec_workdir(tmp_path_factory, "auv_services", "dronecan_services", 61)
     iface = private_iface()
     with ServiceRun(env, d) as r:
         peer = r.start("peer", helper_cmd("battery_peer.py", "--iface", iface, "--node-id", "30", "--generated",

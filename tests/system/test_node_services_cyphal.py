@@ -24,7 +24,7 @@ pytest.importorskip("rclpy")
 
 from helpers.runtime_support import cyphal_udp_lock, runtime_cmd
 from helpers.service_run import ServiceRun
-from helpers.spec_build import built_spec
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -34,9 +34,7 @@ UDP = ["--transport", "udp", "--iface", "127.0.0.1"]
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    built = built_spec("auv_cyphal_services")
-    d = tmp_path_factory.mktemp("node_services_cyphal")
-    env = built.child_env(73)
+    _, d, env = spec_workdir(tmp_path_factory, "auv_cyphal_services", "node_services_cyphal", 73)
     with cyphal_udp_lock(), ServiceRun(env, d) as r:
         sim = r.start("sim", runtime_cmd("sim", *UDP, "--devices", "charger"))
         bridge = r.bridge(*UDP)

@@ -23,7 +23,7 @@ pytest.importorskip("rclpy")
 from helpers.dronecan_support import private_iface
 from helpers.runtime_support import runtime_cmd
 from helpers.service_run import ServiceRun
-from helpers.spec_build import built_spec
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -32,9 +32,7 @@ BMS, STRANGER = 30, 99
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    built = built_spec("auv_services")
-    d = tmp_path_factory.mktemp("node_services_dronecan")
-    env = built.child_env(71)
+    _, d, env = spec_workdir(tmp_path_factory, "auv_services", "node_services_dronecan", 71)
     iface = private_iface()
     with ServiceRun(env, d) as r:
         sim = r.start("sim", runtime_cmd("sim", "--devices", "bms", "--dronecan-iface", iface))

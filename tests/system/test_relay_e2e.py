@@ -24,7 +24,7 @@ pytest.importorskip("rclpy")
 from helpers.bridge_sim_probe import bridge_sim_probe
 from helpers.dronecan_support import private_iface
 from helpers.runtime_support import cyphal_udp_lock, poll_until, read_json
-from helpers.spec_build import built_spec
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -33,9 +33,7 @@ DEVICES = "relays,leak_sensor,led"  # the DroneCAN devices the mappings under te
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    b = built_spec("relay")
-    d = tmp_path_factory.mktemp("relay_e2e")
-    env = b.child_env(47)
+    b, d, env = spec_workdir(tmp_path_factory, "relay", "relay_e2e", 47)
     iface = private_iface()
     dc = ["--layout", "all_dronecan", "--dronecan-iface", iface]
     plan = {"rate_hz": 5, "topics": {
@@ -85,9 +83,7 @@ def test_relay_and_light_commands_reach_the_devices(run: dict[str, Any]) -> None
 
 @pytest.fixture(scope="module")
 def cyphal_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    b = built_spec("relay")
-    d = tmp_path_factory.mktemp("relay_e2e_cyphal")
-    env = b.child_env(48)
+    b, d, env = spec_workdir(tmp_path_factory, "relay", "relay_e2e_cyphal", 48)
     udp = ["--transport", "udp", "--iface", "127.0.0.1"]
     (d / "plan.json").write_text(json.dumps({"rate_hz": 5, "topics": {
         "/rail": [{"data": 0.3}] * 3 + [{"data": 300.0}] * 3}}))
