@@ -84,6 +84,20 @@ class SpunNode:
         while not self._stop.is_set():
             self.ex.spin_once(timeout_sec=0.05)
 
+    def call_duty(self, service: str, srv_name: str, node_id: int, timeout: float = 10.0,
+                  package: str = "sam_msgs") -> Any:
+        """One call of a node duty service (`srv_name` of `package`, its request the node id) from another thread
+        than the spinning one: the response, or None if it did not come within `timeout`."""
+        srv = getattr(importlib.import_module(f"{package}.srv"), srv_name)
+        client = self.node.create_client(srv, service)
+        if not client.wait_for_service(timeout_sec=timeout):
+            raise AssertionError(f"no service {service}")
+        future = client.call_async(srv.Request(node_id=node_id))
+        deadline = time.monotonic() + timeout
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        return future.result()
+
     def close(self, join_timeout_s: float = 5.0) -> None:
         self._stop.set()
         self._thread.join(timeout=join_timeout_s)

@@ -20,7 +20,7 @@ from typing import Any
 import pytest
 
 from helpers.ros_packages import built_prefix, locked
-from helpers.runtime_support import REPO
+from helpers.runtime_support import REPO, child_env, domain_id
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 
@@ -30,6 +30,11 @@ class BuiltSpec:
     spec: Path
     generated: Path  # the generated/ folder of the spec
     prefix: Path  # where its ROS package is installed
+
+    def child_env(self, domain_offset: int) -> dict[str, str]:
+        """The environment of a child process running this spec: its ROS package, a private ROS domain
+        (runtime_support.domain_id), SAM_GENERATED_DIR its generated/ folder."""
+        return child_env(self.prefix, domain_id(domain_offset), {"SAM_GENERATED_DIR": str(self.generated)})
 
 
 def generated_spec(name: str) -> Path:
@@ -57,6 +62,14 @@ def built_spec(name: str) -> BuiltSpec:
     gen_dir = generated_spec(name)
     prefix = built_prefix([GeneratedPackage(gen_dir).ros_package_dir()])
     return BuiltSpec(SPECS / f"{name}.yaml", gen_dir, prefix)
+
+
+def spec_workdir(tmp_path_factory: pytest.TempPathFactory, name: str, folder: str,
+                 domain_offset: int) -> tuple[BuiltSpec, Path, dict[str, str]]:
+    """The prologue of a system test's module fixture: ``tests/specs/<name>.yaml`` built (built_spec), a fresh
+    folder for its processes' files, and their environment (BuiltSpec.child_env)."""
+    built = built_spec(name)
+    return built, tmp_path_factory.mktemp(folder), built.child_env(domain_offset)
 
 
 def forget_generated(gen: Any) -> None:

@@ -49,19 +49,6 @@ class Probe(ThreadedProbe):
     def on_message(self, topic: str, msg: Any) -> None:
         self.messages.setdefault(topic, []).append(msg)
 
-    def call(self, service: str, srv_name: str, node_id: int, timeout: float = 10.0) -> Any:
-        import importlib
-
-        srv = getattr(importlib.import_module("sam_msgs.srv"), srv_name)
-        client = self.node.create_client(srv, service)
-        if not client.wait_for_service(timeout_sec=timeout):
-            raise AssertionError(f"no service {service}")
-        future = client.call_async(srv.Request(node_id=node_id))
-        deadline = time.monotonic() + timeout
-        while not future.done() and time.monotonic() < deadline:
-            time.sleep(0.02)
-        return future.result()
-
 
 def _ready(pub_or_sub: Any) -> bool:
     return (pub_or_sub.get_subscription_count() if hasattr(pub_or_sub, "get_subscription_count")
@@ -126,8 +113,8 @@ async def _scenario(gen: Any, iface: str, wire: str) -> dict[str, Any]:
                     and len(listener.got("uavcan.equipment.actuator.ArrayCommand")) >= 2, 10, "the commands")
 
         # Duties.
-        out["info"] = await asyncio.to_thread(probe.call, "/uavcan_get_node_info", "UavcanGetNodeInfo", IMU_ID)
-        out["restart"] = await asyncio.to_thread(probe.call, "/uavcan_restart_node", "UavcanRestartNode", ESC1_ID)
+        out["info"] = await asyncio.to_thread(probe.call_duty, "/uavcan_get_node_info", "UavcanGetNodeInfo", IMU_ID)
+        out["restart"] = await asyncio.to_thread(probe.call_duty, "/uavcan_restart_node", "UavcanRestartNode", ESC1_ID)
         await until(lambda: _ready(probe.panic_pub), 10, "the bridge's panic subscription")
         probe.panic_pub.publish(__import__("std_msgs.msg", fromlist=["String"]).String(data="ROS-ABORT"))
         stranger.broadcast(dronecan.TYPENAMES["uavcan.protocol.Panic"](reason_text=b"LEAK"))

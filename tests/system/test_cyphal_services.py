@@ -1,7 +1,7 @@
 """Service mappings on Cyphal across processes (issue 19): a plain pycyphal charger serving the spec's
 ran.power.SetChargeLimits.1.0 at service id 200 (tests/helpers/charger_server.py, Cyphal/UDP on 127.0.0.1, with
 GetInfo as every pycyphal application node), the bridge of tests/specs/auv_cyphal_services.yaml, and an
-independent rclpy client (tests/helpers/cyphal_service_client.py).
+independent rclpy client (tests/helpers/ros_service_client.py charger).
 
 - an answered call carries the request's fields to the device (float percent -> uint8) and its answer back
   (bool, uint8[] -> string);
@@ -13,7 +13,6 @@ independent rclpy client (tests/helpers/cyphal_service_client.py).
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import pytest
@@ -21,8 +20,9 @@ import pytest
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
-from helpers.runtime_support import Proc, child_env, cyphal_udp_lock, domain_id, helper_cmd, read_json, runtime_cmd
-from helpers.spec_build import built_spec
+from helpers.runtime_support import cyphal_udp_lock, helper_cmd
+from helpers.service_run import ServiceRun, requests_seen
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -31,30 +31,16 @@ TIMEOUT_S = 0.5  # set_charge_limits', in auv_cyphal_services.yaml
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    built = built_spec("auv_cyphal_services")
-    d = tmp_path_factory.mktemp("cyphal_services")
-    env = child_env(built.prefix, domain_id(63), {"SAM_GENERATED_DIR": str(built.generated)})
-    client = peer = bridge = None
-    with cyphal_udp_lock():
-        try:
-            peer = Proc("peer", helper_cmd("charger_server.py", "--generated", str(built.generated), "--node-id",
-                                           "31", "--late", str(3 * TIMEOUT_S)), env, d)
-            bridge = Proc("bridge", runtime_cmd("bridge", "--transport", "udp", "--iface", "127.0.0.1",
-                                                "--stats-file", str(d / "bridge.json")), env, d)
-            peer.wait_line("READY", 60)
-            bridge.wait_line("READY", 90)
-            client = Proc("client", helper_cmd("cyphal_service_client.py", "--out", str(d / "client.json")), env, d)
-            assert client.wait(120) == 0, client.stderr_tail()
-            result = json.loads((d / "client.json").read_text())
-            assert bridge.proc.poll() is None, bridge.stderr_tail()  # nothing raised into the bridge
-        finally:
-            for p in (client, bridge, peer):
-                if p is not None:
-                    p.stop()
-    result["peer"] = [json.loads(line.split(" ", 1)[1]) for line in peer.lines if line.startswith("REQUEST ")]
-    result["bridge_stats"] = read_json(d / "bridge.json")
-    result["bridge_stderr"] = (d / "bridge.stderr").read_text() if (d / "bridge.stderr").exists() else ""
-    return result
+    built, d, env = spec_workdir(tmp_path_factory, "auv_cyphal_services", "cyphal_services", 63)
+    with cyphal_udp_lock(), ServiceRun(env, d) as r:
+        peer = r.start("peer", helper_cmd("charger_server.py", "--generated", str(built.generated), "--node-id",
+                                          "31", "--late", str(3 * TIMEOUT_S)))
+        bridge = r.bridge("--transport", "udp", "--iface", "127.0.0.1")
+        peer.wait_line("READY", 60)
+        bridge.wait_line("READY", 90)
+        result = r.client("charger")
+        r.assert_bridge_alive()
+    return result | {"peer": requests_seen(peer)} | r.outcome()
 
 
 def test_an_answered_call_carries_both_ways(run: dict[str, Any]) -> None:

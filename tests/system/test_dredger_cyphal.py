@@ -17,7 +17,6 @@ The bridge's stats say it ran them on the codec (`wire: codec`), not on the obje
 from __future__ import annotations
 
 import json
-import signal
 from typing import Any
 
 import pytest
@@ -25,17 +24,9 @@ import pytest
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
-from helpers.runtime_support import (
-    Proc,
-    child_env,
-    cyphal_udp_lock,
-    domain_id,
-    helper_cmd,
-    poll_until,
-    read_json,
-    runtime_cmd,
-)
-from helpers.spec_build import built_spec
+from helpers.bridge_sim_probe import bridge_sim_probe
+from helpers.runtime_support import cyphal_udp_lock, poll_until, read_json
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -62,48 +53,23 @@ PAIR = [  # /valve_pair: fixed [2], saturate
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    b = built_spec("dredger")
-    d = tmp_path_factory.mktemp("dredger_cyphal")
-    env = child_env(b.prefix, domain_id(97), {"SAM_GENERATED_DIR": str(b.generated)})
+    b, d, env = spec_workdir(tmp_path_factory, "dredger", "dredger_cyphal", 97)
     (d / "plan.json").write_text(json.dumps({"rate_hz": 5, "topics": {
         "/valves": [{"seq": i, "valves": v} for i, v in enumerate(VALVES)],
         "/valve_pair": [{"seq": i, "valves": v} for i, v in enumerate(PAIR)]}}))
-    with cyphal_udp_lock():
-        bridge = Proc("bridge", runtime_cmd("bridge", *UDP, "--protocol", "cyphal", "--stats-file",
-                                            str(d / "bridge.json")), env, d)
-        sim = Proc("sim", runtime_cmd("sim", *UDP, "--devices", "pumps,valves", "--report", str(d / "sim.json"),
-                                      "--record", str(d / "sim.jsonl")), env, d)
-        listen = Proc("listen", helper_cmd("ros_probe.py", "listen", "--generated", str(b.generated), "--topics",
-                                           "/pumps", "--out", str(d / "listen.json"), "--record",
-                                           str(d / "pumps.jsonl")), env, d)
-        publish = None
-        try:
-            bridge.wait_line("READY", 120)
-            sim.wait_line("READY", 120)
-            listen.wait_line("READY", 60)
-            poll_until(lambda: (read_json(d / "listen.json") or {}).get("counts", {}).get("/pumps", 0) >= 5, 60,
-                       "pump readings at the probe")
-            publish = Proc("publish", helper_cmd("ros_probe.py", "publish", "--generated", str(b.generated),
-                                                 "--plan", str(d / "plan.json"), "--out", str(d / "publish.json")),
-                           env, d)
-            assert publish.wait(90) == 0, publish.stderr_tail()
+    with cyphal_udp_lock(), bridge_sim_probe(d, env, b.generated, UDP, "cyphal", "pumps,valves", ["/pumps"],
+                                             d / "pumps.jsonl", lambda counts: counts.get("/pumps", 0) >= 5,
+                                             "pump readings at the probe"):
 
-            def handled() -> bool:
-                maps = (read_json(d / "bridge.json") or {}).get("mappings", {})
-                return all(maps.get(m, {}).get("received", 0) >= n
-                           for m, n in (("valve_commands", len(VALVES)), ("valve_pair", len(PAIR))))
+        def handled() -> bool:
+            maps = (read_json(d / "bridge.json") or {}).get("mappings", {})
+            return all(maps.get(m, {}).get("received", 0) >= n
+                       for m, n in (("valve_commands", len(VALVES)), ("valve_pair", len(PAIR))))
 
-            poll_until(handled, 60, "the bridge handling every command")
-            poll_until(lambda: sum(1 for line in (d / "sim.jsonl").read_text().splitlines()
-                                   if json.loads(line)["dir"] == "rx") >= 2 + len(PAIR), 30,
-                       "the valves receiving every command the bridge sent")
-            assert sim.stop(signal.SIGTERM) == 0, sim.stderr_tail()
-            assert listen.stop(signal.SIGTERM) == 0, listen.stderr_tail()
-            assert bridge.stop(signal.SIGTERM) == 0, bridge.stderr_tail()
-        finally:
-            for p in (publish, listen, sim, bridge):
-                if p is not None:
-                    p.stop()
+        poll_until(handled, 60, "the bridge handling every command")
+        poll_until(lambda: sum(1 for line in (d / "sim.jsonl").read_text().splitlines()
+                               if json.loads(line)["dir"] == "rx") >= 2 + len(PAIR), 30,
+                   "the valves receiving every command the bridge sent")
     records = [json.loads(line) for line in (d / "sim.jsonl").read_text().splitlines()]
     return {"stats": read_json(d / "bridge.json"), "records": records,
             "got": [json.loads(line) for line in (d / "pumps.jsonl").read_text().splitlines()]}

@@ -1,6 +1,6 @@
 """A service mapping across processes (issue 19): a plain dronecan battery management system serving the vendor v0
 service UpdateBattery (tests/helpers/battery_peer.py, on a private loopback bus), the bridge of
-tests/specs/auv_services.yaml, and an independent rclpy client (tests/helpers/service_client.py) calling
+tests/specs/auv_services.yaml, and an independent rclpy client (tests/helpers/ros_service_client.py battery) calling
 /bms/update_battery (lolo_msgs/srv/UpdateBattery).
 
 - an answered call carries the request's fields to the device and its answer back (success, status);
@@ -14,7 +14,6 @@ tests/specs/auv_services.yaml, and an independent rclpy client (tests/helpers/se
 
 from __future__ import annotations
 
-import json
 from typing import Any
 
 import pytest
@@ -23,8 +22,9 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
-from helpers.runtime_support import Proc, child_env, domain_id, helper_cmd, read_json, runtime_cmd
-from helpers.spec_build import built_spec
+from helpers.runtime_support import helper_cmd
+from helpers.service_run import ServiceRun, requests_seen
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -33,30 +33,19 @@ TIMEOUT_S = 0.5  # the mapping's, in auv_services.yaml
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    built = built_spec("auv_services")
-    d = tmp_path_factory.mktemp("dronecan_services")
-    env = child_env(built.prefix, domain_id(61), {"SAM_GENERATED_DIR": str(built.generated)})
+    built, d, env = spec_workdir(tmp_path_factory, "auv_services", "dronecan_services", 61)
     iface = private_iface()
-    peer = Proc("peer", helper_cmd("battery_peer.py", "--iface", iface, "--node-id", "30", "--generated",
-                                   str(built.generated), "--late", str(3 * TIMEOUT_S)), env, d)
-    bridge = Proc("bridge", runtime_cmd("bridge", "--dronecan-iface", iface, "--stats-file", str(d / "bridge.json")),
-                  env, d)
-    client = None
-    try:
+    with ServiceRun(env, d) as r:
+        peer = r.start("peer", helper_cmd("battery_peer.py", "--iface", iface, "--node-id", "30", "--generated",
+                                          str(built.generated), "--late", str(3 * TIMEOUT_S)))
+        bridge = r.bridge("--dronecan-iface", iface)
         peer.wait_line("READY", 60)
         bridge.wait_line("READY", 90)
-        client = Proc("client", helper_cmd("service_client.py", "--service", "/bms/update_battery", "--status",
-                                           "bridge/service/update_battery", "--out", str(d / "client.json"),
-                                           "--duties"), env, d)
-        assert client.wait(120) == 0, client.stderr_tail()
-        result = json.loads((d / "client.json").read_text())
-        assert bridge.proc.poll() is None, bridge.stderr_tail()  # nothing raised into the bridge
-    finally:
-        for p in (client, bridge, peer):
-            if p is not None:
-                p.stop()
-    result["peer"] = [json.loads(line.split(" ", 1)[1]) for line in peer.lines if line.startswith("REQUEST ")]
-    result["bridge_stats"] = read_json(d / "bridge.json")
+        result = r.client("battery", "--service", "/bms/update_battery", "--status", "bridge/service/update_battery",
+                          "--duties")
+        r.assert_bridge_alive()
+    result["peer"] = requests_seen(peer)
+    result["bridge_stats"] = r.bridge_stats()
     return result
 
 

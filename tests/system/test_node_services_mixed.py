@@ -10,7 +10,6 @@ process, on a private loopback bus, with an rclpy probe:
 from __future__ import annotations
 
 import asyncio
-import time
 from typing import Any
 
 import pytest
@@ -23,19 +22,6 @@ from helpers.ros_probe import ThreadedProbe
 from helpers.runtime_support import domain_id, generated_or_skip
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
-
-
-def _call(probe: ThreadedProbe, service: str, node_id: int, timeout: float = 20.0) -> Any:
-    from sam_msgs.srv import UavcanGetNodeInfo
-
-    client = probe.node.create_client(UavcanGetNodeInfo, service)
-    if not client.wait_for_service(timeout_sec=timeout):
-        raise AssertionError(f"no service {service}")
-    future = client.call_async(UavcanGetNodeInfo.Request(node_id=node_id))
-    deadline = time.monotonic() + timeout
-    while not future.done() and time.monotonic() < deadline:
-        time.sleep(0.02)
-    return future.result()
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +50,8 @@ async def _scenario(gen: Any, iface: str) -> dict[str, Any]:
         out["services"] = duty_services()
         cyphal_device = min(d.node_id for d in gen.tables().DEVICES if d.node_id not in bridge.selection.devices)
         out["cyphal_device"] = cyphal_device
-        out["refused"] = await asyncio.to_thread(_call, probe, "/uavcan_get_node_info_dronecan", cyphal_device)
+        out["refused"] = await asyncio.to_thread(probe.call_duty, "/uavcan_get_node_info_dronecan",
+                                                  "UavcanGetNodeInfo", cyphal_device, 20.0)
         out["stats"] = bridge.stats()["services"]
     finally:
         if probe is not None:

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import math
-import signal
 from pathlib import Path
 from typing import Any
 
@@ -22,18 +21,10 @@ import pytest
 pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
+from helpers.bridge_sim_probe import bridge_sim_probe
 from helpers.dronecan_support import private_iface
-from helpers.ros_probe import listen_cmd, publish_cmd
-from helpers.runtime_support import (
-    Proc,
-    child_env,
-    cyphal_udp_lock,
-    domain_id,
-    poll_until,
-    read_json,
-    runtime_cmd,
-)
-from helpers.spec_build import built_spec
+from helpers.runtime_support import cyphal_udp_lock, poll_until, read_json
+from helpers.spec_build import spec_workdir
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -42,9 +33,7 @@ DEVICES = "relays,leak_sensor,led"  # the DroneCAN devices the mappings under te
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    b = built_spec("relay")
-    d = tmp_path_factory.mktemp("relay_e2e")
-    env = child_env(b.prefix, domain_id(47), {"SAM_GENERATED_DIR": str(b.generated)})
+    b, d, env = spec_workdir(tmp_path_factory, "relay", "relay_e2e", 47)
     iface = private_iface()
     dc = ["--layout", "all_dronecan", "--dronecan-iface", iface]
     plan = {"rate_hz": 5, "topics": {
@@ -52,35 +41,15 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         "/led": [{"r": 200, "g": 0, "b": 0, "alpha": 255}] * 3 + [{"r": 30, "g": 200, "b": 255, "alpha": 8}] * 3,
     }}
     (d / "plan.json").write_text(json.dumps(plan))
-    bridge = Proc("bridge", runtime_cmd("bridge", *dc, "--protocol", "dronecan", "--stats-file",
-                                        str(d / "bridge.json")), env, d)
-    sim = Proc("sim", runtime_cmd("sim", *dc, "--devices", DEVICES, "--report", str(d / "sim.json"),
-                                  "--record", str(d / "sim.jsonl")), env, d)
-    listen = Proc("listen", listen_cmd(b.generated, ["/leak"], d / "listen.json", d / "leak.jsonl"), env, d)
-    publish = None
-    try:
-        bridge.wait_line("READY", 120)
-        sim.wait_line("READY", 120)
-        listen.wait_line("READY", 60)
-        poll_until(lambda: (read_json(d / "listen.json") or {}).get("counts", {}).get("/leak", 0) >= 5, 60,
-                   "leak flags at the probe")
-        publish = Proc("publish", publish_cmd(b.generated, d / "plan.json", d / "publish.json"), env, d)
-        assert publish.wait(90) == 0, publish.stderr_tail()
+    with bridge_sim_probe(d, env, b.generated, dc, "dronecan", DEVICES, ["/leak"], d / "leak.jsonl",
+                          lambda counts: counts.get("/leak", 0) >= 5, "leak flags at the probe"):
 
         def commands_sent() -> bool:
             maps = (read_json(d / "bridge.json") or {}).get("mappings", {})
             return all(maps.get(m, {}).get("published", 0) >= 6 for m in ("relay_dvl", "led"))
 
         poll_until(commands_sent, 60, "the bridge sending every command")
-        assert sim.stop(signal.SIGTERM) == 0, sim.stderr_tail()  # its report, written at exit
-        report = read_json(d / "sim.json")
-        assert listen.stop(signal.SIGTERM) == 0, listen.stderr_tail()
-        assert bridge.stop(signal.SIGTERM) == 0, bridge.stderr_tail()
-    finally:
-        for p in (publish, listen, sim, bridge):
-            if p is not None:
-                p.stop()
-    return {"report": report, "stats": read_json(d / "bridge.json"), "dir": Path(d),
+    return {"report": read_json(d / "sim.json"), "stats": read_json(d / "bridge.json"), "dir": Path(d),
             "sent": [json.loads(line) for line in (d / "sim.jsonl").read_text().splitlines()],
             "leak": [json.loads(line) for line in (d / "leak.jsonl").read_text().splitlines()]}
 
@@ -114,38 +83,16 @@ def test_relay_and_light_commands_reach_the_devices(run: dict[str, Any]) -> None
 
 @pytest.fixture(scope="module")
 def cyphal_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    b = built_spec("relay")
-    d = tmp_path_factory.mktemp("relay_e2e_cyphal")
-    env = child_env(b.prefix, domain_id(48), {"SAM_GENERATED_DIR": str(b.generated)})
+    b, d, env = spec_workdir(tmp_path_factory, "relay", "relay_e2e_cyphal", 48)
     udp = ["--transport", "udp", "--iface", "127.0.0.1"]
     (d / "plan.json").write_text(json.dumps({"rate_hz": 5, "topics": {
         "/rail": [{"data": 0.3}] * 3 + [{"data": 300.0}] * 3}}))
-    with cyphal_udp_lock():
-        bridge = Proc("bridge", runtime_cmd("bridge", *udp, "--protocol", "cyphal", "--stats-file",
-                                            str(d / "bridge.json")), env, d)
-        sim = Proc("sim", runtime_cmd("sim", *udp, "--devices", "hull,rail", "--report", str(d / "sim.json"),
-                                      "--record", str(d / "sim.jsonl")), env, d)
-        listen = Proc("listen", listen_cmd(b.generated, ["/hull_leak", "/hull_depth"], d / "listen.json",
-                                           d / "hull.jsonl"), env, d)
-        publish = None
-        try:
-            bridge.wait_line("READY", 120)
-            sim.wait_line("READY", 120)
-            listen.wait_line("READY", 60)
-            poll_until(lambda: min((read_json(d / "listen.json") or {}).get("counts", {"": 0}).values()) >= 5, 60,
-                       "hull messages at the probe")
-            publish = Proc("publish", publish_cmd(b.generated, d / "plan.json", d / "publish.json"),
-                           env, d)
-            assert publish.wait(90) == 0, publish.stderr_tail()
-            poll_until(lambda: (read_json(d / "bridge.json") or {}).get("mappings", {}).get("rail", {}).get(
-                "published", 0) >= 6, 60, "the bridge sending every rail command")
-            assert sim.stop(signal.SIGTERM) == 0, sim.stderr_tail()
-            assert listen.stop(signal.SIGTERM) == 0, listen.stderr_tail()
-            assert bridge.stop(signal.SIGTERM) == 0, bridge.stderr_tail()
-        finally:
-            for p in (publish, listen, sim, bridge):
-                if p is not None:
-                    p.stop()
+    with cyphal_udp_lock(), bridge_sim_probe(d, env, b.generated, udp, "cyphal", "hull,rail",
+                                             ["/hull_leak", "/hull_depth"], d / "hull.jsonl",
+                                             lambda counts: bool(counts) and min(counts.values()) >= 5,
+                                             "hull messages at the probe"):
+        poll_until(lambda: (read_json(d / "bridge.json") or {}).get("mappings", {}).get("rail", {}).get(
+            "published", 0) >= 6, 60, "the bridge sending every rail command")
     return {"report": read_json(d / "sim.json"), "stats": read_json(d / "bridge.json"),
             "sent": [json.loads(line) for line in (d / "sim.jsonl").read_text().splitlines()],
             "got": [json.loads(line) for line in (d / "hull.jsonl").read_text().splitlines()]}
