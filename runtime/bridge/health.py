@@ -11,6 +11,12 @@ same tracking. So the backends report every heartbeat as a :class:`~.backend.Dev
   Heartbeat.OFFLINE_TIMEOUT and DroneCAN's NodeStatus.OFFLINE_TIMEOUT_MS); when its timer fires it is lost
   (logged; handlers get ``lost``), when heartbeats come back it is ``back``;
 - a restart (the uptime went down) is counted, logged and reported (``restarted``: its clock may have restarted);
+  so is an uptime that fell behind the time since the last heartbeat by more than :data:`UPTIME_SLACK_S` (plus
+  :data:`UPTIME_DRIFT` of that time): a node that rebooted quickly whose first heartbeats the transport dropped
+  (Cyphal's transfer-id timeout, 2 s: the new node's ids start at 0 again, and pycyphal discards ids below the last
+  one until the timeout has passed), so that the first one heard carries an uptime no lower than the last one
+  before the reboot. The slack covers whole-second uptimes (1 s) and the heartbeats' delivery jitter; the drift a
+  device clock that runs slow over a long gap;
 - nodes that are no device of the spec (tools such as yakut) are tracked too; their first appearance is logged at
   INFO, their comings and goings at DEBUG only, and handlers hear of them only with ``device=False``.
 
@@ -28,9 +34,11 @@ from typing import Any
 from sam_runtime.bridge.backend import DeviceStatus
 from sam_runtime.bridge.counters import log
 
-__all__ = ["OFFLINE_TIMEOUT_S", "DeviceHealth", "NodeRecord"]
+__all__ = ["OFFLINE_TIMEOUT_S", "UPTIME_DRIFT", "UPTIME_SLACK_S", "DeviceHealth", "NodeRecord", "restarted_since"]
 
 OFFLINE_TIMEOUT_S = 3.0
+UPTIME_SLACK_S = 2.5  # whole seconds (1 s) + 1.5 s of delivery jitter between two heartbeats
+UPTIME_DRIFT = 0.02  # a device clock 2 % slow over a gap is no restart
 
 # handler(node_id, event, is_device): event is "lost", "back" or "restarted"
 HealthHandler = Callable[[int, str, bool], None]
@@ -47,6 +55,24 @@ class NodeRecord:
     restarts: int = 0  # times the uptime went backwards
     alive_since: float = 0.0  # when the heartbeat (re)appeared
     timer: Any = None
+
+
+def restarted_since(old_uptime: int, uptime: int, elapsed: float) -> bool:
+    """Whether a node restarted between two of its heartbeats ``elapsed`` seconds apart: its uptime went down, or
+    grew less than the time that passed, by more than the slack (see the module's docstring).
+
+    >>> restarted_since(40, 3, 1.0), restarted_since(3, 4, 1.0), restarted_since(2, 2, 0.9)
+    (True, False, False)
+
+    Up 3 s, rebooted in 1 s, its heartbeats dropped for 2 s: the first one heard (uptime 3, a late one) is no lower,
+    but 5.2 s have passed. A device heard again after 10 minutes, its clock 1 % slow, did not restart:
+
+    >>> restarted_since(3, 3, 5.2), restarted_since(100, 694, 600.0)
+    (True, False)
+    """
+    if uptime < old_uptime:
+        return True
+    return uptime + UPTIME_SLACK_S + UPTIME_DRIFT * elapsed < old_uptime + elapsed
 
 
 class DeviceHealth:
@@ -97,8 +123,8 @@ class DeviceHealth:
             return
         if not rec.alive or now - rec.last_seen >= self.offline_timeout:
             rec.alive_since = now  # back (possibly before its timer noticed it was gone)
-        old_uptime = rec.status.uptime_s
-        restarted = st.uptime_s < old_uptime
+        old_uptime, elapsed = rec.status.uptime_s, now - rec.last_seen
+        restarted = restarted_since(old_uptime, st.uptime_s, elapsed)
         if restarted:
             rec.restarts += 1
             rec.alive_since = now  # a device that just booted gets its grace before it must publish
@@ -108,10 +134,13 @@ class DeviceHealth:
         rec.last_seen = now
         self._arm(rec)
         if restarted:
+            # (when the uptime did not go down, the time since says why it counts)
+            since = "" if st.uptime_s < old_uptime else f", {elapsed:.1f} s ago"
             if nid in self.devices:
-                log.warning("%s restarted (uptime %d s, before %d s)", self.name(nid), st.uptime_s, old_uptime)
+                log.warning("%s restarted (uptime %d s, before %d s%s)", self.name(nid), st.uptime_s, old_uptime,
+                            since)
             else:
-                log.debug("node %d restarted (uptime %d s, before %d s)", nid, st.uptime_s, old_uptime)
+                log.debug("node %d restarted (uptime %d s, before %d s%s)", nid, st.uptime_s, old_uptime, since)
             self._notify(nid, "restarted")
         if not rec.alive:
             rec.alive = True

@@ -174,6 +174,29 @@ def test_health_a_restart_while_alive_and_the_health_level() -> None:
     assert (e["health"], e["level"], e["uptime_s"], e["restarts"]) == ("CAUTION", 1, 0, 1)
 
 
+def test_health_a_restart_hidden_by_dropped_heartbeats_is_seen_from_the_elapsed_time(
+        caplog: pytest.LogCaptureFixture) -> None:
+    h, t, events = _health()
+    caplog.set_level(logging.INFO, logger="sam_runtime.bridge")
+    for up in range(3):  # up 2 s
+        h.on_status(_status(11, up))
+        t.advance(1.0)
+    # It rebooted in 1 s; the transport dropped its new node's first heartbeat (transfer ids from 0 within the 2 s
+    # transfer-id timeout), and the next came late: heard 2.9 s after the last, it carries an uptime no lower.
+    t.advance(1.9)
+    h.on_status(_status(11, 2))
+    assert events == [(11, "restarted", True)] and h.entry(11)["restarts"] == 1 and h.entry(11)["lost_events"] == 0
+    assert [r.getMessage() for r in caplog.records] == [
+        "device imu (node 11) restarted (uptime 2 s, before 2 s, 2.9 s ago)"]
+    # Heard again, its uptime as the time passed: no restart; nor after an outage (its clock a little slow)
+    t.advance(1.0)
+    h.on_status(_status(11, 3))
+    t.advance(120.0)
+    h.on_status(_status(11, 122))
+    assert events == [(11, "restarted", True), (11, "lost", True), (11, "back", True)]
+    assert h.entry(11)["restarts"] == 1
+
+
 def test_health_strangers_are_tracked_quietly(caplog: pytest.LogCaptureFixture) -> None:
     h, t, events = _health()
     caplog.set_level(logging.INFO, logger="sam_runtime.bridge")
