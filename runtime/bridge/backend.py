@@ -61,6 +61,9 @@ class DeviceStatus:
     mode: str  # e.g. OPERATIONAL
     uptime_s: int
     vssc: int  # vendor-specific status code
+    # the transport says the node started over (Cyphal/UDP: its 64-bit transfer ids went back, which they do only
+    # when it restarts), whatever its uptime says: the first heartbeats of a quick reboot may have been dropped
+    ids_restarted: bool = False
 
 
 class BelowBridge:

@@ -10,7 +10,12 @@ same tracking. So the backends report every heartbeat as a :class:`~.backend.Dev
 - a device is alive while its last heartbeat is younger than ``offline_timeout`` (3 s: Cyphal's
   Heartbeat.OFFLINE_TIMEOUT and DroneCAN's NodeStatus.OFFLINE_TIMEOUT_MS); when its timer fires it is lost
   (logged; handlers get ``lost``), when heartbeats come back it is ``back``;
-- a restart (the uptime went down) is counted, logged and reported (``restarted``: its clock may have restarted);
+- a restart (the uptime went down, or the transport saw the node's transfer ids start over:
+  ``DeviceStatus.ids_restarted``) is counted, logged and reported (``restarted``: its clock may have restarted).
+  The second covers a quick reboot on Cyphal/UDP whose first heartbeats the transport dropped (pycyphal discards
+  ids below the last one until its 2 s transfer-id timeout has passed), so that the first one heard carries an
+  uptime no lower than the last one before the reboot. No rule on the time between heartbeats: a bridge held up
+  for seconds would count restarts that never happened;
 - nodes that are no device of the spec (tools such as yakut) are tracked too; their first appearance is logged at
   INFO, their comings and goings at DEBUG only, and handlers hear of them only with ``device=False``.
 
@@ -98,7 +103,7 @@ class DeviceHealth:
         if not rec.alive or now - rec.last_seen >= self.offline_timeout:
             rec.alive_since = now  # back (possibly before its timer noticed it was gone)
         old_uptime = rec.status.uptime_s
-        restarted = st.uptime_s < old_uptime
+        restarted = st.uptime_s < old_uptime or st.ids_restarted
         if restarted:
             rec.restarts += 1
             rec.alive_since = now  # a device that just booted gets its grace before it must publish
@@ -108,10 +113,13 @@ class DeviceHealth:
         rec.last_seen = now
         self._arm(rec)
         if restarted:
+            # (when the uptime did not go down, the transport's word is why it counts)
+            since = "" if st.uptime_s < old_uptime else ", its transfer ids started over"
             if nid in self.devices:
-                log.warning("%s restarted (uptime %d s, before %d s)", self.name(nid), st.uptime_s, old_uptime)
+                log.warning("%s restarted (uptime %d s, before %d s%s)", self.name(nid), st.uptime_s, old_uptime,
+                            since)
             else:
-                log.debug("node %d restarted (uptime %d s, before %d s)", nid, st.uptime_s, old_uptime)
+                log.debug("node %d restarted (uptime %d s, before %d s%s)", nid, st.uptime_s, old_uptime, since)
             self._notify(nid, "restarted")
         if not rec.alive:
             rec.alive = True

@@ -53,3 +53,6 @@ class SimConfig:
     # bus's time-sync master and stamping 0 ("unknown") until it synchronised; off: the shared stamp clock, as
     # under a time scale other than 1 (the vehicle's time is then not the computers')
     device_clocks: bool = True
+    # A reboot (ExecuteCommand RESTART, RestartNode): the device is silent this long (its reset, bootloader and
+    # firmware start) before its new node (uptime and transfer ids from 0) comes up
+    reboot_s: float = 1.0

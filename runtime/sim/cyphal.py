@@ -2,6 +2,11 @@
 port, a subscriber per command subject; generic values from sam_runtime.sim.devices, records as transmitted. Each
 node answers GetInfo (pycyphal's), ExecuteCommand COMMAND_RESTART (a reboot: power off and on, as DroneCAN's
 RestartNode) and GetTransportStatistics (its transport sessions' counts).
+
+Closing a node (power off, reboot, the end) stops its servers' tasks while its sockets are still open, then closes
+the node: pycyphal's ``Server.close()`` cancels the task without waiting and closes the sockets at once, so a
+response in flight (a GetInfo poll during a reboot) would fail on a closed socket (EBADF) and pycyphal would log
+it as a "task failure" traceback. A request that arrives meanwhile goes unanswered, as on a device that is off.
 (The DroneCAN one is sam_runtime.sim.dronecan; the schedule, physics and counters are sam_runtime.sim.simulator's.)"""
 
 from __future__ import annotations
@@ -108,7 +113,7 @@ class CyphalDevices:
         return CYPHAL_MAX_INTERVAL_S, int(dev.node.presentation.transport.protocol_parameters.transfer_id_modulo)
 
     async def close(self, devices: list[SimDevice]) -> None:
-        """Close the devices' ports, then their nodes (never raises)."""
+        """Close the devices' ports, stop their servers, then close their nodes (never raises)."""
         ports = [p.publisher for d in devices for p in d.pubs] + [s.subscriber for d in devices for s in d.subs]
         ports += [d.extra for d in devices]  # the time-sync subscribers
         nodes = [d.node for d in devices]
@@ -120,6 +125,7 @@ class CyphalDevices:
                 sp.subscriber = None
         try:
             await aclose(*[p for p in ports if p is not None])
+            await _stop_serving([n for n in nodes if n is not None])
             await aclose(*[n for n in nodes if n is not None])
         except Exception as ex:
             _log.warning("closing the simulated Cyphal nodes: %s: %s", type(ex).__name__, ex)
@@ -146,3 +152,34 @@ class CyphalDevices:
         if transmitted:  # the values as transmitted (float16 rounding etc.)
             obj = pycyphal.dsdl.deserialize(type(obj), list(pycyphal.dsdl.serialize(obj)))
         return {"subject": port.port.subject_id, "value": pycyphal.dsdl.to_builtin(obj)}
+
+
+async def _stop_serving(nodes: list[Any], timeout: float = 2.0) -> None:
+    """End the background tasks of the nodes' servers (ours, pycyphal's GetInfo and register services) while the
+    sockets are open: a response being sent completes, and no send meets a closed socket. Cancelled again until
+    done, as Python 3.11's ``wait_for`` can swallow a cancellation that meets a completed send."""
+    import uavcan.node
+    import uavcan.register
+
+    served = (uavcan.node.GetInfo_1_0, uavcan.node.ExecuteCommand_1_1, uavcan.node.GetTransportStatistics_0_1,
+              uavcan.register.Access_1_0, uavcan.register.List_1_0)
+    tasks: list[asyncio.Task[None]] = []
+    for node in nodes:
+        for dtype in served:
+            try:
+                server = node.get_server(dtype)  # the existing instance (pycyphal keeps one per service)
+            except Exception:  # a node closed meanwhile (a transport failure): nothing to stop
+                continue
+            task = getattr(server, "_maybe_task", None)  # serve_in_background's task (pycyphal keeps no public one)
+            if isinstance(task, asyncio.Task):
+                tasks.append(task)
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + timeout
+    pending = [t for t in tasks if not t.done()]
+    while pending and loop.time() < deadline:
+        for t in pending:
+            t.cancel()
+        await asyncio.wait(pending, timeout=min(0.05, max(0.0, deadline - loop.time())))
+        pending = [t for t in pending if not t.done()]
+    if pending:
+        _log.warning("%d simulated Cyphal servers did not stop within %.0f s", len(pending), timeout)

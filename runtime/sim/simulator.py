@@ -33,8 +33,9 @@ a Cyphal port is keyed by its subject id (``"1100"``), a DroneCAN one by ``"dron
 without this device's element). ``record`` writes every transmitted and received message (as transmitted) as JSON
 lines (``subject`` for Cyphal, ``protocol``/``data_type``/``data_type_id`` for DroneCAN).
 For fault tests: ``power_off(name)``/``power_on(name)`` (a device that stops - its heartbeat too - and
-reboots; ``restart(name)``: both, as DroneCAN's RestartNode) and ``pause()``/``resume()`` (hold every publication,
-heartbeats go on, nothing left in flight).
+reboots; ``restart(name)``: both, ``SimConfig.reboot_s`` apart, as DroneCAN's RestartNode and Cyphal's
+ExecuteCommand RESTART) and ``pause()``/``resume()`` (hold every publication, heartbeats go on, nothing left in
+flight).
 """
 
 from __future__ import annotations
@@ -213,10 +214,13 @@ class Simulator:
         self._start_device_tasks(dev, restart=True)
 
     async def restart(self, name: str) -> None:
-        """A reboot (DroneCAN's RestartNode): power off, then on again (uptime and transfer ids from 0)."""
+        """A reboot (DroneCAN's RestartNode, Cyphal's ExecuteCommand RESTART): power off, silent for
+        ``config.reboot_s`` (a real device's reset, bootloader and firmware start), then on again (uptime and
+        transfer ids from 0)."""
         if self._closed:
             return
         await self.power_off(name)
+        await asyncio.sleep(self.config.reboot_s)
         await self.power_on(name)
 
     def start_publishing(self, duration: float | None = None) -> None:

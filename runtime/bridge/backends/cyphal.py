@@ -247,6 +247,7 @@ class CyphalBackend(Backend):
         self._subs: list[_Subscription] = []
         self._pubs: list[_Publication] = []
         self._status_handlers: list[Callable[[DeviceStatus], None]] = []
+        self._heartbeat_ids: dict[int, int] = {}  # node id -> transfer id of its last heartbeat
         self._node: Any = None
         self._hb_sub: Any = None
         self._suspect: str | None = None
@@ -400,8 +401,13 @@ class CyphalBackend(Backend):
         if nid is None:
             return
         health, mode = int(msg.health.value), int(msg.mode.value)
+        tid, last = int(transfer.transfer_id), self._heartbeat_ids.get(nid)
+        self._heartbeat_ids[nid] = tid
+        # 64-bit ids (UDP) never wrap: ids that went back mean the node started over; modulo 32 (CAN) says nothing
+        ids_restarted = self._modulo >= 2**32 and last is not None and tid < last
         st = DeviceStatus(nid, _HEALTH.get(health, str(health)), _HEALTH_LEVEL.get(health, 2),
-                          _MODE.get(mode, str(mode)), int(msg.uptime), int(msg.vendor_specific_status_code))
+                          _MODE.get(mode, str(mode)), int(msg.uptime), int(msg.vendor_specific_status_code),
+                          ids_restarted)
         for handler in self._status_handlers:
             handler(st)
 

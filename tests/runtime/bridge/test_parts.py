@@ -16,6 +16,7 @@ import asyncio
 import logging
 import threading
 from collections import Counter
+from dataclasses import replace
 from types import SimpleNamespace as NS
 from typing import Any
 
@@ -172,6 +173,30 @@ def test_health_a_restart_while_alive_and_the_health_level() -> None:
     assert events == [(13, "restarted", True)] and h.alive_since(13) == 1.0
     e = h.entry(13)
     assert (e["health"], e["level"], e["uptime_s"], e["restarts"]) == ("CAUTION", 1, 0, 1)
+
+
+def test_health_a_restart_the_transport_saw_counts_though_the_uptime_did_not_fall(
+        caplog: pytest.LogCaptureFixture) -> None:
+    h, t, events = _health()
+    caplog.set_level(logging.INFO, logger="sam_runtime.bridge")
+    for up in range(3):  # up 2 s
+        h.on_status(_status(11, up))
+        t.advance(1.0)
+    # It rebooted in 1 s; the transport dropped its new node's first heartbeats (transfer ids from 0 within the 2 s
+    # transfer-id timeout), and the first one heard carries an uptime no lower: its transfer ids went back.
+    t.advance(1.9)
+    h.on_status(replace(_status(11, 2), ids_restarted=True))
+    assert events == [(11, "restarted", True)] and h.entry(11)["restarts"] == 1 and h.entry(11)["lost_events"] == 0
+    assert [r.getMessage() for r in caplog.records] == [
+        "device imu (node 11) restarted (uptime 2 s, before 2 s, its transfer ids started over)"]
+    # A bridge held up for seconds hears the next heartbeat late, its uptime behind the time that passed: no
+    # restart (the time between heartbeats is no evidence); nor after an outage
+    t.advance(2.9)
+    h.on_status(_status(11, 3))
+    t.advance(120.0)
+    h.on_status(_status(11, 122))
+    assert events == [(11, "restarted", True), (11, "lost", True), (11, "back", True)]
+    assert h.entry(11)["restarts"] == 1
 
 
 def test_health_strangers_are_tracked_quietly(caplog: pytest.LogCaptureFixture) -> None:
