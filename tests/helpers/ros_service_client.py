@@ -18,13 +18,15 @@ python ros_service_client.py --out result.json charger [--device 31]
   set_charge_limits counts the three calls and the late response, and writes that status too.
 
 python ros_service_client.py --out result.json duties --package lolo_msgs --device 30 --not-device 99 \
-    [--namespace /x] [--suffix _can]
+    [--namespace /x] [--suffix _can] [--reboot-evidence uptime|transfers_tx]
   The bridge's device duties (`bridge.node_services`: the typed services uavcan_get_node_info, uavcan_restart_node,
   uavcan_get_transport_stats): get_node_info of the device and of a node that is no device; get_transport_stats of
   the device until its counters have grown past the first answer's (each call is itself a transfer both ways;
   polled, with the deadline); restart_node of the device (once its uptime is 2 s or more), then get_node_info and
-  get_transport_stats until the device's uptime or its transfer count went below the one it had before the restart
-  (the reboot seen; polled every 0.1 s, with the deadline). Every response (all its fields) goes to the JSON.
+  get_transport_stats until the reboot is seen by the evidence asked for: the device's uptime (GetNodeInfo
+  answered with an uptime below the one before the restart) or its transfer count (below the one before) (polled
+  every 0.1 s, with the deadline; a call that fails while the device is rebooting is recorded and polled past).
+  Every response (all its fields) goes to the JSON.
 """
 
 from __future__ import annotations
@@ -224,18 +226,19 @@ def duties(s: Session, args: argparse.Namespace, result: dict[str, Any]) -> None
     last_stats = call("get_transport_stats", args.device)
     result["stats_before_restart"] = last_stats
     result["restart"] = call("restart_node", args.device)
-    # The reboot seen: the node's uptime went down (DroneCAN's GetNodeInfo carries its own), or its transport
-    # counters started again (Cyphal: GetInfo has no uptime, and the bridge's heartbeat record may not see the
-    # new node's first heartbeats, which reuse transfer ids that pycyphal takes for duplicates for 2 s).
+    # The reboot seen by the evidence the caller asked for, whichever other shows first: the node's uptime went
+    # down (DroneCAN's GetNodeInfo carries its own), or its transport counters started again (Cyphal: GetInfo has
+    # no uptime; the bridge's heartbeat record follows the new node's heartbeats only once pycyphal lets them through).
     after: list[dict[str, Any]] = []
     result["after_restart"] = after
     while not s.late():
         info, stats = call("get_node_info", args.device), call("get_transport_stats", args.device)
         after.append({"info": info, "stats": stats})
-        if info["success"] and info["uptime_sec"] < before["uptime_sec"]:
+        if args.reboot_evidence == "uptime" and info["success"] and info["uptime_sec"] < before["uptime_sec"]:
             result["rebooted_by"] = "uptime"
             break
-        if stats["success"] and stats["transfers_tx"] < last_stats["transfers_tx"]:
+        if args.reboot_evidence == "transfers_tx" and stats["success"] \
+                and stats["transfers_tx"] < last_stats["transfers_tx"]:
             result["rebooted_by"] = "transfers_tx"
             break
         s.pause(0.1)
@@ -266,6 +269,8 @@ def main() -> int:
     n.add_argument("--not-device", type=int, required=True)
     n.add_argument("--namespace", default="/")
     n.add_argument("--suffix", default="", help="the services' protocol suffix (a mixed layout)")
+    n.add_argument("--reboot-evidence", choices=("uptime", "transfers_tx"), default="uptime",
+                   help="what shows the device rebooted: GetNodeInfo's uptime (DroneCAN) or its transfer counters")
     args = p.parse_args()
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 

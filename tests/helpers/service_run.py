@@ -51,12 +51,13 @@ class ServiceRun:
     def assert_bridge_alive(self) -> None:
         assert self.bridge_proc.proc.poll() is None, self.bridge_proc.stderr_tail()  # nothing raised into the bridge
 
-    def duties(self, package: str, device: int, not_device: int) -> dict[str, Any]:
+    def duties(self, package: str, device: int, not_device: int, reboot_evidence: str) -> dict[str, Any]:
         """The client's `duties` scenario (tests/helpers/ros_service_client.py) against the device and a node id
-        that is no device: its JSON, once the bridge's stats file (which follows its counters) has every
-        get_node_info call it made and the bridge is still running."""
+        that is no device, the reboot seen by `reboot_evidence` (uptime or transfers_tx): its JSON, once the
+        bridge's stats file (which follows its counters) has every get_node_info call it made and the bridge is
+        still running."""
         result = self.client("duties", "--package", package, "--device", str(device), "--not-device",
-                             str(not_device))
+                             str(not_device), "--reboot-evidence", reboot_evidence)
         calls = 3 + len(result.get("after_restart", []))  # info, info_not_device, before_restart (at least)
         poll_until(lambda: ((self.bridge_stats() or {}).get("services", {})
                             .get("node_services.get_node_info", {}).get("calls", 0)) >= calls, 20,

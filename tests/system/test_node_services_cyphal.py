@@ -41,7 +41,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         bridge = r.bridge(*UDP)
         sim.wait_line("READY", 90)
         bridge.wait_line("READY", 90)
-        result = r.duties("ran_msgs", CHARGER, STRANGER)
+        result = r.duties("ran_msgs", CHARGER, STRANGER, "transfers_tx")
         poll_until(lambda: ((r.bridge_stats() or {}).get("devices", {}).get("charger", {})
                             .get("restarts", 0)) >= 1, 20, "the bridge counting the charger's restart")
     sim_stderr = d / "sim.stderr"

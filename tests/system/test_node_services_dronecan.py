@@ -39,7 +39,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         bridge = r.bridge("--dronecan-iface", iface)
         sim.wait_line("READY", 90)
         bridge.wait_line("READY", 90)
-        result = r.duties("lolo_msgs", BMS, STRANGER)
+        result = r.duties("lolo_msgs", BMS, STRANGER, "uptime")
     return result | r.outcome()
 
 

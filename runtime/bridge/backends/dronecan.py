@@ -61,7 +61,7 @@ def node_status(node_id: int, msg: Any) -> DeviceStatus:
 
     >>> from types import SimpleNamespace as S
     >>> node_status(12, S(health=2, mode=0, uptime_sec=41, vendor_specific_status_code=7))
-    DeviceStatus(node_id=12, health='ERROR', level=2, mode='OPERATIONAL', uptime_s=41, vssc=7)
+    DeviceStatus(node_id=12, health='ERROR', level=2, mode='OPERATIONAL', uptime_s=41, vssc=7, ids_restarted=False)
     """
     health, mode = int(msg.health), int(msg.mode)
     return DeviceStatus(node_id, _HEALTH.get(health, str(health)), _HEALTH_LEVEL.get(health, 2),
