@@ -15,6 +15,7 @@ import asyncio
 import logging
 from typing import Any
 
+from sam_runtime.common.tasks import cancel_and_wait
 from sam_runtime.cyphal_io.transport import aclose, make_node, quiet_late_media_completions, transport_from_env
 from sam_runtime.sim.devices import PHYSICS, SAM_ACTUATORS, generic_fill, physics_key
 from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
@@ -156,8 +157,8 @@ class CyphalDevices:
 
 async def _stop_serving(nodes: list[Any], timeout: float = 2.0) -> None:
     """End the background tasks of the nodes' servers (ours, pycyphal's GetInfo and register services) while the
-    sockets are open: a response being sent completes, and no send meets a closed socket. Cancelled again until
-    done, as Python 3.11's ``wait_for`` can swallow a cancellation that meets a completed send."""
+    sockets are open: a response being sent completes, and no send meets a closed socket (common.tasks'
+    cancel_and_wait: cancelled again until done)."""
     import uavcan.node
     import uavcan.register
 
@@ -173,13 +174,6 @@ async def _stop_serving(nodes: list[Any], timeout: float = 2.0) -> None:
             task = getattr(server, "_maybe_task", None)  # serve_in_background's task (pycyphal keeps no public one)
             if isinstance(task, asyncio.Task):
                 tasks.append(task)
-    loop = asyncio.get_running_loop()
-    deadline = loop.time() + timeout
-    pending = [t for t in tasks if not t.done()]
-    while pending and loop.time() < deadline:
-        for t in pending:
-            t.cancel()
-        await asyncio.wait(pending, timeout=min(0.05, max(0.0, deadline - loop.time())))
-        pending = [t for t in pending if not t.done()]
+    pending = await cancel_and_wait(tasks, timeout)
     if pending:
         _log.warning("%d simulated Cyphal servers did not stop within %.0f s", len(pending), timeout)
