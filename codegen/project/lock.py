@@ -85,6 +85,8 @@ def command_line() -> str:
     argv = list(getattr(sys, "orig_argv", None) or sys.argv)
     if len(argv) >= 3 and argv[1] == "-m":
         words = ["python", *argv[1:]]
+    elif len(argv) >= 3 and argv[1] == "-c":  # the program itself would fill the line
+        words = ["python", "-c", "...", *argv[3:]]
     elif len(argv) >= 2 and not argv[1].startswith("-"):
         words = [Path(argv[1]).name, *argv[2:]]  # a console script run by its interpreter
     else:

@@ -382,6 +382,7 @@ def ros_build_lock(build_root: Path, *, say: Callable[[str], None] | None = None
     """The lock of a ROS build folder (``build_root``, the parent of the packages' CMake folders) and of what is
     built in it into an install prefix: held across the is-it-current check, the CMake steps and the install, so
     that a second build meanwhile waits and then finds the packages current (see sam_codegen.project.lock)."""
+    build_root = Path(build_root).absolute()
     return ProjectLock(lock_path("ros-build", build_root), f"the ROS build folder {build_root}", say=say,
                        timeout=timeout, cancelled=cancelled)
 

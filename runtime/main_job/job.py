@@ -43,7 +43,7 @@ from typing import Any
 from sam_codegen.build import build
 from sam_codegen.model.diagnostics import SpecError
 from sam_codegen.project.cyphal_path import CyphalPathError
-from sam_codegen.project.lock import LockError
+from sam_codegen.project.lock import LockError, LockTimeout, ProjectLock, lock_path
 from sam_codegen.project.ros_install import RosBuildError, ros_runtime_env
 from sam_codegen.project.workspace import (
     GENERATED_ENV_VAR,
@@ -184,6 +184,28 @@ def _workspace(opts: RunOptions) -> Any:
     if opts.build or opts.spec is not None:
         return workspace_for(opts.spec, generated)
     return workspace_for(None, generated or find_generated(), need_spec=False)
+
+
+def _claim_log_dir(opts: RunOptions, state: Path, say: Any) -> tuple[Path, ProjectLock | None]:
+    """The children's log folder (with the truth file): ``--log-dir``, else the project's ``run-logs``, held by this
+    run (a lock) until it ends. A second run of the project at the same time gets ``run-logs-2`` (and so on)
+    instead of overwriting the first one's logs, which the first one is reading."""
+    if opts.log_dir is not None:
+        return opts.log_dir.resolve(), None
+    base = (state / "run-logs").resolve()
+    for n in range(1, 100):
+        folder = base if n == 1 else base.with_name(f"{base.name}-{n}")
+        lock = ProjectLock(lock_path("run-logs", folder), f"the log folder {folder}", timeout=0.0)
+        try:
+            lock.__enter__()
+        except LockTimeout:  # another run writes there
+            continue
+        except LockError:  # no lock files at all: as before, the one folder
+            break
+        if n > 1:
+            say(f"sam-run: {base} is another run's; this run's logs go to {folder}")
+        return folder, lock
+    return base, None
 
 
 def _build(spec: Path, gen_dir: Path, say: Any, opts: RunOptions, cancelled: Any) -> None:
@@ -384,6 +406,7 @@ def run(opts: RunOptions) -> int:
     old_handlers = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     children: list[_Child] = []
     live: LiveView | None = None
+    log_lock: ProjectLock | None = None
     exit_code = 0
     try:
         prepared = _prepare(opts, say, lambda: bool(stop_reason))
@@ -393,7 +416,7 @@ def run(opts: RunOptions) -> int:
         if stop_reason:
             return 0
         env = _children_env(opts, prepared.prefix, gen_dir, old_handlers)
-        log_dir = (opts.log_dir or prepared.state / "run-logs").resolve()
+        log_dir, log_lock = _claim_log_dir(opts, prepared.state, say)
         tables = gen.tables()
         hosted = implemented(tables) if opts.nodes else []
         missing = unimplemented(tables)
@@ -413,6 +436,8 @@ def run(opts: RunOptions) -> int:
         codes = _stop_children(children)
         for s, h in old_handlers.items():
             signal.signal(s, h)
+        if log_lock is not None:
+            log_lock.release()
         if live is not None:
             with contextlib.suppress(Exception):  # the children are stopped already; nothing else depends on it
                 live.close()
