@@ -186,7 +186,7 @@ def _workspace(opts: RunOptions) -> Any:
     return workspace_for(None, generated or find_generated(), need_spec=False)
 
 
-def _claim_log_dir(opts: RunOptions, state: Path, say: Any) -> tuple[Path, ProjectLock | None]:
+def claim_log_dir(opts: RunOptions, state: Path, say: Any) -> tuple[Path, ProjectLock | None]:
     """The children's log folder (with the truth file): ``--log-dir``, else the project's ``run-logs``, held by this
     run (a lock) until it ends. A second run of the project at the same time gets ``run-logs-2`` (and so on)
     instead of overwriting the first one's logs, which the first one is reading."""
@@ -416,7 +416,7 @@ def run(opts: RunOptions) -> int:
         if stop_reason:
             return 0
         env = _children_env(opts, prepared.prefix, gen_dir, old_handlers)
-        log_dir, log_lock = _claim_log_dir(opts, prepared.state, say)
+        log_dir, log_lock = claim_log_dir(opts, prepared.state, say)
         tables = gen.tables()
         hosted = implemented(tables) if opts.nodes else []
         missing = unimplemented(tables)
