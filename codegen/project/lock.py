@@ -42,6 +42,7 @@ __all__ = [
     "command_line",
     "lock_path",
     "locks_dir",
+    "optional_lock",
 ]
 
 # How often a waiter tries the lock again: a tenth of a second costs nothing beside a build of seconds.

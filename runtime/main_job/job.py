@@ -324,17 +324,17 @@ def _vehicle_up(children: list[_Child], launched: float, opts: RunOptions, say: 
 
 
 def _show_live(live: LiveView, children: list[_Child], tables: Any, opts: RunOptions, stop_reason: list[str],
-               say: Any) -> tuple[int, float | None]:
+               say: Any, launched: float) -> tuple[int, float | None]:
     """Step 5 until a stop reason comes (a signal handler, --duration, a child that died or never came up: exit
-    code 1). Returns the exit code and how long the vehicle ran (None if it never came up).
+    code 1). Returns the exit code and how long the vehicle ran (None if it never came up). ``launched``: when
+    the first child was started (time.monotonic).
 
     ``--duration`` counts from the moment the vehicle is up (every child READY), not from the launch: starting the
     processes takes seconds, more on a loaded machine or beside another run's build."""
     exit_code = 0
     tty = sys.stdout.isatty() and not opts.plain
-    launched = time.monotonic()
     up: float | None = None
-    next_draw = launched
+    next_draw = time.monotonic()
     refresh = opts.refresh_s if tty else 1.0
     while not stop_reason:
         if up is None:
@@ -424,10 +424,11 @@ def run(opts: RunOptions) -> int:
             say(f"no implementation for node(s) {', '.join(missing)} of the spec"
                 + (f"; hosting {', '.join(hosted)}" if hosted else "; demo commands move the actuators"))
         truth = (opts.truth_file or log_dir / "truth.json").resolve()
+        launched = time.monotonic()
         _start_children(children, opts, gen_dir, tables, hosted, env, log_dir, truth)
         live = LiveView(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
                         truth_file=truth, namespace=opts.namespace)
-        exit_code, ran = _show_live(live, children, tables, opts, stop_reason, say)
+        exit_code, ran = _show_live(live, children, tables, opts, stop_reason, say, launched)
         final = live.table(f"final ({stop_reason[0] if stop_reason else 'stopped'}) after "
                            + ("the vehicle never came up" if ran is None else f"{ran:.1f} s of the vehicle up"))
         say("\n".join(final))
