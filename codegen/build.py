@@ -17,6 +17,7 @@ from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.model.diagnostics import Diagnostic, Pos, SpecError
 from sam_codegen.model.spec import DsdlStruct
 from sam_codegen.model.types import DsdlType, split_composite_name
+from sam_codegen.project.lock import LockError, ProjectLock, lock_path, optional_lock
 from sam_codegen.project.workspace import GENERATED_MARKER, OutDirError, check_out_dir
 from sam_codegen.targets.docs.budget import resolved_budgets
 from sam_codegen.targets.dsdl import dsdl_path
@@ -234,19 +235,42 @@ def write_atomically(files: dict[str, str], out_dir: Path) -> None:
 
 
 def build(spec_path: Path, out_dir: Path, *, check: bool = False,
-          report: Callable[[str], None] | None = None) -> Staleness:
+          report: Callable[[str], None] | None = None, say: Callable[[str], None] | None = None,
+          wait_timeout: float | None = None, cancelled: Callable[[], bool] | None = None) -> Staleness:
     """Generate from spec_path. With check, compare only; otherwise write when anything differs. ``report`` gets the
     bus budget's lines (see generate).
 
-    Raises OutDirError, before reading anything, for an out_dir that is or holds the spec (a rebuild replaces it).
+    The comparison and the write hold out_dir's lock (sam_codegen.project.lock): a second build of the same folder
+    started meanwhile waits (``say`` gets its waiting lines; ``wait_timeout``, ``cancelled``: see ProjectLock), then
+    compares again and finds it current. The generation itself, which reads only the spec, runs unlocked.
+
+    Raises OutDirError, before reading anything, for an out_dir that is or holds the spec (a rebuild replaces it);
+    OutputError when out_dir cannot be written or its lock not had.
     """
     out_dir = Path(out_dir).resolve()
     check_out_dir(Path(spec_path).resolve(), out_dir)
     files = generate(spec_path, report=report)  # as given: the spec's diagnostics name it the way the user did
     try:
-        stale = compare(files, out_dir)
-    except OSError as exc:
-        raise OutputError(f"cannot read {out_dir}: {exc}") from None
-    if stale and not check:
-        write_atomically(files, out_dir)
+        with optional_lock(_generated_lock(out_dir, check, say, wait_timeout, cancelled)):
+            try:
+                stale = compare(files, out_dir)
+            except OSError as exc:
+                raise OutputError(f"cannot read {out_dir}: {exc}") from None
+            if stale and not check:
+                write_atomically(files, out_dir)
+    except LockError as exc:
+        raise OutputError(str(exc)) from exc
     return stale
+
+
+def _generated_lock(out_dir: Path, check: bool, say: Callable[[str], None] | None, timeout: float | None,
+                    cancelled: Callable[[], bool] | None) -> ProjectLock | None:
+    """The lock of out_dir; None for a check where no lock file can be made at all (it only reads, and where
+    nothing can be written no build can be writing either)."""
+    try:
+        path = lock_path("generated", out_dir)
+    except LockError:
+        if check:
+            return None
+        raise
+    return ProjectLock(path, f"the generated folder {out_dir}", say=say, timeout=timeout, cancelled=cancelled)

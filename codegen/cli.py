@@ -44,6 +44,11 @@ def _print_budget(lines: list[str]) -> None:
             print(f"sam-codegen: {line}")
 
 
+def _say(line: str) -> None:
+    """A progress line (a step, a wait for another process), at once: a build can take minutes."""
+    print(f"sam-codegen: {line}", flush=True)
+
+
 def _cmd_build(args: argparse.Namespace) -> int:
     from sam_codegen.build import build
 
@@ -54,7 +59,8 @@ def _cmd_build(args: argparse.Namespace) -> int:
     out, spec = _shown(ws.generated, cwd), _shown(ws.spec, cwd)
     try:
         budget: list[str] = []
-        stale = build(ws.spec, ws.generated, check=args.check, report=budget.append)
+        stale = build(ws.spec, ws.generated, check=args.check, report=budget.append, say=_say,
+                      wait_timeout=args.wait_timeout)
     except SpecError as exc:
         for diagnostic in exc.diagnostics:
             print(diagnostic, file=sys.stderr)
@@ -95,7 +101,14 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _cmd_ros_install(args: argparse.Namespace) -> int:
-    from sam_codegen.project.ros_install import RosBuildError, build_ros_packages, ros_packages_in_order
+    from sam_codegen.project.lock import LockError
+    from sam_codegen.project.ros_install import (
+        RosBuildError,
+        build_ros_packages,
+        is_current,
+        ros_build_lock,
+        ros_packages_in_order,
+    )
 
     ws = _workspace(args, need_spec=False)
     ros_dir = ws.generated / "ros"
@@ -114,7 +127,24 @@ def _cmd_ros_install(args: argparse.Namespace) -> int:
     build_root = Path(args.build_dir).absolute() if args.build_dir else ensure_state_dir(ws) / "ros-build"
     names = ", ".join(p.name for p in packages)
     try:
-        build_ros_packages(packages, build_root, prefix, log=lambda line: print(f"sam-codegen: {line}", flush=True))
+        # Held from here to the install: a second ros-install or run of this project waits, then reuses the result.
+        with ros_build_lock(build_root, say=_say, timeout=args.wait_timeout) as lock:
+            todo = packages
+            if lock.contended:  # another process built meanwhile: what it installed from these sources is reused
+                todo = [p for p in packages if not is_current(p, prefix)]
+                reused = [p.name for p in packages if p not in todo]
+                if reused:
+                    holder = f" by pid {lock.held_by.pid}" if lock.held_by is not None else ""
+                    _say(f"{', '.join(reused)} installed into {prefix} meanwhile{holder}: reused")
+
+            def log(line: str) -> None:
+                _say(line)
+                lock.status(line)
+
+            build_ros_packages(todo, build_root, prefix, log=log)
+    except LockError as exc:
+        print(f"sam-codegen: {exc}", file=sys.stderr)
+        return 1
     except RosBuildError as exc:
         print(f"sam-codegen: building {exc.package or names} failed: {exc}", file=sys.stderr)
         return 1
@@ -150,6 +180,14 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+WAIT_TIMEOUT_HELP = ("when another sam-codegen process (build, ros-install, run) is writing {what} of this project, "
+                     "wait at most S seconds for it, then fail (default: as long as it runs; it says what it does)")
+
+
+def _wait_timeout_arg(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--wait-timeout", type=float, default=None, metavar="S", help=WAIT_TIMEOUT_HELP.format(what=what))
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -163,6 +201,7 @@ def make_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("build", help="validate the spec and generate generated/")
     common(p)
     p.add_argument("--check", action="store_true", help="fail and list the stale files instead of writing")
+    _wait_timeout_arg(p, "generated/")
     p.set_defaults(func=_cmd_build)
     p = sub.add_parser("validate", help="validate the spec only")
     common(p)
@@ -173,6 +212,7 @@ def make_parser() -> argparse.ArgumentParser:
     p.add_argument("--prefix", help="install prefix (default: this Python's environment)")
     p.add_argument("--build-dir", default=None,
                    help="parent of the CMake build folders (default: .sam-codegen-cache/ros-build in the project)")
+    _wait_timeout_arg(p, "the build folder")
     p.set_defaults(func=_cmd_ros_install)
     p = sub.add_parser("plot", help="draw a recorded run (an MCAP) as one PNG/SVG report: track, depth, altitude, "
                        "commands, battery, abort, node states")

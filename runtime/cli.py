@@ -405,8 +405,14 @@ def _run_parser() -> argparse.ArgumentParser:
     p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface of sim and bridge (default 127.0.0.1)")
     _add_layout_args(p)
     _add_wire_arg(p)
-    p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until Ctrl-C)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="stop S seconds after the vehicle is up (the sim, the bridge and the nodes READY; default: "
+                        "until Ctrl-C)")
     p.add_argument("--no-build", action="store_true", help="use generated/ as it is")
+    p.add_argument("--wait-timeout", type=float, default=None, metavar="S",
+                   help="when another sam-codegen process (run, build, ros-install) is building generated/ or the "
+                        "ROS packages of this project, wait at most S seconds for it, then fail (default: as long "
+                        "as it runs; this run then reuses what it built)")
     p.add_argument("--no-demo-commands", dest="demo_commands", action="store_false",
                    help="specs without node implementations: do not publish demo actuator commands (by default "
                         "slow sweeps move the actuators)")
@@ -465,7 +471,7 @@ def run_main(argv: Sequence[str] | None = None) -> int:
         window=args.window, plain=args.plain, log_dir=args.log_dir, ros_prefix=args.ros_prefix,
         argv=list(sys.argv[1:] if argv is None else argv), nodes=args.nodes, node_args=node_args,
         sim_args=sim_args, truth_file=args.truth_file, layout=args.layout, dronecan_iface=args.dronecan_iface,
-        wire=args.wire, record=args.record, namespace=namespace,
+        wire=args.wire, record=args.record, namespace=namespace, wait_timeout=args.wait_timeout,
     ))
 
 

@@ -19,12 +19,23 @@ from __future__ import annotations
 import hashlib
 import importlib
 import sys
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, cast
 
-from sam_codegen.project.ros_install import RosBuildError, build_ros_package, is_installed, ros_packages_in_order
+from sam_codegen.project.ros_install import (
+    RosBuildError,
+    build_ros_package,
+    is_current,
+    ros_build_lock,
+    ros_package_hash,
+    ros_packages_in_order,
+    same_interfaces,
+    stamp_install,
+)
 from sam_codegen.project.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
 from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
 
@@ -40,9 +51,6 @@ __all__ = [
     "ros_package_hash",
     "same_interfaces",
 ]
-
-_HASH_STAMP = ".sam_codegen_source_hash"
-
 
 class GeneratedPackageError(Exception):
     """The generated package is missing or incomplete; ``str()`` says what to run."""
@@ -212,37 +220,19 @@ class GeneratedPackage:
         return getattr(importlib.import_module(topic.ros_module), topic.ros_class)
 
 
-def ros_package_hash(package_dir: Path) -> str:
-    """Hash of every file of a ROS package source tree (to tell whether an install is current)."""
-    h = hashlib.sha256()
-    for p in sorted(Path(package_dir).rglob("*")):
-        if p.is_file():
-            h.update(p.relative_to(package_dir).as_posix().encode() + b"\0" + p.read_bytes() + b"\0")
-    return h.hexdigest()[:24]
-
-
-def same_interfaces(src: Path, installed: Path) -> bool:
-    """Whether an install (e.g. by ``sam-codegen ros-install``) holds exactly the source's interface files."""
-    def files(root: Path) -> dict[str, bytes]:
-        return {p.relative_to(root).as_posix(): p.read_bytes()
-                for sub in ("msg", "srv") for p in sorted((root / sub).glob("*.*")) if p.suffix in (".msg", ".srv")}
-
-    try:
-        mine = files(src)
-        return bool(mine) and mine == files(installed)
-    except OSError:
-        return False
-
-
 def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log: Any = None,
-                       build_root: Path | None = None) -> Path:
+                       build_root: Path | None = None, wait_timeout: float | None = None,
+                       cancelled: Callable[[], bool] | None = None) -> Path:
     """Build and install every ROS package under ``<generated>/ros`` (the spec's own and any other it generates, in
     dependency order) into ``prefix`` (default: ``sys.prefix``, the venv), each unless an install of the same sources
     is already there. Returns the prefix.
 
     The build folders are ``<build_root>/<package>-<hash>`` (default build_root: ``ros-build`` in the user's cache
     directory); an install is stamped with its sources' hash, so a changed spec triggers a rebuild and an unchanged
-    one costs a few ms.
+    one costs a few ms. A build holds the build root's lock (sam_codegen.project.ros_install.ros_build_lock) from
+    its check to its install: a second process meanwhile waits (``log`` gets its waiting lines; ``wait_timeout``
+    and ``cancelled``: see sam_codegen.project.lock.ProjectLock, whose LockError it raises), then finds the packages
+    current and reuses them.
     """
 
     prefix = Path(prefix if prefix is not None else sys.prefix).absolute()
@@ -253,21 +243,28 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
         packages = ros_packages_in_order(own.parent)
     except RosBuildError as ex:
         raise GeneratedPackageError(str(ex)) from None
+    stale = [p for p in packages if not is_current(p, prefix)]
+    if not stale:  # the usual case, without touching the lock
+        return prefix
     root = Path(build_root) if build_root is not None else user_cache_dir() / "ros-build"
-    for pkg_dir in packages:
-        name = pkg_dir.name
-        digest = ros_package_hash(pkg_dir)
-        stamp = prefix / "share" / name / _HASH_STAMP
-        if is_installed(name, prefix) and (
-            (stamp.is_file() and stamp.read_text().strip() == digest)
-            or same_interfaces(pkg_dir, prefix / "share" / name)
-        ):
-            continue
-        if log is not None:
-            log(f"building ROS package {name} into {prefix} (about 30 s)...")
-        # The source folder is part of the name: a CMake build folder belongs to one source folder.
-        where = hashlib.sha256(str(pkg_dir.resolve()).encode()).hexdigest()[:8]
-        build_ros_package(pkg_dir, root / f"{name}-{digest}-{where}", prefix)
-        stamp.parent.mkdir(parents=True, exist_ok=True)
-        stamp.write_text(digest + "\n")
+    with ros_build_lock(root, say=log, timeout=wait_timeout, cancelled=cancelled) as lock:
+        for pkg_dir in packages:  # again, under the lock: another process may have installed them meanwhile
+            name = pkg_dir.name
+            digest = ros_package_hash(pkg_dir)
+            if is_current(pkg_dir, prefix, digest):
+                if pkg_dir in stale and log is not None:
+                    holder = f" by pid {lock.held_by.pid}" if lock.held_by is not None else ""
+                    log(f"ROS package {name} was installed into {prefix} meanwhile{holder}: reused")
+                continue
+            if log is not None:
+                log(f"building ROS package {name} into {prefix} (about 30 s)...")
+            lock.status(f"building ROS package {name} into {prefix}")
+            # The source folder is part of the name: a CMake build folder belongs to one source folder.
+            where = hashlib.sha256(str(pkg_dir.resolve()).encode()).hexdigest()[:8]
+
+            def progress(step: str, name: str = name, started: float = time.monotonic()) -> None:
+                lock.status(f"building ROS package {name}: {step} ({time.monotonic() - started:.1f} s)")
+
+            build_ros_package(pkg_dir, root / f"{name}-{digest}-{where}", prefix, progress=progress)
+            stamp_install(pkg_dir, prefix, digest)
     return prefix

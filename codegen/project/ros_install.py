@@ -7,6 +7,7 @@ are passed explicitly (see shared/notes/ros2-jazzy-wheels.md).
 
 from __future__ import annotations
 
+import hashlib
 import os
 import re
 import shutil
@@ -17,15 +18,26 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
+from sam_codegen.project.lock import ProjectLock, lock_path
+
 __all__ = [
+    "HASH_STAMP",
     "RosBuildError",
     "build_ros_package",
     "build_ros_packages",
+    "is_current",
     "is_installed",
     "package_dependencies",
+    "ros_build_lock",
+    "ros_package_hash",
     "ros_packages_in_order",
     "ros_runtime_env",
+    "same_interfaces",
+    "stamp_install",
 ]
+
+# Written beside an installed package.xml: the hash of the sources it was built from (ros_package_hash).
+HASH_STAMP = ".sam_codegen_source_hash"
 
 # Lines of CMake output kept in an error: enough to include rosidl's message and CMake's call stack.
 _TAIL_LINES = 40
@@ -297,6 +309,7 @@ def build_ros_packages(
         except RosBuildError as exc:
             exc.package = name
             raise
+        stamp_install(package_dir, install_prefix)
         if log is not None:
             log(f"[{index}/{total}] {name}: installed in {clock() - started:.1f} s")
 
@@ -325,3 +338,57 @@ def ros_runtime_env(install_prefix: Path, base: Mapping[str, str] | None = None)
 def is_installed(package: str, prefix: Path) -> bool:
     """Whether an ament package is installed in ``prefix`` (its package.xml is where ament puts it)."""
     return (Path(prefix) / "share" / package / "package.xml").is_file()
+
+
+def ros_package_hash(package_dir: Path) -> str:
+    """Hash of every file of a ROS package source tree (to tell whether an install is current)."""
+    h = hashlib.sha256()
+    for p in sorted(Path(package_dir).rglob("*")):
+        if p.is_file():
+            h.update(p.relative_to(package_dir).as_posix().encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()[:24]
+
+
+def same_interfaces(src: Path, installed: Path) -> bool:
+    """Whether an install (e.g. by an older ``sam-codegen ros-install``) holds exactly the source's interface
+    files."""
+    def files(root: Path) -> dict[str, bytes]:
+        return {p.relative_to(root).as_posix(): p.read_bytes()
+                for sub in ("msg", "srv") for p in sorted((root / sub).glob("*.*")) if p.suffix in (".msg", ".srv")}
+
+    try:
+        mine = files(src)
+        return bool(mine) and mine == files(installed)
+    except OSError:
+        return False
+
+
+def is_current(package_dir: Path, prefix: Path, digest: str | None = None) -> bool:
+    """Whether the package in ``package_dir`` is installed in ``prefix`` from these very sources: its stamp holds
+    their hash (``digest``, computed when not given), or the install has exactly its interface files."""
+    name = Path(package_dir).name
+    if not is_installed(name, prefix):
+        return False
+    share = Path(prefix) / "share" / name
+    try:
+        stamped = (share / HASH_STAMP).read_text().strip()
+    except OSError:
+        stamped = ""
+    return stamped == (digest or ros_package_hash(package_dir)) or same_interfaces(package_dir, share)
+
+
+def ros_build_lock(build_root: Path, *, say: Callable[[str], None] | None = None, timeout: float | None = None,
+                   cancelled: Callable[[], bool] | None = None) -> ProjectLock:
+    """The lock of a ROS build folder (``build_root``, the parent of the packages' CMake folders) and of what is
+    built in it into an install prefix: held across the is-it-current check, the CMake steps and the install, so
+    that a second build meanwhile waits and then finds the packages current (see sam_codegen.project.lock)."""
+    build_root = Path(build_root).absolute()
+    return ProjectLock(lock_path("ros-build", build_root), f"the ROS build folder {build_root}", say=say,
+                       timeout=timeout, cancelled=cancelled)
+
+
+def stamp_install(package_dir: Path, prefix: Path, digest: str | None = None) -> None:
+    """Record beside the installed package.xml the hash of the sources just installed (see is_current)."""
+    stamp = Path(prefix) / "share" / Path(package_dir).name / HASH_STAMP
+    stamp.parent.mkdir(parents=True, exist_ok=True)
+    stamp.write_text((digest or ros_package_hash(package_dir)) + "\n")

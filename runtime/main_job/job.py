@@ -43,6 +43,7 @@ from typing import Any
 from sam_codegen.build import build
 from sam_codegen.model.diagnostics import SpecError
 from sam_codegen.project.cyphal_path import CyphalPathError
+from sam_codegen.project.lock import LockError, LockTimeout, ProjectLock, lock_path
 from sam_codegen.project.ros_install import RosBuildError, ros_runtime_env
 from sam_codegen.project.workspace import (
     GENERATED_ENV_VAR,
@@ -63,6 +64,9 @@ from sam_runtime.report.plot import limits_from_params, plot_run
 __all__ = ["LiveView", "RunOptions", "run", "summarize_message"]
 
 CHILD_STOP_TIMEOUT_S = 8.0
+# A vehicle whose processes have not all said READY by then is not coming up (a hung child): the run ends with
+# exit code 1 and their logs. Generous: on a loaded machine the node host's imports alone take seconds.
+VEHICLE_START_TIMEOUT_S = 300.0
 CHILD_KILL_TIMEOUT_S = 5.0
 # The signals that end the main job cleanly; SIGHUP is the terminal closing.
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -92,6 +96,7 @@ class RunOptions:
     wire: str = "codec"  # the bridges' path: the generated wire codecs, or "object" (the object converters)
     record: Path | None = None  # an MCAP file: the recorder (sam-codegen record) runs as one more child
     namespace: Any = None  # sam_runtime.common.ros_namespace.RosNamespace: the bridge's, the nodes' and the view's
+    wait_timeout: float | None = None  # for another process building generated/ or the ROS packages (None: no bound)
 
 
 # ============================================================================================ processes
@@ -104,6 +109,22 @@ class _Child:
         # however we end (even SIGKILL or a crash): they watch this pid (sam_runtime.cli_support.stay_with_parent).
         self.proc = subprocess.Popen(cmd, env={**env, PARENT_ENV_VAR: str(os.getpid())}, stdout=self._fh,
                                      stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
+        self._read = 0  # bytes of the log looked through for READY
+        self._ready = False
+
+    def ready(self) -> bool:
+        """Whether the child has said READY (every command of the runtime prints it, flushed, once it serves)."""
+        if not self._ready:
+            try:
+                with open(self.log, "rb") as fh:
+                    fh.seek(self._read)
+                    chunk = fh.read()
+            except OSError:
+                return False
+            whole = chunk[:chunk.rfind(b"\n") + 1]  # a line still being written is read again next time
+            self._read += len(whole)
+            self._ready = any(line.startswith(b"READY") for line in whole.splitlines())
+        return self._ready
 
     def alive(self) -> bool:
         return self.proc.poll() is None
@@ -165,8 +186,31 @@ def _workspace(opts: RunOptions) -> Any:
     return workspace_for(None, generated or find_generated(), need_spec=False)
 
 
-def _build(spec: Path, gen_dir: Path, say: Any) -> None:
-    stale = build(spec, gen_dir, check=False)
+def claim_log_dir(opts: RunOptions, state: Path, say: Any) -> tuple[Path, ProjectLock | None]:
+    """The children's log folder (with the truth file): ``--log-dir``, else the project's ``run-logs``, held by this
+    run (a lock) until it ends. A second run of the project at the same time gets ``run-logs-2`` (and so on)
+    instead of overwriting the first one's logs, which the first one is reading."""
+    if opts.log_dir is not None:
+        return opts.log_dir.resolve(), None
+    base = (state / "run-logs").resolve()
+    for n in range(1, 100):
+        folder = base if n == 1 else base.with_name(f"{base.name}-{n}")
+        lock = ProjectLock(lock_path("run-logs", folder), f"the log folder {folder}", timeout=0.0)
+        try:
+            lock.__enter__()
+        except LockTimeout:  # another run writes there
+            continue
+        except LockError:  # no lock files at all: as before, the one folder
+            break
+        if n > 1:
+            say(f"sam-run: {base} is another run's; this run's logs go to {folder}")
+        return folder, lock
+    return base, None
+
+
+def _build(spec: Path, gen_dir: Path, say: Any, opts: RunOptions, cancelled: Any) -> None:
+    stale = build(spec, gen_dir, check=False, say=lambda line: say(f"sam-run: {line}"), wait_timeout=opts.wait_timeout,
+                  cancelled=cancelled)
     say(f"generated {gen_dir} from {spec}: " + (f"{len(stale.lines())} file(s) updated" if stale else "up to date"))
 
 
@@ -184,22 +228,31 @@ class _Prepared:
     prefix: Path  # where the generated ROS package is installed
 
 
-def _prepare(opts: RunOptions, say: Any) -> _Prepared | int:
-    """Steps 1-3 of the run (build, ROS package, DSDL); an exit code where one fails (said, never raised)."""
+def _prepare(opts: RunOptions, say: Any, cancelled: Any) -> _Prepared | int:
+    """Steps 1-3 of the run (build, ROS package, DSDL); an exit code where one fails (said, never raised).
+
+    Steps 1 and 2 hold the project's locks (sam_codegen.project.lock) while they write: a second run started at once
+    waits for the first one's build, says for whom it waits, and then reuses what it built. A stop signal while
+    waiting (``cancelled``) ends the run quietly (exit 0)."""
     try:
         ws = _workspace(opts)
         gen_dir = ws.generated
         if opts.build:
-            _build(ws.spec, gen_dir, say)
+            _build(ws.spec, gen_dir, say, opts, cancelled)
         state = ensure_state_dir(ws)
         gen = GeneratedPackage(gen_dir, opts.package)
-        prefix = ensure_ros_package(gen, opts.ros_prefix, log=say, build_root=state / "ros-build")
+        prefix = ensure_ros_package(gen, opts.ros_prefix, log=lambda line: say(f"sam-run: {line}"),
+                                    build_root=state / "ros-build", wait_timeout=opts.wait_timeout,
+                                    cancelled=cancelled)
         importlib.invalidate_caches()  # a package installed just now into this venv
         gen.compile_dsdl()
     except SpecError as ex:
         say(f"sam-run: the spec is invalid:\n{ex}")
         return 1
-    except (WorkspaceError, CyphalPathError, GeneratedPackageError, DsdlCompileError) as ex:
+    except (WorkspaceError, CyphalPathError, GeneratedPackageError, DsdlCompileError, LockError) as ex:
+        if cancelled():  # stopped while waiting for another process: what was asked
+            say(f"sam-run: {ex}" if isinstance(ex, LockError) else "sam-run: stopped")
+            return 0
         say(f"sam-run: {ex}")
         return 1
     except RosBuildError as ex:
@@ -260,19 +313,43 @@ def _start_children(children: list[_Child], opts: RunOptions, gen_dir: Path, tab
                                log_dir / "nodes.log"))
 
 
+def _vehicle_up(children: list[_Child], launched: float, opts: RunOptions, say: Any) -> float | None:
+    """When every child has said READY: the moment the vehicle is up (now), said once; else None."""
+    if not all(c.ready() for c in children):
+        return None
+    now = time.monotonic()
+    say(f"sam-run: vehicle up {now - launched:.1f} s after launch ({', '.join(c.name for c in children)} READY)"
+        + ("" if opts.duration is None else f"; --duration {opts.duration:g} s counts from here"))
+    return now
+
+
 def _show_live(live: LiveView, children: list[_Child], tables: Any, opts: RunOptions, stop_reason: list[str],
-               say: Any) -> int:
-    """Step 5 until a stop reason comes (a signal handler, --duration, a child that died: exit code 1).
-    Returns the exit code."""
+               say: Any, launched: float) -> tuple[int, float | None]:
+    """Step 5 until a stop reason comes (a signal handler, --duration, a child that died or never came up: exit
+    code 1). Returns the exit code and how long the vehicle ran (None if it never came up). ``launched``: when
+    the first child was started (time.monotonic).
+
+    ``--duration`` counts from the moment the vehicle is up (every child READY), not from the launch: starting the
+    processes takes seconds, more on a loaded machine or beside another run's build."""
     exit_code = 0
     tty = sys.stdout.isatty() and not opts.plain
-    started = time.monotonic()
-    next_draw = started
+    up: float | None = None
+    next_draw = time.monotonic()
     refresh = opts.refresh_s if tty else 1.0
     while not stop_reason:
-        elapsed = time.monotonic() - started
-        if opts.duration is not None and elapsed >= opts.duration:
+        if up is None:
+            up = _vehicle_up(children, launched, opts, say)
+        elapsed = time.monotonic() - up if up is not None else 0.0
+        if up is not None and opts.duration is not None and elapsed >= opts.duration:
             stop_reason.append("duration")
+            break
+        late = [c for c in children if not c.ready()] if up is None else []
+        if late and time.monotonic() - launched >= VEHICLE_START_TIMEOUT_S:
+            for c in late:
+                say(f"sam-run: {c.name} is not READY {VEHICLE_START_TIMEOUT_S:.0f} s after launch; its log ({c.log}):"
+                    f"\n{c.tail()}")
+            exit_code = 1
+            stop_reason.append("vehicle not up")
             break
         dead = [c for c in children if not c.alive()]
         if dead:
@@ -284,7 +361,9 @@ def _show_live(live: LiveView, children: list[_Child], tables: Any, opts: RunOpt
         live.spin_for(max(0.0, min(next_draw - time.monotonic(), 0.1)))
         if time.monotonic() >= next_draw:
             next_draw += refresh
-            header = (f"{tables.VEHICLE} bridge run  t={elapsed:6.1f} s  "
+            clock = f"t={elapsed:6.1f} s" if up is not None else "starting: waiting for " + ", ".join(
+                c.name for c in late)
+            header = (f"{tables.VEHICLE} bridge run  {clock}  "
                       + "  ".join(f"{c.name} pid {c.proc.pid}" for c in children)
                       + ("" if opts.duration is None else f"  (stops at {opts.duration:.0f} s)")
                       + ("  Ctrl-C to stop" if tty else ""))
@@ -295,7 +374,7 @@ def _show_live(live: LiveView, children: list[_Child], tables: Any, opts: RunOpt
                 sys.stdout.flush()
             else:
                 say("\n".join(lines) + "\n")
-    return exit_code
+    return exit_code, None if up is None else time.monotonic() - up
 
 
 def _report_stopped(children: list[_Child], codes: Mapping[str, int | None], exit_code: int,
@@ -327,16 +406,17 @@ def run(opts: RunOptions) -> int:
     old_handlers = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
     children: list[_Child] = []
     live: LiveView | None = None
+    log_lock: ProjectLock | None = None
     exit_code = 0
     try:
-        prepared = _prepare(opts, say)
+        prepared = _prepare(opts, say, lambda: bool(stop_reason))
         if isinstance(prepared, int):
             return prepared
         gen_dir, gen = prepared.gen_dir, prepared.gen
         if stop_reason:
             return 0
         env = _children_env(opts, prepared.prefix, gen_dir, old_handlers)
-        log_dir = (opts.log_dir or prepared.state / "run-logs").resolve()
+        log_dir, log_lock = claim_log_dir(opts, prepared.state, say)
         tables = gen.tables()
         hosted = implemented(tables) if opts.nodes else []
         missing = unimplemented(tables)
@@ -344,19 +424,21 @@ def run(opts: RunOptions) -> int:
             say(f"no implementation for node(s) {', '.join(missing)} of the spec"
                 + (f"; hosting {', '.join(hosted)}" if hosted else "; demo commands move the actuators"))
         truth = (opts.truth_file or log_dir / "truth.json").resolve()
+        launched = time.monotonic()
         _start_children(children, opts, gen_dir, tables, hosted, env, log_dir, truth)
         live = LiveView(tables, gen, window=opts.window, demo_commands=opts.demo_commands, hosted=hosted,
                         truth_file=truth, namespace=opts.namespace)
-        started = time.monotonic()
-        exit_code = _show_live(live, children, tables, opts, stop_reason, say)
+        exit_code, ran = _show_live(live, children, tables, opts, stop_reason, say, launched)
         final = live.table(f"final ({stop_reason[0] if stop_reason else 'stopped'}) after "
-                           f"{time.monotonic() - started:.1f} s")
+                           + ("the vehicle never came up" if ran is None else f"{ran:.1f} s of the vehicle up"))
         say("\n".join(final))
     finally:
         # Our handlers stay in place until the children are stopped: a second Ctrl-C must not cut the stop short.
         codes = _stop_children(children)
         for s, h in old_handlers.items():
             signal.signal(s, h)
+        if log_lock is not None:
+            log_lock.release()
         if live is not None:
             with contextlib.suppress(Exception):  # the children are stopped already; nothing else depends on it
                 live.close()
