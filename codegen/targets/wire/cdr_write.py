@@ -95,6 +95,7 @@ __all__ = [
 # The frame prefix's length modulo 8: what the CDR padding after a frame id depends on.
 VARIANTS = 8
 _PADS = "pads"  # a _Run item: padding by variant
+_FRAME = "{}s"  # a _Run item: a frame id's CDR string, its length given when the struct is made
 
 
 # ---- writer --------------------------------------------------------------------------------------------------
@@ -116,9 +117,14 @@ class _Run:
         """Padding that depends on the frame prefix's length: `by_variant[len % 8]` bytes."""
         self.items.append((_PADS, None, by_variant))
 
+    def frame(self, name: str) -> None:
+        """A frame id's CDR string (the bound bytes constant `name`): its length is known once bound."""
+        self.items.append((_FRAME, name, NO_VALUE))
+
     @property
-    def varies(self) -> bool:
-        return any(code == _PADS for code, _, _ in self.items)
+    def bound(self) -> bool:
+        """Whether the struct depends on the frame prefix (a frame id in it, or padding after one)."""
+        return any(code in (_PADS, _FRAME) for code, _, _ in self.items)
 
     def packed(self, consts: Constants, variant: int = 0) -> tuple[str, list[str], bytes | None]:
         """(struct format, arguments, or the bytes when every value is a literal); consecutive literals are
@@ -189,14 +195,16 @@ class _Writer:
         run, self.run = self.run, _Run()
         if not run.items:
             return
-        if run.varies:  # padding after a frame id: the struct (or bytes) bind(frame_prefix) chooses
+        if run.bound:  # a frame id or padding after one: the struct (or bytes) bind(frame_prefix) makes
             variants = [run.packed(self.consts, v) for v in range(VARIANTS)]
             fmt, args, data = variants[0]
             assert all(a == args for _, a, _ in variants)
             if data is not None:
                 self.emit(self.consts.bound_data([d for _, _, d in variants if d is not None]))
             else:
-                self.emit(f"{self.consts.bound_struct([f for f, _, _ in variants])}.pack({', '.join(args)})")
+                frames = [expr for code, expr, _ in run.items if code == _FRAME and expr is not None]
+                name = self.consts.bound_struct([f for f, _, _ in variants], frames)
+                self.emit(f"{name}.pack({', '.join(args)})")
             return
         fmt, args, data = run.packed(self.consts)
         if data is not None:
@@ -285,9 +293,8 @@ class _Writer:
             self.advance(4 + len(data))
             return
         frame = self.consts.frame_of(expr)
-        if frame is not None:  # the frame prefix, then the spec's frame id: bytes bind(frame_prefix) computes
-            self.flush()
-            self.emit(self.consts.framed_string(frame))
+        if frame is not None:  # the frame prefix, then the spec's frame id: bytes bind(frame_prefix) computes,
+            self.run.frame(self.consts.framed_string(frame))  # packed with what is around it as one struct
             size = 4 + len(frame.encode()) + 1
             for variant, phase in enumerate(self.phases):
                 phase.advance(size + variant)

@@ -92,9 +92,14 @@ class Constants:
         """The CDR string (uint32 length with the NUL, the bytes, NUL) of the frame id `frame` after the prefix."""
         return self.named(repr(cdr_string(frame)), f"_cdr_string(frame_prefix + {frame!r})")
 
-    def bound_struct(self, fmts: list[str]) -> str:
-        """A struct whose format depends on the prefix's length: `fmts` by that length modulo 8."""
-        return self.named(f"_struct.Struct({fmts[0]!r})", f"_struct.Struct({tuple(fmts)!r}[shift])")
+    def bound_struct(self, fmts: list[str], frames: list[str]) -> str:
+        """A struct whose format depends on the prefix: `fmts` by its length modulo 8 (the padding), each ``{}``
+        in them the length of a frame id's CDR string, the bytes constants `frames` (framed_string) in order."""
+        lengths = [len(ast.literal_eval(self._exprs[name])) for name in frames]
+        fmt = fmts[0] if len(set(fmts)) == 1 else f"{tuple(fmts)!r}[shift]"
+        return self.named(f"_struct.Struct({fmts[0].format(*lengths)!r})",
+                          f"_struct.Struct({fmt if fmt != fmts[0] else repr(fmt)}.format("
+                          f"{', '.join(f'len({name})' for name in frames)}))")
 
     def bound_data(self, values: list[bytes]) -> str:
         """Bytes that depend on the prefix's length: `values` by that length modulo 8."""
