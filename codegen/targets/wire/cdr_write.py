@@ -27,7 +27,10 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
   string leaves only; cdr_reader reads a sequence of messages wanted at its own path into the same records).
   A leaf without a value gets the field's default, as the ROS message class has it (``ros_default``).
   Literal expressions (``py_literal``: numbers, strings, True/False, ``_NAN``, ``_INF``) are packed at generation
-  time.
+  time. A frame id (``consts.frame_id(frame)``: the spec's, after the run's frame prefix) is the CDR string the
+  module's ``bind(frame_prefix)`` makes, packed in the struct around it; that struct's format (its length) and the
+  padding after it, which depends on the prefix's length modulo 8, are made by ``bind`` too: per message the code
+  is the same as for a literal.
 - ``cdr_reader(message, wanted, lookup, names, consts, buf)`` -> ``(lines, locals)``: statements that check the CDR
   in ``buf`` (bytes or memoryview, header included) and decode the leaves in ``wanted`` into locals: numbers,
   bools, 1-byte ``bytes`` for a ``byte`` scalar, ``str`` for strings, lists for whole arrays (``byte`` arrays as
