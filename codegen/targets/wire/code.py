@@ -41,7 +41,7 @@ class Constants:
     >>> c.bound_data([b"a", b"b"] * 4), c.lines()[-1], c.bind_lines()[-1]
     ('_C2', "_C2 = b'a'", "    _C2 = (b'a', b'b', b'a', b'b', b'a', b'b', b'a', b'b')[shift]")
     >>> s = c.bound_struct(["<d{}s"] * 8, [c.framed_string("odom")])
-    >>> print(*c.lines()[-1:], *c.bind_lines()[-2:], sep="\n")
+    >>> print(*c.lines()[-1:], *c.bind_lines()[-2:], sep="\\n")
     _C4 = _struct.Struct('<d9s')
         _C3 = _cdr_string(frame_prefix + 'odom')
         _C4 = _struct.Struct('<d{}s'.format(len(_C3)))
