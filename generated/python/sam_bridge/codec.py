@@ -139,7 +139,7 @@ _W63 = _struct.Struct('<IHBeHB')
 _W64 = _struct.Struct('<4siI14s2xfI')
 _W65 = _struct.Struct('<fI')
 
-# ---- the frame prefix: the frame ids, and what the CDR alignment after them depends on ------------------------
+# ---- the frame prefix: the frame ids, and what the CDR alignment after them depends on ---------------------
 
 FRAME_PREFIX = ""  # written before every frame id: bind(frame_prefix)
 

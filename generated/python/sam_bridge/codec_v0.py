@@ -119,7 +119,7 @@ _K66 = _struct.Struct('<4siI14s2xfI')
 _K67 = _struct.Struct('<fI')
 _K68 = _struct.Struct('<7sH3s')
 
-# ---- the frame prefix: the frame ids, and what the CDR alignment after them depends on ------------------------
+# ---- the frame prefix: the frame ids, and what the CDR alignment after them depends on ---------------------
 
 FRAME_PREFIX = ""  # written before every frame id: bind(frame_prefix)
 
