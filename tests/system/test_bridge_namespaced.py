@@ -48,7 +48,7 @@ def run(request: pytest.FixtureRequest) -> dict[str, Any]:
     gen = generated_or_skip()
     iface = private_iface()
     with pytest.MonkeyPatch.context() as mp:  # a private ROS domain: no other ROS graph on this machine joins in
-        mp.setenv("ROS_DOMAIN_ID", domain_id(47))
+        mp.setenv("ROS_DOMAIN_ID", domain_id(25))
         return asyncio.run(_scenario(gen, iface, request.param))
 
 
