@@ -367,6 +367,66 @@ def run(gen: Any, *, rounds: int = 15, batch_s: float = 0.005,
     }
 
 
+def run_namespaced(gen: Any, *, prefix: str = "sam1/", rounds: int = 15, batch_s: float = 0.005,
+                   protocols: tuple[str, ...] = ("cyphal", "dronecan")) -> dict[str, Any]:
+    """The namespaced variant (issue 26): a run with a frame prefix (``--namespace /sam1``) stays on the codec path,
+    the codec module bound to the prefix at start (sam_runtime.genpkg.bound_codec), against the object pipeline with
+    the prefix (the path a namespaced bridge took before: the frame id prefixed after ``<m>_to_ros``, as
+    runtime/bridge/inbound.py does) and the unbound codec; the UAVCAN->ROS mappings whose message has a header (where
+    the prefix is written). Checked first: the bound codec's CDR decodes to the object pipeline's message."""
+    from rclpy.serialization import deserialize_message, serialize_message
+
+    rows: list[dict[str, Any]] = []
+    for proto in protocols:
+        codec, bound = gen.codec(proto), gen.codec(proto, prefix)
+        if codec is None or bound is None:
+            log(f"codec (namespaced): the generated package has no {proto} codecs that take a frame prefix: skipped")
+            continue
+        side = CyphalSide(gen) if proto == "cyphal" else DroneCanSide(gen)
+        for m in side.mappings:
+            ros_cls = gen.ros_class(m.topic)
+            if m.direction != "uavcan_to_ros" or m.name not in bound.CODECS or not hasattr(ros_cls(), "header"):
+                continue
+            to_ros, decode = side.convert.CONVERTERS[m.name][0], side.decoder(m)
+
+            def object_to_ros(payload: Any, receive_ns: int, stats: Any, to_ros: Any = to_ros,
+                              decode: Any = decode) -> Any:
+                msg = to_ros(decode(payload), receive_ns, stats)
+                if msg is None:
+                    return None
+                if msg.header.frame_id:
+                    msg.header.frame_id = prefix + msg.header.frame_id
+                return serialize_message(msg)
+
+            args = (side.encoder(m)(side.sample(m)), RECEIVE_NS, side.convert.ConversionStats())
+            ref, out = object_to_ros(*args), bound.CODECS[m.name][0](*args)
+            agree = (ref is None) == (out is None) and (ref is None or same(
+                plain(deserialize_message(bytes(out[0]), ros_cls)), plain(deserialize_message(ref, ros_cls)), 0.0))
+            if not agree:
+                log(f"  codec {proto} {m.name} with prefix {prefix!r}: DISAGREES with the object pipeline")
+            vs_object = time_pair({"codec": (bound.CODECS[m.name][0], args), "object": (object_to_ros, args)},
+                                  rounds, batch_s)
+            vs_unbound = time_pair({"codec": (bound.CODECS[m.name][0], args),
+                                    "object": (codec.CODECS[m.name][0], args)}, rounds, batch_s)
+            # each ratio from its own interleaved pair (the same number of rounds on both sides)
+            ns = {"codec": min(vs_unbound["codec"]), "object": min(vs_object["object"]),
+                  "codec_no_prefix": min(vs_unbound["object"])}
+            rows.append({"protocol": proto, "mapping": m.name, "agree": agree,
+                         "ns_per_msg": {k: round(v, 1) for k, v in ns.items()},
+                         "per_s": {k: round(1e9 / v) for k, v in ns.items()},
+                         "ratio": round(ratio(min(vs_object["object"]), min(vs_object["codec"])), 2),
+                         "vs_no_prefix": round(ratio(ns["codec_no_prefix"], ns["codec"]), 3)})
+    summary = {}
+    for proto in sorted({r["protocol"] for r in rows}):
+        sel = [r for r in rows if r["protocol"] == proto]
+        summary[proto] = {"mappings": len(sel), "agree": sum(r["agree"] for r in sel),
+                          "geomean": round(geomean([r["ratio"] for r in sel]), 2), "min": min(r["ratio"] for r in sel),
+                          "vs_no_prefix": round(geomean([r["vs_no_prefix"] for r in sel]), 3),
+                          "per_s": {k: round(geomean([r["per_s"][k] for r in sel]))
+                                    for k in ("codec", "object", "codec_no_prefix")}}
+    return {"prefix": prefix, "rows": rows, "summary": summary}
+
+
 if __name__ == "__main__":
     import json
     import sys
@@ -383,3 +443,5 @@ if __name__ == "__main__":
               f"  object {r['ns_per_msg']['object']:>9,.0f} ns  x{r['ratio']:.2f}  agree {r['agree']}"
               f"  bytes identical {r['bytes_identical']}")
     print(json.dumps(res["summary"], indent=1))
+    print(json.dumps(run_namespaced(generated_package(), rounds=5 if "quick" in sys.argv[1:] else 15)["summary"],
+                     indent=1))

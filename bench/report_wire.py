@@ -72,7 +72,20 @@ def codec_rows(c: dict[str, Any] | None) -> list[list[str]]:
                      f"geomean {s['geomean']:.2f}x, min {s['min']:.2f}x", REFERENCE[proto],
                      f"{s['meet_target']}/{s['codecs']} at >= {t:g}x", f">= {t:g}x",
                      ok(s["meet_target"] == s["codecs"] and s["agree"] == s["codecs"] and not s["missing"])])
-    return rows
+    return rows + namespaced_rows(c.get("namespaced"))
+
+
+def namespaced_rows(n: dict[str, Any] | None) -> list[list[str]]:
+    """Summary rows of the codecs bound to a frame prefix (a namespaced run, issue 26) against the object pipeline
+    with the prefix: conversions per second, UAVCAN->ROS mappings with a header."""
+    if not n:
+        return []
+    return [[f"Wire codecs with frame prefix {n['prefix']!r} (namespaced run) vs object pipeline with it, {label} "
+             f"UAVCAN->ROS ({s['mappings']} mappings with a header; {s['agree']}/{s['mappings']} give the same values)",
+             f"{num(s['per_s']['codec'])} conversions/s (geomean; no prefix {num(s['per_s']['codec_no_prefix'])})",
+             f"{num(s['per_s']['object'])} conversions/s", f"geomean {s['geomean']:.2f}x, min {s['min']:.2f}x",
+             "codec path", ok(s["agree"] == s["mappings"])]
+            for proto, label in (("cyphal", "Cyphal"), ("dronecan", "DroneCAN")) if (s := n["summary"].get(proto))]
 
 
 # ----------------------------------------------------------------------------------------------- sections
@@ -123,6 +136,17 @@ def codec_markdown(c: dict[str, Any], section: str) -> list[str]:
     lines.append(table(["codecs", "n", "geomean object / codec", "min", "max", f">= {c['target']:g}x", "agree"],
                        [[k, str(v["codecs"]), f"{v['geomean']:.2f}", f"{v['min']:.2f}", f"{v['max']:.2f}",
                          f"{v['meet_target']}/{v['codecs']}", f"{v['agree']}/{v['codecs']}"] for k, v in s.items()]))
+    n = c.get("namespaced")
+    if n and n["rows"]:
+        lines += ["", f"A namespaced run (frame prefix {n['prefix']!r}, issue 26) stays on the codec path: the codec "
+                  "module bound to the prefix at start, against the object pipeline with the prefix (its frame id "
+                  "prefixed after `<m>_to_ros`, the path such a run took before) and the codec without a prefix; "
+                  "UAVCAN->ROS mappings with a header, conversions per second (best round).", "",
+                  table(["protocol", "mapping", "codec with prefix /s", "object with prefix /s", "codec no prefix /s",
+                         "object / codec", "agree"],
+                        [[r["protocol"], r["mapping"], num(r["per_s"]["codec"]), num(r["per_s"]["object"]),
+                          num(r["per_s"]["codec_no_prefix"]), f"{r['ratio']:.2f}", "yes" if r["agree"] else "**no**"]
+                         for r in n["rows"]])]
     return lines
 
 

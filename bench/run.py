@@ -406,6 +406,7 @@ def main(argv: list[str] | None = None) -> int:
 
         log("part 3: wire codecs")
         res["codec"] = codec.run(gen, rounds=5 if args.quick else 15, batch_s=0.005)
+        res["codec"]["namespaced"] = codec.run_namespaced(gen, rounds=5 if args.quick else 15, batch_s=0.005)
     if "bridge" in parts:
         from bench import bridge
 

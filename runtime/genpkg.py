@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib
+import importlib.util
 import sys
 import time
 from collections.abc import Callable
@@ -46,6 +47,7 @@ __all__ = [
     "GENERATED_ENV_VAR",
     "GeneratedPackage",
     "GeneratedPackageError",
+    "bound_codec",
     "default_generated_dir",
     "ensure_ros_package",
     "ros_package_hash",
@@ -97,7 +99,7 @@ class GeneratedPackage:
         self._tables: TablesModule | None = None
         self._convert: ModuleType | None = None
         self._convert_v0: ModuleType | None = None
-        self._codecs: dict[str, ModuleType | None] = {}
+        self._codecs: dict[tuple[str, str], ModuleType | None] = {}  # (module, frame prefix) -> module
 
     # -------------------------------------------------------------------- locations
     @property
@@ -195,18 +197,22 @@ class GeneratedPackage:
                 return None
             raise
 
-    def codec(self, protocol: str = "cyphal") -> ModuleType | None:
+    def codec(self, protocol: str = "cyphal", frame_prefix: str = "") -> ModuleType | None:
         """The generated wire codecs of ``protocol``: ``<pkg>.codec`` (Cyphal) or ``<pkg>.codec_v0`` (DroneCAN),
-        standard library only; None when the package has none (built by an older sam-codegen)."""
+        standard library only, writing ``frame_prefix`` before every frame id (see :func:`bound_codec`); None
+        when the package has none, or none that takes a frame prefix (built by an older sam-codegen)."""
         sub = "codec_v0" if protocol == "dronecan" else "codec"
-        if sub not in self._codecs:
+        if (sub, "") not in self._codecs:
             try:
-                self._codecs[sub] = self._import(sub)
+                self._codecs[sub, ""] = self._import(sub)
             except ModuleNotFoundError as ex:
                 if not ex.name or ex.name.split(".")[-1] != sub:
                     raise
-                self._codecs[sub] = None
-        return self._codecs[sub]
+                self._codecs[sub, ""] = None
+        if (sub, frame_prefix) not in self._codecs:
+            module = self._codecs[sub, ""]
+            self._codecs[sub, frame_prefix] = None if module is None else bound_codec(module, frame_prefix)
+        return self._codecs[sub, frame_prefix]
 
     # -------------------------------------------------------------------- types
     @staticmethod
@@ -218,6 +224,23 @@ class GeneratedPackage:
     def ros_class(topic: Any) -> type:
         """The ROS message class of a TopicInfo (``topic.ros_module``/``topic.ros_class``)."""
         return getattr(importlib.import_module(topic.ros_module), topic.ros_class)
+
+
+def bound_codec(module: ModuleType, frame_prefix: str) -> ModuleType | None:
+    """A generated codec module that writes ``frame_prefix`` before every frame id: `module` itself for none, else a
+    copy of it (its own module object, not in sys.modules) bound to the prefix. The codecs read the constants that
+    depend on the prefix (the frame ids' CDR strings, the structs whose padding follows them) as module globals,
+    which ``bind`` sets once: per message this costs nothing, and runs with other prefixes in the same process (two
+    vehicles) each have their copy. None when `module` predates ``bind`` (an older generated package)."""
+    if not frame_prefix:
+        return module
+    spec = module.__spec__
+    if not callable(getattr(module, "bind", None)) or spec is None or spec.loader is None:
+        return None
+    copy = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(copy)
+    copy.bind(frame_prefix)
+    return copy
 
 
 def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log: Any = None,

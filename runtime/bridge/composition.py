@@ -80,8 +80,8 @@ class Bridge:
         readable reference; also taken, with a warning, when the generated package has no codecs).
     :param namespace: the vehicle's namespace and frame prefix (sam_runtime.common.ros_namespace): the ROS nodes
         are created in it, so the spec's relative topics resolve there; the frame prefix goes before every
-        frame_id the bridge writes and the namespace before its diagnostic statuses' names. A non-empty frame
-        prefix takes the object path: the wire codecs carry the spec's frame ids in their constant bytes.
+        frame_id the bridge writes and the namespace before its diagnostic statuses' names. The wire codecs take
+        it at start (a copy of the codec module bound to it: sam_runtime.genpkg.bound_codec).
     :param time_sync: be the bus's time-sync master (:mod:`.time_sync`): True/False override the spec's
         ``bridge.time_sync`` (None: the spec's; on by default).
     """
@@ -111,10 +111,6 @@ class Bridge:
         if wire not in WIRE_PATHS:
             raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
         self.namespace = namespace or RosNamespace()
-        if self.namespace.frame_prefix and wire == "codec":
-            log.info("frame prefix %r: the object path (the wire codecs hold the spec's frame ids)",
-                     self.namespace.frame_prefix)
-            wire = "object"
         self.wire = wire
         self.gen = gen
         self.tables = tables = gen.tables()
@@ -200,7 +196,7 @@ class Bridge:
         selected mapping; else None (the object path)."""
         if self.wire != "codec":
             return None
-        codec = self.gen.codec(self.selection.protocol)
+        codec = self.gen.codec(self.selection.protocol, self.namespace.frame_prefix)
         missing = missing_codecs(codec, self.selection.mappings)
         if missing:
             log.warning("%s: the generated package has no wire codecs for %s: using the object converters",

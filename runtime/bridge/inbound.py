@@ -105,6 +105,7 @@ class Inbound:
         self._ros, self._backend = ros, backend
         self.groups = {g.port_id: g for g in groups}
         self.frame_prefix = ""  # before every frame id written (sam_runtime.common.ros_namespace); object path only
+        # (the wire codecs write it themselves: the bridge takes a codec module bound to it)
         for g in groups:
             g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
             g.any_source = any(getattr(im.info, "any_node", False) for im in g.mappings)

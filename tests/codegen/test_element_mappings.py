@@ -340,6 +340,9 @@ if CYPHAL_WORKER:
     barge_codec = importlib.import_module("barge_bridge.codec")
     import barge.cargo
     from barge_msgs.msg import HoldState, TagMsg
+    from helpers.codec_support import FRAME_PREFIXES, with_frame_prefix
+
+    from sam_runtime.genpkg import bound_codec
 
     C_SETTINGS = settings(max_examples=int(os.environ.get("SAM_CONVERTERS_EXAMPLES", "60")), deadline=None,
                           database=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -367,6 +370,12 @@ if CYPHAL_WORKER:
         cdr, stamp = barge_codec.CODECS["hold_state"][0](payload, C_RECEIVE_NS, codec_stats)
         assert deserialize_message(cdr, HoldState) == ros and stamp == usec * 1000
         assert not codec_stats.saturated and not codec_stats.rejected and not stats.saturated
+        for prefix in FRAME_PREFIXES:  # a namespaced run's codec: the prefix before the frame id, the rest alike
+            cdr, stamp = bound_codec(barge_codec, prefix).CODECS["hold_state"][0](
+                payload, C_RECEIVE_NS, barge_convert.ConversionStats())
+            want = with_frame_prefix(deserialize_message(serialize_message(ros), HoldState), prefix)
+            assert deserialize_message(cdr, HoldState) == want and stamp == usec * 1000
+            assert want.header.frame_id == f"{prefix}hold_link"
 
     @C_SETTINGS
     @given(tags=st.lists(st.tuples(st.integers(0, 2**32 - 1), st.booleans()), max_size=6))
@@ -408,7 +417,12 @@ if WORKER:
     strict = importlib.util.module_from_spec(_strict_spec)
     sys.modules["power_bridge.convert_v0_strict"] = strict
     _strict_spec.loader.exec_module(strict)
+    from helpers.codec_support import FRAME_PREFIXES, with_frame_prefix
     from power_msgs.msg import Command, Commands
+
+    from sam_runtime.genpkg import bound_codec
+
+    codec_v0 = importlib.import_module("power_bridge.codec_v0")
 
     SETTINGS = settings(max_examples=int(os.environ.get("SAM_CONVERTERS_EXAMPLES", "60")), deadline=None,
                         database=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -452,6 +466,16 @@ if WORKER:
             assert element.header == ros.header  # the message's stamp and frame id
         assert ros.header.frame_id == "base_link"
         assert not stats.rejected and not stats.saturated
+        payload = bytes(Transfer(payload=msg).payload)
+        for prefix in FRAME_PREFIXES:  # a namespaced run's codec: the prefix before every element's frame id too
+            out = bound_codec(codec_v0, prefix).CODECS["charges"][0](payload, RECEIVE_NS, convert.ConversionStats())
+            assert out is not None
+            got = deserialize_message(out[0], type(ros))
+            want = with_frame_prefix(deserialize_message(serialize_message(ros), type(ros)), prefix)
+            assert [e.header.frame_id for e in want.charges] == [f"{prefix}base_link"] * len(items)
+            assert got.header == want.header and len(got.charges) == len(want.charges)
+            for a, b in zip(got.charges, want.charges, strict=True):
+                assert (a.header, a.circuit_id) == (b.header, b.circuit_id) and same(a.charge, b.charge)
         back = convert.charges_to_uavcan(ros, stats)  # and back: the same payload
         assert back is not None
         if usec != 0 and usec * 1000 == expected_ns:  # a stamp Time holds: the same payload

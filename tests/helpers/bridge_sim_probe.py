@@ -22,12 +22,13 @@ from helpers.runtime_support import Proc, poll_until, read_json, runtime_cmd
 @contextmanager
 def bridge_sim_probe(d: Path, env: dict[str, str], generated: Path, bus: Sequence[str], protocol: str,
                      devices: str, topics: Sequence[str], record: Path,
-                     heard: Callable[[dict[str, int]], bool], what: str) -> Iterator[None]:
+                     heard: Callable[[dict[str, int]], bool], what: str,
+                     bridge_args: Sequence[str] = ()) -> Iterator[None]:
     """`bus` the transport arguments both the bridge and the simulator take; `topics` what the probe listens to
     (recorded in `record`); `heard` when the probe's message counts show the devices are heard (`what` names
-    it)."""
+    it); `bridge_args` more arguments of the bridge (``--namespace /sam1``)."""
     bridge = Proc("bridge", runtime_cmd("bridge", *bus, "--protocol", protocol, "--stats-file",
-                                        str(d / "bridge.json")), env, d)
+                                        str(d / "bridge.json"), *bridge_args), env, d)
     sim = Proc("sim", runtime_cmd("sim", *bus, "--devices", devices, "--report", str(d / "sim.json"),
                                   "--record", str(d / "sim.jsonl")), env, d)
     listen = Proc("listen", listen_cmd(generated, topics, d / "listen.json", record), env, d)

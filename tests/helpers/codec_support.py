@@ -49,6 +49,25 @@ def _plain(value: Any) -> Any:
     return value
 
 
+# Frame prefixes of every length modulo 8 (2 to 9 characters): the CDR padding after a frame id depends on it.
+FRAME_PREFIXES = ("v/", "v1/", "v12/", "v123/", "sam1/x/", "v12345/", "v123456/", "sam_two/")
+
+
+def with_frame_prefix(msg: Any, prefix: str) -> Any:
+    """`msg` (a ROS message; changed in place and returned) with `prefix` before the frame id of every
+    std_msgs/Header in it, a sequence's elements' included, that has one: what a namespaced bridge writes."""
+    if type(msg).__name__ == "Header" and type(msg).__module__.startswith("std_msgs"):
+        if msg.frame_id:
+            msg.frame_id = prefix + msg.frame_id
+        return msg
+    for name in msg.get_fields_and_field_types():
+        value = getattr(msg, name)
+        for item in value if isinstance(value, list) else [value]:
+            if hasattr(item, "get_fields_and_field_types"):
+                with_frame_prefix(item, prefix)
+    return msg
+
+
 def ros_plain(msg: Any) -> Any:
     """A ROS message as nested dicts and lists of plain values."""
     if hasattr(msg, "get_fields_and_field_types"):

@@ -29,12 +29,13 @@ if WORKER:
     from hypothesis import strategies as st
     from rclpy.serialization import deserialize_message, serialize_message
 
+    from helpers.codec_support import FRAME_PREFIXES, with_frame_prefix
     from sam_codegen.frontend.loader import load_spec_file
     from sam_codegen.model.spec import RosMessage
     from sam_codegen.model.types import ROS_INT_RANGES, RosType
     from sam_codegen.validate.mapping_rules import Key, ResolvedMapping
     from sam_codegen.validate.resolve import Resolved, validate
-    from sam_runtime.genpkg import GeneratedPackage
+    from sam_runtime.genpkg import GeneratedPackage, bound_codec
 
     CONFIG = json.loads(WORKER)
     RESOLVED: Resolved = validate(load_spec_file(Path(CONFIG["spec"])))
@@ -43,6 +44,7 @@ if WORKER:
     convert = GEN.convert_v0()  # the spec's own v0 types added beside dronecan's (ensure_types), never reloaded
     codec = GEN.codec("dronecan")
     assert codec is not None
+    BOUND = {p: bound_codec(codec, p) for p in FRAME_PREFIXES}  # as a namespaced bridge takes it
     MAPPINGS: dict[str, ResolvedMapping] = {rm.mapping.name: rm for rm in RESOLVED.dronecan_mappings}
     SETTINGS = settings(max_examples=int(os.environ.get("SAM_CODEC_EXAMPLES", "80")), deadline=None, database=None,
                         suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -333,6 +335,46 @@ if WORKER:
         obj = convert.CONVERTERS[name][1](msg, convert.ConversionStats())
         assert out == (None if obj is None else bytes(transport.Transfer(payload=obj).payload))
 
+
+    @pytest.mark.parametrize("name", sorted(MAPPINGS))
+    @SETTINGS
+    @given(data=st.data())
+    def test_frame_prefixes_of_every_length(name: str, data: st.DataObject) -> None:
+        """A namespaced run's codecs, bound to a frame prefix of each length modulo 8 (the padding after a frame id
+        depends on it): UAVCAN -> ROS, the object path's message with the prefix before its frame ids (element
+        headers' too), its stamp, the same counts, WireError where the object path refuses; ROS -> UAVCAN, the
+        unbound codec's payload (no frame id is read)."""
+        rm = MAPPINGS[name]
+        to_ros = convert.CONVERTERS[name][0]
+        payload = data.draw(payloads(rm), label="payload")
+        cdr_in = data.draw(cdrs(rm), label="cdr")
+        for prefix in FRAME_PREFIXES:
+            bound = BOUND[prefix]
+            assert bound.CODECS[name][1](cdr_in, convert.ConversionStats()) == \
+                codec.CODECS[name][1](cdr_in, convert.ConversionStats())
+            wire_to_ros = bound.CODECS[name][0]
+            expected, actual = convert.ConversionStats(), convert.ConversionStats()
+            try:
+                obj = dronecan_decode(rm, payload)
+                msg = to_ros(obj, RECEIVE_NS, expected)
+                cdr = serialize_message(msg) if msg is not None else None
+            except Exception:  # dronecan refuses it, or rclpy its values (an array beyond its ROS bound)
+                with pytest.raises(codec.WireError):
+                    wire_to_ros(payload, RECEIVE_NS, actual)
+                continue
+            out = wire_to_ros(payload, RECEIVE_NS, actual)
+            assert counts(actual) == counts(expected)
+            if msg is None:
+                assert out is None
+                continue
+            assert out is not None and cdr is not None
+            ours, stamp = out
+            assert stamp == stamp_of(msg)
+            cls = type(msg)
+            want = with_frame_prefix(deserialize_message(cdr, cls), prefix)
+            assert same(deserialize_message(ours, cls), want), (prefix, ours.hex(), cdr.hex())
+            if msg is not None and getattr(msg, "header", None) is not None and msg.header.frame_id:
+                assert deserialize_message(ours, cls).header.frame_id.startswith(prefix)
 
     def test_every_mapping_has_both_codecs() -> None:
         assert list(codec.CODECS) == list(MAPPINGS) == list(convert.CONVERTERS)

@@ -24,6 +24,7 @@ if WORKER:
     from rclpy.serialization import deserialize_message, serialize_message
 
     from helpers.codec_support import (
+        FRAME_PREFIXES,
         bad_lengths,
         corruptions,
         dsdl_plain,
@@ -31,6 +32,7 @@ if WORKER:
         ros_plain,
         ros_strategy,
         same,
+        with_frame_prefix,
     )
     from sam_codegen.frontend.loader import load_spec_file
     from sam_codegen.model.spec import DsdlStruct
@@ -39,6 +41,7 @@ if WORKER:
     from sam_codegen.targets.wire.cdr_write import Constants, cdr_reader, cdr_writer
     from sam_codegen.validate.mapping_rules import ResolvedMapping
     from sam_codegen.validate.resolve import validate
+    from sam_runtime.genpkg import bound_codec
 
     CONFIG = json.loads(WORKER)
     RESOLVED = validate(load_spec_file(Path(CONFIG["spec"])))
@@ -46,6 +49,7 @@ if WORKER:
     sys.path.insert(0, CONFIG["python"])
     convert = importlib.import_module(f"{CONFIG['package']}.convert")
     codec = importlib.import_module(f"{CONFIG['package']}.codec")
+    BOUND = {"": codec, **{p: bound_codec(codec, p) for p in FRAME_PREFIXES}}  # as a namespaced bridge takes it
     MAPPINGS: dict[str, ResolvedMapping] = {rm.mapping.name: rm for rm in RESOLVED.mappings}
     EXAMPLES = int(os.environ.get("SAM_CODEC_EXAMPLES", "40"))
     SETTINGS = settings(max_examples=EXAMPLES, deadline=None, database=None,
@@ -86,10 +90,11 @@ if WORKER:
 
     # ---------------------------------------------------------------------------------------- both paths
 
-    def check_wire_to_ros(rm: ResolvedMapping, payload: bytes) -> bool:
-        """The codec against the object path for one payload; returns whether pycyphal refused it."""
+    def check_wire_to_ros(rm: ResolvedMapping, payload: bytes, prefix: str = "") -> bool:
+        """The codec against the object path for one payload; returns whether pycyphal refused it. `prefix`: the
+        codec bound to that frame prefix, against the object path's message with it before every frame id."""
         to_ros = convert.CONVERTERS[rm.mapping.name][0]
-        wire_to_ros = codec.CODECS[rm.mapping.name][0]
+        wire_to_ros = BOUND[prefix].CODECS[rm.mapping.name][0]
         received = decode(rm.dsdl_struct, payload)
         so, sc = convert.ConversionStats(), convert.ConversionStats()
         try:
@@ -108,7 +113,7 @@ if WORKER:
         assert isinstance(cdr, bytes) and cdr[:4] == b"\x00\x01\x00\x00"
         for view in (memoryview(bytearray(payload)), bytearray(payload)):  # what transports hand over
             assert wire_to_ros(view, RECEIVE_NS, convert.ConversionStats()) == out
-        want = ros_wire(ref)
+        want = ros_wire(with_frame_prefix(ref, prefix))
         got = deserialize_message(cdr, type(ref))
         assert same(ros_plain(got), ros_plain(want)), (payload.hex(), ros_plain(got), ros_plain(want))
         header = getattr(want, "header", None)
@@ -188,6 +193,27 @@ if WORKER:
         noise = data.draw(st.binary(min_size=1, max_size=24), label="noise")
         for case in corruptions(cdr, noise):
             check_ros_to_wire(rm, case, strict=False)
+
+    @pytest.mark.parametrize("name", sorted(MAPPINGS))
+    @FEWER
+    @given(data=st.data())
+    def test_frame_prefixes_of_every_length(name: str, data: st.DataObject) -> None:
+        """A namespaced run's codecs (bound to a frame prefix of each length modulo 8: the padding after a frame id
+        depends on it): UAVCAN -> ROS, the object path's message with the prefix before its frame ids, malformed
+        payloads refused alike; ROS -> UAVCAN, the unbound codec's payload (no frame id is read)."""
+        rm = MAPPINGS[name]
+        obj = data.draw(uavcan_strategy(rm), label="uavcan")
+        payload = b"".join(bytes(x) for x in pycyphal.dsdl.serialize(obj))
+        msg = data.draw(ros_strategy(rm.ros_message, RESOLVED.ros.get, ros_class), label="ros")
+        cdr = serialize_message(msg)
+        noise = data.draw(st.binary(min_size=1, max_size=8), label="noise")
+        for prefix in FRAME_PREFIXES:
+            assert not check_wire_to_ros(rm, payload, prefix)
+            for case in list(corruptions(payload, noise))[::7]:
+                check_wire_to_ros(rm, case, prefix)
+            assert not check_ros_to_wire(rm, cdr)
+            stats = convert.ConversionStats()
+            assert BOUND[prefix].CODECS[name][1](cdr, stats) == codec.CODECS[name][1](cdr, convert.ConversionStats())
 
     def test_every_mapping_has_both_codecs() -> None:
         assert sorted(codec.CODECS) == sorted(MAPPINGS) == sorted(convert.CONVERTERS)

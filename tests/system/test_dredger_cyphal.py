@@ -11,7 +11,10 @@ valve controller receiving the commands) and ROS probes, under the machine-wide 
   uint6, drop the message, counted; on /valve_pair (a fixed array of 2, saturating) one element is padded with a
   zero element and three are cut to two, counted once each, a float16 opening saturated and counted.
 
-The bridge's stats say it ran them on the codec (`wire: codec`), not on the object converters' fallback.
+The bridge's stats say it ran them on the codec (`wire: codec`), not on the object converters' fallback. The
+same again with the bridge as vehicle /sam1 (issue 26: a namespaced run stays on the codec, bound to the frame prefix
+at start): the same values, every frame id (the message's and its elements') ``sam1/pump_link``; the spec's topics
+are absolute, so they stay global.
 """
 
 from __future__ import annotations
@@ -51,15 +54,17 @@ PAIR = [  # /valve_pair: fixed [2], saturate
 ]
 
 
-@pytest.fixture(scope="module")
-def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+@pytest.fixture(scope="module", params=["", "/sam1"], ids=["root", "namespaced"])
+def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    namespace = request.param
     b, d, env = spec_workdir(tmp_path_factory, "dredger", "dredger_cyphal", 97)
     (d / "plan.json").write_text(json.dumps({"rate_hz": 5, "topics": {
         "/valves": [{"seq": i, "valves": v} for i, v in enumerate(VALVES)],
         "/valve_pair": [{"seq": i, "valves": v} for i, v in enumerate(PAIR)]}}))
     with cyphal_udp_lock(), bridge_sim_probe(d, env, b.generated, UDP, "cyphal", "pumps,valves", ["/pumps"],
                                              d / "pumps.jsonl", lambda counts: counts.get("/pumps", 0) >= 5,
-                                             "pump readings at the probe"):
+                                             "pump readings at the probe",
+                                             ("--namespace", namespace) if namespace else ()):
 
         def handled() -> bool:
             maps = (read_json(d / "bridge.json") or {}).get("mappings", {})
@@ -72,6 +77,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                    "the valves receiving every command the bridge sent")
     records = [json.loads(line) for line in (d / "sim.jsonl").read_text().splitlines()]
     return {"stats": read_json(d / "bridge.json"), "records": records,
+            "frame_prefix": f"{namespace[1:]}/" if namespace else "",
             "got": [json.loads(line) for line in (d / "pumps.jsonl").read_text().splitlines()]}
 
 
@@ -96,7 +102,7 @@ def test_pump_readings_reach_ros_element_by_element(run: dict[str, Any]) -> None
     assert len(got) >= 5
     for msg in got:
         assert msg["pumps"] and all(p["header"] == msg["header"] for p in msg["pumps"]), msg
-        assert msg["header"]["frame_id"] == "pump_link"
+        assert msg["header"]["frame_id"] == f"{run['frame_prefix']}pump_link"
     values = [expected(v) for v in sent]
     received = [[{k: p[k] for k in ("pump_id", "running", "flow", "temp", "pressure", "state", "fault")}
                  for p in m["pumps"]] for m in got]

@@ -10,6 +10,7 @@ judges from what arrived:
 
 - each namespace's /nav_goal carries only its own goal (in its own world frame), each /gps_fix only its own origin,
   each /global_plan ends at its own goal; the global /nav_goal, /gps_fix, /imu and /thruster_rpms get nothing;
+- each bridge runs its codec path (the wire codecs bound to its frame prefix), its frame ids prefixed;
 - every frame on the shared /tf carries a vehicle's prefix (``sam1/``, ``sam2/``), every status on the shared
   /diagnostics a vehicle's namespace; both vehicles report every node;
 - both missions complete (the mission node's status), and each simulated vehicle (its truth file) ends near its own
@@ -207,6 +208,8 @@ def test_two_vehicles_fly_side_by_side_and_no_message_crosses(tmp_path: Path) ->
         for name, p in procs.items():
             line = p.wait_line(f"READY {name.split('_')[1]}", START_TIMEOUT_S)
             assert f"namespace=/{name.split('_')[0]}" in line, line
+            if name.endswith("_bridge"):  # a namespaced bridge stays on the codec path (issue 26)
+                assert "wire=codec" in line, line
         probe = Probe(int(domain))
 
         def logs() -> str:

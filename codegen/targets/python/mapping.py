@@ -157,7 +157,10 @@ class MappingEmitter:
         root = self.module.ros_ctor(rm.ros_message)
         for fs in self.plan.ros_fields:
             if isinstance(fs.op, StaticFrameId):
-                self.module.insert(root, fs.path, py_literal(fs.op.value))
+                # the wire codecs write the run's frame prefix before it (a name bound at start), the object
+                # converters the spec's frame id (the bridge adds the prefix)
+                frame_id = getattr(self.module.build, "frame_id", py_literal)
+                self.module.insert(root, fs.path, frame_id(fs.op.value))
             elif isinstance(fs.op, ReceiveTime):
                 self.module.insert(root, (*fs.path, ("sec", None)), "receive_ns // 1_000_000_000")
                 self.module.insert(root, (*fs.path, ("nanosec", None)), "receive_ns % 1_000_000_000")

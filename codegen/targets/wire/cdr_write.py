@@ -27,7 +27,10 @@ None), ("sec", None))``, ``(("orientation_covariance", 0),)`` for one element of
   string leaves only; cdr_reader reads a sequence of messages wanted at its own path into the same records).
   A leaf without a value gets the field's default, as the ROS message class has it (``ros_default``).
   Literal expressions (``py_literal``: numbers, strings, True/False, ``_NAN``, ``_INF``) are packed at generation
-  time.
+  time. A frame id (``consts.frame_id(frame)``: the spec's, after the run's frame prefix) is the CDR string the
+  module's ``bind(frame_prefix)`` makes, packed in the struct around it; that struct's format (its length) and the
+  padding after it, which depends on the prefix's length modulo 8, are made by ``bind`` too: per message the code
+  is the same as for a literal.
 - ``cdr_reader(message, wanted, lookup, names, consts, buf)`` -> ``(lines, locals)``: statements that check the CDR
   in ``buf`` (bytes or memoryview, header included) and decode the leaves in ``wanted`` into locals: numbers,
   bools, 1-byte ``bytes`` for a ``byte`` scalar, ``str`` for strings, lists for whole arrays (``byte`` arrays as
@@ -92,6 +95,12 @@ __all__ = [
 ]
 
 
+# The frame prefix's length modulo 8: what the CDR padding after a frame id depends on.
+VARIANTS = 8
+_PADS = "pads"  # a _Run item: padding by variant
+_FRAME = "{}s"  # a _Run item: a frame id's CDR string, its length given when the struct is made
+
+
 # ---- writer --------------------------------------------------------------------------------------------------
 
 
@@ -107,9 +116,29 @@ class _Run:
     def pad(self, n: int) -> None:
         self.items.append(("x" * n, None, NO_VALUE))
 
-    def packed(self, consts: Constants) -> tuple[str, list[str], bytes | None]:
+    def pads(self, by_variant: tuple[int, ...]) -> None:
+        """Padding that depends on the frame prefix's length: `by_variant[len % 8]` bytes."""
+        self.items.append((_PADS, None, by_variant))
+
+    def frame(self, name: str) -> None:
+        """A frame id's CDR string (the bound bytes constant `name`): its length is known once bound."""
+        self.items.append((_FRAME, name, NO_VALUE))
+
+    @property
+    def bound(self) -> bool:
+        """Whether the struct depends on the frame prefix (a frame id in it, or padding after one)."""
+        return any(code in (_PADS, _FRAME) for code, _, _ in self.items)
+
+    def packed(self, consts: Constants, variant: int = 0) -> tuple[str, list[str], bytes | None]:
         """(struct format, arguments, or the bytes when every value is a literal); consecutive literals are
-        packed here, at generation time, into one `Ns` argument (zeros into pad bytes)."""
+        packed here, at generation time, into one `Ns` argument (zeros into pad bytes). Padding that depends on the
+        frame prefix is that of `variant` (the prefix's length % 8); it ends a literal chunk, so the arguments are
+        the same for every variant and only the format differs."""
+        if all(expr is None or value is not NO_VALUE for _, expr, value in self.items):  # literals only
+            items = [("x" * value[variant], NO_VALUE) if code == _PADS else (code, value)
+                     for code, _, value in self.items]
+            fmt = "<" + "".join(code for code, _ in items)
+            return fmt, [], struct.pack(fmt, *[v for _, v in items if v is not NO_VALUE])
         codes: list[str] = []
         args: list[str] = []
         chunk: list[tuple[str, Any]] = []  # literal items (and pads) not yet emitted
@@ -127,15 +156,16 @@ class _Run:
             chunk.clear()
 
         for code, expr, value in self.items:
+            if code == _PADS:
+                close()
+                codes.append("x" * value[variant])
+                continue
             if expr is None or value is not NO_VALUE:
                 chunk.append((code, value))
                 continue
             close()
             codes.append(code)
             args.append(expr)
-        if not args:
-            fmt = "<" + "".join(code for code, _ in chunk)
-            return fmt, [], struct.pack(fmt, *[v for _, v in chunk if v is not NO_VALUE])
         close()
         return strip_pads("<" + "".join(codes)), args, None
 
@@ -145,7 +175,9 @@ class _Writer:
                  values: dict[FieldPath, str]) -> None:
         self.lookup, self.names, self.consts, self.values = lookup, names, consts, values
         self.used: set[FieldPath] = set()
-        self.phase = Phase()
+        # what is known of the offset, for each length of the frame prefix modulo 8 (VARIANTS): the same until a
+        # frame id is written, then shifted by that length (static padding becomes padding by variant)
+        self.phases = [Phase() for _ in range(VARIANTS)]
         self.run = _Run()
         self.lines: list[str] = []
         self.parts: list[str] = []  # expressions appended to the output so far (before `buf` exists)
@@ -165,6 +197,17 @@ class _Writer:
     def flush(self) -> None:
         run, self.run = self.run, _Run()
         if not run.items:
+            return
+        if run.bound:  # a frame id or padding after one: the struct (or bytes) bind(frame_prefix) makes
+            variants = [run.packed(self.consts, v) for v in range(VARIANTS)]
+            fmt, args, data = variants[0]
+            assert all(a == args for _, a, _ in variants)
+            if data is not None:
+                self.emit(self.consts.bound_data([d for _, _, d in variants if d is not None]))
+            else:
+                frames = [expr for code, expr, _ in run.items if code == _FRAME and expr is not None]
+                name = self.consts.bound_struct([f for f, _, _ in variants], frames)
+                self.emit(f"{name}.pack({', '.join(args)})")
             return
         fmt, args, data = run.packed(self.consts)
         if data is not None:
@@ -189,16 +232,34 @@ class _Writer:
         return self.buf
 
     def align(self, size: int) -> None:
-        """Padding before an item of `size` bytes: static when the phase allows, else computed at run time."""
+        """Padding before an item of `size` bytes: static when the phase allows (by variant after a frame id),
+        else computed at run time."""
         align = min(size, 8)
-        pad = self.phase.pad(align)
-        if pad is None:
+        pads = [phase.pad(align) for phase in self.phases]
+        if pads[0] is None:  # (the variants differ in `rem` only: all None or none)
             buf = self.need_buffer()
             self.lines.append(f"{buf} += _ZEROS[:(4 - len({buf})) & {align - 1}]")
-            self.phase.unknown(align)
-        elif pad:
-            self.run.pad(pad)
-            self.phase.advance(pad)
+            self.unknown(align)
+            return
+        if len(set(pads)) > 1:
+            self.run.pads(tuple(p or 0 for p in pads))
+        elif pads[0]:
+            self.run.pad(pads[0])
+        for phase, pad in zip(self.phases, pads, strict=True):
+            phase.advance(pad or 0)
+
+    def advance(self, size: int) -> None:
+        for phase in self.phases:
+            phase.advance(size)
+
+    def unknown(self, mod: int = 1) -> None:
+        for phase in self.phases:
+            phase.unknown(mod)
+
+    def static_pad(self, align: int) -> int | None:
+        """The padding before an item of alignment `align` when it is the same for every variant, else None."""
+        pads = {phase.pad(align) for phase in self.phases}
+        return pads.pop() if len(pads) == 1 else None
 
     # -- layout
     def write(self, leaves: list[Leaf]) -> None:
@@ -210,7 +271,7 @@ class _Writer:
         self.align(size)
         expr, value = self.value(leaf.path, leaf.default)
         self.run.add(code, expr, value)
-        self.phase.advance(size)
+        self.advance(size)
 
     def write_block(self, leaf: Leaf) -> None:
         code, size = PRIM[leaf.base]
@@ -223,7 +284,7 @@ class _Writer:
             for i in range(leaf.count):
                 expr, value = self.value(elem_path(leaf.path, i), leaf.default)
                 self.run.add(code, expr, value)
-        self.phase.advance(size * leaf.count)
+        self.advance(size * leaf.count)
 
     def write_string(self, leaf: Leaf) -> None:
         self.align(4)
@@ -232,29 +293,36 @@ class _Writer:
             data = str(value).encode().partition(b"\0")[0] + b"\0"  # rclpy ends a string at its first NUL
             self.run.add("I", str(len(data)), len(data))
             self.run.add(f"{len(data)}s", repr(data), data)
-            self.phase.advance(4 + len(data))
+            self.advance(4 + len(data))
+            return
+        frame = self.consts.frame_of(expr)
+        if frame is not None:  # the frame prefix, then the spec's frame id: bytes bind(frame_prefix) computes,
+            self.run.frame(self.consts.framed_string(frame))  # packed with what is around it as one struct
+            size = 4 + len(frame.encode()) + 1
+            for variant, phase in enumerate(self.phases):
+                phase.advance(size + variant)
             return
         self.flush()
         text = self.names.new("text")
         self.lines.append(f"{text} = {expr}.encode().partition(b'\\0')[0]")
         self.emit(f"{self.consts.struct('<I')}.pack(len({text}) + 1) + {text} + b'\\0'")
-        self.phase.unknown()
+        self.unknown()
 
     def write_seq(self, leaf: Leaf) -> None:
         self.align(4)
         expr = self.values.get(leaf.path)
         if expr is None:
             self.run.add("I", "0", 0)
-            self.phase.advance(4)
+            self.advance(4)
             return
         self.used.add(leaf.path)
         self.flush()
         seq = self.names.new(leaf.path[-1][0])
         self.lines.append(f"{seq} = {expr}")
         self.emit(f"{self.consts.struct('<I')}.pack(len({seq}))")
-        self.phase.advance(4)
+        self.advance(4)
         size = PRIM[leaf.base][1]
-        pad = self.phase.pad(size)
+        pad = self.static_pad(size)
         if pad != 0:  # 8-byte elements after the count; Fast CDR aligns them only when there are some
             buf = self.need_buffer()
             fill = f"_ZEROS[:{pad}]" if pad is not None else f"_ZEROS[:(4 - len({buf})) & {size - 1}]"
@@ -266,7 +334,7 @@ class _Writer:
         else:
             self.consts.imports.add("array")
             self.emit(f"_array({ARRAY_CODE[leaf.base]!r}, {seq}).tobytes()")
-        self.phase.unknown(min(size, 4))
+        self.unknown(min(size, 4))
 
     def write_msgseq(self, leaf: Leaf) -> None:
         """Empty, or from a list of records (tuples of the element's leaves in `flatten` order, prim and string
@@ -275,7 +343,7 @@ class _Writer:
         self.align(4)
         if expr is None:
             self.run.add("I", "0", 0)
-            self.phase.advance(4)
+            self.advance(4)
             return
         if leaf.message is None:
             raise NotImplementedError(f"{leaf.path}: a sequence of strings is written empty only")
@@ -291,12 +359,12 @@ class _Writer:
         inner = _Writer(self.lookup, self.names, self.consts,
                         {x.path: f"{record}[{i}]" for i, x in enumerate(leaves)})
         inner.buf = buf
-        inner.phase.unknown()  # an element starts wherever the one before ended
+        inner.unknown()  # an element starts wherever the one before ended
         inner.write(leaves)
         inner.flush()
         self.lines.append(f"for {record} in {seq}:")
         self.lines.extend("    " + line for line in inner.lines)
-        self.phase.unknown()
+        self.unknown()
 
 
 def _lit(value: float) -> str:

@@ -8,13 +8,14 @@ import ast
 import itertools
 import math
 import re
+import struct
 from collections.abc import Iterable
 from typing import Any, Protocol
 
 from sam_codegen.render.pysource import LINE_LIMIT
 
-__all__ = ["LINE_LIMIT", "NO_VALUE", "Constants", "FieldPath", "Names", "literal_value", "prune", "runs_of",
-           "wrap_line"]
+__all__ = ["LINE_LIMIT", "NO_VALUE", "Constants", "FieldPath", "Names", "cdr_string", "literal_value", "prune",
+           "runs_of", "wrap_line"]
 
 # A path into a message: (field name, index or None) per level, as mapping_rules gives them.
 FieldPath = tuple[tuple[str, Any], ...]
@@ -30,17 +31,39 @@ class Constants:
     >>> c = Constants("_C")
     >>> c.struct("<id"), c.struct("<id"), c.data(b"ab"), c.lines()
     ('_C0', '_C0', '_C1', ["_C0 = _struct.Struct('<id')", "_C1 = b'ab'"])
+
+    Some depend on the run's frame prefix (the vehicle's namespace, given when the bridge starts): a frame id, the
+    CDR string of one, and the structs and bytes whose padding follows one (the CDR alignment after a string depends
+    on its length: ``variants`` of them, by the prefix's length modulo 8). They are defined at module level for the
+    empty prefix, as the spec has them, and again by the module's ``bind(frame_prefix)`` (``bind_lines``), once
+    per run: per message there is no extra work.
+
+    >>> c.bound_data([b"a", b"b"] * 4), c.lines()[-1], c.bind_lines()[-1]
+    ('_C2', "_C2 = b'a'", "    _C2 = (b'a', b'b', b'a', b'b', b'a', b'b', b'a', b'b')[shift]")
+    >>> s = c.bound_struct(["<d{}s"] * 8, [c.framed_string("odom")])
+    >>> print(*c.lines()[-1:], *c.bind_lines()[-2:], sep="\\n")
+    _C4 = _struct.Struct('<d9s')
+        _C3 = _cdr_string(frame_prefix + 'odom')
+        _C4 = _struct.Struct('<d{}s'.format(len(_C3)))
     """
 
     def __init__(self, prefix: str = "_K") -> None:
         self.prefix = prefix
-        self._names: dict[str, str] = {}  # expression -> name
+        self._names: dict[str, str] = {}  # expression (a bound one's: with its bind expression) -> name
+        self._exprs: dict[str, str] = {}  # name -> its module-level expression
+        self._bound: dict[str, str] = {}  # name -> its expression in bind(frame_prefix)
+        self._frames: dict[str, str] = {}  # frame id expression (frame_id) -> the spec's frame id
+        self._frame_names: dict[str, str] = {}  # the reverse
         self.imports: set[str] = set()  # optional imports the code uses ("array"): the module imports them
 
-    def named(self, expr: str) -> str:
-        if expr not in self._names:
-            self._names[expr] = f"{self.prefix}{len(self._names)}"
-        return self._names[expr]
+    def named(self, expr: str, bound: str | None = None) -> str:
+        key = expr if bound is None else f"{expr}\n{bound}"
+        if key not in self._names:
+            self._names[key] = name = f"{self.prefix}{len(self._names)}"
+            self._exprs[name] = expr
+            if bound is not None:
+                self._bound[name] = bound
+        return self._names[key]
 
     def struct(self, fmt: str) -> str:
         return self.named(f"_struct.Struct({fmt!r})")
@@ -48,9 +71,48 @@ class Constants:
     def data(self, value: bytes) -> str:
         return self.named(repr(value))
 
+    # -- what depends on the frame prefix
+    def frame_id(self, frame: str) -> str:
+        """The expression of a frame id the spec gives (the frame prefix before it): a name the CDR writer
+        recognises (frame_of: it writes the precomputed CDR string) and anything else reads as a string."""
+        if frame not in self._frame_names:
+            self._frame_names[frame] = name = f"{self.prefix}F{len(self._frames)}"
+            self._frames[name] = frame
+        return self._frame_names[frame]
+
+    def frame_of(self, expr: str) -> str | None:
+        """The frame id `expr` stands for (see frame_id), else None."""
+        return self._frames.get(expr)
+
+    def use_frames(self, exprs: Iterable[str]) -> None:
+        """Define the frame ids among `exprs` (as strings: an element record holds them) in the module."""
+        for expr in exprs:
+            frame = self._frames.get(expr)
+            if frame is not None and expr not in self._bound:
+                self._names[f"{frame!r}\n{expr}"] = expr
+                self._exprs[expr] = repr(frame)
+                self._bound[expr] = f"frame_prefix + {frame!r}"
+
+    def framed_string(self, frame: str) -> str:
+        """The CDR string (uint32 length with the NUL, the bytes, NUL) of the frame id `frame` after the prefix."""
+        return self.named(repr(cdr_string(frame)), f"_cdr_string(frame_prefix + {frame!r})")
+
+    def bound_struct(self, fmts: list[str], frames: list[str]) -> str:
+        """A struct whose format depends on the prefix: `fmts` by its length modulo 8 (the padding), each ``{}``
+        in them the length of a frame id's CDR string, the bytes constants `frames` (framed_string) in order."""
+        lengths = [len(ast.literal_eval(self._exprs[name])) for name in frames]
+        fmt = fmts[0] if len(set(fmts)) == 1 else f"{tuple(fmts)!r}[shift]"
+        return self.named(f"_struct.Struct({fmts[0].format(*lengths)!r})",
+                          f"_struct.Struct({fmt if fmt != fmts[0] else repr(fmt)}.format("
+                          f"{', '.join(f'len({name})' for name in frames)}))")
+
+    def bound_data(self, values: list[bytes]) -> str:
+        """Bytes that depend on the prefix's length: `values` by that length modulo 8."""
+        return self.named(repr(values[0]), f"{tuple(values)!r}[shift]")
+
     def lines(self) -> list[str]:
         out = []
-        for expr, name in self._names.items():
+        for name, expr in self._exprs.items():
             line = f"{name} = {expr}"
             if len(line) > LINE_LIMIT and expr.startswith("b"):  # long bytes: implicitly joined chunks
                 data = ast.literal_eval(expr)
@@ -59,6 +121,53 @@ class Constants:
             else:
                 out.append(line)
         return out
+
+    def bind_lines(self) -> list[str]:
+        """The module's ``bind(frame_prefix)``: its frame prefix, and the constants above that depend on it."""
+        names = sorted(self._bound, key=lambda n: (len(n), n))
+        out = []
+        if any(e.startswith("_cdr_string(") for e in self._bound.values()):
+            out += ["def _cdr_string(text: str) -> bytes:",
+                    "    data = text.encode()",
+                    "    return _struct.pack('<I', len(data) + 1) + data + b'\\0'", "", ""]
+        out += ["def bind(frame_prefix: str) -> None:",
+               '    """Make this module\'s codecs write `frame_prefix` (a namespace\'s, "sam1/") before every frame '
+               'id: the',
+               "    constants that depend on it computed once. One module object serves one prefix: a run with "
+               "another loads",
+               '    a copy of the module (sam_runtime.genpkg)."""',
+               *_statements("    global ", ["FRAME_PREFIX", *names])]
+        if any("[shift]" in self._bound[n] for n in names):
+            out.append("    shift = len(frame_prefix.encode()) % 8  # the CDR padding after a frame id depends on it")
+        out.append("    FRAME_PREFIX = frame_prefix")
+        for name in names:
+            out.extend(wrap_line(f"    {name} = {self._bound[name]}", LINE_LIMIT))
+        return out
+
+
+def _statements(head: str, names: list[str]) -> list[str]:
+    """`head` (``global``) with `names`, as many statements as the line limit needs.
+
+    >>> _statements("global ", ["a" * 70, "b" * 70, "c"])[1:] == ["global " + "b" * 70 + ", c"]
+    True
+    """
+    out: list[str] = []
+    for name in names:
+        if out and len(out[-1]) + 2 + len(name) <= LINE_LIMIT:
+            out[-1] += f", {name}"
+        else:
+            out.append(head + name)
+    return out
+
+
+def cdr_string(text: str) -> bytes:
+    """A CDR string: uint32 length including the NUL, the UTF-8 bytes, NUL (what the module's _cdr_string gives).
+
+    >>> cdr_string("ab")
+    b'\\x03\\x00\\x00\\x00ab\\x00'
+    """
+    data = text.encode()
+    return struct.pack("<I", len(data) + 1) + data + b"\0"
 
 
 _SPECIAL = {"_NAN": math.nan, "_INF": math.inf, "-_INF": -math.inf}

@@ -85,6 +85,9 @@ class CyphalWire:
     def ros_ctor(self, message: RosMessage) -> CtorNode:
         return WireCtorNode(message, [(f.name, f.type) for f in message.fields])
 
+    def frame_id(self, frame: str) -> str:
+        return self.consts.frame_id(frame)  # the frame prefix before it: bound at start (code.Constants)
+
     def element_default(self, t: DsdlType | RosType) -> str:
         if isinstance(t, DsdlType) and t.kind == "composite":
             return zero_record(self.struct(t.composite or ""), self.struct)  # a fixed array of records padded
@@ -95,6 +98,7 @@ class CyphalWire:
         values = tree_values(root)
         if self.records:
             if isinstance(root.of, RosMessage):
+                self.consts.use_frames(values.values())  # a record holds its frame id as a string
                 record = element_record(root.of, values, self.resolved.ros.get, default_literal)
             else:
                 record = element_record(root.of, values, lambda t: self.struct(t.composite or ""))
@@ -255,6 +259,7 @@ def codec_context(resolved: Resolved) -> dict[str, Any]:
         "uses_array": "array" in consts.imports,
         "prelude": [*MODULE_PRELUDE, *CYPHAL_PRELUDE],
         "constants": consts.lines(),
+        "bind": consts.bind_lines(),
         "tables": module.tables,
         "functions": functions,
         "mappings": [rm.mapping.name for rm in mappings],

@@ -89,6 +89,9 @@ class DroneCanWire:
     def ros_ctor(self, message: RosMessage) -> CtorNode:
         return WireCtorNode(message, [(f.name, f.type) for f in message.fields])
 
+    def frame_id(self, frame: str) -> str:
+        return self.consts.frame_id(frame)  # the frame prefix before it: bound at start (code.Constants)
+
     def element_default(self, t: DsdlType | RosType) -> str:
         if isinstance(t, DsdlType):
             return _DEFAULT if t.kind == "composite" else typed_literal(0, "float" if t.kind == "float" else t.kind)
@@ -103,6 +106,7 @@ class DroneCanWire:
                 record = element_record(root.of, leaves, self.layout.struct)
             else:
                 _ros_values(root, (), leaves, [])
+                self.consts.use_frames(leaves.values())  # a record holds its frame id as a string
                 record = element_record(root.of, leaves, self.resolved.ros.get, default_literal)
             return _lines([f"return {record}"])
         if isinstance(root.of, V0Struct):
@@ -381,6 +385,7 @@ def _context(resolved: Resolved) -> dict[str, Any]:
         "mappings": [rm.mapping.name for rm in mappings],
         "object_only": list(object_only.items()),
         "constants": consts.lines(),
+        "bind": consts.bind_lines(),
         "prelude": MODULE_PRELUDE,
         "helpers": HELPERS.strip("\n").splitlines(),
     }

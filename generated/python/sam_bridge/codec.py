@@ -19,6 +19,10 @@ a bound exceeded, not little-endian plain CDR) raise WireError, a ValueError; no
 any bytes. A short payload reads as zero-extended and a long one as truncated (a newer minor version), as
 in pycyphal.
 
+The frame ids the spec gives are written after ``FRAME_PREFIX`` ("" on import): ``bind(frame_prefix)`` sets it
+for a namespaced run ("sam1/"), with the bytes and structs that depend on it, once; one module object serves
+one prefix.
+
 Standard library only: importable without ROS or pycyphal.
 """
 
@@ -30,7 +34,7 @@ from typing import Any
 
 from . import conversion_support as _support
 
-__all__ = ["CODECS", "WireError"]
+__all__ = ["CODECS", "FRAME_PREFIX", "WireError", "bind"]
 
 WireError = _support.WireError
 _NAN = float("nan")
@@ -62,77 +66,166 @@ _BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_UAVCAN: dict[int, int] = {0: 127, 3: 0}
 # ---- the structs and constant bytes the codecs pack and unpack ---------------------------------------------
 
 _W0 = _struct.Struct('<IHBxxxxeeexxxxxxxxxxxxeeexxxxxxxxxxxxB')
-_W1 = b'\x00\x01\x00\x00'
-_W2 = (
-    b'\t\x00\x00\x00imu_link\x00\x00\x00\x00\x00\x00\x00\x00'
+_W1 = b'\t\x00\x00\x00imu_link\x00'
+_W2 = b'\x00\x01\x00\x00'
+_W3 = (
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
-    b'\x00\x00\x00\x00\x00\x00\xf0?\x00\x00\x00\x00\x00\x00\xf0\xbf\x00\x00\x00\x00'
+    b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\xf0?\x00\x00\x00\x00\x00\x00\xf0\xbf'
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
+    b'\x00\x00\x00\x00'
 )
-_W3 = _struct.Struct('<4siI120sddd72xddd72x')
-_W4 = _struct.Struct('<iII')
-_W5 = _struct.Struct('<104xddd72xddd72x')
-_W6 = _struct.Struct('<IHBfeeefffeeefffB')
-_W7 = _struct.Struct('<eeeB')
-_W8 = b'\x12\x00\x00\x00magnetometer_link\x00\x00\x00'
-_W9 = _struct.Struct('<4siI24sddd9d')
-_W10 = _struct.Struct('<8xI')
-_W11 = _struct.Struct('<dddddddddddd')
-_W12 = _struct.Struct('<eee')
-_W13 = _struct.Struct('<B')
-_W14 = _struct.Struct('<IHBQQxxxxxxxxxxxxBxxB')
-_W15 = b'\t\x00\x00\x00gps_link\x00'
-_W16 = b'\x01\x00'
-_W17 = b'\x03'
-_W18 = _struct.Struct('<4siI13sb2sddd9d1s')
-_W19 = _struct.Struct('<b')
-_W20 = _struct.Struct('<ddddddddddddx')
-_W21 = _struct.Struct('<IHBQQfffBe')
-_W22 = _struct.Struct('<fe')
-_W23 = b'\x0e\x00\x00\x00pressure_link\x00\x00\x00\x00\x00\x00\x00'
-_W24 = _struct.Struct('<4siI24sdd')
-_W25 = _struct.Struct('<dd')
-_W26 = _struct.Struct('<eeexxxxxxxxIxxxxxB')
-_W27 = b'\n\x00\x00\x00base_link\x00\x00\x00'
-_W28 = b'\x00\x00\xc0\x7f\x00\x00\xc0\x7f\x00\x00\xc0\x7f'
-_W29 = b'\x00\x01\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00'
-_W30 = _struct.Struct('<4siI16sfff12sfxB23s')
-_W31 = _struct.Struct('<fff12xfxB2xI')
-_W32 = _struct.Struct('<I')
-_W33 = _struct.Struct('<eeeeeeeIBIB')
-_W34 = _struct.Struct('<IHBfe')
-_W35 = b'\x0f\x00\x00\x00altimeter_link\x00\x00\xcd\xcc\xcc=\x9a\x99\x99>\x00\x00\xc8B'
-_W36 = _struct.Struct('<4siI32sff')
-_W37 = _struct.Struct('<12xff')
-_W38 = _struct.Struct('<4siI16sfffffffHBBBB2xI')
-_W39 = _struct.Struct('<fffffffHBBBB2xII')
-_W40 = _struct.Struct('<eeeeeeeIBI')
-_W41 = _struct.Struct('<HB')
-_W42 = b'\x01\x00\x00\x00\x00'
-_W43 = _struct.Struct('<4si4xiI5s')
-_W44 = _struct.Struct('<i12xI')
-_W45 = b'\x00\x01\x00\x00\x00\x00\x00\x00'
-_W46 = _struct.Struct('<8siiI5s')
-_W47 = _struct.Struct('<4xi8xI')
-_W48 = _struct.Struct('<ee')
-_W49 = _struct.Struct('<4sffiI5s')
-_W50 = _struct.Struct('<ff8xI')
-_W51 = _struct.Struct('<e')
-_W52 = _struct.Struct('<4sfiI5s')
-_W53 = _struct.Struct('<f8xI')
-_W54 = _struct.Struct('<H')
-_W55 = _struct.Struct('<IHBIH')
-_W56 = _struct.Struct('<4siI16sifB')
-_W57 = _struct.Struct('<ifB')
-_W58 = _struct.Struct('<IHBI')
-_W59 = b'\n\x00\x00\x00base_link\x00'
-_W60 = _struct.Struct('<4siI14shh')
-_W61 = _struct.Struct('<hh')
-_W62 = _struct.Struct('<IHBeHB')
-_W63 = _struct.Struct('<4siI16sfI')
-_W64 = _struct.Struct('<fI')
+_W4 = _struct.Struct('<4siI13s3x104sddd72xddd72x')
+_W5 = _struct.Struct('<iII')
+_W6 = _struct.Struct('<104xddd72xddd72x')
+_W7 = _struct.Struct('<IHBfeeefffeeefffB')
+_W8 = _struct.Struct('<eeeB')
+_W9 = b'\x12\x00\x00\x00magnetometer_link\x00'
+_W10 = _struct.Struct('<4siI22s2xddd9d')
+_W11 = _struct.Struct('<8xI')
+_W12 = _struct.Struct('<dddddddddddd')
+_W13 = _struct.Struct('<eee')
+_W14 = _struct.Struct('<B')
+_W15 = _struct.Struct('<IHBQQxxxxxxxxxxxxBxxB')
+_W16 = b'\t\x00\x00\x00gps_link\x00'
+_W17 = b'\x01\x00'
+_W18 = b'\x03'
+_W19 = _struct.Struct('<4siI13sb2sddd9d1s')
+_W20 = _struct.Struct('<b')
+_W21 = _struct.Struct('<ddddddddddddx')
+_W22 = _struct.Struct('<IHBQQfffBe')
+_W23 = _struct.Struct('<fe')
+_W24 = b'\x0e\x00\x00\x00pressure_link\x00'
+_W25 = _struct.Struct('<4siI18s6xdd')
+_W26 = _struct.Struct('<dd')
+_W27 = _struct.Struct('<eeexxxxxxxxIxxxxxB')
+_W28 = b'\n\x00\x00\x00base_link\x00'
+_W29 = b'\x00\x00\xc0\x7f\x00\x00\xc0\x7f\x00\x00\xc0\x7f'
+_W30 = b'\x00\x01\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00'
+_W31 = _struct.Struct('<4siI14s2xfff12sfxB23s')
+_W32 = _struct.Struct('<fff12xfxB2xI')
+_W33 = _struct.Struct('<I')
+_W34 = _struct.Struct('<eeeeeeeIBIB')
+_W35 = _struct.Struct('<IHBfe')
+_W36 = b'\x0f\x00\x00\x00altimeter_link\x00'
+_W37 = b'\xcd\xcc\xcc=\x9a\x99\x99>\x00\x00\xc8B'
+_W38 = _struct.Struct('<4siI19sx12sff')
+_W39 = _struct.Struct('<12xff')
+_W40 = _struct.Struct('<4siI14s2xfffffffHBBBB2xI')
+_W41 = _struct.Struct('<fffffffHBBBB2xII')
+_W42 = _struct.Struct('<eeeeeeeIBI')
+_W43 = _struct.Struct('<HB')
+_W44 = b'\x01\x00\x00\x00\x00'
+_W45 = _struct.Struct('<4si4xiI5s')
+_W46 = _struct.Struct('<i12xI')
+_W47 = b'\x00\x01\x00\x00\x00\x00\x00\x00'
+_W48 = _struct.Struct('<8siiI5s')
+_W49 = _struct.Struct('<4xi8xI')
+_W50 = _struct.Struct('<ee')
+_W51 = _struct.Struct('<4sffiI5s')
+_W52 = _struct.Struct('<ff8xI')
+_W53 = _struct.Struct('<e')
+_W54 = _struct.Struct('<4sfiI5s')
+_W55 = _struct.Struct('<f8xI')
+_W56 = _struct.Struct('<H')
+_W57 = _struct.Struct('<IHBIH')
+_W58 = _struct.Struct('<4siI14s2xifB')
+_W59 = _struct.Struct('<ifB')
+_W60 = _struct.Struct('<IHBI')
+_W61 = _struct.Struct('<4siI14shh')
+_W62 = _struct.Struct('<hh')
+_W63 = _struct.Struct('<IHBeHB')
+_W64 = _struct.Struct('<4siI14s2xfI')
+_W65 = _struct.Struct('<fI')
+
+# ---- the frame prefix: the frame ids, and what the CDR alignment after them depends on ---------------------
+
+FRAME_PREFIX = ""  # written before every frame id: bind(frame_prefix)
+
+
+def _cdr_string(text: str) -> bytes:
+    data = text.encode()
+    return _struct.pack('<I', len(data) + 1) + data + b'\0'
+
+
+def bind(frame_prefix: str) -> None:
+    """Make this module's codecs write `frame_prefix` (a namespace's, "sam1/") before every frame id: the
+    constants that depend on it computed once. One module object serves one prefix: a run with another loads
+    a copy of the module (sam_runtime.genpkg)."""
+    global FRAME_PREFIX, _W1, _W4, _W9, _W10, _W16, _W19, _W24, _W25, _W28, _W31, _W36, _W38, _W40, _W58, _W61
+    global _W64
+    shift = len(frame_prefix.encode()) % 8  # the CDR padding after a frame id depends on it
+    FRAME_PREFIX = frame_prefix
+    _W1 = _cdr_string(frame_prefix + 'imu_link')
+    _W4 = _struct.Struct(
+        (
+            '<4siI{}s3x104sddd72xddd72x', '<4siI{}s2x104sddd72xddd72x', '<4siI{}sx104sddd72xddd72x',
+            '<4siI{}s104sddd72xddd72x', '<4siI{}s7x104sddd72xddd72x', '<4siI{}s6x104sddd72xddd72x',
+            '<4siI{}s5x104sddd72xddd72x', '<4siI{}s4x104sddd72xddd72x',
+        )[shift].format(len(_W1)),
+    )
+    _W9 = _cdr_string(frame_prefix + 'magnetometer_link')
+    _W10 = _struct.Struct(
+        (
+            '<4siI{}s2xddd9d', '<4siI{}sxddd9d', '<4siI{}sddd9d', '<4siI{}s7xddd9d', '<4siI{}s6xddd9d',
+            '<4siI{}s5xddd9d', '<4siI{}s4xddd9d', '<4siI{}s3xddd9d',
+        )[shift].format(len(_W9)),
+    )
+    _W16 = _cdr_string(frame_prefix + 'gps_link')
+    _W19 = _struct.Struct(
+        (
+            '<4siI{}sb2sddd9d1s', '<4siI{}sbx2s6xddd9d1s', '<4siI{}sb2s6xddd9d1s', '<4siI{}sbx2s4xddd9d1s',
+            '<4siI{}sb2s4xddd9d1s', '<4siI{}sbx2s2xddd9d1s', '<4siI{}sb2s2xddd9d1s', '<4siI{}sbx2sddd9d1s',
+        )[shift].format(len(_W16)),
+    )
+    _W24 = _cdr_string(frame_prefix + 'pressure_link')
+    _W25 = _struct.Struct(
+        (
+            '<4siI{}s6xdd', '<4siI{}s5xdd', '<4siI{}s4xdd', '<4siI{}s3xdd', '<4siI{}s2xdd', '<4siI{}sxdd',
+            '<4siI{}sdd', '<4siI{}s7xdd',
+        )[shift].format(len(_W24)),
+    )
+    _W28 = _cdr_string(frame_prefix + 'base_link')
+    _W31 = _struct.Struct(
+        (
+            '<4siI{}s2xfff12sfxB23s', '<4siI{}sxfff12sfxB23s', '<4siI{}sfff12sfxB23s',
+            '<4siI{}s3xfff12sfxB23s', '<4siI{}s2xfff12sfxB23s', '<4siI{}sxfff12sfxB23s',
+            '<4siI{}sfff12sfxB23s', '<4siI{}s3xfff12sfxB23s',
+        )[shift].format(len(_W28)),
+    )
+    _W36 = _cdr_string(frame_prefix + 'altimeter_link')
+    _W38 = _struct.Struct(
+        (
+            '<4siI{}sx12sff', '<4siI{}s4x12sff', '<4siI{}s3x12sff', '<4siI{}s2x12sff', '<4siI{}sx12sff',
+            '<4siI{}s4x12sff', '<4siI{}s3x12sff', '<4siI{}s2x12sff',
+        )[shift].format(len(_W36)),
+    )
+    _W40 = _struct.Struct(
+        (
+            '<4siI{}s2xfffffffHBBBB2xI', '<4siI{}sxfffffffHBBBB2xI', '<4siI{}sfffffffHBBBB2xI',
+            '<4siI{}s3xfffffffHBBBB2xI', '<4siI{}s2xfffffffHBBBB2xI', '<4siI{}sxfffffffHBBBB2xI',
+            '<4siI{}sfffffffHBBBB2xI', '<4siI{}s3xfffffffHBBBB2xI',
+        )[shift].format(len(_W28)),
+    )
+    _W58 = _struct.Struct(
+        (
+            '<4siI{}s2xifB', '<4siI{}sxifB', '<4siI{}sifB', '<4siI{}s3xifB', '<4siI{}s2xifB', '<4siI{}sxifB',
+            '<4siI{}sifB', '<4siI{}s3xifB',
+        )[shift].format(len(_W28)),
+    )
+    _W61 = _struct.Struct(
+        (
+            '<4siI{}shh', '<4siI{}sxhh', '<4siI{}shh', '<4siI{}sxhh', '<4siI{}shh', '<4siI{}sxhh',
+            '<4siI{}shh', '<4siI{}sxhh',
+        )[shift].format(len(_W28)),
+    )
+    _W64 = _struct.Struct(
+        (
+            '<4siI{}s2xfI', '<4siI{}sxfI', '<4siI{}sfI', '<4siI{}s3xfI', '<4siI{}s2xfI', '<4siI{}sxfI',
+            '<4siI{}sfI', '<4siI{}s3xfI',
+        )[shift].format(len(_W28)),
+    )
 
 
 def imu_wire_to_ros(
@@ -163,8 +256,8 @@ def imu_wire_to_ros(
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
     return (
-        _W3.pack(
-            _W1, sec, nanosec, _W2, rate_gyro_latest_0, rate_gyro_latest_1, rate_gyro_latest_2,
+        _W4.pack(
+            _W2, sec, nanosec, _W1, _W3, rate_gyro_latest_0, rate_gyro_latest_1, rate_gyro_latest_2,
             accelerometer_latest_0, accelerometer_latest_1, accelerometer_latest_2,
         ),
         sec * 1_000_000_000 + nanosec,
@@ -181,7 +274,7 @@ def imu_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -192,7 +285,7 @@ def imu_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     (
         angular_velocity_x, angular_velocity_y, angular_velocity_z, linear_acceleration_x,
         linear_acceleration_y, linear_acceleration_z,
-    ) = _W5.unpack_from(cdr, offset + 4)
+    ) = _W6.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('imu.timestamp.microsecond')
@@ -240,7 +333,7 @@ def imu_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         stats.saturate('imu.accelerometer_latest[2]')
         accelerometer_latest_2 = -65504.0
     bits = us
-    return _W6.pack(
+    return _W7.pack(
         bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, 0.0, rate_gyro_latest_0, rate_gyro_latest_1,
         rate_gyro_latest_2, 0.0, 0.0, 0.0, accelerometer_latest_0, accelerometer_latest_1,
         accelerometer_latest_2, 0.0, 0.0, 0.0, 0,
@@ -255,7 +348,7 @@ def magnetic_field_wire_to_ros(
     sam.sensor.MagneticFieldStrength.0.1 -> sensor_msgs/MagneticField
     """
     buf = _extend(payload, 33)
-    magnetic_field_ga_0, magnetic_field_ga_1, magnetic_field_ga_2, count = _W7.unpack_from(buf, 0)
+    magnetic_field_ga_0, magnetic_field_ga_1, magnetic_field_ga_2, count = _W8.unpack_from(buf, 0)
     offset = 7
     if count > 9:
         raise WireError('array length prefix beyond float16[<=9]')
@@ -263,8 +356,8 @@ def magnetic_field_wire_to_ros(
     magnetic_field_covariance_2 = [x * 1e-08 for x in magnetic_field_covariance]
     magnetic_field_covariance_2 += [0.0] * (9 - len(magnetic_field_covariance_2))  # zero = unknown
     return (
-        _W9.pack(
-            _W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W8, magnetic_field_ga_0 * 0.0001,
+        _W10.pack(
+            _W2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W9, magnetic_field_ga_0 * 0.0001,
             magnetic_field_ga_1 * 0.0001, magnetic_field_ga_2 * 0.0001, *magnetic_field_covariance_2,
         ),
         receive_ns,
@@ -281,7 +374,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
+    length, = _W11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -294,7 +387,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         magnetic_field_covariance_1, magnetic_field_covariance_2, magnetic_field_covariance_3,
         magnetic_field_covariance_4, magnetic_field_covariance_5, magnetic_field_covariance_6,
         magnetic_field_covariance_7, magnetic_field_covariance_8,
-    ) = _W11.unpack_from(cdr, offset + 4)
+    ) = _W12.unpack_from(cdr, offset + 4)
     magnetic_field_covariance = [
         magnetic_field_covariance_0, magnetic_field_covariance_1, magnetic_field_covariance_2,
         magnetic_field_covariance_3, magnetic_field_covariance_4, magnetic_field_covariance_5,
@@ -329,7 +422,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         return None
     magnetic_field_covariance_10 = magnetic_field_covariance_9
     return (
-        _W12.pack(magnetic_field_ga_0, magnetic_field_ga_1, magnetic_field_ga_2)
+        _W13.pack(magnetic_field_ga_0, magnetic_field_ga_1, magnetic_field_ga_2)
         + _struct.pack(
             f'<B{len(magnetic_field_covariance_10)}e', len(magnetic_field_covariance_10),
             *magnetic_field_covariance_10,
@@ -345,7 +438,7 @@ def gps_fix_wire_to_ros(
     sam.sensor.GNSSFix.0.1 -> sensor_msgs/NavSatFix
     """
     buf = _extend(payload, 65)
-    bits, bits_2, bits_3, bits_5, bits_6, bits_8, count = _W14.unpack_from(buf, 0)
+    bits, bits_2, bits_3, bits_5, bits_6, bits_8, count = _W15.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     bits_7 = bits_5 | bits_6 << 64
@@ -375,9 +468,9 @@ def gps_fix_wire_to_ros(
     position_covariance_2 = position_covariance
     position_covariance_2 += [0.0] * (9 - len(position_covariance_2))  # zero = unknown
     return (
-        _W18.pack(
-            _W1, sec, nanosec, _W15, status_status, _W16, latitude_deg_1e8 * 1e-08, longitude_deg_1e8 * 1e-08,
-            height_ellipsoid_mm * 0.001, *position_covariance_2, _W17,
+        _W19.pack(
+            _W2, sec, nanosec, _W16, status_status, _W17, latitude_deg_1e8 * 1e-08, longitude_deg_1e8 * 1e-08,
+            height_ellipsoid_mm * 0.001, *position_covariance_2, _W18,
         ),
         sec * 1_000_000_000 + nanosec,
     )
@@ -393,14 +486,14 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
     offset += length
     if size < offset + 5:
         raise WireError('CDR: truncated')
-    status_status, = _W19.unpack_from(cdr, offset + 4)
+    status_status, = _W20.unpack_from(cdr, offset + 4)
     offset += 1
     offset += -offset & 1
     if size < offset + 6:
@@ -413,7 +506,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         latitude, longitude, altitude, position_covariance_0, position_covariance_1, position_covariance_2,
         position_covariance_3, position_covariance_4, position_covariance_5, position_covariance_6,
         position_covariance_7, position_covariance_8,
-    ) = _W20.unpack_from(cdr, offset + 4)
+    ) = _W21.unpack_from(cdr, offset + 4)
     position_covariance = [
         position_covariance_0, position_covariance_1, position_covariance_2, position_covariance_3,
         position_covariance_4, position_covariance_5, position_covariance_6, position_covariance_7,
@@ -477,7 +570,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     )
     position_covariance_10 = position_covariance_9
     return (
-        _W21.pack(
+        _W22.pack(
             bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, bits_2 & 18446744073709551615,
             bits_2 >> 64 & 18446744073709551615, 0.0, 0.0, 0.0, status << 6, 0.0,
         )
@@ -495,10 +588,10 @@ def pressure_wire_to_ros(
     sam.sensor.StaticPressure.0.1 -> sensor_msgs/FluidPressure
     """
     buf = _extend(payload, 14)
-    static_pressure, static_pressure_variance = _W22.unpack_from(buf, 0)
+    static_pressure, static_pressure_variance = _W23.unpack_from(buf, 0)
     return (
-        _W24.pack(
-            _W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W23, static_pressure,
+        _W25.pack(
+            _W2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W24, static_pressure,
             static_pressure_variance,
         ),
         receive_ns,
@@ -515,7 +608,7 @@ def pressure_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
+    length, = _W11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -523,7 +616,7 @@ def pressure_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     offset += -offset & 7
     if size < offset + 20:
         raise WireError('CDR: truncated')
-    fluid_pressure, variance = _W25.unpack_from(cdr, offset + 4)
+    fluid_pressure, variance = _W26.unpack_from(cdr, offset + 4)
     static_pressure = fluid_pressure
     if 3.4028234663852886e+38 < static_pressure < _INF:
         stats.saturate('pressure.static_pressure')
@@ -538,7 +631,7 @@ def pressure_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     elif static_pressure_variance < -65504.0:
         stats.saturate('pressure.static_pressure_variance')
         static_pressure_variance = -65504.0
-    return _W22.pack(static_pressure, static_pressure_variance)
+    return _W23.pack(static_pressure, static_pressure_variance)
 
 
 def battery_state_wire_to_ros(
@@ -549,16 +642,16 @@ def battery_state_wire_to_ros(
     sam.power.BatteryInfo.0.1 -> sensor_msgs/BatteryState
     """
     buf = _extend(payload, 63)
-    temperature, voltage, current, bits, count = _W26.unpack_from(buf, 0)
+    temperature, voltage, current, bits, count = _W27.unpack_from(buf, 0)
     state_of_health_pct = (bits >> 11 & 127)
     state_of_charge_pct = (bits >> 18 & 127)
     if count > 31:
         raise WireError('array length prefix beyond uint8[<=31]')
     power_supply_health = _BATTERY_STATE_POWER_SUPPLY_HEALTH_TO_ROS.get(state_of_health_pct, 1)
     return (
-        _W30.pack(
-            _W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W27, voltage, temperature - 273.15,
-            current, _W28, state_of_charge_pct * 0.01, power_supply_health, _W29,
+        _W31.pack(
+            _W2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W28, voltage, temperature - 273.15,
+            current, _W29, state_of_charge_pct * 0.01, power_supply_health, _W30,
         ),
         receive_ns,
     )
@@ -574,7 +667,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
+    length, = _W11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -582,21 +675,21 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     offset += -offset & 3
     if size < offset + 40:
         raise WireError('CDR: truncated')
-    voltage, temperature, current, percentage, power_supply_health, count = _W31.unpack_from(cdr, offset + 4)
+    voltage, temperature, current, percentage, power_supply_health, count = _W32.unpack_from(cdr, offset + 4)
     offset += 36
     if size < offset + 4 + count * 4:
         raise WireError('CDR: sequence beyond the buffer')
     offset += count * 4
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    count_2, = _W32.unpack_from(cdr, offset + 4)
+    count_2, = _W33.unpack_from(cdr, offset + 4)
     offset += 4
     if size < offset + 4 + count_2 * 4:
         raise WireError('CDR: sequence beyond the buffer')
     offset += count_2 * 4
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    length_2, = _W32.unpack_from(cdr, offset + 4)
+    length_2, = _W33.unpack_from(cdr, offset + 4)
     offset += 4
     if length_2 and (size < offset + 4 + length_2 or cdr[offset + 3 + length_2] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -604,7 +697,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     offset += -offset & 3
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    length_3, = _W32.unpack_from(cdr, offset + 4)
+    length_3, = _W33.unpack_from(cdr, offset + 4)
     offset += 4
     if length_3 and (size < offset + 4 + length_3 or cdr[offset + 3 + length_3] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -645,7 +738,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     if state_of_health_pct is None:
         stats.reject('battery_state.state_of_health_pct')
         return None
-    return _W33.pack(
+    return _W34.pack(
         temperature_2, voltage_2, current_2, 0.0, 0.0, 0.0, 0.0,
         state_of_health_pct << 11 | state_of_charge_pct << 18, 0, 0, 0,
     )
@@ -659,7 +752,7 @@ def altitude_wire_to_ros(
     sam.sensor.Altitude.0.1 -> sensor_msgs/Range
     """
     buf = _extend(payload, 21)
-    bits, bits_2, bits_3, altitude, altitude_variance = _W34.unpack_from(buf, 0)
+    bits, bits_2, bits_3, altitude, altitude_variance = _W35.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     us = timestamp_microsecond
@@ -673,7 +766,9 @@ def altitude_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _W36.pack(_W1, sec, nanosec, _W35, altitude, altitude_variance), sec * 1_000_000_000 + nanosec
+    return (
+        _W38.pack(_W2, sec, nanosec, _W36, _W37, altitude, altitude_variance), sec * 1_000_000_000 + nanosec,
+    )
 
 
 def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -686,7 +781,7 @@ def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -697,7 +792,7 @@ def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     offset += -offset & 3
     if size < offset + 24:
         raise WireError('CDR: truncated')
-    range_2, variance = _W37.unpack_from(cdr, offset + 4)
+    range_2, variance = _W39.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('altitude.timestamp.microsecond')
@@ -710,7 +805,7 @@ def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         stats.saturate('altitude.altitude_variance')
         altitude_variance = -65504.0
     bits = us
-    return _W34.pack(bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, range_2, altitude_variance)
+    return _W35.pack(bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, range_2, altitude_variance)
 
 
 def battery_info_wire_to_ros(
@@ -724,7 +819,7 @@ def battery_info_wire_to_ros(
     (
         temperature, voltage, current, average_power_10sec, remaining_capacity_wh, full_charge_capacity_wh,
         hours_to_full_charge, bits, battery_id, model_instance_id, count,
-    ) = _W33.unpack_from(buf, 0)
+    ) = _W34.unpack_from(buf, 0)
     status_flags = (bits & 2047)
     state_of_health_pct = (bits >> 11 & 127)
     state_of_charge_pct = (bits >> 18 & 127)
@@ -736,13 +831,13 @@ def battery_info_wire_to_ros(
     model_name_2 = model_name
     return (
         (
-            _W38.pack(
-                _W1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W27, temperature, voltage,
+            _W40.pack(
+                _W2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W28, temperature, voltage,
                 current, average_power_10sec, remaining_capacity_wh, full_charge_capacity_wh,
                 hours_to_full_charge, status_flags, state_of_health_pct, state_of_charge_pct,
                 state_of_charge_pct_stdev, battery_id, model_instance_id,
             )
-            + _W32.pack(len(model_name_2))
+            + _W33.pack(len(model_name_2))
             + bytes(model_name_2)
         ),
         receive_ns,
@@ -759,7 +854,7 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _W10.unpack_from(cdr, 4)
+    length, = _W11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -771,7 +866,7 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
         temperature, voltage, current, average_power_10sec, remaining_capacity_wh, full_charge_capacity_wh,
         hours_to_full_charge, status_flags, state_of_health_pct, state_of_charge_pct,
         state_of_charge_pct_stdev, battery_id, model_instance_id, count,
-    ) = _W39.unpack_from(cdr, offset + 4)
+    ) = _W41.unpack_from(cdr, offset + 4)
     if count > 31:
         raise WireError('CDR: seq bound exceeded')
     offset += 44
@@ -846,7 +941,7 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
     model_name_2 = model_name
     model_name_3 = bytes(model_name_2)
     return (
-        _W40.pack(
+        _W42.pack(
             temperature_2, voltage_2, current_2, average_power_10sec_2, remaining_capacity_wh_2,
             full_charge_capacity_wh_2, hours_to_full_charge_2,
             (
@@ -857,7 +952,7 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
             ),
             battery_id, model_instance_id,
         )
-        + _W13.pack(len(model_name_3))
+        + _W14.pack(len(model_name_3))
         + model_name_3
     )
 
@@ -870,10 +965,10 @@ def thruster_1_rpm_wire_to_ros(
     sam.actuator.ThrusterRPM.0.1 -> sam_msgs/ThrusterRPMs
     """
     buf = _extend(payload, 11)
-    bits, bits_2 = _W41.unpack_from(buf, 0)
+    bits, bits_2 = _W43.unpack_from(buf, 0)
     bits_3 = bits | bits_2 << 16
     rpm = (((bits_3 & 262143) ^ 131072) - 131072)
-    return _W43.pack(_W1, rpm, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
+    return _W45.pack(_W2, rpm, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W44), receive_ns
 
 
 def thruster_1_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -886,7 +981,7 @@ def thruster_1_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    thruster_1_rpm, length = _W44.unpack_from(cdr, 4)
+    thruster_1_rpm, length = _W46.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -898,7 +993,7 @@ def thruster_1_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         stats.saturate('thruster_1_rpm.rpm')
         rpm = -131072
     bits = (rpm & 262143)
-    return _W41.pack(bits & 65535, bits >> 16 & 255)
+    return _W43.pack(bits & 65535, bits >> 16 & 255)
 
 
 def thruster_2_rpm_wire_to_ros(
@@ -909,10 +1004,10 @@ def thruster_2_rpm_wire_to_ros(
     sam.actuator.ThrusterRPM.0.1 -> sam_msgs/ThrusterRPMs
     """
     buf = _extend(payload, 11)
-    bits, bits_2 = _W41.unpack_from(buf, 0)
+    bits, bits_2 = _W43.unpack_from(buf, 0)
     bits_3 = bits | bits_2 << 16
     rpm = (((bits_3 & 262143) ^ 131072) - 131072)
-    return _W46.pack(_W45, rpm, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
+    return _W48.pack(_W47, rpm, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W44), receive_ns
 
 
 def thruster_2_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -925,7 +1020,7 @@ def thruster_2_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    thruster_2_rpm, length = _W47.unpack_from(cdr, 4)
+    thruster_2_rpm, length = _W49.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -937,7 +1032,7 @@ def thruster_2_rpm_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         stats.saturate('thruster_2_rpm.rpm')
         rpm = -131072
     bits = (rpm & 262143)
-    return _W41.pack(bits & 65535, bits >> 16 & 255)
+    return _W43.pack(bits & 65535, bits >> 16 & 255)
 
 
 def thrust_vector_wire_to_ros(
@@ -948,11 +1043,11 @@ def thrust_vector_wire_to_ros(
     sam.actuator.ThrustVector.0.1 -> sam_msgs/ThrusterAngles
     """
     buf = _extend(payload, 12)
-    vertical_radians, horizontal_radians = _W48.unpack_from(buf, 0)
+    vertical_radians, horizontal_radians = _W50.unpack_from(buf, 0)
     return (
-        _W49.pack(
-            _W1, vertical_radians, horizontal_radians, receive_ns // 1_000_000_000,
-            receive_ns % 1_000_000_000, _W42,
+        _W51.pack(
+            _W2, vertical_radians, horizontal_radians, receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _W44,
         ),
         receive_ns,
     )
@@ -968,7 +1063,7 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    thruster_vertical_radians, thruster_horizontal_radians, length = _W50.unpack_from(cdr, 4)
+    thruster_vertical_radians, thruster_horizontal_radians, length = _W52.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -986,7 +1081,7 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     elif horizontal_radians < -65504.0:
         stats.saturate('thrust_vector.horizontal_radians')
         horizontal_radians = -65504.0
-    return _W48.pack(vertical_radians, horizontal_radians)
+    return _W50.pack(vertical_radians, horizontal_radians)
 
 
 def ballast_wire_to_ros(
@@ -997,11 +1092,11 @@ def ballast_wire_to_ros(
     sam.actuator.BallastAngles.0.1 -> sam_msgs/BallastAngles
     """
     buf = _extend(payload, 12)
-    weight_1_offset_radians, weight_2_offset_radians = _W48.unpack_from(buf, 0)
+    weight_1_offset_radians, weight_2_offset_radians = _W50.unpack_from(buf, 0)
     return (
-        _W49.pack(
-            _W1, weight_1_offset_radians, weight_2_offset_radians, receive_ns // 1_000_000_000,
-            receive_ns % 1_000_000_000, _W42,
+        _W51.pack(
+            _W2, weight_1_offset_radians, weight_2_offset_radians, receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _W44,
         ),
         receive_ns,
     )
@@ -1017,7 +1112,7 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    weight_1_offset_radians, weight_2_offset_radians, length = _W50.unpack_from(cdr, 4)
+    weight_1_offset_radians, weight_2_offset_radians, length = _W52.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1035,7 +1130,7 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     elif weight_2_offset_radians_2 < -65504.0:
         stats.saturate('ballast.weight_2_offset_radians')
         weight_2_offset_radians_2 = -65504.0
-    return _W48.pack(weight_1_offset_radians_2, weight_2_offset_radians_2)
+    return _W50.pack(weight_1_offset_radians_2, weight_2_offset_radians_2)
 
 
 def longitudinal_weight_wire_to_ros(
@@ -1046,8 +1141,8 @@ def longitudinal_weight_wire_to_ros(
     sam.actuator.PercentCommand.0.1 -> sam_msgs/PercentStamped
     """
     buf = _extend(payload, 10)
-    percent, = _W51.unpack_from(buf, 0)
-    return _W52.pack(_W1, percent, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
+    percent, = _W53.unpack_from(buf, 0)
+    return _W54.pack(_W2, percent, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W44), receive_ns
 
 
 def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1060,7 +1155,7 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 20:
         raise WireError('CDR: truncated')
-    percent, length = _W53.unpack_from(cdr, 4)
+    percent, length = _W55.unpack_from(cdr, 4)
     offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1074,7 +1169,7 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     elif percent_2 > 100.0:
         stats.saturate('longitudinal_weight.percent')
         percent_2 = 100.0
-    return _W51.pack(percent_2)
+    return _W53.pack(percent_2)
 
 
 def buoyancy_piston_wire_to_ros(
@@ -1085,8 +1180,8 @@ def buoyancy_piston_wire_to_ros(
     sam.actuator.PercentCommand.0.1 -> sam_msgs/PercentStamped
     """
     buf = _extend(payload, 10)
-    percent, = _W51.unpack_from(buf, 0)
-    return _W52.pack(_W1, percent, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W42), receive_ns
+    percent, = _W53.unpack_from(buf, 0)
+    return _W54.pack(_W2, percent, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _W44), receive_ns
 
 
 def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1099,7 +1194,7 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 20:
         raise WireError('CDR: truncated')
-    percent, length = _W53.unpack_from(cdr, 4)
+    percent, length = _W55.unpack_from(cdr, 4)
     offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1113,7 +1208,7 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
     elif percent_2 > 100.0:
         stats.saturate('buoyancy_piston.percent')
         percent_2 = 100.0
-    return _W51.pack(percent_2)
+    return _W53.pack(percent_2)
 
 
 def thruster_1_feedback_wire_to_ros(
@@ -1124,12 +1219,12 @@ def thruster_1_feedback_wire_to_ros(
     sam.actuator.ThrusterFeedback.0.1 -> sam_msgs/ThrusterFeedback
     """
     buf = _extend(payload, 21)
-    bits, bits_2, bits_3, bits_5, bits_6 = _W55.unpack_from(buf, 0)
+    bits, bits_2, bits_3, bits_5, bits_6 = _W57.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     bits_7 = bits_5 | bits_6 << 32
     rpm = (((bits_7 & 262143) ^ 131072) - 131072)
-    current = _W51.unpack(_W54.pack(bits_7 >> 18 & 65535))[0]
+    current = _W53.unpack(_W56.pack(bits_7 >> 18 & 65535))[0]
     temperature_c = (bits_7 >> 34 & 127)
     us = timestamp_microsecond
     if us == 0:  # unknown: the receive time
@@ -1142,7 +1237,7 @@ def thruster_1_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _W56.pack(_W1, sec, nanosec, _W27, rpm, current, temperature_c), sec * 1_000_000_000 + nanosec
+    return _W58.pack(_W2, sec, nanosec, _W28, rpm, current, temperature_c), sec * 1_000_000_000 + nanosec
 
 
 def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1155,7 +1250,7 @@ def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1163,7 +1258,7 @@ def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     offset += -offset & 3
     if size < offset + 13:
         raise WireError('CDR: truncated')
-    rpm, current, temperature_c = _W57.unpack_from(cdr, offset + 4)
+    rpm, current, temperature_c = _W59.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('thruster_1_feedback.timestamp.microsecond')
@@ -1187,8 +1282,8 @@ def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         stats.saturate('thruster_1_feedback.temperature_c')
         temperature_c_2 = 127
     bits = us
-    bits_2 = (rpm_2 & 262143) | _W54.unpack(_W51.pack(current_2))[0] << 18 | temperature_c_2 << 34
-    return _W55.pack(
+    bits_2 = (rpm_2 & 262143) | _W56.unpack(_W53.pack(current_2))[0] << 18 | temperature_c_2 << 34
+    return _W57.pack(
         bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, bits_2 & 4294967295, bits_2 >> 32 & 65535,
     )
 
@@ -1201,12 +1296,12 @@ def thruster_2_feedback_wire_to_ros(
     sam.actuator.ThrusterFeedback.0.1 -> sam_msgs/ThrusterFeedback
     """
     buf = _extend(payload, 21)
-    bits, bits_2, bits_3, bits_5, bits_6 = _W55.unpack_from(buf, 0)
+    bits, bits_2, bits_3, bits_5, bits_6 = _W57.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     bits_7 = bits_5 | bits_6 << 32
     rpm = (((bits_7 & 262143) ^ 131072) - 131072)
-    current = _W51.unpack(_W54.pack(bits_7 >> 18 & 65535))[0]
+    current = _W53.unpack(_W56.pack(bits_7 >> 18 & 65535))[0]
     temperature_c = (bits_7 >> 34 & 127)
     us = timestamp_microsecond
     if us == 0:  # unknown: the receive time
@@ -1219,7 +1314,7 @@ def thruster_2_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _W56.pack(_W1, sec, nanosec, _W27, rpm, current, temperature_c), sec * 1_000_000_000 + nanosec
+    return _W58.pack(_W2, sec, nanosec, _W28, rpm, current, temperature_c), sec * 1_000_000_000 + nanosec
 
 
 def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1232,7 +1327,7 @@ def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1240,7 +1335,7 @@ def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     offset += -offset & 3
     if size < offset + 13:
         raise WireError('CDR: truncated')
-    rpm, current, temperature_c = _W57.unpack_from(cdr, offset + 4)
+    rpm, current, temperature_c = _W59.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('thruster_2_feedback.timestamp.microsecond')
@@ -1264,8 +1359,8 @@ def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         stats.saturate('thruster_2_feedback.temperature_c')
         temperature_c_2 = 127
     bits = us
-    bits_2 = (rpm_2 & 262143) | _W54.unpack(_W51.pack(current_2))[0] << 18 | temperature_c_2 << 34
-    return _W55.pack(
+    bits_2 = (rpm_2 & 262143) | _W56.unpack(_W53.pack(current_2))[0] << 18 | temperature_c_2 << 34
+    return _W57.pack(
         bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, bits_2 & 4294967295, bits_2 >> 32 & 65535,
     )
 
@@ -1278,7 +1373,7 @@ def thrust_vector_feedback_wire_to_ros(
     sam.actuator.ThrustVectorFeedback.0.1 -> sam_msgs/ThrustVectorFeedback
     """
     buf = _extend(payload, 19)
-    bits, bits_2, bits_3, bits_5 = _W58.unpack_from(buf, 0)
+    bits, bits_2, bits_3, bits_5 = _W60.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     vertical_mrad = (((bits_5 & 8191) ^ 4096) - 4096)
@@ -1294,7 +1389,7 @@ def thrust_vector_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _W60.pack(_W1, sec, nanosec, _W59, vertical_mrad, horizontal_mrad), sec * 1_000_000_000 + nanosec
+    return _W61.pack(_W2, sec, nanosec, _W28, vertical_mrad, horizontal_mrad), sec * 1_000_000_000 + nanosec
 
 
 def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1307,7 +1402,7 @@ def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> b
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1315,7 +1410,7 @@ def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> b
     offset += -offset & 1
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    vertical_mrad, horizontal_mrad = _W61.unpack_from(cdr, offset + 4)
+    vertical_mrad, horizontal_mrad = _W62.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('thrust_vector_feedback.timestamp.microsecond')
@@ -1335,7 +1430,7 @@ def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> b
         stats.saturate('thrust_vector_feedback.horizontal_mrad')
         horizontal_mrad_2 = -4096
     bits = us
-    return _W58.pack(
+    return _W60.pack(
         bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255,
         (vertical_mrad_2 & 8191) | (horizontal_mrad_2 & 8191) << 13,
     )
@@ -1349,7 +1444,7 @@ def longitudinal_weight_feedback_wire_to_ros(
     sam.actuator.PositionFeedback.0.1 -> sam_msgs/PositionFeedback
     """
     buf = _extend(payload, 20)
-    bits, bits_2, bits_3, percent, bits_5, bits_6 = _W62.unpack_from(buf, 0)
+    bits, bits_2, bits_3, percent, bits_5, bits_6 = _W63.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     bits_7 = bits_5 | bits_6 << 16
@@ -1365,7 +1460,7 @@ def longitudinal_weight_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _W63.pack(_W1, sec, nanosec, _W27, percent, encoder_count), sec * 1_000_000_000 + nanosec
+    return _W64.pack(_W2, sec, nanosec, _W28, percent, encoder_count), sec * 1_000_000_000 + nanosec
 
 
 def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1378,7 +1473,7 @@ def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1386,7 +1481,7 @@ def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any
     offset += -offset & 3
     if size < offset + 12:
         raise WireError('CDR: truncated')
-    percent, encoder_count = _W64.unpack_from(cdr, offset + 4)
+    percent, encoder_count = _W65.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('longitudinal_weight_feedback.timestamp.microsecond')
@@ -1404,7 +1499,7 @@ def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any
         encoder_count_2 = 16777215
     bits = us
     bits_2 = encoder_count_2
-    return _W62.pack(
+    return _W63.pack(
         bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, percent_2, bits_2 & 65535,
         bits_2 >> 16 & 255,
     )
@@ -1418,7 +1513,7 @@ def buoyancy_piston_feedback_wire_to_ros(
     sam.actuator.PositionFeedback.0.1 -> sam_msgs/PositionFeedback
     """
     buf = _extend(payload, 20)
-    bits, bits_2, bits_3, percent, bits_5, bits_6 = _W62.unpack_from(buf, 0)
+    bits, bits_2, bits_3, percent, bits_5, bits_6 = _W63.unpack_from(buf, 0)
     bits_4 = bits | bits_2 << 32 | bits_3 << 48
     timestamp_microsecond = (bits_4 & 72057594037927935)
     bits_7 = bits_5 | bits_6 << 16
@@ -1434,7 +1529,7 @@ def buoyancy_piston_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _W63.pack(_W1, sec, nanosec, _W27, percent, encoder_count), sec * 1_000_000_000 + nanosec
+    return _W64.pack(_W2, sec, nanosec, _W28, percent, encoder_count), sec * 1_000_000_000 + nanosec
 
 
 def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1447,7 +1542,7 @@ def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) ->
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _W4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _W5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1455,7 +1550,7 @@ def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) ->
     offset += -offset & 3
     if size < offset + 12:
         raise WireError('CDR: truncated')
-    percent, encoder_count = _W64.unpack_from(cdr, offset + 4)
+    percent, encoder_count = _W65.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('buoyancy_piston_feedback.timestamp.microsecond')
@@ -1473,7 +1568,7 @@ def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) ->
         encoder_count_2 = 16777215
     bits = us
     bits_2 = encoder_count_2
-    return _W62.pack(
+    return _W63.pack(
         bits & 4294967295, bits >> 32 & 65535, bits >> 48 & 255, percent_2, bits_2 & 65535,
         bits_2 >> 16 & 255,
     )

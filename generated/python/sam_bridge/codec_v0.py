@@ -20,6 +20,10 @@ never another exception. dronecan accepts bits beyond the type's end, padding cu
 longer than their capacity (a length prefix may count more, a tail array takes every whole element): so do
 these codecs.
 
+The frame ids the spec gives are written after ``FRAME_PREFIX`` ("" on import): ``bind(frame_prefix)`` sets it
+for a namespaced run ("sam1/"), with the bytes and structs that depend on it, once; one module object serves
+one prefix.
+
 Standard library only.
 """
 
@@ -31,7 +35,7 @@ from typing import Any
 
 from . import conversion_support as _support
 
-__all__ = ["CODECS", "WIRE_MATCHES", "ConversionStats", "WireError"]
+__all__ = ["CODECS", "FRAME_PREFIX", "WIRE_MATCHES", "ConversionStats", "WireError", "bind"]
 
 ConversionStats = _support.ConversionStats
 WireError = _support.WireError
@@ -39,80 +43,168 @@ _NAN = float("nan")
 _INF = float("inf")
 _ZEROS = bytes(64)
 _K0 = _struct.Struct('<7s4x3e12x3e')
-_K1 = b'\x00\x01\x00\x00'
-_K2 = (
-    b'\t\x00\x00\x00imu_link\x00\x00\x00\x00\x00\x00\x00\x00'
+_K1 = b'\t\x00\x00\x00imu_link\x00'
+_K2 = b'\x00\x01\x00\x00'
+_K3 = (
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
-    b'\x00\x00\x00\x00\x00\x00\xf0?\x00\x00\x00\x00\x00\x00\xf0\xbf\x00\x00\x00\x00'
+    b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\xf0?\x00\x00\x00\x00\x00\x00\xf0\xbf'
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
     b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
+    b'\x00\x00\x00\x00'
 )
-_K3 = _struct.Struct('<4siI120sddd72xddd72x')
-_K4 = _struct.Struct('<iII')
-_K5 = _struct.Struct('<104xddd72xddd72x')
-_K6 = _struct.Struct('<7s4xHHH12xHHH12x')
-_K7 = _struct.Struct('<3e')
-_K8 = b'\x12\x00\x00\x00magnetometer_link\x00\x00\x00'
-_K9 = _struct.Struct('<4siI24sddd9d')
-_K10 = _struct.Struct('<8xI')
-_K11 = _struct.Struct('<dddddddddddd')
-_K12 = _struct.Struct('<HHH')
-_K13 = _struct.Struct('<7s')
-_K14 = b'\t\x00\x00\x00gps_link\x00'
-_K15 = b'\x01\x00'
-_K16 = _struct.Struct('<4siI13sb2sddd73x')
-_K17 = _struct.Struct('<b')
-_K18 = _struct.Struct('<ddd73x')
-_K19 = _struct.Struct('<7s7x')
-_K20 = b'\x00\x00\x00'
-_K21 = b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
-_K22 = b'\x00\x00\x00\x00'
-_K23 = _struct.Struct('<fe')
-_K24 = b'\x0e\x00\x00\x00pressure_link\x00\x00\x00\x00\x00\x00\x00'
-_K25 = _struct.Struct('<4siI24sdd')
-_K26 = _struct.Struct('<dd')
-_K27 = _struct.Struct('<fH')
-_K28 = _struct.Struct('<eee')
-_K29 = b'\n\x00\x00\x00base_link\x00\x00\x00'
-_K30 = b'\x00\x00\xc0\x7f\x00\x00\xc0\x7f\x00\x00\xc0\x7f'
-_K31 = b'\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00'
-_K32 = _struct.Struct('<4siI16sfff12sf25s')
-_K33 = _struct.Struct('<fff12xf4xI')
-_K34 = _struct.Struct('<I')
-_K35 = _struct.Struct('<HHH8x')
-_K36 = b'\x00\x00\x00\x00\x00'
-_K37 = _struct.Struct('<eeeeeee')
-_K38 = _struct.Struct('<BI')
-_K39 = _struct.Struct('<4siI16sfffffffHBBBB2xI')
-_K40 = _struct.Struct('<fffffffHBBBB2xII')
-_K41 = _struct.Struct('<HHHHHHH')
-_K42 = _struct.Struct('<7sfe')
-_K43 = b'\x0f\x00\x00\x00altimeter_link\x00\x00\xcd\xcc\xcc=\x9a\x99\x99>\x00\x00\xc8B'
-_K44 = _struct.Struct('<4siI32sff')
-_K45 = _struct.Struct('<12xff')
-_K46 = _struct.Struct('<7sfH')
-_K47 = b'\x01\x00\x00\x00\x00'
-_K48 = _struct.Struct('<4siiiI5s')
-_K49 = _struct.Struct('<ii8xI')
-_K50 = _struct.Struct('<BBe')
-_K51 = _struct.Struct('<4sffiI5s')
-_K52 = _struct.Struct('<ff8xI')
-_K53 = _struct.Struct('<BBHBBH')
-_K54 = _struct.Struct('<4sfiI5s')
-_K55 = _struct.Struct('<f8xI')
-_K56 = _struct.Struct('<BBH')
-_K57 = _struct.Struct('<ee')
-_K58 = _struct.Struct('<4siI16sifB')
-_K59 = _struct.Struct('<ifB')
-_K60 = _struct.Struct('<6xHH')
-_K61 = b'\n\x00\x00\x00base_link\x00'
-_K62 = _struct.Struct('<4siI14shh')
-_K63 = _struct.Struct('<hh')
-_K64 = _struct.Struct('<7se3s')
-_K65 = _struct.Struct('<4siI16sfI')
-_K66 = _struct.Struct('<fI')
-_K67 = _struct.Struct('<7sH3s')
+_K4 = _struct.Struct('<4siI13s3x104sddd72xddd72x')
+_K5 = _struct.Struct('<iII')
+_K6 = _struct.Struct('<104xddd72xddd72x')
+_K7 = _struct.Struct('<7s4xHHH12xHHH12x')
+_K8 = _struct.Struct('<3e')
+_K9 = b'\x12\x00\x00\x00magnetometer_link\x00'
+_K10 = _struct.Struct('<4siI22s2xddd9d')
+_K11 = _struct.Struct('<8xI')
+_K12 = _struct.Struct('<dddddddddddd')
+_K13 = _struct.Struct('<HHH')
+_K14 = _struct.Struct('<7s')
+_K15 = b'\t\x00\x00\x00gps_link\x00'
+_K16 = b'\x01\x00'
+_K17 = _struct.Struct('<4siI13sb2sddd73x')
+_K18 = _struct.Struct('<b')
+_K19 = _struct.Struct('<ddd73x')
+_K20 = _struct.Struct('<7s7x')
+_K21 = b'\x00\x00\x00'
+_K22 = b'\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00'
+_K23 = b'\x00\x00\x00\x00'
+_K24 = _struct.Struct('<fe')
+_K25 = b'\x0e\x00\x00\x00pressure_link\x00'
+_K26 = _struct.Struct('<4siI18s6xdd')
+_K27 = _struct.Struct('<dd')
+_K28 = _struct.Struct('<fH')
+_K29 = _struct.Struct('<eee')
+_K30 = b'\n\x00\x00\x00base_link\x00'
+_K31 = b'\x00\x00\xc0\x7f\x00\x00\xc0\x7f\x00\x00\xc0\x7f'
+_K32 = b'\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00'
+_K33 = _struct.Struct('<4siI14s2xfff12sf25s')
+_K34 = _struct.Struct('<fff12xf4xI')
+_K35 = _struct.Struct('<I')
+_K36 = _struct.Struct('<HHH8x')
+_K37 = b'\x00\x00\x00\x00\x00'
+_K38 = _struct.Struct('<eeeeeee')
+_K39 = _struct.Struct('<BI')
+_K40 = _struct.Struct('<4siI14s2xfffffffHBBBB2xI')
+_K41 = _struct.Struct('<fffffffHBBBB2xII')
+_K42 = _struct.Struct('<HHHHHHH')
+_K43 = _struct.Struct('<7sfe')
+_K44 = b'\x0f\x00\x00\x00altimeter_link\x00'
+_K45 = b'\xcd\xcc\xcc=\x9a\x99\x99>\x00\x00\xc8B'
+_K46 = _struct.Struct('<4siI19sx12sff')
+_K47 = _struct.Struct('<12xff')
+_K48 = _struct.Struct('<7sfH')
+_K49 = b'\x01\x00\x00\x00\x00'
+_K50 = _struct.Struct('<4siiiI5s')
+_K51 = _struct.Struct('<ii8xI')
+_K52 = _struct.Struct('<BBe')
+_K53 = _struct.Struct('<4sffiI5s')
+_K54 = _struct.Struct('<ff8xI')
+_K55 = _struct.Struct('<BBHBBH')
+_K56 = _struct.Struct('<4sfiI5s')
+_K57 = _struct.Struct('<f8xI')
+_K58 = _struct.Struct('<BBH')
+_K59 = _struct.Struct('<ee')
+_K60 = _struct.Struct('<4siI14s2xifB')
+_K61 = _struct.Struct('<ifB')
+_K62 = _struct.Struct('<6xHH')
+_K63 = _struct.Struct('<4siI14shh')
+_K64 = _struct.Struct('<hh')
+_K65 = _struct.Struct('<7se3s')
+_K66 = _struct.Struct('<4siI14s2xfI')
+_K67 = _struct.Struct('<fI')
+_K68 = _struct.Struct('<7sH3s')
+
+# ---- the frame prefix: the frame ids, and what the CDR alignment after them depends on ---------------------
+
+FRAME_PREFIX = ""  # written before every frame id: bind(frame_prefix)
+
+
+def _cdr_string(text: str) -> bytes:
+    data = text.encode()
+    return _struct.pack('<I', len(data) + 1) + data + b'\0'
+
+
+def bind(frame_prefix: str) -> None:
+    """Make this module's codecs write `frame_prefix` (a namespace's, "sam1/") before every frame id: the
+    constants that depend on it computed once. One module object serves one prefix: a run with another loads
+    a copy of the module (sam_runtime.genpkg)."""
+    global FRAME_PREFIX, _K1, _K4, _K9, _K10, _K15, _K17, _K25, _K26, _K30, _K33, _K40, _K44, _K46, _K60, _K63
+    global _K66
+    shift = len(frame_prefix.encode()) % 8  # the CDR padding after a frame id depends on it
+    FRAME_PREFIX = frame_prefix
+    _K1 = _cdr_string(frame_prefix + 'imu_link')
+    _K4 = _struct.Struct(
+        (
+            '<4siI{}s3x104sddd72xddd72x', '<4siI{}s2x104sddd72xddd72x', '<4siI{}sx104sddd72xddd72x',
+            '<4siI{}s104sddd72xddd72x', '<4siI{}s7x104sddd72xddd72x', '<4siI{}s6x104sddd72xddd72x',
+            '<4siI{}s5x104sddd72xddd72x', '<4siI{}s4x104sddd72xddd72x',
+        )[shift].format(len(_K1)),
+    )
+    _K9 = _cdr_string(frame_prefix + 'magnetometer_link')
+    _K10 = _struct.Struct(
+        (
+            '<4siI{}s2xddd9d', '<4siI{}sxddd9d', '<4siI{}sddd9d', '<4siI{}s7xddd9d', '<4siI{}s6xddd9d',
+            '<4siI{}s5xddd9d', '<4siI{}s4xddd9d', '<4siI{}s3xddd9d',
+        )[shift].format(len(_K9)),
+    )
+    _K15 = _cdr_string(frame_prefix + 'gps_link')
+    _K17 = _struct.Struct(
+        (
+            '<4siI{}sb2sddd73x', '<4siI{}sbx2s6xddd73x', '<4siI{}sb2s6xddd73x', '<4siI{}sbx2s4xddd73x',
+            '<4siI{}sb2s4xddd73x', '<4siI{}sbx2s2xddd73x', '<4siI{}sb2s2xddd73x', '<4siI{}sbx2sddd73x',
+        )[shift].format(len(_K15)),
+    )
+    _K25 = _cdr_string(frame_prefix + 'pressure_link')
+    _K26 = _struct.Struct(
+        (
+            '<4siI{}s6xdd', '<4siI{}s5xdd', '<4siI{}s4xdd', '<4siI{}s3xdd', '<4siI{}s2xdd', '<4siI{}sxdd',
+            '<4siI{}sdd', '<4siI{}s7xdd',
+        )[shift].format(len(_K25)),
+    )
+    _K30 = _cdr_string(frame_prefix + 'base_link')
+    _K33 = _struct.Struct(
+        (
+            '<4siI{}s2xfff12sf25s', '<4siI{}sxfff12sf25s', '<4siI{}sfff12sf25s', '<4siI{}s3xfff12sf25s',
+            '<4siI{}s2xfff12sf25s', '<4siI{}sxfff12sf25s', '<4siI{}sfff12sf25s', '<4siI{}s3xfff12sf25s',
+        )[shift].format(len(_K30)),
+    )
+    _K40 = _struct.Struct(
+        (
+            '<4siI{}s2xfffffffHBBBB2xI', '<4siI{}sxfffffffHBBBB2xI', '<4siI{}sfffffffHBBBB2xI',
+            '<4siI{}s3xfffffffHBBBB2xI', '<4siI{}s2xfffffffHBBBB2xI', '<4siI{}sxfffffffHBBBB2xI',
+            '<4siI{}sfffffffHBBBB2xI', '<4siI{}s3xfffffffHBBBB2xI',
+        )[shift].format(len(_K30)),
+    )
+    _K44 = _cdr_string(frame_prefix + 'altimeter_link')
+    _K46 = _struct.Struct(
+        (
+            '<4siI{}sx12sff', '<4siI{}s4x12sff', '<4siI{}s3x12sff', '<4siI{}s2x12sff', '<4siI{}sx12sff',
+            '<4siI{}s4x12sff', '<4siI{}s3x12sff', '<4siI{}s2x12sff',
+        )[shift].format(len(_K44)),
+    )
+    _K60 = _struct.Struct(
+        (
+            '<4siI{}s2xifB', '<4siI{}sxifB', '<4siI{}sifB', '<4siI{}s3xifB', '<4siI{}s2xifB', '<4siI{}sxifB',
+            '<4siI{}sifB', '<4siI{}s3xifB',
+        )[shift].format(len(_K30)),
+    )
+    _K63 = _struct.Struct(
+        (
+            '<4siI{}shh', '<4siI{}sxhh', '<4siI{}shh', '<4siI{}sxhh', '<4siI{}shh', '<4siI{}sxhh',
+            '<4siI{}shh', '<4siI{}sxhh',
+        )[shift].format(len(_K30)),
+    )
+    _K66 = _struct.Struct(
+        (
+            '<4siI{}s2xfI', '<4siI{}sxfI', '<4siI{}sfI', '<4siI{}s3xfI', '<4siI{}s2xfI', '<4siI{}sxfI',
+            '<4siI{}sfI', '<4siI{}s3xfI',
+        )[shift].format(len(_K30)),
+    )
 
 # gps_fix: status -> status.status
 _GPS_FIX_STATUS_STATUS_TO_ROS: dict[int, int] = {0: -1, 1: -1, 2: 0, 3: 0}
@@ -209,8 +301,8 @@ def imu_wire_to_ros(
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
     return (
-        _K3.pack(
-            _K1, sec, nanosec, _K2, rate_gyro_latest[0], rate_gyro_latest[1], rate_gyro_latest[2],
+        _K4.pack(
+            _K2, sec, nanosec, _K1, _K3, rate_gyro_latest[0], rate_gyro_latest[1], rate_gyro_latest[2],
             accelerometer_latest[0], accelerometer_latest[1], accelerometer_latest[2],
         ),
         sec * 1_000_000_000 + nanosec,
@@ -227,7 +319,7 @@ def imu_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _K4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _K5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -238,7 +330,7 @@ def imu_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     (
         angular_velocity_x, angular_velocity_y, angular_velocity_z, linear_acceleration_x,
         linear_acceleration_y, linear_acceleration_z,
-    ) = _K5.unpack_from(cdr, offset + 4)
+    ) = _K6.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('imu.timestamp.usec')
@@ -285,7 +377,7 @@ def imu_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     elif accelerometer_latest_2 < -65504.0:
         stats.saturate('imu.accelerometer_latest[2]')
         accelerometer_latest_2 = -65504.0
-    return _K6.pack(
+    return _K7.pack(
         (us & 0xffffffffffffff).to_bytes(7, 'little'), _f16(rate_gyro_latest_0), _f16(rate_gyro_latest_1),
         _f16(rate_gyro_latest_2), _f16(accelerometer_latest_0), _f16(accelerometer_latest_1),
         _f16(accelerometer_latest_2),
@@ -303,7 +395,7 @@ def magnetic_field_wire_to_ros(
     _L = _n << 3
     if _n < 6:
         raise WireError('uavcan.equipment.ahrs.MagneticFieldStrength: payload too short')
-    _t1 = _K7.unpack_from(payload, 0)
+    _t1 = _K8.unpack_from(payload, 0)
     u_magnetic_field_ga = list(_t1[0:3])
     _o = 48
     _t2 = (_L - _o - 8) // 16 + 1 if _L - _o >= 8 else 0
@@ -314,8 +406,8 @@ def magnetic_field_wire_to_ros(
     magnetic_field_covariance = [x * 1e-08 for x in list(u_magnetic_field_covariance)]
     magnetic_field_covariance += [0.0] * (9 - len(magnetic_field_covariance))  # zero = unknown
     return (
-        _K9.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K8, magnetic_field_ga[0] * 0.0001,
+        _K10.pack(
+            _K2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K9, magnetic_field_ga[0] * 0.0001,
             magnetic_field_ga[1] * 0.0001, magnetic_field_ga[2] * 0.0001, *magnetic_field_covariance[:9],
         ),
         receive_ns,
@@ -332,7 +424,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
+    length, = _K11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -345,7 +437,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
         magnetic_field_covariance_1, magnetic_field_covariance_2, magnetic_field_covariance_3,
         magnetic_field_covariance_4, magnetic_field_covariance_5, magnetic_field_covariance_6,
         magnetic_field_covariance_7, magnetic_field_covariance_8,
-    ) = _K11.unpack_from(cdr, offset + 4)
+    ) = _K12.unpack_from(cdr, offset + 4)
     magnetic_field_covariance = [
         magnetic_field_covariance_0, magnetic_field_covariance_1, magnetic_field_covariance_2,
         magnetic_field_covariance_3, magnetic_field_covariance_4, magnetic_field_covariance_5,
@@ -379,7 +471,7 @@ def magnetic_field_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | N
     if magnetic_field_covariance_9 is None:
         return None
     return (
-        _K12.pack(_f16(magnetic_field_ga_0), _f16(magnetic_field_ga_1), _f16(magnetic_field_ga_2))
+        _K13.pack(_f16(magnetic_field_ga_0), _f16(magnetic_field_ga_1), _f16(magnetic_field_ga_2))
         + _struct.pack(
             f'<{len(magnetic_field_covariance_9)}H', *[_f16(x) for x in magnetic_field_covariance_9],
         )
@@ -398,7 +490,7 @@ def gps_fix_wire_to_ros(
     _P = int.from_bytes(payload, 'big')
     if _n < 48:
         raise WireError('uavcan.equipment.gnss.Fix2: payload too short')
-    _t1 = _K13.unpack_from(payload, 0)
+    _t1 = _K14.unpack_from(payload, 0)
     u_timestamp_usec = int.from_bytes(_t1[0], 'little')
     _t2 = _P >> (_L - 237) & 0x1fffffffffffffffffffffffff
     u_longitude_deg_1e8 = (
@@ -468,8 +560,8 @@ def gps_fix_wire_to_ros(
         stats.reject('gps_fix.status.status')
         return None
     return (
-        _K16.pack(
-            _K1, sec, nanosec, _K14, status_status, _K15, u_latitude_deg_1e8 * 1e-08,
+        _K17.pack(
+            _K2, sec, nanosec, _K15, status_status, _K16, u_latitude_deg_1e8 * 1e-08,
             u_longitude_deg_1e8 * 1e-08, u_height_ellipsoid_mm * 0.001,
         ),
         sec * 1_000_000_000 + nanosec,
@@ -486,14 +578,14 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _K4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _K5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
     offset += length
     if size < offset + 5:
         raise WireError('CDR: truncated')
-    status_status, = _K17.unpack_from(cdr, offset + 4)
+    status_status, = _K18.unpack_from(cdr, offset + 4)
     offset += 1
     offset += -offset & 1
     if size < offset + 6:
@@ -502,7 +594,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     offset += -offset & 7
     if size < offset + 101:
         raise WireError('CDR: truncated')
-    latitude, longitude, altitude = _K18.unpack_from(cdr, offset + 4)
+    latitude, longitude, altitude = _K19.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('gps_fix.timestamp.usec')
@@ -568,12 +660,12 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     _v7 = _v2 << 91 | _v4 << 54 | _v6 << 27
     _v8 = status & 0x3
     return (
-        _K19.pack((us & 0xffffffffffffff).to_bytes(7, 'little'))
-        + _K20
-        + _v7.to_bytes(16, 'big')
+        _K20.pack((us & 0xffffffffffffff).to_bytes(7, 'little'))
         + _K21
-        + _v8.to_bytes(1, 'big')
+        + _v7.to_bytes(16, 'big')
         + _K22
+        + _v8.to_bytes(1, 'big')
+        + _K23
     )
 
 
@@ -587,10 +679,10 @@ def pressure_wire_to_ros(
     _n = len(payload)
     if _n < 6:
         raise WireError('uavcan.equipment.air_data.StaticPressure: payload too short')
-    u_static_pressure, u_static_pressure_variance = _K23.unpack_from(payload, 0)
+    u_static_pressure, u_static_pressure_variance = _K24.unpack_from(payload, 0)
     return (
-        _K25.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K24, u_static_pressure,
+        _K26.pack(
+            _K2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K25, u_static_pressure,
             u_static_pressure_variance,
         ),
         receive_ns,
@@ -607,7 +699,7 @@ def pressure_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
+    length, = _K11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -615,7 +707,7 @@ def pressure_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     offset += -offset & 7
     if size < offset + 20:
         raise WireError('CDR: truncated')
-    fluid_pressure, variance = _K26.unpack_from(cdr, offset + 4)
+    fluid_pressure, variance = _K27.unpack_from(cdr, offset + 4)
     static_pressure = fluid_pressure
     if 3.4028234663852886e+38 < static_pressure < _INF:
         stats.saturate('pressure.static_pressure')
@@ -630,7 +722,7 @@ def pressure_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     elif static_pressure_variance < -65504.0:
         stats.saturate('pressure.static_pressure_variance')
         static_pressure_variance = -65504.0
-    return _K27.pack(
+    return _K28.pack(
         static_pressure if -3.4028234663852886e+38 <= static_pressure <= 3.4028234663852886e+38 else _clamp(
             static_pressure, 3.4028234663852886e+38,
         ),
@@ -650,13 +742,13 @@ def battery_state_wire_to_ros(
     _P = int.from_bytes(payload, 'big')
     if _n < 23:
         raise WireError('uavcan.equipment.power.BatteryInfo: payload too short')
-    u_temperature, u_voltage, u_current = _K28.unpack_from(payload, 0)
+    u_temperature, u_voltage, u_current = _K29.unpack_from(payload, 0)
     _t1 = _P >> (_L - 137) & 0x7f
     u_state_of_charge_pct = _t1 & 0x7f
     return (
-        _K32.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K29, u_voltage,
-            u_temperature - 273.15, u_current, _K30, u_state_of_charge_pct * 0.01, _K31,
+        _K33.pack(
+            _K2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K30, u_voltage,
+            u_temperature - 273.15, u_current, _K31, u_state_of_charge_pct * 0.01, _K32,
         ),
         receive_ns,
     )
@@ -672,7 +764,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
+    length, = _K11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -680,21 +772,21 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     offset += -offset & 3
     if size < offset + 40:
         raise WireError('CDR: truncated')
-    voltage, temperature, current, percentage, count = _K33.unpack_from(cdr, offset + 4)
+    voltage, temperature, current, percentage, count = _K34.unpack_from(cdr, offset + 4)
     offset += 36
     if size < offset + 4 + count * 4:
         raise WireError('CDR: sequence beyond the buffer')
     offset += count * 4
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    count_2, = _K34.unpack_from(cdr, offset + 4)
+    count_2, = _K35.unpack_from(cdr, offset + 4)
     offset += 4
     if size < offset + 4 + count_2 * 4:
         raise WireError('CDR: sequence beyond the buffer')
     offset += count_2 * 4
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    length_2, = _K34.unpack_from(cdr, offset + 4)
+    length_2, = _K35.unpack_from(cdr, offset + 4)
     offset += 4
     if length_2 and (size < offset + 4 + length_2 or cdr[offset + 3 + length_2] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -702,7 +794,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     offset += -offset & 3
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    length_3, = _K34.unpack_from(cdr, offset + 4)
+    length_3, = _K35.unpack_from(cdr, offset + 4)
     offset += 4
     if length_3 and (size < offset + 4 + length_3 or cdr[offset + 3 + length_3] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -740,7 +832,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     else:
         state_of_charge_pct = round(state_of_charge_pct)
     _v1 = (state_of_charge_pct & 0x7f) << 7
-    return _K35.pack(_f16(temperature_2), _f16(voltage_2), _f16(current_2)) + _v1.to_bytes(4, 'big') + _K36
+    return _K36.pack(_f16(temperature_2), _f16(voltage_2), _f16(current_2)) + _v1.to_bytes(4, 'big') + _K37
 
 
 def battery_info_wire_to_ros(
@@ -757,13 +849,13 @@ def battery_info_wire_to_ros(
     (
         u_temperature, u_voltage, u_current, u_average_power_10sec, u_remaining_capacity_wh,
         u_full_charge_capacity_wh, u_hours_to_full_charge,
-    ) = _K37.unpack_from(payload, 0)
+    ) = _K38.unpack_from(payload, 0)
     _t1 = int.from_bytes(payload[14:18], 'big')
     u_status_flags = (_t1 >> 24 & 0xff) | (_t1 >> 21 & 0x7) << 8
     u_state_of_health_pct = _t1 >> 14 & 0x7f
     u_state_of_charge_pct = _t1 >> 7 & 0x7f
     u_state_of_charge_pct_stdev = _t1 & 0x7f
-    u_battery_id, u_model_instance_id = _K38.unpack_from(payload, 18)
+    u_battery_id, u_model_instance_id = _K39.unpack_from(payload, 18)
     _o = 184
     _t2 = (_L - _o - 8) // 8 + 1 if _L - _o >= 8 else 0
     u_model_name = list(payload[_o >> 3:(_o >> 3) + _t2])
@@ -772,13 +864,13 @@ def battery_info_wire_to_ros(
     model_name = list(u_model_name)
     return (
         (
-            _K39.pack(
-                _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K29, u_temperature, u_voltage,
+            _K40.pack(
+                _K2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K30, u_temperature, u_voltage,
                 u_current, u_average_power_10sec, u_remaining_capacity_wh, u_full_charge_capacity_wh,
                 u_hours_to_full_charge, u_status_flags, u_state_of_health_pct, u_state_of_charge_pct,
                 u_state_of_charge_pct_stdev, u_battery_id, u_model_instance_id,
             )
-            + _K34.pack(len(model_name))
+            + _K35.pack(len(model_name))
             + bytes(model_name)
         ),
         receive_ns,
@@ -795,7 +887,7 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
+    length, = _K11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -807,7 +899,7 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
         temperature, voltage, current, average_power_10sec, remaining_capacity_wh, full_charge_capacity_wh,
         hours_to_full_charge, status_flags, state_of_health_pct, state_of_charge_pct,
         state_of_charge_pct_stdev, battery_id, model_instance_id, count,
-    ) = _K40.unpack_from(cdr, offset + 4)
+    ) = _K41.unpack_from(cdr, offset + 4)
     if count > 31:
         raise WireError('CDR: seq bound exceeded')
     offset += 44
@@ -889,12 +981,12 @@ def battery_info_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | Non
         | state_of_charge_pct_stdev_2 & 0x7f
     )
     return (
-        _K41.pack(
+        _K42.pack(
             _f16(temperature_2), _f16(voltage_2), _f16(current_2), _f16(average_power_10sec_2),
             _f16(remaining_capacity_wh_2), _f16(full_charge_capacity_wh_2), _f16(hours_to_full_charge_2),
         )
         + _v3.to_bytes(4, 'big')
-        + _K38.pack(battery_id, model_instance_id)
+        + _K39.pack(battery_id, model_instance_id)
         + bytes(model_name_2)
     )
 
@@ -909,7 +1001,7 @@ def altitude_wire_to_ros(
     _n = len(payload)
     if _n < 13:
         raise WireError('sam.sensor.Altitude: payload too short')
-    _t1 = _K42.unpack_from(payload, 0)
+    _t1 = _K43.unpack_from(payload, 0)
     u_timestamp_usec = int.from_bytes(_t1[0], 'little')
     u_altitude = _t1[1]
     u_altitude_variance = _t1[2]
@@ -924,7 +1016,10 @@ def altitude_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _K44.pack(_K1, sec, nanosec, _K43, u_altitude, u_altitude_variance), sec * 1_000_000_000 + nanosec
+    return (
+        _K46.pack(_K2, sec, nanosec, _K44, _K45, u_altitude, u_altitude_variance),
+        sec * 1_000_000_000 + nanosec,
+    )
 
 
 def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -937,7 +1032,7 @@ def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _K4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _K5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -948,7 +1043,7 @@ def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     offset += -offset & 3
     if size < offset + 24:
         raise WireError('CDR: truncated')
-    range_2, variance = _K45.unpack_from(cdr, offset + 4)
+    range_2, variance = _K47.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('altitude.timestamp.usec')
@@ -960,7 +1055,7 @@ def altitude_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     elif altitude_variance < -65504.0:
         stats.saturate('altitude.altitude_variance')
         altitude_variance = -65504.0
-    return _K46.pack(
+    return _K48.pack(
         (us & 0xffffffffffffff).to_bytes(7, 'little'),
         range_2 if -3.4028234663852886e+38 <= range_2 <= 3.4028234663852886e+38 else _clamp(
             range_2, 3.4028234663852886e+38,
@@ -996,7 +1091,7 @@ def thruster_rpms_wire_to_ros(
         stats.reject('thruster_rpms.rpm[1]')
         return None
     return (
-        _K48.pack(_K1, rpm[0], rpm[1], receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K47),
+        _K50.pack(_K2, rpm[0], rpm[1], receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K49),
         receive_ns,
     )
 
@@ -1011,7 +1106,7 @@ def thruster_rpms_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    thruster_1_rpm, thruster_2_rpm, length = _K49.unpack_from(cdr, 4)
+    thruster_1_rpm, thruster_2_rpm, length = _K51.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1050,7 +1145,7 @@ def thrust_vector_wire_to_ros(
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     commands_actuator_id_0 = _item(u_commands, 0, 0)
     if commands_actuator_id_0 is None:  # no item for this mapping
         stats.reject('thrust_vector.commands[actuator_id=0]')
@@ -1060,9 +1155,9 @@ def thrust_vector_wire_to_ros(
         stats.reject('thrust_vector.commands[actuator_id=1]')
         return None
     return (
-        _K51.pack(
-            _K1, commands_actuator_id_0[2], commands_actuator_id_1[2], receive_ns // 1_000_000_000,
-            receive_ns % 1_000_000_000, _K47,
+        _K53.pack(
+            _K2, commands_actuator_id_0[2], commands_actuator_id_1[2], receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _K49,
         ),
         receive_ns,
     )
@@ -1078,7 +1173,7 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    thruster_vertical_radians, thruster_horizontal_radians, length = _K52.unpack_from(cdr, 4)
+    thruster_vertical_radians, thruster_horizontal_radians, length = _K54.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1096,7 +1191,7 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     elif commands_actuator_id_1_command_value < -65504.0:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
         commands_actuator_id_1_command_value = -65504.0
-    return _K53.pack(
+    return _K55.pack(
         0, 1, _f16(commands_actuator_id_0_command_value), 1, 1, _f16(commands_actuator_id_1_command_value),
     )
 
@@ -1114,7 +1209,7 @@ def ballast_wire_to_ros(
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     commands_actuator_id_2 = _item(u_commands, 0, 2)
     if commands_actuator_id_2 is None:  # no item for this mapping
         stats.reject('ballast.commands[actuator_id=2]')
@@ -1124,9 +1219,9 @@ def ballast_wire_to_ros(
         stats.reject('ballast.commands[actuator_id=3]')
         return None
     return (
-        _K51.pack(
-            _K1, commands_actuator_id_2[2], commands_actuator_id_3[2], receive_ns // 1_000_000_000,
-            receive_ns % 1_000_000_000, _K47,
+        _K53.pack(
+            _K2, commands_actuator_id_2[2], commands_actuator_id_3[2], receive_ns // 1_000_000_000,
+            receive_ns % 1_000_000_000, _K49,
         ),
         receive_ns,
     )
@@ -1142,7 +1237,7 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 24:
         raise WireError('CDR: truncated')
-    weight_1_offset_radians, weight_2_offset_radians, length = _K52.unpack_from(cdr, 4)
+    weight_1_offset_radians, weight_2_offset_radians, length = _K54.unpack_from(cdr, 4)
     offset = 20
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1160,7 +1255,7 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     elif commands_actuator_id_3_command_value < -65504.0:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
         commands_actuator_id_3_command_value = -65504.0
-    return _K53.pack(
+    return _K55.pack(
         2, 1, _f16(commands_actuator_id_2_command_value), 3, 1, _f16(commands_actuator_id_3_command_value),
     )
 
@@ -1178,15 +1273,15 @@ def longitudinal_weight_wire_to_ros(
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     commands_actuator_id_4 = _item(u_commands, 0, 4)
     if commands_actuator_id_4 is None:  # no item for this mapping
         stats.reject('longitudinal_weight.commands[actuator_id=4]')
         return None
     return (
-        _K54.pack(
-            _K1, commands_actuator_id_4[2] * 100.0, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000,
-            _K47,
+        _K56.pack(
+            _K2, commands_actuator_id_4[2] * 100.0, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000,
+            _K49,
         ),
         receive_ns,
     )
@@ -1202,7 +1297,7 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 20:
         raise WireError('CDR: truncated')
-    percent, length = _K55.unpack_from(cdr, 4)
+    percent, length = _K57.unpack_from(cdr, 4)
     offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1223,7 +1318,7 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     elif commands_actuator_id_4_command_value < -65504.0:
         stats.saturate('longitudinal_weight.commands[actuator_id=4].command_value')
         commands_actuator_id_4_command_value = -65504.0
-    return _K56.pack(4, 0, _f16(commands_actuator_id_4_command_value))
+    return _K58.pack(4, 0, _f16(commands_actuator_id_4_command_value))
 
 
 def buoyancy_piston_wire_to_ros(
@@ -1239,15 +1334,15 @@ def buoyancy_piston_wire_to_ros(
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     commands_actuator_id_5 = _item(u_commands, 0, 5)
     if commands_actuator_id_5 is None:  # no item for this mapping
         stats.reject('buoyancy_piston.commands[actuator_id=5]')
         return None
     return (
-        _K54.pack(
-            _K1, commands_actuator_id_5[2] * 100.0, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000,
-            _K47,
+        _K56.pack(
+            _K2, commands_actuator_id_5[2] * 100.0, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000,
+            _K49,
         ),
         receive_ns,
     )
@@ -1263,7 +1358,7 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 20:
         raise WireError('CDR: truncated')
-    percent, length = _K55.unpack_from(cdr, 4)
+    percent, length = _K57.unpack_from(cdr, 4)
     offset = 16
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1284,7 +1379,7 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
     elif commands_actuator_id_5_command_value < -65504.0:
         stats.saturate('buoyancy_piston.commands[actuator_id=5].command_value')
         commands_actuator_id_5_command_value = -65504.0
-    return _K56.pack(5, 0, _f16(commands_actuator_id_5_command_value))
+    return _K58.pack(5, 0, _f16(commands_actuator_id_5_command_value))
 
 
 def thruster_1_feedback_wire_to_ros(
@@ -1299,7 +1394,7 @@ def thruster_1_feedback_wire_to_ros(
     _P = int.from_bytes(payload, 'big')
     if _n < 14:
         raise WireError('uavcan.equipment.esc.Status: payload too short')
-    u_current, u_temperature = _K57.unpack_from(payload, 6)
+    u_current, u_temperature = _K59.unpack_from(payload, 6)
     _t1 = _P >> (_L - 98) & 0x3ffff
     u_rpm = (((_t1 >> 10 & 0xff) | (_t1 >> 2 & 0xff) << 8 | (_t1 & 0x3) << 16) ^ 0x20000) - 0x20000
     temperature_c = u_temperature - 273.15
@@ -1315,8 +1410,8 @@ def thruster_1_feedback_wire_to_ros(
     else:
         temperature_c = round(temperature_c)
     return (
-        _K58.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K29, u_rpm, u_current,
+        _K60.pack(
+            _K2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K30, u_rpm, u_current,
             temperature_c,
         ),
         receive_ns,
@@ -1333,7 +1428,7 @@ def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
+    length, = _K11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1341,7 +1436,7 @@ def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     offset += -offset & 3
     if size < offset + 13:
         raise WireError('CDR: truncated')
-    rpm, current, temperature_c = _K59.unpack_from(cdr, offset + 4)
+    rpm, current, temperature_c = _K61.unpack_from(cdr, offset + 4)
     rpm_2 = rpm
     if rpm_2 > 131071:
         stats.saturate('thruster_1_feedback.rpm')
@@ -1366,7 +1461,7 @@ def thruster_1_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     _v1 = rpm_2 & 0x3ffff
     _v2 = (_v1 & 0xff) << 10 | (_v1 >> 8 & 0xff) << 2 | _v1 >> 16
     _a = _v2 << 12
-    return _K60.pack(_f16(current_2), _f16(temperature)) + (_a << 2).to_bytes(4, 'big')
+    return _K62.pack(_f16(current_2), _f16(temperature)) + (_a << 2).to_bytes(4, 'big')
 
 
 def thruster_2_feedback_wire_to_ros(
@@ -1381,7 +1476,7 @@ def thruster_2_feedback_wire_to_ros(
     _P = int.from_bytes(payload, 'big')
     if _n < 14:
         raise WireError('uavcan.equipment.esc.Status: payload too short')
-    u_current, u_temperature = _K57.unpack_from(payload, 6)
+    u_current, u_temperature = _K59.unpack_from(payload, 6)
     _t1 = _P >> (_L - 98) & 0x3ffff
     u_rpm = (((_t1 >> 10 & 0xff) | (_t1 >> 2 & 0xff) << 8 | (_t1 & 0x3) << 16) ^ 0x20000) - 0x20000
     temperature_c = u_temperature - 273.15
@@ -1397,8 +1492,8 @@ def thruster_2_feedback_wire_to_ros(
     else:
         temperature_c = round(temperature_c)
     return (
-        _K58.pack(
-            _K1, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K29, u_rpm, u_current,
+        _K60.pack(
+            _K2, receive_ns // 1_000_000_000, receive_ns % 1_000_000_000, _K30, u_rpm, u_current,
             temperature_c,
         ),
         receive_ns,
@@ -1415,7 +1510,7 @@ def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    length, = _K10.unpack_from(cdr, 4)
+    length, = _K11.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1423,7 +1518,7 @@ def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     offset += -offset & 3
     if size < offset + 13:
         raise WireError('CDR: truncated')
-    rpm, current, temperature_c = _K59.unpack_from(cdr, offset + 4)
+    rpm, current, temperature_c = _K61.unpack_from(cdr, offset + 4)
     rpm_2 = rpm
     if rpm_2 > 131071:
         stats.saturate('thruster_2_feedback.rpm')
@@ -1448,7 +1543,7 @@ def thruster_2_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
     _v1 = rpm_2 & 0x3ffff
     _v2 = (_v1 & 0xff) << 10 | (_v1 >> 8 & 0xff) << 2 | _v1 >> 16
     _a = _v2 << 12 | 0x1
-    return _K60.pack(_f16(current_2), _f16(temperature)) + (_a << 2).to_bytes(4, 'big')
+    return _K62.pack(_f16(current_2), _f16(temperature)) + (_a << 2).to_bytes(4, 'big')
 
 
 def thrust_vector_feedback_wire_to_ros(
@@ -1463,7 +1558,7 @@ def thrust_vector_feedback_wire_to_ros(
     _P = int.from_bytes(payload, 'big')
     if _n < 11:
         raise WireError('sam.actuator.ThrustVectorFeedback: payload too short')
-    _t1 = _K13.unpack_from(payload, 0)
+    _t1 = _K14.unpack_from(payload, 0)
     u_timestamp_usec = int.from_bytes(_t1[0], 'little')
     _t2 = _P >> (_L - 82) & 0x3ffffff
     u_vertical_mrad = (((_t2 >> 18 & 0xff) | (_t2 >> 13 & 0x1f) << 8) ^ 0x1000) - 0x1000
@@ -1480,7 +1575,7 @@ def thrust_vector_feedback_wire_to_ros(
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
     return (
-        _K62.pack(_K1, sec, nanosec, _K61, u_vertical_mrad, u_horizontal_mrad), sec * 1_000_000_000 + nanosec,
+        _K63.pack(_K2, sec, nanosec, _K30, u_vertical_mrad, u_horizontal_mrad), sec * 1_000_000_000 + nanosec,
     )
 
 
@@ -1494,7 +1589,7 @@ def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> b
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _K4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _K5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1502,7 +1597,7 @@ def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> b
     offset += -offset & 1
     if size < offset + 8:
         raise WireError('CDR: truncated')
-    vertical_mrad, horizontal_mrad = _K63.unpack_from(cdr, offset + 4)
+    vertical_mrad, horizontal_mrad = _K64.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('thrust_vector_feedback.timestamp.usec')
@@ -1526,7 +1621,7 @@ def thrust_vector_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> b
     _v3 = horizontal_mrad_2 & 0x1fff
     _v4 = (_v3 & 0xff) << 5 | _v3 >> 8
     _a = _v2 << 13 | _v4
-    return _K13.pack((us & 0xffffffffffffff).to_bytes(7, 'little')) + (_a << 6).to_bytes(4, 'big')
+    return _K14.pack((us & 0xffffffffffffff).to_bytes(7, 'little')) + (_a << 6).to_bytes(4, 'big')
 
 
 def longitudinal_weight_feedback_wire_to_ros(
@@ -1539,7 +1634,7 @@ def longitudinal_weight_feedback_wire_to_ros(
     _n = len(payload)
     if _n < 12:
         raise WireError('sam.actuator.PositionFeedback: payload too short')
-    _t1 = _K64.unpack_from(payload, 0)
+    _t1 = _K65.unpack_from(payload, 0)
     u_timestamp_usec = int.from_bytes(_t1[0], 'little')
     u_percent = _t1[1]
     u_encoder_count = int.from_bytes(_t1[2], 'little')
@@ -1554,7 +1649,7 @@ def longitudinal_weight_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _K65.pack(_K1, sec, nanosec, _K29, u_percent, u_encoder_count), sec * 1_000_000_000 + nanosec
+    return _K66.pack(_K2, sec, nanosec, _K30, u_percent, u_encoder_count), sec * 1_000_000_000 + nanosec
 
 
 def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1567,7 +1662,7 @@ def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _K4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _K5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1575,7 +1670,7 @@ def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any
     offset += -offset & 3
     if size < offset + 12:
         raise WireError('CDR: truncated')
-    percent, encoder_count = _K66.unpack_from(cdr, offset + 4)
+    percent, encoder_count = _K67.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('longitudinal_weight_feedback.timestamp.usec')
@@ -1591,7 +1686,7 @@ def longitudinal_weight_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any
     if encoder_count_2 > 16777215:
         stats.saturate('longitudinal_weight_feedback.encoder_count')
         encoder_count_2 = 16777215
-    return _K67.pack(
+    return _K68.pack(
         (us & 0xffffffffffffff).to_bytes(7, 'little'), _f16(percent_2),
         (encoder_count_2 & 0xffffff).to_bytes(3, 'little'),
     )
@@ -1607,7 +1702,7 @@ def buoyancy_piston_feedback_wire_to_ros(
     _n = len(payload)
     if _n < 12:
         raise WireError('sam.actuator.PositionFeedback: payload too short')
-    _t1 = _K64.unpack_from(payload, 0)
+    _t1 = _K65.unpack_from(payload, 0)
     u_timestamp_usec = int.from_bytes(_t1[0], 'little')
     u_percent = _t1[1]
     u_encoder_count = int.from_bytes(_t1[2], 'little')
@@ -1622,7 +1717,7 @@ def buoyancy_piston_feedback_wire_to_ros(
     else:
         sec = us // 1_000_000
         nanosec = us % 1_000_000 * 1000
-    return _K65.pack(_K1, sec, nanosec, _K29, u_percent, u_encoder_count), sec * 1_000_000_000 + nanosec
+    return _K66.pack(_K2, sec, nanosec, _K30, u_percent, u_encoder_count), sec * 1_000_000_000 + nanosec
 
 
 def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
@@ -1635,7 +1730,7 @@ def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) ->
         raise WireError('CDR: not little-endian plain CDR (encapsulation 00 01)')
     if size < 16:
         raise WireError('CDR: truncated')
-    header_stamp_sec, header_stamp_nanosec, length = _K4.unpack_from(cdr, 4)
+    header_stamp_sec, header_stamp_nanosec, length = _K5.unpack_from(cdr, 4)
     offset = 12
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
@@ -1643,7 +1738,7 @@ def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) ->
     offset += -offset & 3
     if size < offset + 12:
         raise WireError('CDR: truncated')
-    percent, encoder_count = _K66.unpack_from(cdr, offset + 4)
+    percent, encoder_count = _K67.unpack_from(cdr, offset + 4)
     us = header_stamp_sec * 1_000_000 + header_stamp_nanosec // 1000
     if us < 0:
         stats.saturate('buoyancy_piston_feedback.timestamp.usec')
@@ -1659,7 +1754,7 @@ def buoyancy_piston_feedback_ros_to_wire(cdr: bytes | memoryview, stats: Any) ->
     if encoder_count_2 > 16777215:
         stats.saturate('buoyancy_piston_feedback.encoder_count')
         encoder_count_2 = 16777215
-    return _K67.pack(
+    return _K68.pack(
         (us & 0xffffffffffffff).to_bytes(7, 'little'), _f16(percent_2),
         (encoder_count_2 & 0xffffff).to_bytes(3, 'little'),
     )
@@ -1691,7 +1786,7 @@ def _wire_matches_thrust_vector(payload: bytes | bytearray | memoryview) -> bool
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     return _item(u_commands, 0, 0) is not None and _item(u_commands, 0, 1) is not None
 
 
@@ -1702,7 +1797,7 @@ def _wire_matches_ballast(payload: bytes | bytearray | memoryview) -> bool:
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     return _item(u_commands, 0, 2) is not None and _item(u_commands, 0, 3) is not None
 
 
@@ -1713,7 +1808,7 @@ def _wire_matches_longitudinal_weight(payload: bytes | bytearray | memoryview) -
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     return _item(u_commands, 0, 4) is not None
 
 
@@ -1724,7 +1819,7 @@ def _wire_matches_buoyancy_piston(payload: bytes | bytearray | memoryview) -> bo
     _t1 = (_L - _o - 8) // 32 + 1 if _L - _o >= 8 else 0
     if _t1 and _L - _o - (_t1 - 1) * 32 < 32:
         raise WireError('uavcan.equipment.actuator.ArrayCommand: tail array element cut short')
-    u_commands = list(_K50.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
+    u_commands = list(_K52.iter_unpack(payload[_o >> 3:(_o >> 3) + _t1 * 4]))
     return _item(u_commands, 0, 5) is not None
 
 
