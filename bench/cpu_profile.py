@@ -3,16 +3,19 @@
     python -m bench.cpu_profile --py-spy PATH [--seconds 20] [--protocols cyphal,dronecan] [--out DIR]
     python -m bench.cpu_profile --summarise FILE       (a py-spy ``--format raw`` file: print its summary)
 
-Each protocol gets a run of its own (bench/cpu_rig.py with ``--profile``: the bridge, the raw receiver and the sim
-as in the CPU section, py-spy ``record --format raw --threads --nonblocking`` for ``--seconds`` of the nominal
-window). py-spy is not a dependency of the project: install it anywhere (``python3 -m pip install py-spy``) and
-give its path. The summary goes into the CPU section of DIR/results.json and results.md (default bench/results);
-the full listing is printed.
+Each protocol gets two runs of its own (bench/cpu_rig.py with ``--profile``: the bridge, the raw receiver and the
+sim as in the CPU section, py-spy ``record --format raw --threads --nonblocking`` for ``--seconds`` of the nominal
+window): ``active``, every thread that is not sleeping, and ``gil``, only the thread holding the GIL (``--gil``:
+Python at work, without the time in system calls and in the run queue). py-spy is not a dependency of the
+project: install it anywhere (``python3 -m pip install py-spy``) and give its path. The summary goes into the CPU
+section of DIR/results.json and results.md (default bench/results); the full listing is printed.
 
-A sample is one running thread at one instant (py-spy leaves out threads it sees idle), so samples / (seconds x
-rate) approximates the share of a core. Each sample is charged to the subsystem of its innermost frame that one of
-``RULES`` names (a leaf in the standard library is charged to its caller's subsystem), or to ``waiting`` when the
-innermost line is a select/poll/wait call (a thread woken up, or its polling timeout).
+A sample is one running thread at one instant (py-spy leaves out threads it sees idle). A thread woken up but
+waiting for a core, or for the GIL, is not idle to py-spy: on a loaded machine samples / (seconds x rate) is well
+above the process's CPU (both are recorded), which is why the ``gil`` view is taken beside it. Each sample is
+charged to the subsystem of its innermost frame that one of ``RULES`` names (a leaf in the standard library is
+charged to its caller's subsystem), or to ``waiting`` when the innermost line is a select/poll/wait call (a thread
+woken up, or its polling timeout).
 """
 
 from __future__ import annotations
@@ -101,10 +104,13 @@ def summarise(path: Path, seconds: float, rate_hz: float = RATE_HZ) -> dict[str,
         own[frames[-1] if frames else head] += n
 
     def pct(c: Counter[str]) -> dict[str, float]:
-        return {k: round(100.0 * v / total, 1) for k, v in c.most_common()} if total else {}
+        n = sum(c.values())
+        return {k: round(100.0 * v / n, 1) for k, v in c.most_common()} if n else {}
 
+    working = Counter({k: v for k, v in by_sub.items() if not k.startswith("waiting")})
     return {"samples": total, "cpu_percent_est": round(100.0 * total / (seconds * rate_hz), 1) if seconds else None,
-            "threads_seen": len(threads), "by_subsystem_percent": pct(by_sub), "by_thread_percent": pct(by_thread),
+            "threads_seen": len(threads), "by_subsystem_percent": pct(by_sub),
+            "working_by_subsystem_percent": pct(working), "by_thread_percent": pct(by_thread),
             "top_own_percent": dict(list(pct(own).items())[:15])}
 
 
@@ -112,6 +118,8 @@ def listing(proto: str, s: dict[str, Any]) -> str:
     out = [f"== {proto}: {s['samples']} samples, ~{s['cpu_percent_est']} % of a core, {s['threads_seen']} threads "
            "sampled", "by subsystem (innermost frame):"]
     out += [f"  {v:5.1f} %  {k}" for k, v in s["by_subsystem_percent"].items()]
+    out.append("the samples not waiting, by subsystem:")
+    out += [f"  {v:5.1f} %  {k}" for k, v in s["working_by_subsystem_percent"].items()]
     out.append("by thread:")
     out += [f"  {v:5.1f} %  {k}" for k, v in s["by_thread_percent"].items()]
     out.append("innermost frames:")
@@ -139,18 +147,21 @@ def main(argv: list[str] | None = None) -> int:
     prof: dict[str, Any] = {"seconds": args.seconds, "rate_hz": RATE_HZ, "py_spy_version": "".join(version),
                             "protocols": {}}
     for proto in [p.strip() for p in args.protocols.split(",") if p.strip()]:
-        log(f"profile: {proto}, {args.seconds:g} s")
-        r = profile(proto, args.seconds, args.py_spy, args.warm)
-        f = Path(r["profile_file"])
-        if "error" in r or not f.is_file() or r.get("nominal", {}).get("profile_rc"):
-            err = r.get("error") or r.get("nominal", {}).get("profile_error") or "no profile written"
-            prof["protocols"][proto] = {"error": err}
-            log(f"profile: {proto} failed: {err}")
-            continue
-        s = summarise(f, args.seconds)
-        s["bridge_cpu_percent_in_run"] = r["nominal"]["bridge"]["cpu_percent"]
-        prof["protocols"][proto] = s
-        print(listing(proto, s), flush=True)
+        views: dict[str, Any] = {}
+        for view in ("active", "gil"):
+            log(f"profile: {proto}, {view}, {args.seconds:g} s")
+            r = profile(proto, args.seconds, args.py_spy, args.warm, gil=view == "gil")
+            f = Path(r["profile_file"])
+            if "error" in r or not f.is_file() or r.get("nominal", {}).get("profile_rc"):
+                err = r.get("error") or r.get("nominal", {}).get("profile_error") or "no profile written"
+                views[view] = {"error": err}
+                log(f"profile: {proto} {view} failed: {err}")
+                continue
+            s = summarise(f, args.seconds)
+            s["bridge_cpu_percent_in_run"] = r["nominal"]["bridge"]["cpu_percent"]
+            views[view] = s
+            print(listing(f"{proto} ({view})", s), flush=True)
+        prof["protocols"][proto] = views
     res_path = args.out / "results.json"
     res = json.loads(res_path.read_text()) if res_path.is_file() else {}
     if not res.get("cpu"):

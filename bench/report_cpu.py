@@ -25,13 +25,14 @@ def cpu_markdown(cpu: dict[str, Any]) -> list[str]:
     meth, code, m = cpu["method"], cpu["code"], cpu["machine"]
     ns = ("each run in a network namespace of its own (`unshare -n`, loopback up)" if meth["netns"] else
           f"in the machine's network namespace ({meth['netns_unavailable']})")
+    label = f"**{cpu['label']}** " if cpu.get("label") else ""
     lines = [HEADING, "",
-             f"Taken {m['date']}, code of commit {code['commit']} (runtime/ tree {code['runtime_tree']}, generated/ "
-             f"tree {code['generated_tree']}{', with uncommitted changes' if code['uncommitted_changes'] else ''}) "
-             f"on {m['cpu']}, {m['cores']} cores. Load average before/after: {cpu['loadavg_before']} / "
-             f"{cpu['loadavg_after']}; section wall time {cpu['wall_s']:.0f} s. Command: `python -m bench.run --parts "
-             "cpu` (bench/cpu.py).", "",
-             "`sam-codegen bridge` (with `--stats-file`, which gives the messages bridged) beside a raw receiver "
+             f"{label}Taken {m['date']}, code of commit {code['commit']} (runtime/ tree {code['runtime_tree']}, "
+             f"generated/ tree {code['generated_tree']}"
+             f"{', with uncommitted changes' if code['uncommitted_changes'] else ''}) on {m['cpu']}, {m['cores']} "
+             f"cores. Load average before/after: {cpu['loadavg_before']} / {cpu['loadavg_after']}; section wall "
+             f"time {cpu['wall_s']:.0f} s. The section alone: `python -m bench.run --parts cpu` (bench/cpu.py).", "",
+             "`sam-codegen bridge` (its messages counted from its /diagnostics) beside a raw receiver "
              "(bench/cpu_raw.py: a pycyphal node, resp. a dronecan node on the project's `mcast-lo:` driver, "
              "subscribed to the same ports, doing nothing), " + ns + ": both idle (no devices) for "
              f"{meth['window_s']:g} s after {meth['warm_s']:g} s of warm-up, then `sam-codegen sim` started (SAM's "
@@ -65,26 +66,38 @@ def cpu_markdown(cpu: dict[str, Any]) -> list[str]:
               "", *guard_lines(cpu["guard"])]
     prof = cpu.get("profile")
     if prof:
-        lines += ["", profile_paragraph(prof)]
+        lines += ["", *profile_markdown(prof)]
     return lines
 
 
-def profile_paragraph(prof: dict[str, Any]) -> str:
-    """The py-spy summary (bench/cpu_profile.py), short: share of the bridge's samples per subsystem."""
-    parts = []
-    for proto, s in prof["protocols"].items():
-        if "error" in s:
-            parts.append(f"{proto}: no profile ({s['error'][:200]})")
-            continue
-        cats = "; ".join(f"{k} {v:.0f} %" for k, v in s["by_subsystem_percent"].items() if v >= 1.0)
-        thr = "; ".join(f"{k} {v:.0f} %" for k, v in s["by_thread_percent"].items() if v >= 1.0)
-        parts.append(f"**{PROTOCOL_LABEL.get(proto, proto)}** ({s['samples']} samples = {s['cpu_percent_est']:.1f} % "
-                     f"of a core, {s['threads_seen']} threads sampled): by subsystem {cats}; by thread {thr}")
-    return (f"Profile at nominal traffic (py-spy {prof.get('py_spy_version', '')} `record --format raw --threads "
-            f"--nonblocking`, {prof['seconds']:g} s at {prof['rate_hz']:g} Hz on the bridge, a run of its own; share "
-            "of the samples in which a thread was running, by the innermost frame's subsystem, bench/cpu_profile.py; "
-            "`waiting` = samples inside a select/poll/wait call, i.e. wake-ups and timeouts): " + " ".join(
-                f"{p}." for p in parts))
+def profile_markdown(prof: dict[str, Any]) -> list[str]:
+    """The py-spy summary (bench/cpu_profile.py), short: per protocol and view, the share of the bridge's samples
+    per subsystem, and per thread."""
+    views = [(proto, view, v.get(view, {})) for proto, v in prof["protocols"].items() for view in ("active", "gil")]
+    views = [(p, w, s) for p, w, s in views if "samples" in s]
+    failed = [f"{p}: {str(v.get(w, {}).get('error', ''))[:200]}" for p, v in prof["protocols"].items()
+              for w in ("active", "gil") if "samples" not in v.get(w, {})]
+    lines = [f"Profile at nominal traffic: py-spy {prof.get('py_spy_version', '')} `record --format raw --threads "
+             f"--nonblocking` on the bridge for {prof['seconds']:g} s at {prof['rate_hz']:g} Hz, in runs of their "
+             "own (bench/cpu_profile.py). `active`: every thread not asleep; `gil`: only the thread holding the GIL "
+             "(py-spy `--gil`: Python at work). A sample is charged to the subsystem of its innermost frame; "
+             "`waiting` = inside a select/poll/wait call: a wake-up, a polling timeout, or a woken thread waiting "
+             "for a core or the GIL (py-spy counts those as running: on this loaded machine the active samples "
+             "add up to about twice the CPU that /proc gives for the same run)."]
+    if failed:
+        lines.append("No profile: " + "; ".join(failed) + ".")
+    if not views:
+        return lines
+    subs = list(dict.fromkeys(k for _, _, s in views for k in s["by_subsystem_percent"]))
+    rows = [[k, *(f"{s['by_subsystem_percent'].get(k, 0.0):.0f}" for _, _, s in views)] for k in subs]
+    rows.append(["samples (~% of a core; /proc %)",
+                 *(f"{s['samples']} ({s['cpu_percent_est']:.0f}; {s['bridge_cpu_percent_in_run']:.0f})"
+                   for _, _, s in views)])
+    lines += ["", table(["% of the samples", *(f"{p} {w}" for p, w, _ in views)], rows), ""]
+    lines += ["Samples by thread (active): " + " ".join(
+        f"{p}: " + ", ".join(f"{k} {v:.0f} %" for k, v in s["by_thread_percent"].items() if v >= 1.0) + "."
+        for p, w, s in views if w == "active")]
+    return lines
 
 
 def splice(md: str, section: list[str]) -> str:

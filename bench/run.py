@@ -1,12 +1,13 @@
 """The benchmark session of issue 5 (`nox -s bench`; not part of the tests), with issue 10's DroneCAN part and
 issue 12's wire codecs.
 
-    python -m bench.run [--quick] [--parts generator,converters,codec,bridge,dronecan] [--transports udp,can]
+    python -m bench.run [--quick] [--parts generator,converters,codec,bridge,dronecan,cpu] [--transports udp,can]
                         [--out DIR]
 
 Runs the parts, prints the tables, writes DIR/results.md, DIR/results.json and DIR/scaling.png
 (DIR default bench/results). Every figure is a ratio against a reference measured in the same run, with the
-absolute numbers beside it. About 11 minutes on the project's 2-core machine (``--quick``: about 5).
+absolute numbers beside it. About 23 minutes on the project's 2-core machine, half of it the CPU section
+(``--quick``: about 7).
 
 Parts: ``generator``, ``converters``, ``codec`` (every generated wire codec against the object pipeline it
 replaces, Cyphal and DroneCAN, bench/codec.py: ~15 s), ``bridge`` (Cyphal/UDP and Cyphal/CAN FD, bench/bridge.py:
@@ -397,9 +398,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cpu-warm", type=float, default=None, help="cpu part: warm-up s (default 15, --quick 5)")
     ap.add_argument("--cpu-window", type=float, default=None, help="cpu part: window s (default 40, --quick 15)")
     ap.add_argument("--cpu-protocols", default="cyphal,dronecan")
+    ap.add_argument("--cpu-label", default=None, help="cpu part: what these figures are (e.g. 'BEFORE issue 26')")
     ap.add_argument("--render", action="store_true",
-                    help="only rewrite results.md and scaling.png from the results.json in --out")
+                    help="only rewrite results.md and scaling.png from the results.json in --out (with --parts cpu: "
+                         "only results.md's CPU section)")
     args = ap.parse_args(argv)
+    if args.render and args.parts == "cpu":  # the CPU section alone, spliced into results.md
+        res = json.loads((args.out / "results.json").read_text())
+        md_path = args.out / "results.md"
+        md_path.write_text(splice(md_path.read_text() if md_path.is_file() else "", cpu_markdown(res["cpu"])))
+        return 0
     if args.render:
         res = json.loads((args.out / "results.json").read_text())
         res["notes"] = notes(res)
@@ -453,7 +461,8 @@ def main(argv: list[str] | None = None) -> int:
         res["cpu"] = cpu.run(tuple(p.strip() for p in args.cpu_protocols.split(",") if p.strip()),
                              runs=args.cpu_runs or (1 if args.quick else 3),
                              warm_s=args.cpu_warm if args.cpu_warm is not None else 5.0 if args.quick else 15.0,
-                             window_s=args.cpu_window if args.cpu_window is not None else 15.0 if args.quick else 40.0)
+                             window_s=args.cpu_window if args.cpu_window is not None else 15.0 if args.quick else 40.0,
+                             label=args.cpu_label)
         for line in cpu.guard_lines(res["cpu"]["guard"]):
             log(line)
         if parts == ["cpu"]:
