@@ -40,7 +40,7 @@ RULES: tuple[tuple[str, re.Pattern[str]], ...] = (
     ("codec / converters (generated)", re.compile(r"sam_bridge/(codec|codec_v0|convert|convert_v0|"
                                                   r"conversion_support)\.py")),
     ("rclpy publish", re.compile(r"rclpy/publisher\.py|Publisher\.publish")),
-    ("diagnostics, stats file", re.compile(r"sam_runtime/bridge/(diagnostics|reporting|health|liveness|silence)\.py|"
+    ("diagnostics", re.compile(r"sam_runtime/bridge/(diagnostics|reporting|health|liveness|silence)\.py|"
                                            r"write_json_atomic|Bridge\.stats|sam_runtime/bridge/counters\.py")),
     ("time sync", re.compile(r"sam_runtime/bridge/time_sync\.py")),
     ("transport receive (pycyphal UDP / dronecan driver, FrameGate)",

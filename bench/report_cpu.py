@@ -25,7 +25,7 @@ def cpu_markdown(cpu: dict[str, Any]) -> list[str]:
     meth, code, m = cpu["method"], cpu["code"], cpu["machine"]
     ns = ("each run in a network namespace of its own (`unshare -n`, loopback up)" if meth["netns"] else
           f"in the machine's network namespace ({meth['netns_unavailable']})")
-    label = f"**{cpu['label']}** " if cpu.get("label") else ""
+    label = f"**{cpu['label']}**. " if cpu.get("label") else ""
     lines = [HEADING, "",
              f"{label}Taken {m['date']}, code of commit {code['commit']} (runtime/ tree {code['runtime_tree']}, "
              f"generated/ tree {code['generated_tree']}"
@@ -82,8 +82,9 @@ def profile_markdown(prof: dict[str, Any]) -> list[str]:
              "own (bench/cpu_profile.py). `active`: every thread not asleep; `gil`: only the thread holding the GIL "
              "(py-spy `--gil`: Python at work). A sample is charged to the subsystem of its innermost frame; "
              "`waiting` = inside a select/poll/wait call: a wake-up, a polling timeout, or a woken thread waiting "
-             "for a core or the GIL (py-spy counts those as running: on this loaded machine the active samples "
-             "add up to about twice the CPU that /proc gives for the same run)."]
+             "for a core or the GIL (py-spy counts those as running: on a loaded machine the active samples add up "
+             "to well above the CPU that /proc gives for the same run, last row; the GIL view, below it, leaves out "
+             "the time outside Python: system calls, DDS's own threads)."]
     if failed:
         lines.append("No profile: " + "; ".join(failed) + ".")
     if not views:
