@@ -14,7 +14,7 @@ beside them. Default: 3 x 2 x (15 + 40 + 15 + 40 s + start-up): about 12 minutes
 
 The guard (:func:`guard`) compares every figure with the CPU section of the committed bench/results/results.json
 (``git show HEAD:...``) and calls a figure worse when it exceeds the previous median by more than its noise:
-the larger of the two runs' min-max spreads, ``REL_TOLERANCE`` of the previous median (not for thread counts:
+the larger of the two runs' min-max spreads, ``REL_TOLERANCE`` (10 %) of the previous median (not for thread counts:
 one thread more is worse), and a floor per figure (about the CPU clock's 10 ms tick over a window).
 """
 
@@ -34,7 +34,9 @@ from bench.common import REPO, TMP, log, machine, median
 PROTOCOLS = ("cyphal", "dronecan")
 PROTOCOL_LABEL = {"cyphal": "Cyphal/UDP (layout default)", "dronecan": "DroneCAN on mcast-lo: (layout dronecan)"}
 RESULTS_JSON = "bench/results/results.json"
-REL_TOLERANCE = 0.05
+# The same code measured twice on this shared 2-core machine moved by up to 7-10 % (two baselines of main 23a38b9,
+# a quick run after them), more than three runs' spread sometimes shows: below this a move is not called a change.
+REL_TOLERANCE = 0.10
 # (condition, figure, label, floor of its tolerance, relative tolerance, guarded: the bridge's own figures; the raw
 # receiver's are the machine's and the libraries' drift, shown for reading the others). A thread count is exact:
 # one thread more is worse.
@@ -229,11 +231,17 @@ def guard_lines(g: dict[str, Any]) -> list[str]:
         return [f"Regression guard: no previous figure ({g['source']}); these figures are the first."]
     p = g["previous"]
     lines = [f"Regression guard against {g['source']} (commit {p['commit']}, taken {p['date']}): {g['verdict']}."]
+    verdict = {(r["protocol"], r["condition"], r["figure"]): r["verdict"] for r in g["rows"]}
     for r in g["rows"]:
         if r["verdict"] in ("worse", "better"):
             what = "" if r["guarded"] else " (reference, not guarded)"
+            # The raw receiver moved the same way on the same traffic: the machine, more likely than the bridge.
+            raw = verdict.get((r["protocol"], r["condition"], "raw_percent"))
+            hint = (f"; the raw receiver moved the same way ({raw}): the machine?"
+                    if r["guarded"] and r["figure"] in ("bridge_percent", "us_per_message") and raw == r["verdict"]
+                    else "")
             lines.append(f"- {r['verdict'].upper()}: {r['protocol']} {r['label']}{what}: {r['before']:g} -> "
-                         f"{r['now']:g} ({r['delta']:+g}, noise +/-{r['tolerance']:g})")
+                         f"{r['now']:g} ({r['delta']:+g}, noise +/-{r['tolerance']:g}{hint})")
     return lines
 
 

@@ -105,3 +105,13 @@ def test_counters_from_the_bridges_diagnostics() -> None:
                      status(heartbeats=3)])  # a device's status: not counted
     assert counters_of(msg) == Counters(published=107, dropped=1, uptime_s=12.5, mappings=2)
     assert counters_of(NS(status=[status(heartbeats=3)])) is None  # another node's /diagnostics
+
+
+def test_a_bridge_figure_that_moved_with_the_raw_receiver_points_at_the_machine() -> None:
+    before, now = _cpu([19.0, 20.0, 21.0], [3.5, 3.5, 3.5]), _cpu([24.0, 25.0, 26.0], [3.5, 3.5, 3.5])
+    for cpu, raw in ((before, [10.0, 10.0, 10.0]), (now, [13.0, 13.0, 13.0])):
+        cpu["protocols"]["cyphal"]["figures"]["nominal"]["raw_percent"] = {
+            "median": raw[1], "min": min(raw), "max": max(raw), "values": raw}
+    lines = guard_lines(guard(before, now, "HEAD"))
+    line = next(ln for ln in lines if "bridge CPU % at nominal" in ln)
+    assert line.startswith("- WORSE") and "the raw receiver moved the same way (worse): the machine?" in line
