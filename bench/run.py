@@ -1,22 +1,29 @@
 """The benchmark session of issue 5 (`nox -s bench`; not part of the tests), with issue 10's DroneCAN part and
 issue 12's wire codecs.
 
-    python -m bench.run [--quick] [--parts generator,converters,codec,bridge,dronecan] [--transports udp,can]
+    python -m bench.run [--quick] [--parts generator,converters,codec,bridge,dronecan,cpu] [--transports udp,can]
                         [--out DIR]
 
 Runs the parts, prints the tables, writes DIR/results.md, DIR/results.json and DIR/scaling.png
 (DIR default bench/results). Every figure is a ratio against a reference measured in the same run, with the
-absolute numbers beside it. About 11 minutes on the project's 2-core machine (``--quick``: about 5).
+absolute numbers beside it. About 23 minutes on the project's 2-core machine, half of it the CPU section
+(``--quick``: about 7).
 
 Parts: ``generator``, ``converters``, ``codec`` (every generated wire codec against the object pipeline it
 replaces, Cyphal and DroneCAN, bench/codec.py: ~15 s), ``bridge`` (Cyphal/UDP and Cyphal/CAN FD, bench/bridge.py:
 the bridge on its wire path, then on its object path, each against raw pycyphal: ~6 min) and ``dronecan`` (the
 bridge on DroneCAN, layout ``dronecan``, both paths against raw dronecan on the loopback multicast bus,
-bench/bridge_dronecan.py: ~2.5 min, ``--quick`` ~1). One part alone, e.g. the DroneCAN one:
+bench/bridge_dronecan.py: ~2.5 min, ``--quick`` ~1) and ``cpu`` (issue 26: ``sam-codegen bridge`` beside a raw
+receiver at SAM's nominal traffic and idle, both protocols, each run in a network namespace of its own, and the
+regression guard against the committed results, bench/cpu.py: ~12 min, ``--quick`` ~2). One part alone, e.g. the
+DroneCAN one:
 
     python -m bench.run --parts dronecan [--quick] [--out DIR]
 
 (--out another directory to keep bench/results/ of a whole run: results.md and results.json hold what was run.)
+The ``cpu`` part alone is merged instead: its section of results.json and results.md is replaced, the rest kept:
+
+    python -m bench.run --parts cpu [--cpu-runs N] [--cpu-warm S] [--cpu-window S] [--cpu-protocols cyphal,dronecan]
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ from typing import Any
 
 import bench.common  # noqa: F401  (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST before anything can import rclpy)
 from bench.common import RESULTS, generated_package, log, machine
+from bench.report_cpu import cpu_markdown, splice
 from bench.report_fmt import num as _f
 from bench.report_fmt import ok as _ok
 from bench.report_fmt import table
@@ -47,7 +55,7 @@ from bench.report_wire import (
     transport_rows,
 )
 
-DEFAULT_PARTS = "generator,converters,codec,bridge,dronecan"
+DEFAULT_PARTS = "generator,converters,codec,bridge,dronecan,cpu"
 
 
 def loadavg() -> list[float]:
@@ -270,6 +278,8 @@ def markdown(res: dict[str, Any], command: str) -> str:
     dc = res.get("dronecan")
     if dc and "throughput" in dc:
         lines += dronecan_markdown(dc)
+    if res.get("cpu"):
+        lines += [*cpu_markdown(res["cpu"]), ""]
     notes = res.get("notes")
     if notes:
         lines += ["## What limits the figures", "", *notes]
@@ -363,6 +373,20 @@ def write_plot(res: dict[str, Any], out: Path) -> None:
         log(f"no PNG: {ex} (pip install matplotlib)")
 
 
+def merge_cpu(cpu: dict[str, Any], out: Path) -> int:
+    """The cpu part run alone: its section replaces the one in OUT/results.json and results.md, the rest is kept."""
+    out.mkdir(parents=True, exist_ok=True)
+    res_path, md_path = out / "results.json", out / "results.md"
+    res = json.loads(res_path.read_text()) if res_path.is_file() else {}
+    res["cpu"] = cpu
+    res_path.write_text(json.dumps(res, indent=1, default=str) + "\n")
+    section = cpu_markdown(cpu)
+    md_path.write_text(splice(md_path.read_text() if md_path.is_file() else "# Benchmark results\n", section))
+    print("\n".join(section))
+    log(f"merged the CPU section into {res_path} and {md_path}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.run", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -370,9 +394,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--parts", default=DEFAULT_PARTS, help=f"comma-separated, of {DEFAULT_PARTS}")
     ap.add_argument("--transports", default="udp,can")
     ap.add_argument("--out", type=Path, default=RESULTS)
+    ap.add_argument("--cpu-runs", type=int, default=None, help="cpu part: runs per protocol (default 3, --quick 1)")
+    ap.add_argument("--cpu-warm", type=float, default=None, help="cpu part: warm-up s (default 15, --quick 5)")
+    ap.add_argument("--cpu-window", type=float, default=None, help="cpu part: window s (default 40, --quick 15)")
+    ap.add_argument("--cpu-protocols", default="cyphal,dronecan")
+    ap.add_argument("--cpu-label", default=None, help="cpu part: what these figures are (e.g. 'BEFORE issue 26')")
     ap.add_argument("--render", action="store_true",
-                    help="only rewrite results.md and scaling.png from the results.json in --out")
+                    help="only rewrite results.md and scaling.png from the results.json in --out (with --parts cpu: "
+                         "only results.md's CPU section)")
     args = ap.parse_args(argv)
+    if args.render and args.parts == "cpu":  # the CPU section alone, spliced into results.md
+        res = json.loads((args.out / "results.json").read_text())
+        md_path = args.out / "results.md"
+        md_path.write_text(splice(md_path.read_text() if md_path.is_file() else "", cpu_markdown(res["cpu"])))
+        return 0
     if args.render:
         res = json.loads((args.out / "results.json").read_text())
         res["notes"] = notes(res)
@@ -420,6 +455,19 @@ def main(argv: list[str] | None = None) -> int:
 
         log("part 5: bridge on DroneCAN")
         res["dronecan"] = bridge_dronecan.run(gen, **(bridge_dronecan.QUICK if args.quick else {}))
+    if "cpu" in parts:
+        from bench import cpu
+
+        log("part 6: bridge CPU at nominal traffic")
+        res["cpu"] = cpu.run(tuple(p.strip() for p in args.cpu_protocols.split(",") if p.strip()),
+                             runs=args.cpu_runs or (1 if args.quick else 3),
+                             warm_s=args.cpu_warm if args.cpu_warm is not None else 5.0 if args.quick else 15.0,
+                             window_s=args.cpu_window if args.cpu_window is not None else 15.0 if args.quick else 40.0,
+                             label=args.cpu_label)
+        for line in cpu.guard_lines(res["cpu"]["guard"]):
+            log(line)
+        if parts == ["cpu"]:
+            return merge_cpu(res["cpu"], args.out)
     res["loadavg_after"] = loadavg()
     res["wall_s"] = time.monotonic() - t0
     res["notes"] = notes(res)
