@@ -14,11 +14,11 @@ its own thread.
   on a future that completes only when the bridge stops, instead of returning to Python after every callback as
   spin_once does (~15 % less CPU per command in the rclpy thread). No polling: the thread sleeps until a callback
   is due, however long (the slice is an hour: without a timeout, rclpy 7's EventsExecutor keeps the GIL while it
-  waits); stopping completes the future and wakes the executor. The Python executors (the fallback) wait in
-  spin_once without a timeout and are woken the same way. It is the one executor of the bridge's ROS nodes but
-  the service mappings' (their calls wait for a device, on threads of their own): the node duties
-  (sam_runtime.bridge.backends.dronecan_duties) add their node to it (:meth:`RosSide.add_node`). An exception out
-  of a callback is counted (``spin_error``) and the executor goes on.
+  waits); stopping completes the future and wakes the executor. The Python executors (the fallback) spin for the
+  same future without a timeout (they add a done callback to it per call: one call here). It is the one executor
+  of the bridge's ROS nodes but the service mappings' (their calls wait for a device, on threads of their own):
+  the node duties (sam_runtime.bridge.backends.dronecan_duties) add their node to it (:meth:`RosSide.add_node`).
+  An exception out of a callback is counted (``spin_error``) and the executor goes on.
 """
 
 from __future__ import annotations
@@ -65,6 +65,7 @@ class RosSide:
         self._publishers: dict[str, Any] = {}
         self._subscriptions: dict[str, Any] = {}
         self._spin_future: Any = None
+        self._events = False  # the executor is rclpy's EventsExecutor
         self._spin_thread: threading.Thread | None = None
         self._stop_spin = threading.Event()
         self._extra_nodes: list[Any] = []  # other parts' ROS nodes on this executor (RosSide.add_node)
@@ -95,12 +96,12 @@ class RosSide:
             raise BridgeConfigError(str(ex)) from None
         try:
             from rclpy.experimental import EventsExecutor
-            from rclpy.task import Future
 
             self.executor = EventsExecutor(context=self.context)
-            self._spin_future = Future()
+            self._events = True
         except ImportError:
             self.executor = SingleThreadedExecutor(context=self.context)
+            self._events = False
         self.executor.add_node(self.node)
 
     def add_node(self, node: Any) -> None:
@@ -130,8 +131,7 @@ class RosSide:
         from rclpy.task import Future
 
         self._stop_spin.clear()
-        if self._spin_future is not None:
-            self._spin_future = Future()  # a new one per start: the last stop completed the old one
+        self._spin_future = Future()  # a new one per start: the last stop completed the old one
         self._spin_thread = threading.Thread(target=self._spin, name=f"{self.name}-rclpy", daemon=True)
         self._spin_thread.start()
 
@@ -141,10 +141,11 @@ class RosSide:
         self._stop_spin.set()
         if self._spin_future is not None and not self._spin_future.done():
             self._spin_future.set_result(None)
-        try:
-            self.executor.wake()  # out of its wait at once: it waits for a callback without a timeout
-        except Exception:  # the context is going down: the executor stops anyway
-            pass
+        if self._events:
+            try:
+                self.executor.wake()  # (the EventsExecutor does not wake for the future alone)
+            except Exception:  # the context is going down: the executor stops anyway
+                pass
         if self._spin_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._spin_thread.join, 5.0)
 
@@ -152,10 +153,10 @@ class RosSide:
         executor, future = self.executor, self._spin_future
         while not self._stop_spin.is_set():
             try:
-                if future is not None:
+                if self._events:
                     executor.spin_until_future_complete(future, timeout_sec=_SPIN_SLICE_S)
-                else:
-                    executor.spin_once()
+                else:  # no timeout: a Python executor wakes when the future completes
+                    executor.spin_until_future_complete(future)
             except Exception as ex:  # a callback bug or a context going down: keep spinning until told
                 if self._stop_spin.is_set() or not self.context.ok():
                     break

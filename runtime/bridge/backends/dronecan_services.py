@@ -83,7 +83,7 @@ class DroneCanServices(ServiceMappingsRos):
             return
         if call.key is not None:
             self._pending[call.key] = call
-        node_loop = self.backend.node_loop
+        node_loop = getattr(self.backend, "node_loop", None)
         if node_loop is not None:  # the request's timeout is on dronecan's scheduler: the NodeLoop re-arms its timer
             node_loop.wake()
 

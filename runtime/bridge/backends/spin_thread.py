@@ -22,28 +22,29 @@ class SpinThread:
         self.lifetime, self.context, self.executor, self.node = lifetime, context, executor, node
         self.error_key, self.what = error_key, what
         executor.add_node(node)
-        self._stop = threading.Event()
+        from rclpy.task import Future
+
+        # Done at close(): rclpy's Python executors wake when a future they spin for completes (a guard condition
+        # alone only makes them wait again).
+        self._stop: Any = Future()
         self.thread = threading.Thread(target=self._spin, name=name, daemon=True)
 
     def start(self) -> None:
         self.thread.start()
 
     def _spin(self) -> None:
-        while not self._stop.is_set() and not self.lifetime.closed and self.context.ok():
+        while not self._stop.done() and not self.lifetime.closed and self.context.ok():
             try:
-                self.executor.spin_once()  # until a callback ran or close() woke it
+                self.executor.spin_until_future_complete(self._stop)  # no timeout: no polling
             except Exception as ex:  # the context shutting down under us, or a callback's bug
-                if self._stop.is_set() or self.lifetime.closed:
+                if self._stop.done() or self.lifetime.closed:
                     return
                 self.lifetime.errors[self.error_key] += 1
                 log.warning("%s: %s: %s", self.what, type(ex).__name__, ex)
 
     def close(self) -> None:
-        self._stop.set()
-        try:
-            self.executor.wake()
-        except Exception:  # the context is gone already: its shutdown woke the executor
-            pass
+        if not self._stop.done():
+            self._stop.set_result(None)
         if self.thread.is_alive():
             self.thread.join(timeout=2.0)
         for step in (lambda: self.executor.shutdown(timeout_sec=1.0), self.node.destroy_node):
