@@ -25,7 +25,8 @@ module                 job
                        (Cyphal v1 through pycyphal: transports, node, registers/ports, heartbeats, pycyphal's
                        counters; its wire path ``backends.cyphal_wire``), ``backends.dronecan`` (DroneCAN through
                        sam_runtime.dronecan_io; its node duties ``backends.dronecan_duties``)
-``ros_side``           the ROS node: parameters, each topic's QoS, the receive clock, the executor thread
+``ros_side``           the ROS node: parameters, each topic's QoS, the receive clock, the executor thread (which
+                       spins the DroneCAN duties' node too; it sleeps until a callback is due)
 ``inbound``            the UAVCAN -> ROS path (source filter, conversion, stamps, publish)
 ``outbound``           the ROS -> UAVCAN path (conversion, bounded queues, workers)
 ``handoff``            the rclpy thread -> asyncio loop hand-off, one wake-up per batch

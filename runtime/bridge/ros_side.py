@@ -10,11 +10,15 @@ its own thread.
   use_sim_time made ROS time active; time.time_ns costs ~0.06 us against ~2.4 us for Clock.now(), so the clock is
   asked only while ROS time is active (tracked after every parameter set: use_sim_time may change at run time).
 - The executor: rclpy's EventsExecutor where it exists (it does not rebuild a wait set per wake-up: ~3x the
-  command throughput of SingleThreadedExecutor here, bench/profile_bridge.py), spun in 0.1 s slices of
-  spin_until_future_complete on a future that never completes, instead of returning to Python after every
-  callback as spin_once does (~15 % less CPU per command in the rclpy thread). Not for the Python executors: they
-  add a done callback to the future on every call. An exception out of a callback is counted (``spin_error``) and
-  the executor goes on.
+  command throughput of SingleThreadedExecutor here, bench/profile_bridge.py), spun by spin_until_future_complete
+  on a future that completes only when the bridge stops, instead of returning to Python after every callback as
+  spin_once does (~15 % less CPU per command in the rclpy thread). No polling: the thread sleeps until a callback
+  is due, however long (the slice is an hour: without a timeout, rclpy 7's EventsExecutor keeps the GIL while it
+  waits); stopping completes the future and wakes the executor. The Python executors (the fallback) spin for the
+  same future without a timeout (they add a done callback to it per call: one call here). It is the one executor
+  of the bridge's ROS nodes but the service mappings' (their calls wait for a device, on threads of their own):
+  the node duties (sam_runtime.bridge.backends.dronecan_duties) add their node to it (:meth:`RosSide.add_node`).
+  An exception out of a callback is counted (``spin_error``) and the executor goes on.
 """
 
 from __future__ import annotations
@@ -30,6 +34,10 @@ from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.node_support import ParameterConfigError, declare_parameters, qos_profile
 
 __all__ = ["RosSide"]
+
+# How long one spin_until_future_complete waits at most: not a poll (stopping wakes it), a bound that keeps the
+# call's timeout finite (rclpy 7's EventsExecutor holds the GIL while it waits without one).
+_SPIN_SLICE_S = 3600.0
 
 
 class RosSide:
@@ -57,8 +65,10 @@ class RosSide:
         self._publishers: dict[str, Any] = {}
         self._subscriptions: dict[str, Any] = {}
         self._spin_future: Any = None
+        self._events = False  # the executor is rclpy's EventsExecutor
         self._spin_thread: threading.Thread | None = None
         self._stop_spin = threading.Event()
+        self._extra_nodes: list[Any] = []  # other parts' ROS nodes on this executor (RosSide.add_node)
 
     def attach(self) -> None:
         """The node first when the bridge starts; destroyed last."""
@@ -86,17 +96,24 @@ class RosSide:
             raise BridgeConfigError(str(ex)) from None
         try:
             from rclpy.experimental import EventsExecutor
-            from rclpy.task import Future
 
             self.executor = EventsExecutor(context=self.context)
-            self._spin_future = Future()
+            self._events = True
         except ImportError:
             self.executor = SingleThreadedExecutor(context=self.context)
+            self._events = False
         self.executor.add_node(self.node)
 
+    def add_node(self, node: Any) -> None:
+        """Another ROS node of the bridge on this executor (before the spinner starts); destroyed at close, before
+        the bridge's node."""
+        self.executor.add_node(node)
+        self._extra_nodes.append(node)
+
     def _close(self) -> None:
-        """After everything else: the executor, the node, the context (each may already be gone)."""
+        """After everything else: the executor, the nodes, the context (each may already be gone)."""
         steps = [lambda: self.executor.shutdown(timeout_sec=1.0) if self.executor is not None else None,
+                 *[node.destroy_node for node in self._extra_nodes],
                  lambda: self.node.destroy_node() if self.node is not None else None,
                  lambda: self.context.shutdown() if self.context is not None and self.context.ok() else None]
         for step in steps:
@@ -111,7 +128,10 @@ class RosSide:
         self.lifetime.add_hooks("rclpy executor", start=self._start_spinning, close=self._stop_spinning)
 
     def _start_spinning(self) -> None:
+        from rclpy.task import Future
+
         self._stop_spin.clear()
+        self._spin_future = Future()  # a new one per start: the last stop completed the old one
         self._spin_thread = threading.Thread(target=self._spin, name=f"{self.name}-rclpy", daemon=True)
         self._spin_thread.start()
 
@@ -119,6 +139,13 @@ class RosSide:
         import asyncio
 
         self._stop_spin.set()
+        if self._spin_future is not None and not self._spin_future.done():
+            self._spin_future.set_result(None)
+        if self._events:
+            try:
+                self.executor.wake()  # (the EventsExecutor does not wake for the future alone)
+            except Exception:  # the context is going down: the executor stops anyway
+                pass
         if self._spin_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._spin_thread.join, 5.0)
 
@@ -126,10 +153,10 @@ class RosSide:
         executor, future = self.executor, self._spin_future
         while not self._stop_spin.is_set():
             try:
-                if future is not None:
-                    executor.spin_until_future_complete(future, timeout_sec=0.1)
-                else:
-                    executor.spin_once(timeout_sec=0.1)
+                if self._events:
+                    executor.spin_until_future_complete(future, timeout_sec=_SPIN_SLICE_S)
+                else:  # no timeout: a Python executor wakes when the future completes
+                    executor.spin_until_future_complete(future)
             except Exception as ex:  # a callback bug or a context going down: keep spinning until told
                 if self._stop_spin.is_set() or not self.context.ok():
                     break

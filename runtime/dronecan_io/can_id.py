@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["TAIL_EOT", "TAIL_SOT", "TAIL_TOGGLE", "Tail", "V0Id"]
+__all__ = ["TAIL_EOT", "TAIL_SOT", "TAIL_TID", "TAIL_TOGGLE", "Tail", "V0Id"]
 
 TAIL_SOT = 0x80
 TAIL_EOT = 0x40
 TAIL_TOGGLE = 0x20
-_TID_MASK = 0x1F
+TAIL_TID = 0x1F
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class Tail:
         if not data:
             return None
         b = data[-1]
-        return cls(bool(b & TAIL_SOT), bool(b & TAIL_EOT), bool(b & TAIL_TOGGLE), b & _TID_MASK)
+        return cls(bool(b & TAIL_SOT), bool(b & TAIL_EOT), bool(b & TAIL_TOGGLE), b & TAIL_TID)
 
     @property
     def is_cyphal_v1_start(self) -> bool:

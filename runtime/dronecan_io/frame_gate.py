@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from dronecan.driver.common import AbstractDriver, CANFrame
 
-from sam_runtime.dronecan_io.can_id import Tail, V0Id
+from sam_runtime.dronecan_io.can_id import TAIL_EOT, TAIL_SOT, TAIL_TID, TAIL_TOGGLE, V0Id
 from sam_runtime.dronecan_io.drops import DropCounter, DropReason
 from sam_runtime.dronecan_io.wire import TransferTaps
 
@@ -143,31 +143,36 @@ class FrameGate(AbstractDriver):
         if not frame.extended:
             self.drops.add(DropReason.NOT_EXTENDED_ID, detail=f"11-bit frame 0x{frame.id:03x}")
             return None
-        tail = Tail.of(frame.data)
-        if tail is None:
+        data = frame.data
+        if not data:
             self._drop(DropReason.EMPTY_FRAME, frame, "frame without a tail byte")
             return None
-        key = (frame.id, tail.transfer_id)
-        now = self._clock()
-        if tail.start:
-            if tail.is_cyphal_v1_start:
+        tail = data[-1]  # (the bits of can_id.Tail, read inline: this runs for every frame of the bus)
+        end = tail & TAIL_EOT
+        key = (frame.id, tail & TAIL_TID)
+        if tail & TAIL_SOT:
+            if end and not tail & TAIL_TOGGLE and not self._partial:  # a single-frame v0 transfer, nothing held
+                return None if self.taps is not None and self.taps.take([frame]) else frame
+            now = self._clock()
+            if tail & TAIL_TOGGLE:
                 self._drop(DropReason.CYPHAL_V1_FRAME, frame, "first frame with the toggle bit set (Cyphal v1)")
-                if not tail.end:
+                if not end:
                     self._v1[key] = now
                 return None
             if key in self._partial:
                 self._drop_partial(key, "restarted by a new first frame")
-            if tail.end:
+            if end:
                 return None if self.taps is not None and self.taps.take([frame]) else frame
             if len(self._partial) >= self._max_partial:
                 self._drop_partial(next(iter(self._partial)), "too many unfinished transfers")
             self._partial[key] = _Partial([frame], now)
             return None
+        now = self._clock()
         partial = self._partial.get(key)
         if partial is not None:
             partial.frames.append(frame)
             partial.last_seen = now
-            if tail.end:
+            if end:
                 del self._partial[key]
                 if self.taps is not None and self.taps.take(partial.frames):
                     return None
@@ -178,7 +183,7 @@ class FrameGate(AbstractDriver):
             return None
         if key in self._v1:
             self._drop(DropReason.CYPHAL_V1_FRAME, frame, "frame of a Cyphal v1 transfer")
-            if tail.end:
+            if end:
                 del self._v1[key]
             else:
                 self._v1[key] = now

@@ -42,6 +42,7 @@ from sam_runtime.dronecan_io.mcast_packet import MCAST_PORT, PacketError, decode
 __all__ = ["LOOPBACK_ADDRESS", "Acceptance", "LoopbackMulticastDriver"]
 
 LOOPBACK_ADDRESS = "127.0.0.1"
+OVERFLOW_CHECK_S = 0.05
 _RECV_SIZE = 2048  # more than the largest valid packet (74 bytes), so an oversized one is seen whole and rejected
 
 
@@ -123,6 +124,11 @@ class LoopbackMulticastDriver(AbstractDriver):
         # that a time-sync master knows when its frame left however late its caller reads it.
         self.last_tx_ns: tuple[int, int] | None = None
         self._overflow_reported = 0
+        # The kernel's drop counter is read when the socket is found empty, at most every OVERFLOW_CHECK_S: a
+        # system call per wake-up of a loop that reads every frame at once (hundreds a second) costs more than the
+        # frames; an overflow is reported at the next empty read after that (a NodeLoop reads at least once a
+        # second), never lost.
+        self._next_overflow_check = 0.0
         self._poll = select.poll()
         self._poll.register(self._rx.fileno(), select.POLLIN)
         self._closed = False
@@ -149,7 +155,7 @@ class LoopbackMulticastDriver(AbstractDriver):
             try:
                 data, ancdata, _flags, source = self._rx.recvmsg(_RECV_SIZE, _ANC_SIZE)
             except BlockingIOError:
-                if self._count_drops:
+                if self._count_drops and time.monotonic() >= self._next_overflow_check:
                     self._count_overflow()
                 if not self._wait_readable(deadline):
                     return None
@@ -208,6 +214,7 @@ class LoopbackMulticastDriver(AbstractDriver):
         return self._sent
 
     def _count_overflow(self) -> None:
+        self._next_overflow_check = time.monotonic() + OVERFLOW_CHECK_S
         kernel_drops = _kernel_drops(self._rx)
         if kernel_drops is None:
             return

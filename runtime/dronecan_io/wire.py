@@ -14,6 +14,7 @@ bytes, CRC, transfer ids from the node's own counter, classic CAN with tail arra
 
 from __future__ import annotations
 
+import binascii
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -29,30 +30,15 @@ PayloadHandler = Callable[[bytes, int, int, float], None]  # (payload, source no
 DEFAULT_PRIORITY = 20  # what dronecan's node.broadcast uses when given none (dronecan.node.DEFAULT_TRANSFER_PRIORITY)
 
 
-def _crc_table() -> tuple[int, ...]:
-    table = []
-    for byte in range(256):
-        crc = byte << 8
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
-        table.append(crc)
-    return tuple(table)
-
-
-_CRC_TABLE = _crc_table()
-
-
-def crc16(data: bytes, initial: int) -> int:
-    """CRC-16-CCITT as UAVCAN v0 computes a multi-frame transfer's CRC (dronecan.dsdl.common.crc16_from_bytes),
-    a table lookup per byte instead of dronecan's eight shifts.
+def crc16(data: bytes | bytearray, initial: int) -> int:
+    """CRC-16-CCITT as UAVCAN v0 computes a multi-frame transfer's CRC (dronecan.dsdl.common.crc16_from_bytes):
+    binascii's crc_hqx is that CRC (polynomial 0x1021, not reflected, any seed), in C instead of dronecan's eight
+    shifts a byte (tests/runtime/dronecan_io/test_wire_path.py compares them).
 
     >>> hex(crc16(b"123456789", 0xFFFF))
     '0x29b1'
     """
-    crc, table = initial, _CRC_TABLE
-    for byte in data:
-        crc = ((crc << 8) & 0xFFFF) ^ table[(crc >> 8) ^ byte]
-    return crc
+    return binascii.crc_hqx(data, initial)
 
 
 @dataclass(frozen=True)
@@ -102,10 +88,10 @@ class TransferTaps:
                 self._drop(DropReason.TOGGLE_ERROR, dtid, src, f"toggle bit wrong on frame {i}")
                 return None
             toggle ^= TAIL_TOGGLE
-        data = b"".join(bytes(f.data[:-1]) for f in frames)
+        data = b"".join([f.data[:-1] for f in frames])
         payload = data[2:]
         expected = data[0] | data[1] << 8
-        crc = crc16(payload, crc_base)
+        crc = binascii.crc_hqx(payload, crc_base)
         if crc != expected:
             self._drop(DropReason.CRC_MISMATCH, dtid, src, f"CRC mismatch: expected {crc:x}, got {expected:x}")
             return None

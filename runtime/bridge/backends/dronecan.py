@@ -51,6 +51,7 @@ from sam_runtime.dronecan_io.wire import TransferTaps, broadcast_payload
 __all__ = ["DroneCanBackend", "node_status"]
 
 TRANSFER_ID_MODULO = 32  # v0 tail byte: 5-bit transfer ids
+IDLE_WAKEUP_S = 1.0  # the NodeLoop's longest sleep without a frame or a scheduler deadline
 _HEALTH = {0: "OK", 1: "WARNING", 2: "ERROR", 3: "CRITICAL"}
 _HEALTH_LEVEL = {0: 0, 1: 1}  # /diagnostics: OK OK, WARNING WARN, ERROR and CRITICAL ERROR
 _MODE = {0: "OPERATIONAL", 1: "INITIALIZATION", 2: "MAINTENANCE", 3: "SOFTWARE_UPDATE", 7: "OFFLINE"}
@@ -256,7 +257,10 @@ class DroneCanBackend(Backend):
         try:
             node.mode = dronecan.uavcan.protocol.NodeStatus().MODE_OPERATIONAL
             node.health = dronecan.uavcan.protocol.NodeStatus().HEALTH_OK
-            loop = NodeLoop(node, logger=log)
+            # max_idle 1 s, not 0.1 s: the loop's timer wakes the bridge at dronecan's next deadline (NodeStatus at
+            # 1 Hz) and for the gate's sweep, not ten times a second; whoever adds scheduled work outside dronecan's
+            # handlers wakes the NodeLoop (the service mappings' requests)
+            loop = NodeLoop(node, logger=log, max_idle=IDLE_WAKEUP_S)
             taps = TransferTaps(loop.drops)
             for sub, t in types:
                 sub.transfers, sub.seen, sub.drops = 0, {}, loop.drops

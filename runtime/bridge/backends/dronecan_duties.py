@@ -11,9 +11,10 @@ spec's ``bridge.node_services``, served with the service mappings: backends.serv
 - optional: a dynamic node id allocation server (dronecan's CentralizedServer with its NodeMonitor, in memory).
   (The bus's GlobalTimeSync master is sam_runtime.bridge.time_sync's, on both protocols.)
 
-The Panic topics live on a ROS node of their own with its own executor thread. The dronecan node belongs to the
-asyncio loop's thread: broadcasts are handed to it with ``call_soon_threadsafe``. Handlers are registered on every
-node the backend opens (it reopens after a failure).
+The Panic topics live on a ROS node of their own, spun by the bridge's executor (RosSide.add_node: no thread of
+their own; their callback only hands the broadcasts over, and an exception out of it is counted as
+``dronecan_duties_error``). The dronecan node belongs to the asyncio loop's thread: broadcasts are handed to it with
+``call_soon_threadsafe``. Handlers are registered on every node the backend opens (it reopens after a failure).
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ import logging
 from collections.abc import Mapping
 from typing import Any
 
-from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 
@@ -46,7 +46,7 @@ class DroneCanDuties:
         self.dna_server = bool(dna_server)
         self.counts: dict[str, int] = {"panic_in": 0, "panic_out": 0}
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._spinner: SpinThread | None = None  # the services' node on its executor thread
+        self.ros_node: Any = None  # the Panic topics' node, on the bridge's executor
         self._panic_pub: Any = None
         self._dna: Any = None
 
@@ -57,7 +57,6 @@ class DroneCanDuties:
 
     # ------------------------------------------------------------------------------------------------ ROS side
     def _start(self) -> None:
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
         from std_msgs.msg import String
 
@@ -68,17 +67,21 @@ class DroneCanDuties:
         if self.panic:
             self._panic_pub = node.create_publisher(String, f"{base}/panic_received", 10)
             node.create_subscription(String, f"{base}/panic", self._on_ros_panic, 10)
-        executor = SingleThreadedExecutor(context=self.ros.context)
-        self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-dronecan-duties",
-                                   "dronecan_duties_error", "DroneCAN duties")
-        self._spinner.start()
+        self.ros_node = node
+        self.ros.add_node(node)  # the bridge's executor spins it from its start on (the spinner starts last)
 
     def _close(self) -> None:
-        if self._spinner is not None:
-            self._spinner.close()
+        """Nothing to stop: the bridge's executor stopped first and destroys the node at its close."""
 
     # ------------------------------------------------------------------------------------------------ panic
     def _on_ros_panic(self, msg: Any) -> None:
+        try:
+            self._hand_over_panic(msg)
+        except Exception as ex:  # a bug: counted here, not as the bridge executor's spin_error
+            self.lifetime.errors["dronecan_duties_error"] += 1
+            log.warning("DroneCAN duties: %s: %s", type(ex).__name__, ex)
+
+    def _hand_over_panic(self, msg: Any) -> None:
         reason = msg.data.encode()[:7]
         loop = self._loop
         if loop is None or loop.is_closed():

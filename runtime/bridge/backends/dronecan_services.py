@@ -83,6 +83,9 @@ class DroneCanServices(ServiceMappingsRos):
             return
         if call.key is not None:
             self._pending[call.key] = call
+        node_loop = getattr(self.backend, "node_loop", None)
+        if node_loop is not None:  # the request's timeout is on dronecan's scheduler: the NodeLoop re-arms its timer
+            node_loop.wake()
 
     def _on_response(self, m: Any, nid: int, call: Call, event: Any) -> None:
         """dronecan's request callback (the loop's thread): the response, or None at the timeout."""
