@@ -3,25 +3,33 @@
 The presentation layer deserializes every transfer into a numpy-backed object and serializes every object it sends;
 the generated codecs do both straight from and to the bytes, so the wire path skips it:
 
-- :class:`RawReceiver`: one transport input session per subject (extent: the DSDL type's) and one task that hands
-  every transfer's payload to the core's handler, with its source node id, transfer id and timestamp, as
-  pycyphal's own subscriber task does (no queue: the handler is quick and never raises);
+- :func:`open_receiver`: on Cyphal/UDP (one interface: a ``loop_udp_transport``) a :class:`LoopReceiver`: the subject's
+  port of the transport's receiver on the event loop (sam_runtime.cyphal_io.udp_receiver: one socket, no thread,
+  pycyphal's parsing, reassembly and counters), which calls the core's handler with each transfer's payload bytes,
+  source node id, transfer id and timestamp; on any other transport (CAN, loopback, custom, redundant) a
+  :class:`RawReceiver`: one transport input session per subject (extent: the DSDL type's) and one task that hands
+  every transfer's payload to the handler, as pycyphal's own subscriber task does (no queue: the handler is quick
+  and never raises);
 - :class:`RawSender`: one transport output session per subject and a transfer-id counter that lives across
   reopenings of the transport (pycyphal keeps it per presentation; a reopened node would start again at 0).
 
-The sessions are the transport's, so pycyphal's node still lists the ports in ``uavcan.node.port.List``, and the
-transport counts frames, transfers, errors and drops per session exactly as under a presentation-layer port.
+Either way the transport lists the ports (pycyphal's node still names them in ``uavcan.node.port.List``) and
+:meth:`statistics` gives pycyphal's session statistics: frames, transfers, errors and drops, with the reassembly
+errors per source node on UDP, exactly as under a presentation-layer port.
 """
 
 from __future__ import annotations
 
+import abc
 import asyncio
 import logging
 import time
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["RawReceiver", "RawSender"]
+from sam_runtime.cyphal_io.udp_receiver import UDPLoopReceiver
+
+__all__ = ["LoopReceiver", "RawReceiver", "RawSender", "Receiver", "open_receiver"]
 
 _log = logging.getLogger(__name__)
 _RECEIVE_TIMEOUT_S = 1.0  # pycyphal's subscriber task wakes up as often; the task is cancelled on close anyway
@@ -33,11 +41,53 @@ def _extent_bytes(dtype: Any) -> int:
     return int(nunavut_support.get_extent_bytes(dtype))
 
 
-class RawReceiver:
+Handler = Callable[[bytes, "int | None", int, float], None]
+
+
+def open_receiver(transport: Any, subject_id: int, dtype: Any, handler: Handler) -> Receiver:
+    """The subject's receiver on ``transport``: on the event loop where the transport allows (Cyphal/UDP)."""
+    loop_rx = getattr(transport, "loop_receiver", None)  # sam_runtime.cyphal_io.udp_receiver.loop_udp_transport's
+    if loop_rx is not None:
+        return LoopReceiver(loop_rx, subject_id, dtype, handler)
+    return RawReceiver(transport, subject_id, dtype, handler)
+
+
+class Receiver(abc.ABC):
     """Receives the transfers of one subject as payload bytes until closed."""
 
-    def __init__(self, transport: Any, subject_id: int, dtype: Any,
-                 handler: Callable[[bytes, int | None, int, float], None]) -> None:
+    @abc.abstractmethod
+    def statistics(self) -> Any:
+        """pycyphal's statistics of the subject's input session."""
+
+    @abc.abstractmethod
+    def abort(self) -> None:
+        """Stop at once (a failed open; no await)."""
+
+    @abc.abstractmethod
+    async def close(self) -> None:
+        """Stop and release the port."""
+
+
+class LoopReceiver(Receiver):
+    """The subject's port of a UDPLoopReceiver: the handler is called from the event loop's reader."""
+
+    def __init__(self, receiver: UDPLoopReceiver, subject_id: int, dtype: Any, handler: Handler) -> None:
+        self.port = receiver.subscribe(subject_id, _extent_bytes(dtype), handler)
+
+    def statistics(self) -> Any:
+        return self.port.sample_statistics()
+
+    def abort(self) -> None:
+        self.port.close()
+
+    async def close(self) -> None:
+        self.port.close()
+
+
+class RawReceiver(Receiver):
+    """Receives the transfers of one subject as payload bytes until closed: a transport input session and a task."""
+
+    def __init__(self, transport: Any, subject_id: int, dtype: Any, handler: Handler) -> None:
         from pycyphal.transport import InputSessionSpecifier, MessageDataSpecifier, PayloadMetadata
 
         self.session = transport.get_input_session(
@@ -68,6 +118,9 @@ class RawReceiver:
 
     def statistics(self) -> Any:
         return self.session.sample_statistics()
+
+    def abort(self) -> None:
+        self.task.cancel()
 
     async def close(self) -> None:
         self.task.cancel()
