@@ -41,7 +41,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 __all__ = ["BATCH", "CYPHAL_PORT", "FRAME_INDEX_LIMIT", "MAX_FRAME_INDEX", "RCVBUF_BYTES", "TRANSFER_ID_TIMEOUT_S",
-           "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "subject_group"]
+           "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "single_frame_datagram", "subject_group"]
 
 _log = logging.getLogger(__name__)
 
@@ -110,6 +110,17 @@ def _crc32c_register(data: bytes, value: int = 0xFFFFFFFF) -> int:
     for x in data:
         value = (value >> 8) ^ table[x ^ (value & 0xFF)]
     return value
+
+
+def single_frame_datagram(source_node_id: int | None, subject_id: int, transfer_id: int, payload: bytes,
+                          priority: int = 4) -> bytes:
+    """The datagram of a single-frame message transfer, as pycyphal's UDP output session makes it (header with its
+    CRC, payload, transfer CRC); the caller checks that it fits the MTU (``len(payload) + 4 <= mtu``).
+    ``priority``: 4 = NOMINAL."""
+    header = _HEADER.pack(_VERSION, priority, _ANONYMOUS if source_node_id is None else source_node_id, _ANONYMOUS,
+                          subject_id, transfer_id & 0xFFFFFFFFFFFFFFFF, _EOT, 0)
+    crc = _crc32c_register(payload) ^ 0xFFFFFFFF
+    return b"".join((header, binascii.crc_hqx(header, 0xFFFF).to_bytes(2, "big"), payload, crc.to_bytes(4, "little")))
 
 
 class _Source:

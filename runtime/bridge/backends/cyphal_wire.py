@@ -11,7 +11,11 @@ the generated codecs do both straight from and to the bytes, so the wire path sk
   every transfer's payload to the handler, as pycyphal's own subscriber task does (no queue: the handler is quick
   and never raises);
 - :class:`RawSender`: one transport output session per subject and a transfer-id counter that lives across
-  reopenings of the transport (pycyphal keeps it per presentation; a reopened node would start again at 0).
+  reopenings of the transport (pycyphal keeps it per presentation; a reopened node would start again at 0). On
+  Cyphal/UDP a transfer that fits one frame is sent straight on the session's non-blocking socket, its datagram
+  made as pycyphal makes it (sam_runtime.cyphal_io.udp_receiver.single_frame_datagram): pycyphal's send builds
+  frame objects and a task per frame (``wait_for(sock_sendall)``), some 40 us a message against 7 here; when the
+  socket would block, and for multi-frame transfers, pycyphal's session sends it.
 
 Either way the transport lists the ports (pycyphal's node still names them in ``uavcan.node.port.List``) and
 :meth:`statistics` gives pycyphal's session statistics: frames, transfers, errors and drops, with the reassembly
@@ -23,11 +27,12 @@ from __future__ import annotations
 import abc
 import asyncio
 import logging
+import socket
 import time
 from collections.abc import Callable
 from typing import Any
 
-from sam_runtime.cyphal_io.udp_receiver import UDPLoopReceiver
+from sam_runtime.cyphal_io.udp_receiver import UDPLoopReceiver, single_frame_datagram
 
 __all__ = ["LoopReceiver", "RawReceiver", "RawSender", "Receiver", "open_receiver"]
 
@@ -137,12 +142,19 @@ class RawSender:
     def __init__(self) -> None:
         self.session: Any = None
         self._next_transfer_id = 0
+        self._sock: socket.socket | None = None  # Cyphal/UDP: the session's socket (connected to the group)
+        self._udp: tuple[int | None, int, int] = (None, 0, 0)  # source node id, subject id, largest one-frame payload
 
     def reopen(self, transport: Any, subject_id: int, dtype: Any) -> None:
         from pycyphal.transport import MessageDataSpecifier, OutputSessionSpecifier, PayloadMetadata
 
         self.session = transport.get_output_session(
             OutputSessionSpecifier(MessageDataSpecifier(subject_id), None), PayloadMetadata(_extent_bytes(dtype)))
+        sock = getattr(self.session, "socket", None)  # a UDPOutputSession's
+        self._sock = sock if isinstance(sock, socket.socket) else None
+        if self._sock is not None:
+            mtu = int(transport.protocol_parameters.mtu)
+            self._udp = (transport.local_node_id, int(subject_id), mtu - 4)
 
     async def send(self, payload: bytes, timeout: float) -> bool:
         from pycyphal.transport import Priority, Timestamp, Transfer
@@ -150,12 +162,20 @@ class RawSender:
         session = self.session
         tid = self._next_transfer_id
         self._next_transfer_id = tid + 1  # the transport takes it modulo its own transfer-id modulo
+        sock = self._sock
+        if sock is not None and len(payload) <= self._udp[2] and sock.fileno() >= 0:
+            src, subject, _ = self._udp
+            try:
+                sock.send(single_frame_datagram(src, subject, tid, payload))
+                return True
+            except BlockingIOError:  # the socket's buffer is full: pycyphal's send waits for room
+                pass
         loop = asyncio.get_running_loop()
         return bool(await session.send(Transfer(Timestamp.now(), Priority.NOMINAL, tid, [memoryview(payload)]),
                                        loop.time() + timeout))
 
     def close(self) -> None:
-        session, self.session = self.session, None
+        session, self.session, self._sock = self.session, None, None
         if session is not None:
             try:
                 session.close()

@@ -39,7 +39,13 @@ from pycyphal.transport.commons.high_overhead_transport import TransferCRC, Tran
 from pycyphal.transport.udp import PromiscuousUDPInputSession, PromiscuousUDPInputSessionStatistics, UDPFrame
 from pycyphal.transport.udp._ip._endpoint_mapping import message_data_specifier_to_multicast_group
 
-from sam_runtime.cyphal_io.udp_receiver import FRAME_INDEX_LIMIT, MAX_FRAME_INDEX, SubjectPort, subject_group
+from sam_runtime.cyphal_io.udp_receiver import (
+    FRAME_INDEX_LIMIT,
+    MAX_FRAME_INDEX,
+    SubjectPort,
+    single_frame_datagram,
+    subject_group,
+)
 
 SUBJECT = 1234
 OTHER_SUBJECT = 1235
@@ -314,3 +320,13 @@ def test_same_as_pycyphal_on_any_datagram_sequence(episodes: list[tuple[list[byt
         event("unparsable datagram")
     if ref.raised:
         event("pycyphal's parser raised")
+
+
+@given(st.one_of(st.none(), st.integers(0, 0xFFFE)), st.integers(0, 8191), st.integers(0, 2**64 - 1),
+       st.binary(max_size=80), st.integers(0, 7))
+@settings(max_examples=200, deadline=None)
+def test_the_single_frame_datagram_is_pycyphals(src: int | None, subject: int, tid: int, payload: bytes,
+                                                 prio: int) -> None:
+    ref = _frame(payload + TransferCRC.new(payload).value_as_bytes, src=src, tid=tid, subject=subject,
+                 prio=Priority(prio))
+    assert single_frame_datagram(src, subject, tid, payload, prio) == ref

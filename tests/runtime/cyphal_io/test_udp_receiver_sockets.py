@@ -255,3 +255,4 @@ def test_yakut_pub_reaches_the_receiver() -> None:
         got = asyncio.run(go())
     assert [(p, src) for p, src, _ in got] == [((123456).to_bytes(4, "little"), 42)] * 3
     assert [tid for _, _, tid in got] == sorted(tid for _, _, tid in got)
+
