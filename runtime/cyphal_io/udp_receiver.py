@@ -49,7 +49,10 @@ Handler = Callable[[bytes, "int | None", int, float], None]  # (payload, source 
 
 CYPHAL_PORT = 9382  # pycyphal.transport.udp's CYPHAL_PORT
 BATCH = 256  # datagrams per wake-up at most: a flood cannot hold the loop
-RCVBUF_BYTES = 4 << 20  # asked for (the kernel caps it at 2 * net.core.rmem_max): one socket buffers every subject
+# The receive buffer asked for (the kernel doubles it, capped at 2 * net.core.rmem_max): one socket queues every
+# subject, so it holds more than one of pycyphal's sockets (rmem_default, 208 KiB) yet not so much that a flood on
+# one subject holds the others for long: 2 MiB, ~2,700 small datagrams, about a second of the bridge's throughput.
+RCVBUF_BYTES = 1 << 20
 MAX_FRAME_INDEX = 4095  # 4096 frames: 4.9 MB at pycyphal's default MTU, far beyond any extent the bridge has
 _READ_SIZE = 0xFFFF  # as pycyphal's reader: any UDP/IPv4 datagram fits
 # Linux values; Python 3.11's socket module names none of them.
