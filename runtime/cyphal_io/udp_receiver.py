@@ -40,6 +40,9 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from sam_runtime.cyphal_io.crc32c import RESIDUE as CRC32C_RESIDUE
+from sam_runtime.cyphal_io.crc32c import crc32c_register
+
 __all__ = ["BATCH", "CYPHAL_PORT", "FRAME_INDEX_LIMIT", "MAX_FRAME_INDEX", "RCVBUF_BYTES", "TRANSFER_ID_TIMEOUT_S",
            "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "single_frame_datagram", "subject_group"]
 
@@ -70,21 +73,6 @@ _SNM = 1 << 15
 _EOT = 1 << 31
 _INDEX_MASK = _EOT - 1
 _CRC_SIZE = 4
-_CRC32C_RESIDUE = 0xB798B438  # the register after a message and its CRC (before the output XOR)
-
-
-def _crc32c_table() -> tuple[int, ...]:
-    """CRC-32C (Castagnoli, reflected polynomial 0x82F63B78): pycyphal's TransferCRC."""
-    out = []
-    for i in range(256):
-        v = i
-        for _ in range(8):
-            v = (v >> 1) ^ (0x82F63B78 if v & 1 else 0)
-        out.append(v)
-    return tuple(out)
-
-
-_CRC32C_TABLE = _crc32c_table()
 TRANSFER_ID_TIMEOUT_S = 2.0  # pycyphal's UDPInputSession.DEFAULT_TRANSFER_ID_TIMEOUT
 
 # The reassembly errors by the names of pycyphal's TransferReassembler.Error (its members in sample_statistics());
@@ -108,13 +96,6 @@ def subject_group(subject_id: int) -> bytes:
     return bytes((239, 0, (subject_id >> 8) & 0x7F, subject_id & 0xFF))
 
 
-def _crc32c_register(data: bytes, value: int = 0xFFFFFFFF) -> int:
-    table = _CRC32C_TABLE
-    for x in data:
-        value = (value >> 8) ^ table[x ^ (value & 0xFF)]
-    return value
-
-
 def single_frame_datagram(source_node_id: int | None, subject_id: int, transfer_id: int, payload: bytes,
                           priority: int = 4) -> bytes:
     """The datagram of a single-frame message transfer, as pycyphal's UDP output session makes it (header with its
@@ -122,7 +103,7 @@ def single_frame_datagram(source_node_id: int | None, subject_id: int, transfer_
     ``priority``: 4 = NOMINAL."""
     header = _HEADER.pack(_VERSION, priority, _ANONYMOUS if source_node_id is None else source_node_id, _ANONYMOUS,
                           subject_id, transfer_id & 0xFFFFFFFFFFFFFFFF, _EOT, 0)
-    crc = _crc32c_register(payload) ^ 0xFFFFFFFF
+    crc = crc32c_register(payload) ^ 0xFFFFFFFF
     return b"".join((header, binascii.crc_hqx(header, 0xFFFF).to_bytes(2, "big"), payload, crc.to_bytes(4, "little")))
 
 
@@ -214,7 +195,7 @@ class SubjectPort:
         eot = index_eot >= _EOT
         if src == _ANONYMOUS:  # TransferReassembler.construct_anonymous_transfer: stateless, no error counted
             if index == 0 and eot and len(data) > _HEADER_SIZE + _CRC_SIZE and \
-                    _crc32c_register(data[_HEADER_SIZE:]) == _CRC32C_RESIDUE:
+                    crc32c_register(data[_HEADER_SIZE:]) == CRC32C_RESIDUE:
                 self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], None, tid, now_ns)
             return
         st = self._sources.get(src)
@@ -231,7 +212,7 @@ class SubjectPort:
             st.ts_ns = now_ns
             st.tid = tid + 1
             if len(data) >= _HEADER_SIZE + _CRC_SIZE and \
-                    _crc32c_register(data[_HEADER_SIZE:]) == _CRC32C_RESIDUE:
+                    crc32c_register(data[_HEADER_SIZE:]) == CRC32C_RESIDUE:
                 self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], src, tid, now_ns)
             else:
                 self._error(src, _INTEGRITY)
@@ -270,7 +251,7 @@ class SubjectPort:
             return
         whole = b"".join(payloads)
         size_ok = len(whole) > _CRC_SIZE if len(payloads) > 1 else len(whole) >= _CRC_SIZE
-        ok = size_ok and _crc32c_register(whole) == _CRC32C_RESIDUE
+        ok = size_ok and crc32c_register(whole) == CRC32C_RESIDUE
         stamp_ns = st.ts_ns
         self._restart(st, src, tid + 1, None if ok else _INTEGRITY)
         if ok:

@@ -39,6 +39,7 @@ from pycyphal.transport.commons.high_overhead_transport import TransferCRC, Tran
 from pycyphal.transport.udp import PromiscuousUDPInputSession, PromiscuousUDPInputSessionStatistics, UDPFrame
 from pycyphal.transport.udp._ip._endpoint_mapping import message_data_specifier_to_multicast_group
 
+from sam_runtime.cyphal_io.crc32c import crc32c_register
 from sam_runtime.cyphal_io.udp_receiver import (
     FRAME_INDEX_LIMIT,
     MAX_FRAME_INDEX,
@@ -330,3 +331,14 @@ def test_the_single_frame_datagram_is_pycyphals(src: int | None, subject: int, t
     ref = _frame(payload + TransferCRC.new(payload).value_as_bytes, src=src, tid=tid, subject=subject,
                  prio=Priority(prio))
     assert single_frame_datagram(src, subject, tid, payload, prio) == ref
+
+
+@given(st.binary(max_size=300), st.integers(0, 2**32 - 1))
+@settings(max_examples=300, deadline=None)
+def test_crc32c_is_pycyphals_transfer_crc(data: bytes, start: int) -> None:
+    from pycyphal.transport.commons.crc import CRC32C
+
+    ref = CRC32C()
+    ref._value = start  # pycyphal's register, from any state: the word steps must agree with its byte steps
+    ref.add(data)
+    assert crc32c_register(data, start) == ref._value
