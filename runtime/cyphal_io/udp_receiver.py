@@ -23,6 +23,10 @@ index past :data:`MAX_FRAME_INDEX` (pycyphal would grow its fragment list up to 
 hostile datagram); these are ``errors`` too, the last with its own kind (``FRAME_INDEX_LIMIT``).
 Like pycyphal, the transport delivers the whole payload: the extent's implicit truncation is the deserializer's.
 
+Also here: :func:`loop_udp_transport`, pycyphal's UDPTransport that owns such a receiver (it lists the receiver's
+subjects among its input sessions and closes it), and :func:`single_frame_datagram`, a one-frame transfer's
+datagram as pycyphal's output session makes it (the bridge's wire path sends with it).
+
 The proof against the library is tests/runtime/cyphal_io/test_udp_receiver.py: the same datagram sequences,
 malformed ones included, fed to pycyphal's UDP input session and to this give the same transfers and counters.
 """

@@ -342,3 +342,11 @@ def test_crc32c_is_pycyphals_transfer_crc(data: bytes, start: int) -> None:
     ref._value = start  # pycyphal's register, from any state: the word steps must agree with its byte steps
     ref.add(data)
     assert crc32c_register(data, start) == ref._value
+
+
+def test_the_transfer_id_timeout_is_pycyphals() -> None:
+    from pycyphal.transport.udp import UDPInputSession
+
+    from sam_runtime.cyphal_io.udp_receiver import TRANSFER_ID_TIMEOUT_S
+
+    assert TRANSFER_ID_TIMEOUT_S == UDPInputSession.DEFAULT_TRANSFER_ID_TIMEOUT
