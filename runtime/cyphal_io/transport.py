@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled, find_compiled
+from sam_runtime.cyphal_io.udp_receiver import loop_udp_transport
 
 if TYPE_CHECKING:  # pragma: no cover
     import pycyphal.application
@@ -92,6 +93,7 @@ def make_transport(
     node_id: int | None,
     iface: str | None = None,
     mtu: int | None = None,
+    loop_rx: bool = False,
 ) -> pycyphal.transport.Transport:
     """A pycyphal transport.
 
@@ -104,6 +106,8 @@ def make_transport(
         Several whitespace-separated ifaces give a RedundantTransport. Unused for loopback.
     :param mtu: UDP: payload bytes per datagram (pycyphal default 1200). CAN: 8 = Classic CAN,
         64 (default) = CAN FD; 12..48 are CAN FD too.
+    :param loop_rx: UDP on one interface: a transport whose message subscriptions can be received on the event
+        loop instead of pycyphal's thread per session (sam_runtime.cyphal_io.udp_receiver.loop_udp_transport).
     """
     kind = kind.lower().strip()
     if kind not in TRANSPORT_KINDS:
@@ -120,8 +124,12 @@ def make_transport(
         from pycyphal.transport.udp import UDPTransport
 
         kw: dict[str, Any] = {} if mtu is None else {"mtu": int(mtu)}
-        for ip in (iface or _DEFAULT_UDP_IFACE).split():
-            factories.append(functools.partial(UDPTransport, ip, node_id, **kw))
+        ips = (iface or _DEFAULT_UDP_IFACE).split()
+        make_udp: Callable[..., pycyphal.transport.Transport] = UDPTransport
+        if loop_rx and len(ips) == 1:
+            make_udp = loop_udp_transport
+        for ip in ips:
+            factories.append(functools.partial(make_udp, ip, node_id, **kw))
     else:
         from pycyphal.transport.can import CANTransport
 
@@ -175,7 +183,7 @@ def _registry(environ: Mapping[str, str] | None) -> Any:
     return pycyphal.application.make_registry(None, environment_variables=env)
 
 
-def transport_from_env(env: Mapping[str, str] | None = None) -> pycyphal.transport.Transport:
+def transport_from_env(env: Mapping[str, str] | None = None, *, loop_rx: bool = False) -> pycyphal.transport.Transport:
     """A transport configured by the standard register environment variables (default: ``os.environ``).
 
     UAVCAN__NODE__ID (absent or 65535 = anonymous), UAVCAN__UDP__IFACE (space-separated IPs),
@@ -183,18 +191,26 @@ def transport_from_env(env: Mapping[str, str] | None = None) -> pycyphal.transpo
     (8 or 64; default 64), UAVCAN__CAN__BITRATE ('1000000 1000000' for Classic CAN), UAVCAN__LOOPBACK=1,
     UAVCAN__SERIAL__IFACE. Several configured transports give a RedundantTransport.
     Needs the compiled ``uavcan`` namespace (it is compiled on demand).
+    ``loop_rx``: one UDP interface gives a loop_udp_transport (see :func:`make_transport`), configured as pycyphal's.
     """
     _ensure_uavcan()
     import pycyphal.application
+    from pycyphal.transport.udp import UDPTransport
 
     env = os.environ if env is None else env
     env = dict(_classic_can_bitrate_default(env))
-    tr = pycyphal.application.make_transport(_registry(env))
+    registry = _registry(env)
+    tr = pycyphal.application.make_transport(registry)
     if tr is None:
         raise TransportConfigError(
             "no transport configured: set UAVCAN__UDP__IFACE (e.g. 127.0.0.1), UAVCAN__CAN__IFACE "
             "(e.g. virtual:vcan0) or UAVCAN__LOOPBACK=1"
         )
+    if loop_rx and type(tr) is UDPTransport:  # pycyphal built it from the registers, which give its settings
+        multiplier = int(registry["uavcan.udp.duplicate_service_transfers"]) + 1
+        ip, node_id, mtu = tr.local_ip_address, tr.local_node_id, tr.protocol_parameters.mtu
+        tr.close()  # no session opened yet: nothing else to undo
+        tr = loop_udp_transport(str(ip), node_id, mtu=mtu, service_transfer_multiplier=multiplier)
     return tr
 
 

@@ -232,16 +232,18 @@ def test_burst_above_capacity_every_message_published_or_counted(udp_run: dict[s
 
 
 def test_udp_drops_are_logged_at_a_bounded_rate(udp_run: dict[str, Any]) -> None:
-    """Thousands of drops, a handful of log lines: one per (mapping, reason) per log_interval at most."""
+    """Many drops, a handful of log lines: one per (mapping, reason) per log_interval at most."""
     lines = udp_run["log_lines"]
     imu = udp_run["bridge"]["mappings"]["imu"]
     uptime, interval = udp_run["bridge"]["bridge"]["uptime_s"], udp_run["log_interval"]
     _figures("bounded-rate logging (UDP)", {"log_lines": lines, "drops": imu["dropped"],
                                             "uptime_s": uptime, "log_interval_s": interval})
     limit = 1 + math.ceil(uptime / interval)
-    # Thousands lost (how many depends on how fast the injector gets the CPU: 3,878 of the bursts' 10,000 with a
-    # CPU burner beside the test, more when idle), yet a handful of lines.
-    assert imu["dropped"]["lost"] > 1000 and 1 <= lines["imu|lost"] <= limit
+    # Every lost transfer is an occurrence: the 50 broken on purpose, and what the bursts lose (how many depends on
+    # how fast the injector gets the CPU and on the receive buffer: 3,878 of the bursts' 10,000 with a CPU burner
+    # beside the test when pycyphal's threads received them; none to a few thousand since the bridge receives on
+    # its loop through one socket), yet a handful of lines.
+    assert imu["dropped"]["lost"] >= 50 and 1 <= lines["imu|lost"] <= limit
     assert 1 <= lines["imu|unknown_source"] <= limit
     assert all(n <= limit for n in lines.values()), lines
     # In the log (stderr): the same lines, plus at most one flushed at close; together they count every loss.

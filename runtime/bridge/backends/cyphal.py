@@ -40,7 +40,7 @@ from sam_runtime.bridge.backend import (
     LinkDownError,
     Outlet,
 )
-from sam_runtime.bridge.backends.cyphal_wire import RawReceiver, RawSender
+from sam_runtime.bridge.backends.cyphal_wire import RawSender, Receiver, open_receiver
 from sam_runtime.bridge.counters import log
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.tx_timestamps import KernelTxStamps, TxWindow
@@ -149,7 +149,7 @@ class _Subscription(Inlet):
         self.port_name = f"uavcan.sub.{name}"
         self.port_id: int | None = None
         self.below = BelowBridge()
-        self.subscriber: Any = None  # a pycyphal Subscriber, or on the wire path a RawReceiver
+        self.subscriber: Any = None  # a pycyphal Subscriber, or on the wire path a cyphal_wire.Receiver
         self.seen: dict[str, int] = {}  # pycyphal's counters of the current subscriber already accumulated
         self.refused = 0  # the wire path: payloads the codec refused since the port opened
 
@@ -249,7 +249,9 @@ class CyphalBackend(Backend):
         self._status_handlers: list[Callable[[DeviceStatus], None]] = []
         self._heartbeat_ids: dict[int, int] = {}  # node id -> transfer id of its last heartbeat
         self._node: Any = None
-        self._hb_sub: Any = None
+        self._hb_sub: Any = None  # a pycyphal Subscriber, or on Cyphal/UDP the heartbeat's port of the loop receiver
+        self._loop_rx: Any = None  # on Cyphal/UDP: the transport's UDPLoopReceiver
+        self._overflows_seen = 0
         self._suspect: str | None = None
         self._modulo = 2**64
         self._poll_lock = threading.Lock()
@@ -290,6 +292,8 @@ class CyphalBackend(Backend):
             return "no Cyphal node"
         if self._suspect:
             return self._suspect
+        if self._loop_rx is not None and self._loop_rx.failure:
+            return str(self._loop_rx.failure)
         try:
             if _transport_dead(self._node.presentation.transport):
                 return "the transport's media closed itself"
@@ -302,12 +306,13 @@ class CyphalBackend(Backend):
         if tc.kind == "env":
             env = dict(tc.env())
             env["UAVCAN__NODE__ID"] = str(self.node_id)
-            return transport_from_env(env)
+            return transport_from_env(env, loop_rx=True)
         if tc.kind == "custom":
             if tc.factory is None:
                 raise BridgeConfigError("a custom transport needs a factory")
             return tc.factory(self.node_id)
-        return make_transport(tc.kind, node_id=self.node_id, iface=tc.iface, mtu=tc.mtu)
+        # Cyphal/UDP on one interface: the subscriptions are received on the event loop (no thread per session)
+        return make_transport(tc.kind, node_id=self.node_id, iface=tc.iface, mtu=tc.mtu, loop_rx=True)
 
     async def open(self) -> None:
         """The Cyphal node and every port (at start and whenever the transport is reopened)."""
@@ -317,6 +322,7 @@ class CyphalBackend(Backend):
             raise BridgeConfigError(str(ex)) from None
 
     def _open(self) -> None:
+        import pycyphal.dsdl
         import uavcan.node
 
         tc = self.transport_config
@@ -352,27 +358,34 @@ class CyphalBackend(Backend):
                 sub.port_id = resolve_subject(node.registry, "sub", sub.name, sub.dtype, sub.spec_id)
                 sub.seen, sub.refused = {}, 0
                 if sub.raw:
-                    sub.subscriber = RawReceiver(transport, sub.port_id, sub.dtype, sub.handler)
+                    sub.subscriber = open_receiver(transport, sub.port_id, sub.dtype, sub.handler)
                     continue
                 sub.subscriber = node.presentation.make_subscriber(sub.dtype, sub.port_id, rxq)
                 sub.subscriber.receive_in_background(sub.on_transfer)
-            self._hb_sub = node.make_subscriber(uavcan.node.Heartbeat_1_0)
-            self._hb_sub.receive_in_background(self._on_heartbeat)
+            loop_rx = getattr(transport, "loop_receiver", None)  # a LoopUDPTransport's
+            if loop_rx is not None:
+                hb = uavcan.node.Heartbeat_1_0
+                self._hb_sub = loop_rx.subscribe(pycyphal.dsdl.get_fixed_port_id(hb),
+                                                 pycyphal.dsdl.get_extent_bytes(hb), self._on_heartbeat_payload)
+            else:
+                self._hb_sub = node.make_subscriber(uavcan.node.Heartbeat_1_0)
+                self._hb_sub.receive_in_background(self._on_heartbeat)
         except BaseException:
             for sub in self._subs:
-                if isinstance(sub.subscriber, RawReceiver):
-                    sub.subscriber.task.cancel()
+                if isinstance(sub.subscriber, Receiver):
+                    sub.subscriber.abort()
                     sub.subscriber = None
             node.close()
             raise
         self._node = node
+        self._loop_rx, self._overflows_seen = loop_rx, 0
         self._suspect = None
 
     async def close(self) -> None:
         """Close every port and the node (what their subscribers counted is kept)."""
         self.poll_statistics()
-        receivers = [s.subscriber for s in self._subs if isinstance(s.subscriber, RawReceiver)]
-        ports: list[Any] = [s.subscriber for s in self._subs if not isinstance(s.subscriber, RawReceiver)]
+        receivers = [s.subscriber for s in self._subs if isinstance(s.subscriber, Receiver)]
+        ports: list[Any] = [s.subscriber for s in self._subs if not isinstance(s.subscriber, Receiver)]
         ports += [p.publisher for p in self._pubs if not isinstance(p.publisher, RawSender)] + [self._hb_sub]
         for s in self._subs:
             s.subscriber = None
@@ -380,7 +393,7 @@ class CyphalBackend(Backend):
             if p.raw_sender is not None:
                 p.raw_sender.close()
             p.publisher = None
-        self._hb_sub = None
+        self._hb_sub = self._loop_rx = None
         node, self._node = self._node, None
         try:
             for receiver in receivers:
@@ -396,12 +409,26 @@ class CyphalBackend(Backend):
         self._errors[f"cyphal.{kind}"] += 1
         self._rlog.note(("cyphal", kind), logging.WARNING, "transport error %s", kind)
 
+    def _on_heartbeat_payload(self, payload: bytes, nid: int | None, tid: int, stamp: float) -> None:
+        import pycyphal.dsdl
+        import uavcan.node
+
+        msg = pycyphal.dsdl.deserialize(uavcan.node.Heartbeat_1_0, [memoryview(payload)])
+        if msg is None:  # what pycyphal's subscriber counts as a deserialization failure
+            self._errors["cyphal.heartbeat_malformed"] += 1
+            self._rlog.note(("cyphal", "heartbeat_malformed"), logging.WARNING,
+                            "an undecodable heartbeat from node %s", nid)
+            return
+        self._heartbeat(msg, nid, tid)
+
     def _on_heartbeat(self, msg: Any, transfer: Any) -> None:
-        nid = transfer.source_node_id
+        self._heartbeat(msg, transfer.source_node_id, int(transfer.transfer_id))
+
+    def _heartbeat(self, msg: Any, nid: int | None, tid: int) -> None:
         if nid is None:
             return
         health, mode = int(msg.health.value), int(msg.mode.value)
-        tid, last = int(transfer.transfer_id), self._heartbeat_ids.get(nid)
+        last = self._heartbeat_ids.get(nid)
         self._heartbeat_ids[nid] = tid
         # 64-bit ids (UDP) never wrap: ids that went back mean the node started over; modulo 32 (CAN) says nothing
         ids_restarted = self._modulo >= 2**32 and last is not None and tid < last
@@ -416,6 +443,13 @@ class CyphalBackend(Backend):
         """Accumulate pycyphal's per-subject counters (they restart with each new subscriber) and log their
         increments at a bounded rate (thread-safe)."""
         with self._poll_lock:
+            loop_rx = self._loop_rx
+            if loop_rx is not None and loop_rx.overflows > self._overflows_seen:
+                # Datagrams the kernel dropped for a full receive buffer (their transfers are also lost to the core)
+                delta, self._overflows_seen = loop_rx.overflows - self._overflows_seen, loop_rx.overflows
+                self._errors["cyphal.udp_rx_overflow"] += delta
+                self._rlog.note(("cyphal", "udp_rx_overflow"), logging.WARNING,
+                                "%d datagrams dropped by the kernel (receive buffer full)", delta, count=delta)
             for sub in self._subs:
                 subscriber = sub.subscriber
                 if subscriber is None:

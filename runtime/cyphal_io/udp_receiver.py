@@ -1,0 +1,445 @@
+"""Cyphal/UDP message reception on the asyncio event loop: one socket, no thread per subscription (issue 26).
+
+pycyphal 1.x's UDP transport gives every input session a socket and a reader thread that polls ``select`` every
+0.1 s and hands each datagram to the event loop with ``call_soon_threadsafe``: with SAM's 27 subscriptions that is
+most of the bridge's CPU, idle or not. :class:`UDPLoopReceiver` does the same reception on the loop itself:
+
+- one non-blocking socket bound to the Cyphal/UDP port on every address, ``IP_MULTICAST_ALL`` off, joining each
+  subscribed subject's multicast group on the transport's interface, watched with ``loop.add_reader``; every wake-up
+  drains the queued datagrams (at most :data:`BATCH` of them, so the loop stays fair; the rest wake it again);
+- ``IP_PKTINFO`` gives each datagram's destination group, which says whose it is, as pycyphal's per-group socket
+  does; ``SO_RXQ_OVFL`` gives the datagrams the kernel dropped for a full receive buffer (pycyphal cannot see
+  those): :attr:`UDPLoopReceiver.overflows`;
+- each datagram is parsed as pycyphal 1.27 parses it (``pycyphal.transport.udp.UDPFrame.parse``: header version,
+  header CRC) and goes through the same per-source state machine (``TransferReassembler``: transfer-id
+  deduplication and timeout, multi-frame reassembly in any frame order, the transfer CRC), with the same counters
+  (:class:`SubjectPort`: transfers, frames, errors, the reassembly errors per source node). A single-frame transfer
+  takes a fast path (the state is two numbers), and the payload goes to the handler as bytes, with no frame or
+  transfer object between.
+
+Where pycyphal raises instead of counting, the receiver counts: a header with a priority above 7 or a service
+transfer from an anonymous node (pycyphal logs a traceback from its reader thread and counts nothing), and a frame
+index past :data:`MAX_FRAME_INDEX` (pycyphal would grow its fragment list up to the index, 2**31 entries for a
+hostile datagram); these are ``errors`` too, the last with its own kind (``FRAME_INDEX_LIMIT``).
+Like pycyphal, the transport delivers the whole payload: the extent's implicit truncation is the deserializer's.
+
+Also here: :func:`loop_udp_transport`, pycyphal's UDPTransport that owns such a receiver (it lists the receiver's
+subjects among its input sessions and closes it), and :func:`single_frame_datagram`, a one-frame transfer's
+datagram as pycyphal's output session makes it (the bridge's wire path sends with it).
+
+The proof against the library is tests/runtime/cyphal_io/test_udp_receiver.py: the same datagram sequences,
+malformed ones included, fed to pycyphal's UDP input session and to this give the same transfers and counters.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import binascii
+import functools
+import logging
+import socket
+import struct
+import sys
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from sam_runtime.cyphal_io.crc32c import RESIDUE as CRC32C_RESIDUE
+from sam_runtime.cyphal_io.crc32c import crc32c_register
+
+__all__ = ["BATCH", "CYPHAL_PORT", "FRAME_INDEX_LIMIT", "MAX_FRAME_INDEX", "RCVBUF_BYTES", "TRANSFER_ID_TIMEOUT_S",
+           "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "single_frame_datagram", "subject_group"]
+
+_log = logging.getLogger(__name__)
+
+Handler = Callable[[bytes, "int | None", int, float], None]  # (payload, source node id, transfer id, monotonic s)
+
+CYPHAL_PORT = 9382  # pycyphal.transport.udp's CYPHAL_PORT
+BATCH = 256  # datagrams per wake-up at most: a flood cannot hold the loop
+# The receive buffer asked for (the kernel doubles it, capped at 2 * net.core.rmem_max): one socket queues every
+# subject, so it holds more than one of pycyphal's sockets (rmem_default, 208 KiB) yet not so much that a flood on
+# one subject holds the others for long: 2 MiB, ~2,700 small datagrams, about a second of the bridge's throughput.
+RCVBUF_BYTES = 1 << 20
+MAX_FRAME_INDEX = 4095  # 4096 frames: 4.9 MB at pycyphal's default MTU, far beyond any extent the bridge has
+_READ_SIZE = 0xFFFF  # as pycyphal's reader: any UDP/IPv4 datagram fits
+# Linux values; Python 3.11's socket module names none of them.
+_IP_PKTINFO = 8
+_IP_MULTICAST_ALL = 49
+_SO_RXQ_OVFL = 40
+_ANC_SIZE = socket.CMSG_SPACE(12) + socket.CMSG_SPACE(4)  # struct in_pktinfo; the drop counter (uint32)
+_SOL_IP, _SOL_SOCKET = socket.IPPROTO_IP, socket.SOL_SOCKET
+
+_HEADER = struct.Struct("<BBHHHQIH")  # pycyphal's UDPFrame header without its CRC (22 bytes)
+_HEADER_SIZE = _HEADER.size + 2
+_VERSION = 1
+_ANONYMOUS = 0xFFFF
+_SNM = 1 << 15
+_EOT = 1 << 31
+_INDEX_MASK = _EOT - 1
+_CRC_SIZE = 4
+TRANSFER_ID_TIMEOUT_S = 2.0  # pycyphal's UDPInputSession.DEFAULT_TRANSFER_ID_TIMEOUT
+
+# The reassembly errors by the names of pycyphal's TransferReassembler.Error (its members in sample_statistics());
+# pycyphal is imported only where it is used, so that importing this module (the transport module does) costs
+# nothing on a DroneCAN-only vehicle.
+_INTEGRITY = "INTEGRITY_ERROR"
+_UNEXPECTED_TID = "UNEXPECTED_TRANSFER_ID"
+_MISSING_FRAMES = "MULTIFRAME_MISSING_FRAMES"
+_EMPTY_FRAME = "MULTIFRAME_EMPTY_FRAME"
+_EOT_MISPLACED = "MULTIFRAME_EOT_MISPLACED"
+_EOT_INCONSISTENT = "MULTIFRAME_EOT_INCONSISTENT"
+FRAME_INDEX_LIMIT = "FRAME_INDEX_LIMIT"  # not pycyphal's (see the module's docstring)
+
+
+def subject_group(subject_id: int) -> bytes:
+    """The subject's multicast group, packed (pycyphal's ``message_data_specifier_to_multicast_group``).
+
+    >>> socket.inet_ntoa(subject_group(7509))
+    '239.0.29.85'
+    """
+    return bytes((239, 0, (subject_id >> 8) & 0x7F, subject_id & 0xFF))
+
+
+def single_frame_datagram(source_node_id: int | None, subject_id: int, transfer_id: int, payload: bytes,
+                          priority: int = 4) -> bytes:
+    """The datagram of a single-frame message transfer, as pycyphal's UDP output session makes it (header with its
+    CRC, payload, transfer CRC); the caller checks that it fits the MTU (``len(payload) + 4 <= mtu``).
+    ``priority``: 4 = NOMINAL."""
+    header = _HEADER.pack(_VERSION, priority, _ANONYMOUS if source_node_id is None else source_node_id, _ANONYMOUS,
+                          subject_id, transfer_id & 0xFFFFFFFFFFFFFFFF, _EOT, 0)
+    crc = crc32c_register(payload) ^ 0xFFFFFFFF
+    return b"".join((header, binascii.crc_hqx(header, 0xFFFF).to_bytes(2, "big"), payload, crc.to_bytes(4, "little")))
+
+
+class _Source:
+    """One source node's state: pycyphal's TransferReassembler in plain slots. ``ts_ns``: monotonic time of the
+    last first frame (the transfer's timestamp, and the reference of the transfer-id timeout); ``payloads``: the
+    fragments of the transfer being reassembled (empty bytes: not received yet)."""
+
+    __slots__ = ("max_index", "payloads", "tid", "ts_ns")
+
+    def __init__(self) -> None:
+        self.tid = 0
+        self.ts_ns = 0
+        self.payloads: list[bytes] = []
+        self.max_index: int | None = None
+
+
+class SubjectPort:
+    """One subscribed subject: its handler, its per-source states and pycyphal's counters of an input session.
+
+    ``specifier`` and ``payload_metadata`` as a pycyphal input session's (so the node's ``uavcan.node.port.List``
+    lists the subject); :meth:`sample_statistics` gives pycyphal's ``PromiscuousUDPInputSessionStatistics``."""
+
+    def __init__(self, receiver: UDPLoopReceiver, subject_id: int, extent_bytes: int, handler: Handler) -> None:
+        from pycyphal.transport import InputSessionSpecifier, MessageDataSpecifier, PayloadMetadata
+
+        self.subject_id = int(subject_id)
+        self.specifier = InputSessionSpecifier(MessageDataSpecifier(self.subject_id), None)
+        self.payload_metadata = PayloadMetadata(int(extent_bytes))
+        self.handler = handler
+        self.transfer_id_timeout_ns = round(TRANSFER_ID_TIMEOUT_S * 1e9)
+        self.transfers = self.frames = self.errors = self.payload_bytes = 0
+        self.errors_per_source: dict[int, dict[str, int]] = {}
+        self.handler_failures = 0
+        self._sources: dict[int, _Source] = {}
+        self._receiver: UDPLoopReceiver | None = receiver
+        self._local_node_id = receiver.local_node_id
+
+    @property
+    def transfer_id_timeout(self) -> float:
+        return self.transfer_id_timeout_ns * 1e-9
+
+    @transfer_id_timeout.setter
+    def transfer_id_timeout(self, value: float) -> None:
+        if not value > 0:
+            raise ValueError(f"Invalid value for transfer-ID timeout [second]: {value}")
+        self.transfer_id_timeout_ns = round(value * 1e9)
+
+    def sample_statistics(self) -> Any:
+        """pycyphal's PromiscuousUDPInputSessionStatistics, its error kinds TransferReassembler.Error members."""
+        from pycyphal.transport.commons.high_overhead_transport import TransferReassembler
+        from pycyphal.transport.udp import PromiscuousUDPInputSessionStatistics
+
+        kinds = TransferReassembler.Error.__members__
+        # Copies built from atomic dict copies: another thread may sample while the loop counts.
+        per_src: dict[int, dict[Any, int]] = {src: {kinds.get(k, k): n for k, n in list(errs.items())}
+                                              for src, errs in list(self.errors_per_source.items())}
+        return PromiscuousUDPInputSessionStatistics(
+            transfers=self.transfers, frames=self.frames, payload_bytes=self.payload_bytes, errors=self.errors,
+            drops=0, reassembly_errors_per_source_node_id=per_src)
+
+    def close(self) -> None:
+        receiver, self._receiver = self._receiver, None
+        if receiver is not None:
+            receiver.unsubscribe(self)
+
+    # ------------------------------------------------------------------------------------------ the hot path
+    def feed(self, data: bytes, now_ns: int) -> None:
+        """One datagram that came to this subject's group (pycyphal: ``UDPFrame.parse`` in the reader thread,
+        then ``UDPInputSession.receive`` on the loop)."""
+        if len(data) < _HEADER.size:
+            self.errors += 1  # pycyphal: parse() -> None, counted by receive()
+            return
+        version, prio, src, _dst, dsn, tid, index_eot, _user = _HEADER.unpack_from(data)
+        # The header CRC: CRC-16/CCITT-FALSE (pycyphal's CRC16CCITT) is binascii's CRC-CCITT from 0xFFFF; the
+        # residue of a header with its big-endian CRC is 0 (over what there is of the 24 bytes, as pycyphal).
+        if version != _VERSION or binascii.crc_hqx(data[:_HEADER_SIZE], 0xFFFF):
+            self.errors += 1
+            return
+        if prio > 7 or (dsn & _SNM and src == _ANONYMOUS):
+            self.errors += 1  # pycyphal raises in parse() (Priority(), UDPFrame.__post_init__): see the docstring
+            return
+        if dsn != self.subject_id:  # a service frame, or another subject's (pycyphal: skipped, not counted)
+            return
+        if src == self._local_node_id:  # our own publication looped back (pycyphal: skipped, not counted)
+            return
+        self.frames += 1
+        index = index_eot & _INDEX_MASK
+        eot = index_eot >= _EOT
+        if src == _ANONYMOUS:  # TransferReassembler.construct_anonymous_transfer: stateless, no error counted
+            if index == 0 and eot and len(data) > _HEADER_SIZE + _CRC_SIZE and \
+                    crc32c_register(data[_HEADER_SIZE:]) == CRC32C_RESIDUE:
+                self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], None, tid, now_ns)
+            return
+        st = self._sources.get(src)
+        if st is None:
+            st = self._sources[src] = _Source()
+            self.errors_per_source.setdefault(src, {})
+        if index == 0 and eot and not st.payloads:
+            # The fast path: a single-frame transfer with nothing pending (process_frame's steps, in order).
+            if tid > st.tid or (tid != st.tid and now_ns - st.ts_ns > self.transfer_id_timeout_ns):
+                st.tid = tid  # a restart with nothing to discard: no error
+            if tid != st.tid:
+                self._error(src, _UNEXPECTED_TID)
+                return
+            st.ts_ns = now_ns
+            st.tid = tid + 1
+            if len(data) >= _HEADER_SIZE + _CRC_SIZE and \
+                    crc32c_register(data[_HEADER_SIZE:]) == CRC32C_RESIDUE:
+                self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], src, tid, now_ns)
+            else:
+                self._error(src, _INTEGRITY)
+            return
+        self._reassemble(st, src, tid, index, eot, data[_HEADER_SIZE:], now_ns)
+
+    def _reassemble(self, st: _Source, src: int, tid: int, index: int, eot: bool, payload: bytes,
+                    now_ns: int) -> None:
+        """TransferReassembler.process_frame, step by step."""
+        if not (index == 0 and eot) and not payload:
+            self._error(src, _EMPTY_FRAME)
+            return
+        if index > MAX_FRAME_INDEX:
+            self._error(src, FRAME_INDEX_LIMIT)
+            return
+        if tid > st.tid or (index == 0 and tid != st.tid and now_ns - st.ts_ns > self.transfer_id_timeout_ns):
+            self._restart(st, src, tid, _MISSING_FRAMES if st.payloads else None)
+        if tid != st.tid:
+            self._error(src, _UNEXPECTED_TID)
+            return
+        payloads = st.payloads
+        if eot:
+            if st.max_index is not None and st.max_index != index:
+                self._restart(st, src, tid + 1, _EOT_INCONSISTENT)
+                return
+            st.max_index = index
+        if st.max_index is not None and max(index, len(payloads) - 1) > st.max_index:
+            self._restart(st, src, tid + 1, _EOT_MISPLACED)
+            return
+        if index == 0:
+            st.ts_ns = now_ns
+        while len(payloads) <= index:
+            payloads.append(b"")
+        payloads[index] = payload
+        if st.max_index is None or (st.max_index > 0 and not all(payloads)):
+            return
+        whole = b"".join(payloads)
+        size_ok = len(whole) > _CRC_SIZE if len(payloads) > 1 else len(whole) >= _CRC_SIZE
+        ok = size_ok and crc32c_register(whole) == CRC32C_RESIDUE
+        stamp_ns = st.ts_ns
+        self._restart(st, src, tid + 1, None if ok else _INTEGRITY)
+        if ok:
+            self._deliver(whole[:-_CRC_SIZE], src, tid, stamp_ns)
+
+    def _restart(self, st: _Source, src: int, tid: int, error: str | None) -> None:
+        if error is not None:
+            self._error(src, error)
+        st.tid = tid
+        st.max_index = None
+        st.payloads = []
+
+    def _error(self, src: int, error: str) -> None:
+        self.errors += 1
+        errs = self.errors_per_source[src]
+        errs[error] = errs.get(error, 0) + 1
+
+    def _deliver(self, payload: bytes, src: int | None, tid: int, stamp_ns: int) -> None:
+        self.transfers += 1
+        self.payload_bytes += len(payload)
+        try:
+            self.handler(payload, src, tid, stamp_ns * 1e-9)
+        except Exception as ex:  # the handlers never raise; if one did, the other subjects go on
+            self.handler_failures += 1
+            if self.handler_failures == 1 or not self.handler_failures & (self.handler_failures - 1):
+                _log.error("subject %d: the handler failed (%d times): %s: %s", self.subject_id,
+                           self.handler_failures, type(ex).__name__, ex)
+
+
+class UDPLoopReceiver:
+    """The subscribed subjects of one Cyphal/UDP node, received on the running loop through one socket.
+
+    :param local_ip: the transport's interface address (its multicast memberships are made there).
+    :param local_node_id: the node's own id (its looped-back frames are skipped, as pycyphal does) or None.
+    :param rcvbuf_bytes: the socket's receive buffer to ask for (pycyphal's sockets keep the default, one each).
+    Create, subscribe and close it in the loop's thread."""
+
+    def __init__(self, local_ip: str, local_node_id: int | None, rcvbuf_bytes: int = RCVBUF_BYTES) -> None:
+        self.local_ip = str(local_ip)
+        self.local_node_id = local_node_id
+        self.overflows = 0  # datagrams the kernel dropped (receive buffer full): SO_RXQ_OVFL
+        self.failure: str | None = None  # why the socket stopped (the link supervisor reopens the transport)
+        self._loop = asyncio.get_running_loop()
+        self._ports: dict[bytes, SubjectPort] = {}
+        self._iface = socket.inet_aton(self.local_ip)
+        self._kernel_drops = 0
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        try:
+            sock.setblocking(False)
+            # Shared with pycyphal's sockets and other nodes on this host (set before bind, as pycyphal does).
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+            # Only the groups this socket joined (the default, 1, delivers every group any socket joined).
+            sock.setsockopt(socket.IPPROTO_IP, _IP_MULTICAST_ALL, 0)
+            sock.setsockopt(socket.IPPROTO_IP, _IP_PKTINFO, 1)
+            sock.setsockopt(socket.SOL_SOCKET, _SO_RXQ_OVFL, 1)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, int(rcvbuf_bytes))
+            sock.bind(("", CYPHAL_PORT))  # every destination: the group (IP_PKTINFO) says whose a datagram is
+        except BaseException:
+            sock.close()
+            raise
+        self._sock: socket.socket | None = sock
+        self._loop.add_reader(sock.fileno(), self._on_readable)
+
+    @property
+    def ports(self) -> list[SubjectPort]:
+        return list(self._ports.values())
+
+    def subscribe(self, subject_id: int, extent_bytes: int, handler: Handler) -> SubjectPort:
+        """A port for ``subject_id`` (one per subject) whose transfers go to ``handler``."""
+        sock = self._sock
+        if sock is None:
+            raise OSError(f"the Cyphal/UDP receiver on {self.local_ip} is closed")
+        group = subject_group(subject_id)
+        if group in self._ports:
+            raise ValueError(f"subject {subject_id} is subscribed already")
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, group + self._iface)
+        port = self._ports[group] = SubjectPort(self, subject_id, extent_bytes, handler)
+        return port
+
+    def unsubscribe(self, port: SubjectPort) -> None:
+        group = subject_group(port.subject_id)
+        if self._ports.get(group) is not port:
+            return
+        del self._ports[group]
+        if self._sock is not None:
+            try:
+                self._sock.setsockopt(socket.IPPROTO_IP, socket.IP_DROP_MEMBERSHIP, group + self._iface)
+            except OSError as ex:  # the interface went away: the membership went with it
+                _log.debug("leaving %s: %s", socket.inet_ntoa(group), ex)
+
+    def close(self) -> None:
+        sock, self._sock = self._sock, None
+        self._ports.clear()
+        if sock is not None:
+            if not self._loop.is_closed():
+                self._loop.remove_reader(sock.fileno())
+            sock.close()
+
+    def _on_readable(self) -> None:
+        sock = self._sock
+        if sock is None:
+            return
+        recvmsg, ports, clock = sock.recvmsg, self._ports, time.monotonic_ns
+        for _ in range(BATCH):
+            try:
+                data, ancdata, _flags, _addr = recvmsg(_READ_SIZE, _ANC_SIZE)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as ex:
+                self._fail(ex)
+                return
+            now = clock()
+            group = b""
+            for level, kind, cdata in ancdata:
+                if kind == _IP_PKTINFO and level == _SOL_IP:
+                    group = cdata[8:12]  # in_pktinfo.ipi_addr: the datagram's destination
+                elif kind == _SO_RXQ_OVFL and level == _SOL_SOCKET:
+                    self._note_kernel_drops(int.from_bytes(cdata[:4], sys.byteorder))
+            port = ports.get(group)
+            if port is not None:  # else: not a subscribed group (a unicast datagram to the port, a late one)
+                port.feed(data, now)
+
+    def _note_kernel_drops(self, total: int) -> None:
+        # The counter is the socket's total so far (32 bits, wrapping): count what it grew by.
+        grew = (total - self._kernel_drops) & 0xFFFFFFFF
+        if grew:
+            self._kernel_drops = total
+            self.overflows += grew
+
+    def _fail(self, ex: OSError) -> None:
+        self.failure = f"Cyphal/UDP receive on {self.local_ip}: {type(ex).__name__}: {ex}"
+        _log.warning("%s", self.failure)
+        sock = self._sock
+        if sock is not None and not self._loop.is_closed():
+            self._loop.remove_reader(sock.fileno())  # no busy loop on a broken socket; the reopen replaces it
+
+    def __repr__(self) -> str:
+        subjects = sorted(p.subject_id for p in self._ports.values())
+        return f"UDPLoopReceiver({self.local_ip!r}, local_node_id={self.local_node_id}, subjects={subjects})"
+
+
+
+def loop_udp_transport(local_ip_address: str, local_node_id: int | None, **kwargs: Any) -> Any:
+    """pycyphal's UDPTransport whose message subscriptions may be received on the loop (its ``loop_receiver``).
+
+    The receiver's subjects are listed among the transport's input sessions (so the node's
+    ``uavcan.node.port.List`` still names them) and it closes with the transport; publications, services and any
+    pycyphal input session stay pycyphal's. ``kwargs``: UDPTransport's (mtu, service_transfer_multiplier)."""
+    return _loop_udp_transport_class()(local_ip_address, local_node_id, **kwargs)
+
+
+@functools.cache
+def _loop_udp_transport_class() -> type:
+    from pycyphal.transport import ResourceClosedError
+    from pycyphal.transport.udp import UDPTransport
+
+    class LoopUDPTransport(UDPTransport):
+        __doc__ = loop_udp_transport.__doc__
+
+        def __init__(self, local_ip_address: str, local_node_id: int | None, **kw: Any) -> None:
+            super().__init__(local_ip_address, local_node_id, **kw)
+            self._loop_receiver: UDPLoopReceiver | None = None
+            self._loop_receiver_closed = False
+
+        @property
+        def loop_receiver(self) -> UDPLoopReceiver:
+            """The receiver (made on first use, in the running loop)."""
+            if self._loop_receiver_closed:
+                raise ResourceClosedError(f"{self!r} is closed")
+            if self._loop_receiver is None:
+                self._loop_receiver = UDPLoopReceiver(str(self.local_ip_address), self.local_node_id)
+            return self._loop_receiver
+
+        @property
+        def input_sessions(self) -> Sequence[Any]:
+            receiver = self._loop_receiver
+            return [*super().input_sessions, *(receiver.ports if receiver is not None else ())]
+
+        def close(self) -> None:
+            self._loop_receiver_closed = True
+            super().close()
+            receiver, self._loop_receiver = self._loop_receiver, None
+            if receiver is not None:
+                receiver.close()
+
+    return LoopUDPTransport
