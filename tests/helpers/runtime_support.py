@@ -18,6 +18,8 @@ from typing import Any, TypeVar
 
 import pytest
 
+from helpers.isolation import isolated
+
 REPO = Path(__file__).resolve().parents[2]
 HELPERS = Path(__file__).resolve().parent
 TEST_ROS_PREFIX = REPO / ".cache" / "ros-test-prefix"
@@ -29,8 +31,13 @@ UDP_LOCK = Path("/tmp") / "sam-runtime-tests-cyphal-udp.lock"
 
 @contextlib.contextmanager
 def cyphal_udp_lock(timeout: float = 600.0) -> Iterator[None]:
-    """Cyphal/UDP subjects are multicast groups shared by the whole machine (ROS_DOMAIN_ID does not separate
-    them): two runs of these tests at once would see each other's devices. Serialize them machine-wide."""
+    """Cyphal/UDP subjects are multicast groups shared by everything on one network (ROS_DOMAIN_ID does not
+    separate them). In a private network namespace (helpers.isolation: the normal case) nothing else shares it and
+    this is a no-op; where none could be made, two runs of these tests at once would see each other's devices:
+    serialize them machine-wide."""
+    if isolated():
+        yield
+        return
     with open(UDP_LOCK, "a+") as fh:
         deadline = time.monotonic() + timeout
         while True:
@@ -80,8 +87,11 @@ def _installed_current(gen: Any, prefix: Path) -> bool:
 
 
 def domain_id(offset: int) -> str:
-    """A ROS_DOMAIN_ID private to this test session (pid-derived, 1..101) so parallel runs do not cross-talk."""
-    return str(1 + (os.getpid() * 7 + offset * 13) % 101)
+    """The ROS_DOMAIN_ID of a test (1..101 by its offset, so the tests of one process never share one). In a private
+    network namespace no other run can see it; without one (helpers.isolation's fallback) the pid is mixed in so that
+    parallel runs on the machine do not cross-talk (they may still collide: 101 ids)."""
+    salt = 0 if isolated() else os.getpid() * 7
+    return str(1 + (salt + offset * 13) % 101)
 
 
 def child_env(prefix: Path, domain: str, extra: Mapping[str, str] | None = None) -> dict[str, str]:
