@@ -19,10 +19,10 @@ from typing import Any, TypeVar
 import pytest
 
 from helpers.isolation import isolated
+from helpers.ros_packages import chained_env
 
 REPO = Path(__file__).resolve().parents[2]
 HELPERS = Path(__file__).resolve().parent
-TEST_ROS_PREFIX = REPO / ".cache" / "ros-test-prefix"
 T = TypeVar("T")
 
 
@@ -67,23 +67,16 @@ def generated_or_skip() -> Any:
 
 
 def ros_prefix_for(gen: Any) -> Path:
-    """A prefix where the generated ROS package is installed and current: the venv if it is there (nox and
-    `sam-codegen ros-install` put it there), else a test prefix under .cache (built once, ~30 s)."""
-    from sam_runtime.genpkg import ensure_ros_package
+    """Where the generated ROS packages are usable (a prefix for child_env): the venv when they are current there
+    (nox's tests session and `sam-codegen ros-install` put them there), else prefixes built for the tests
+    (helpers.ros_packages: once per package content, ~30 s)."""
+    from helpers.ros_packages import built_prefix
+    from sam_codegen.project.ros_install import ros_packages_in_order
 
-    venv = Path(sys.prefix).absolute()
     try:
-        return ensure_ros_package(gen, venv) if _installed_current(gen, venv) else ensure_ros_package(
-            gen, TEST_ROS_PREFIX)
+        return built_prefix(ros_packages_in_order(gen.ros_package_dir().parent))
     except Exception as ex:  # a build problem is the ROS build tests' business; here it is a skip reason
         pytest.skip(f"cannot build the generated ROS package: {type(ex).__name__}: {ex}")
-
-
-def _installed_current(gen: Any, prefix: Path) -> bool:
-    from sam_runtime.genpkg import same_interfaces
-
-    name = gen.tables().ROS_PACKAGE
-    return same_interfaces(gen.ros_package_dir(), prefix / "share" / name)
 
 
 def domain_id(offset: int) -> str:
@@ -95,14 +88,12 @@ def domain_id(offset: int) -> str:
 
 
 def child_env(prefix: Path, domain: str, extra: Mapping[str, str] | None = None) -> dict[str, str]:
-    from sam_codegen.project.ros_install import ros_runtime_env
-
     base = dict(os.environ)
     # Never inherit a Cyphal transport from the caller's shell: the tests choose it explicitly.
     for k in list(base):
         if k.startswith("UAVCAN__"):
             del base[k]
-    env = ros_runtime_env(prefix, base) if prefix != Path(sys.prefix).absolute() else base
+    env = chained_env(prefix, base)
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     env["ROS_DOMAIN_ID"] = domain
     env["PYTHONUNBUFFERED"] = "1"

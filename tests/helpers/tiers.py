@@ -41,8 +41,8 @@ class ChildProcessGuard:
 
     # (module, attribute): the calls that create a process. subprocess ends in its own alias of fork_exec (or in
     # os.posix_spawn), multiprocessing in _posixsubprocess.fork_exec or os.fork.
-    TARGETS = ((subprocess, "_fork_exec"), (_posixsubprocess, "fork_exec"), (os, "fork"), (os, "forkpty"), (os, "posix_spawn"),
-               (os, "posix_spawnp"), (os, "system"), (os, "execv"), (os, "execve"))
+    TARGETS = ((subprocess, "_fork_exec"), (_posixsubprocess, "fork_exec"), (os, "fork"), (os, "forkpty"),
+               (os, "posix_spawn"), (os, "posix_spawnp"), (os, "system"), (os, "execv"), (os, "execve"))
 
     def __init__(self) -> None:
         self.attempts: list[str] = []
