@@ -64,6 +64,8 @@ def pytest_configure(config: pytest.Config) -> None:
     # is, so that its workers, started from it, can reach it before they leave.
     if not config.pluginmanager.hasplugin("dsession"):
         isolation.enter_private_network()
+    if config.getoption("--unit-tier"):
+        tiers.warm_up()
 
 
 def pytest_report_header(config: pytest.Config) -> str:
@@ -90,6 +92,7 @@ def isolation_lock_name() -> str:
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     tiers.mark_system(items)
+    tiers.system_first(items)
     if config.getoption("--unit-tier"):
         keep = [item for item in items if item.get_closest_marker("system") is None]
         dropped = [item for item in items if item.get_closest_marker("system") is not None]

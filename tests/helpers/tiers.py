@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import _posixsubprocess
 import os
+import platform
 import subprocess
+import traceback
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -35,6 +37,20 @@ def mark_system(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.system)
 
 
+def warm_up() -> None:
+    """Run once, before the guard, what libraries start a process for the first time they are asked and cache
+    (a test must not fail for being the first in its worker to ask): platform.uname()'s processor runs `uname -p`
+    (pycyphal and matplotlib ask)."""
+    platform.processor()
+
+
+def system_first(items: list[pytest.Item]) -> None:
+    """System tests (the long ones: processes, CMake) first, each group in its own order: with xdist's
+    distribution by file, a long module started last would leave one core alone at the end. Test order must not
+    matter (each test sets up what it needs), so this changes only the wall time."""
+    items.sort(key=lambda item: item.get_closest_marker("system") is None)
+
+
 class ChildProcessGuard:
     """While active, every way of starting a process records the attempt and raises: the unit tier's proof that its
     tests stay in the pytest process. The attempt is recorded because code under test may catch the exception."""
@@ -50,7 +66,12 @@ class ChildProcessGuard:
 
     def _refuse(self, what: str) -> Callable[..., Any]:
         def refused(*args: Any, **kwargs: Any) -> Any:
-            self.attempts.append(what)
+            # Where: the innermost frame outside the standard library's process modules (the code that asked).
+            frames = [f for f in traceback.extract_stack()[:-1]
+                      if Path(f.filename).name not in ("subprocess.py", "popen_fork.py", "popen_spawn_posix.py",
+                                                       "util.py", "context.py", "process.py")]
+            where = f" at {frames[-1].filename}:{frames[-1].lineno}" if frames else ""
+            self.attempts.append(what + where)
             raise OSError(f"the unit tier starts no process ({what}); mark the test `system` "
                           "(pytestmark = pytest.mark.system) or move it to tests/system/")
         return refused
