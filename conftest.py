@@ -57,12 +57,31 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      help="run the unit tier only (no system test) and fail a test that starts a process")
 
 
+_SERIAL_FALLBACK: list[str] = []
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config: pytest.Config) -> None:
+    """Before xdist starts workers: where they could not each have a network of their own, run serially (the
+    machine-wide lock and pid-derived domain ids of runtime_support then keep concurrent runs apart, as before)."""
+    if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        why = isolation.workers_can_isolate()
+        if why is not None:
+            _SERIAL_FALLBACK.append(why)
+            config.option.numprocesses = 0
+
+
+def _xdist_controller(config: pytest.Config) -> bool:
+    return (not hasattr(config, "workerinput") and getattr(config.option, "dist", "no") != "no"
+            and bool(getattr(config.option, "tx", None)) and not config.getoption("collectonly"))
+
+
 @pytest.hookimpl(trylast=True)
 def pytest_configure(config: pytest.Config) -> None:
     # Last: a plugin may connect to the xdist controller here (pytest-rerunfailures does, over 127.0.0.1); a socket
     # made before keeps working in the new namespace. The controller of an xdist run runs no test and stays where it
     # is, so that its workers, started from it, can reach it before they leave.
-    if not config.pluginmanager.hasplugin("dsession"):
+    if not _xdist_controller(config):
         isolation.enter_private_network()
     if config.getoption("--unit-tier"):
         tiers.warm_up()
@@ -77,10 +96,13 @@ def _isolation_line(config: pytest.Config) -> str:
     states = _WORKER_ISOLATION or [{"isolated": mine.isolated, "how": mine.how}]
     if all(s["isolated"] for s in states):
         who = f"each of {len(states)} workers" if _WORKER_ISOLATION else "this process"
-        return f"network isolation: {who} in a private network namespace ({states[0]['how']})"
-    why = "; ".join(sorted({str(s["how"]) for s in states if not s["isolated"]}))
+        serial = f"; one test at a time: workers could not have one each ({_SERIAL_FALLBACK[0]})" \
+            if _SERIAL_FALLBACK else ""
+        return f"network isolation: {who} in a private network namespace ({states[0]['how']}){serial}"
+    why = "; ".join(sorted({str(s["how"]) for s in states if not s["isolated"]} | set(_SERIAL_FALLBACK)))
+    serial = ", one test at a time instead of in parallel" if _SERIAL_FALLBACK else ""
     return (f"network isolation: NONE ({why}): Cyphal/UDP tests serialise on {isolation_lock_name()}, "
-            "ROS domain ids are derived from the pid")
+            f"ROS domain ids are derived from the pid{serial}")
 
 
 def isolation_lock_name() -> str:

@@ -80,18 +80,46 @@ def _loopback_up() -> None:
         fcntl.ioctl(s.fileno(), _SIOCSIFFLAGS, struct.pack("16sh", b"lo", flags | _IFF_UP))
 
 
+# Set to 1: make no namespace (to see the fallback, or to debug with the machine's network).
+OFF_ENV = "SAM_TEST_NO_NETNS"
+
+
 def _try_enter() -> str:
     """Enter a new network namespace; returns how, raises OSError with the reason when it cannot."""
+    if os.environ.get(OFF_ENV) == "1":
+        raise OSError(errno.EPERM, f"{OFF_ENV}=1")
     if not os.path.exists("/proc/self/ns/net"):
         raise OSError(errno.ENOSYS, "no Linux network namespaces here")
     if os.geteuid() == 0:
         _unshare(CLONE_NEWNET)
         return "unshare(CLONE_NEWNET) as root"
     uid, gid = os.getuid(), os.getgid()
-    # CLONE_NEWUSER is refused (EINVAL) in a process with more than one thread.
+    # CLONE_NEWUSER is refused (EINVAL) in a process with more than one thread (an xdist worker has execnet's).
     _unshare(CLONE_NEWUSER | CLONE_NEWNET)
     _map_to_root(uid, gid)
     return "unshare(CLONE_NEWUSER|CLONE_NEWNET), unprivileged"
+
+
+def workers_can_isolate() -> str | None:
+    """Whether xdist workers will be able to enter namespaces of their own (None) or why not. Asked before the
+    workers start, in a forked child so that this process stays where it is. Only root can: a worker has more
+    than one thread (execnet's), and CLONE_NEWUSER refuses a multi-threaded process."""
+    if os.environ.get(OFF_ENV) == "1":
+        return f"{OFF_ENV}=1"
+    if not os.path.exists("/proc/self/ns/net"):
+        return "no Linux network namespaces here"
+    if os.geteuid() != 0:
+        return "not root (an unprivileged namespace cannot be made in a multi-threaded xdist worker)"
+    pid = os.fork()
+    if pid == 0:  # the child: try, report by exit code, never return into pytest
+        try:
+            _unshare(CLONE_NEWNET)
+            _loopback_up()
+            os._exit(0)
+        except BaseException:
+            os._exit(1)
+    _, status = os.waitpid(pid, 0)
+    return None if os.waitstatus_to_exitcode(status) == 0 else "unshare(CLONE_NEWNET) refused"
 
 
 def enter_private_network() -> Isolation:
