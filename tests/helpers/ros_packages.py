@@ -23,6 +23,7 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -69,38 +70,50 @@ def current_in_venv(package_dir: Path) -> bool:
     return is_installed(name, venv) and same_interfaces(package_dir, venv / "share" / name)
 
 
+@dataclass(frozen=True)
+class Planned:
+    name: str
+    folder: Path
+    key: str  # its content, the build type, the Python version and its dependencies' keys
+    needs: frozenset[str]  # the packages of the same list it depends on, transitively
+
+
+def plan(package_dirs: Sequence[Path]) -> list[Planned]:
+    """The packages in order with their keys: a package's key is the same in whatever list it is (its content and
+    what it depends on decide it, not what else is built)."""
+    from sam_codegen.project.ros_install import package_dependencies
+    from sam_runtime.genpkg import ros_package_hash
+
+    done: dict[str, Planned] = {}
+    for d in (Path(p) for p in package_dirs):
+        name, depends = package_dependencies(d)
+        deps = [done[n] for n in done if n in depends]
+        h = hashlib.sha256(f"{sys.version_info[:2]} {BUILD_TYPE!r} {ros_package_hash(d)}".encode())
+        for dep in deps:
+            h.update(f" {dep.name}={dep.key}".encode())
+        needs = frozenset(dep.name for dep in deps).union(*(dep.needs for dep in deps))
+        done[name] = Planned(name, d, h.hexdigest()[:20], needs)
+    return list(done.values())
+
+
 def built_prefix(package_dirs: Sequence[Path]) -> Path:
     """Every package of `package_dirs` (a later one may depend on an earlier one) built and usable together.
 
     Returns a prefix for :func:`chained_env` (and so for ``run_child``, ``child_env`` of runtime_support and
-    spec_build): the venv when all of them are current there; the one package's own prefix when one had to be built
-    (its chain file names the prefixes of its built dependencies); else a folder naming the whole chain."""
-    from sam_codegen.project.ros_install import package_dependencies
-    from sam_runtime.genpkg import ros_package_hash
-
-    keys: dict[str, str] = {}  # package name -> its key (its content and its dependencies')
-    needs: dict[str, set[str]] = {}  # package name -> the packages of the list it needs, transitively
+    spec_build): the venv when all of them are current there; the last package's own prefix when it needs every
+    other one built (its chain file names them); else a folder whose chain file names them all."""
     prefixes: dict[str, Path] = {}  # package name -> where it was built (absent: current in the venv)
-    order: list[str] = []
-    for d in (Path(p) for p in package_dirs):
-        name, depends = package_dependencies(d)
-        deps = [n for n in order if n in depends]
-        h = hashlib.sha256(f"{sys.version_info[:2]} {BUILD_TYPE!r} {ros_package_hash(d)}".encode())
-        for dep in deps:
-            h.update(f" {dep}={keys[dep]}".encode())
-        keys[name] = h.hexdigest()[:20]
-        needs[name] = set(deps).union(*(needs[dep] for dep in deps))
-        order.append(name)
+    planned = plan(package_dirs)
+    for p in planned:
         # The venv's copy was built on the venv's dependencies: usable only when none of them had to be built.
-        if not (needs[name] & prefixes.keys()) and current_in_venv(d):
+        if not (p.needs & prefixes.keys()) and current_in_venv(p.folder):
             continue
-        prefixes[name] = _build_once(d, name, keys[name], [prefixes[n] for n in order if n in needs[name]
-                                                                and n in prefixes])
-    built = [n for n in order if n in prefixes]
+        prefixes[p.name] = _build_once(p, [prefixes[n] for n in prefixes if n in p.needs])
+    built = [p.name for p in planned if p.name in prefixes]
     if not built:
         return Path(sys.prefix).absolute()
-    if set(built[:-1]) <= needs[built[-1]]:
-        return prefixes[built[-1]]  # its own chain file names the others
+    if set(built[:-1]) <= planned[-1].needs and built[-1] == planned[-1].name:
+        return prefixes[built[-1]]
     chain = [prefixes[n] for n in built]
     view = CACHE / "chains" / hashlib.sha256("\n".join(map(str, chain)).encode()).hexdigest()[:20]
     with locked(CACHE / "chains" / f".lock-{view.name}"):
@@ -109,14 +122,14 @@ def built_prefix(package_dirs: Sequence[Path]) -> Path:
     return view
 
 
-def _build_once(package_dir: Path, name: str, key: str, chain: Sequence[Path]) -> Path:
-    prefix = CACHE / f"{name}-{key}"
+def _build_once(p: Planned, chain: Sequence[Path]) -> Path:
+    prefix = CACHE / f"{p.name}-{p.key}"
     with locked(CACHE / f".lock-{prefix.name}"):
         if not (prefix / ".complete").is_file():
             shutil.rmtree(prefix, ignore_errors=True)
             build_dir = CACHE / "build" / prefix.name
             shutil.rmtree(build_dir, ignore_errors=True)
-            cmake_build(package_dir, build_dir, prefix, chain)
+            cmake_build(p.folder, build_dir, prefix, chain)
             (prefix / CHAIN_FILE).write_text("".join(f"{p}\n" for p in chain))
             (prefix / ".complete").write_text("built by tests/helpers/ros_packages.py\n")
             shutil.rmtree(build_dir, ignore_errors=True)  # objects only: the prefix is what is used
