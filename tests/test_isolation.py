@@ -61,3 +61,11 @@ def test_a_child_process_shares_the_network(private: isolation.Isolation) -> Non
     proc = subprocess.run([sys.executable, "-c", "import os; print(os.readlink('/proc/thread-self/ns/net'))"],
                           capture_output=True, text=True, timeout=120, check=True)
     assert proc.stdout.strip() == private.namespace
+
+
+def test_machine_network_goes_back_and_returns(private: isolation.Isolation) -> None:
+    # pip reaching the package index (tests/system/test_install_wheel.py) steps out for that call only.
+    with isolation.machine_network():
+        outside = isolation.current_namespace()
+    assert outside != private.namespace
+    assert isolation.current_namespace() == private.namespace

@@ -16,12 +16,14 @@ derived from the pid (``helpers.runtime_support``), and the pytest header says s
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import errno
 import fcntl
 import os
 import socket
 import struct
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,6 +50,7 @@ class Isolation:
 
 _state: Isolation | None = None
 _sentinel: socket.socket | None = None
+_machine_ns: int | None = None  # an fd of the network this process started in (machine_network goes back to it)
 
 
 def current_namespace() -> str:
@@ -125,10 +128,14 @@ def workers_can_isolate() -> str | None:
 def enter_private_network() -> Isolation:
     """Move the calling thread (and what it starts later) into a private network with loopback up; once per
     process. Never raises: where it cannot, the result says why and the tests serialise as before."""
-    global _state, _sentinel
+    global _state, _sentinel, _machine_ns
     if _state is not None:
         return _state
     os.environ.pop(ENV, None)
+    try:
+        machine = os.open("/proc/thread-self/ns/net", os.O_RDONLY | os.O_CLOEXEC)
+    except OSError:
+        machine = None
     try:
         how = _try_enter()
     except OSError as ex:
@@ -143,9 +150,40 @@ def enter_private_network() -> Isolation:
                            current_namespace())
         return _state
     _sentinel = sentinel
+    _machine_ns = machine
     _state = Isolation(True, True, how, current_namespace())
     os.environ[ENV] = _state.namespace
     return _state
+
+
+def _setns(fd: int) -> None:
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.setns(ctypes.c_int(fd), ctypes.c_int(CLONE_NEWNET)) != 0:
+        err = ctypes.get_errno()
+        raise OSError(err, os.strerror(err))
+
+
+@contextlib.contextmanager
+def machine_network() -> Iterator[None]:
+    """The calling thread (and the processes it starts meanwhile) back in the machine's network for a step that
+    needs more than loopback, e.g. pip reaching the package index; the private one again after. Where the
+    process is not isolated, or cannot go back (a user namespace), it stays where it is."""
+    if _machine_ns is None or not isolated():
+        yield
+        return
+    private = os.open("/proc/thread-self/ns/net", os.O_RDONLY | os.O_CLOEXEC)
+    try:
+        try:
+            _setns(_machine_ns)
+        except OSError:
+            yield
+            return
+        try:
+            yield
+        finally:
+            _setns(private)
+    finally:
+        os.close(private)
 
 
 def state() -> Isolation:
