@@ -49,15 +49,13 @@ sys.meta_path.insert(0, _SourceFolderAlias())
 # enter a private network. pyproject's `pythonpath = ["tests"]` is applied before this file is imported.
 
 _GUARD = pytest.StashKey["tiers.ChildProcessGuard"]()
-_WORKER_ISOLATION: list[dict[str, object]] = []
+_WORKER_ISOLATION: list[dict[str, object]] = []  # what each xdist worker reported (the controller's summary)
+_SERIAL_FALLBACK: list[str] = []  # why the run was made serial, if it was
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addoption("--unit-tier", action="store_true", default=False,
                      help="run the unit tier only (no system test) and fail a test that starts a process")
-
-
-_SERIAL_FALLBACK: list[str] = []
 
 
 @pytest.hookimpl(tryfirst=True)
