@@ -14,9 +14,13 @@ from __future__ import annotations
 import importlib
 import importlib.abc
 import importlib.util
+import json
 import sys
 from types import ModuleType
 from typing import ClassVar
+
+import pytest
+from helpers import isolation, tiers
 
 collect_ignore = [f"runtime/nodes/{name}.py" for name in
                   ("controller", "dead_reckoning", "mission", "motion_planner", "performance_monitor", "slam")]
@@ -37,3 +41,118 @@ class _SourceFolderAlias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
 
 sys.meta_path.insert(0, _SourceFolderAlias())
+
+
+# --- Isolation and tiers (tests/helpers/isolation.py, tests/helpers/tiers.py) ------------------------------------
+# Here, not in tests/conftest.py: this file is loaded by every run (also one of codegen/ or runtime/ doctests alone),
+# and pytest_configure of the rootdir's conftest runs in each process's main thread before any test: the moment to
+# enter a private network. pyproject's `pythonpath = ["tests"]` is applied before this file is imported.
+
+_GUARD = pytest.StashKey["tiers.ChildProcessGuard"]()
+_WORKER_ISOLATION: list[dict[str, object]] = []  # what each xdist worker reported (the controller's summary)
+_SERIAL_FALLBACK: list[str] = []  # why the run was made serial, if it was
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--unit-tier", action="store_true", default=False,
+                     help="run the unit tier only (no system test) and fail a test that starts a process")
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config: pytest.Config) -> None:
+    """Before xdist starts workers: where they could not each have a network of their own, run serially (the
+    machine-wide lock and pid-derived domain ids of runtime_support then keep concurrent runs apart, as before)."""
+    if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        why = isolation.workers_can_isolate()
+        if why is not None:
+            _SERIAL_FALLBACK.append(why)
+            config.option.numprocesses = 0
+
+
+def _xdist_controller(config: pytest.Config) -> bool:
+    return (not hasattr(config, "workerinput") and getattr(config.option, "dist", "no") != "no"
+            and bool(getattr(config.option, "tx", None)) and not config.getoption("collectonly"))
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_configure(config: pytest.Config) -> None:
+    # Last: a plugin may connect to the xdist controller here (pytest-rerunfailures does, over 127.0.0.1); a socket
+    # made before keeps working in the new namespace. The controller of an xdist run runs no test and stays where it
+    # is, so that its workers, started from it, can reach it before they leave.
+    if not _xdist_controller(config):
+        isolation.enter_private_network()
+    if config.getoption("--unit-tier"):
+        tiers.warm_up()
+
+
+def pytest_report_header(config: pytest.Config) -> str:
+    return _isolation_line(config)
+
+
+def _isolation_line(config: pytest.Config) -> str:
+    mine = isolation.state()
+    states = _WORKER_ISOLATION or [{"isolated": mine.isolated, "how": mine.how}]
+    if all(s["isolated"] for s in states):
+        who = f"each of {len(states)} workers" if _WORKER_ISOLATION else "this process"
+        serial = f"; one test at a time: workers could not have one each ({_SERIAL_FALLBACK[0]})" \
+            if _SERIAL_FALLBACK else ""
+        return f"network isolation: {who} in a private network namespace ({states[0]['how']}){serial}"
+    why = "; ".join(sorted({str(s["how"]) for s in states if not s["isolated"]} | set(_SERIAL_FALLBACK)))
+    serial = ", one test at a time instead of in parallel" if _SERIAL_FALLBACK else ""
+    return (f"network isolation: NONE ({why}): Cyphal/UDP tests serialise on {isolation_lock_name()}, "
+            f"ROS domain ids are derived from the pid{serial}")
+
+
+def isolation_lock_name() -> str:
+    """The fallback's lock file (helpers.runtime_support)."""
+    from helpers.runtime_support import UDP_LOCK
+
+    return str(UDP_LOCK)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    tiers.mark_system(items)
+    tiers.system_first(items)
+    if config.getoption("--unit-tier"):
+        keep = [item for item in items if item.get_closest_marker("system") is None]
+        dropped = [item for item in items if item.get_closest_marker("system") is not None]
+        if dropped:
+            config.hook.pytest_deselected(items=dropped)
+        items[:] = keep
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> object:
+    if not item.config.getoption("--unit-tier"):
+        yield
+        return
+    with tiers.ChildProcessGuard() as guard:
+        item.stash[_GUARD] = guard
+        yield
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> object:
+    outcome = yield
+    guard = item.stash.get(_GUARD, None)
+    if guard is not None:
+        tiers.fail_if_guarded(item, outcome.get_result(), guard)
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None:  # an xdist worker tells the controller how it was isolated
+        mine = isolation.state()
+        workeroutput["isolation"] = json.dumps({"isolated": mine.isolated, "how": mine.how})
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node: object, error: object) -> None:
+    output = getattr(node, "workeroutput", {}) or {}
+    if "isolation" in output:
+        _WORKER_ISOLATION.append(json.loads(output["isolation"]))
+
+
+def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter, exitstatus: int,
+                            config: pytest.Config) -> None:
+    terminalreporter.write_line(_isolation_line(config))

@@ -1,4 +1,4 @@
-"""Sessions: tests (the CI gate), lint, build, run (the main job on simulated devices), bench."""
+"""Sessions: tests (the CI gate), unit (its fast tier), lint, build, run (the main job on simulated devices), bench."""
 
 from __future__ import annotations
 
@@ -46,15 +46,28 @@ def _ros_install(session: nox.Session) -> None:
                 env=LOOPBACK)
 
 
+# pytest-xdist: one worker per core, each in a private network (tests/helpers/isolation.py). A module's tests stay on
+# one worker (--dist loadfile): their module fixtures (a built spec, a running stack) are set up once.
+PARALLEL = ["-n", "auto", "--dist", "loadfile"]
+
+
 @nox.session(python="3.11")
 def tests(session: nox.Session) -> None:
     """Everything: ruff, mypy and the import layers, generated/ is current, sam_msgs builds, then unit, golden,
-    conformance and end-to-end tests."""
+    conformance and end-to-end tests, on every core."""
     _install(session, "runtime,rosbuild,test")
     _static_checks(session)
     session.run("sam-codegen", "build", "--check")
     _ros_install(session)
-    session.run("pytest", *(session.posargs or ["-q"]), env=LOOPBACK)
+    session.run("pytest", *(session.posargs or ["-q", *PARALLEL]), env=LOOPBACK)
+
+
+@nox.session(python="3.11")
+def unit(session: nox.Session) -> None:
+    """The fast tier for the edit-test loop: the tests that start no process, build nothing with CMake and need no
+    built ROS package (tests/helpers/tiers.py; one that starts a process fails here). `nox -s tests` is the gate."""
+    _install(session, "runtime,test")
+    session.run("pytest", *(session.posargs or ["-q", "-n", "auto"]), "--unit-tier", env=LOOPBACK)
 
 
 @nox.session(python="3.11")

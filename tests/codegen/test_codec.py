@@ -70,6 +70,7 @@ if not WORKER:
             GOLDEN.write_bytes(text.encode("utf-8"))
         assert text == GOLDEN.read_bytes().decode("utf-8"), "codec.py changed: SAM_UPDATE_GOLDEN=1 rewrites it"
 
+    @pytest.mark.system  # starts a process: not in the unit tier
     def test_deterministic() -> None:
         """The same bytes from a fresh model and from another process with another hash seed."""
         text = _codec(SPECS["sam"])
@@ -83,6 +84,7 @@ if not WORKER:
         assert text.startswith("# Generated from interfaces.yaml by sam-codegen; do not edit.\n")
         assert "/work/" not in text and "/tmp" not in text and "\t" not in text
 
+    @pytest.mark.system  # starts a process: not in the unit tier
     @pytest.mark.parametrize("spec", sorted(SPECS))
     def test_ruff_clean_and_standard_library_only(spec: str, tmp_path: Path) -> None:
         text = _codec(SPECS[spec])
@@ -108,6 +110,7 @@ if not WORKER:
             capture_output=True, text=True, check=False)
         assert proc.returncode == 0, proc.stdout + proc.stderr
 
+    @pytest.mark.system  # starts a process: not in the unit tier
     def test_user_project_gets_a_codec(tmp_path: Path) -> None:
         """`build` in a project of its own (outside this repository) writes codec.py, importable without ROS or
         pycyphal: a codec for each mapping, both directions."""

@@ -258,6 +258,7 @@ if not WORKER:
         assert text == (GOLDEN / "python" / "sam_bridge" / "codec_v0.py.golden").read_text(encoding="utf-8"), \
             "run tests/test_v0_dsdl.py with SAM_UPDATE_GOLDEN=1 after an intended change"
 
+    @pytest.mark.system  # starts a process: not in the unit tier
     @pytest.mark.parametrize("spec", sorted(SPECS))
     def test_codec_is_lint_clean_deterministic_and_standard_library_only(
             spec: str, modules: dict[str, dict[str, str]], tmp_path: Path) -> None:

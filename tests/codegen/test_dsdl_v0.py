@@ -181,6 +181,7 @@ def test_golden_converters(resolved: dict[str, Resolved]) -> None:
     _golden(GOLDEN / "python_v0", {**emit_python_v0.emit(resolved["sam"]), **emit_codec_v0.emit(resolved["sam"])})
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 @pytest.mark.parametrize("spec", ["sam", "ferry"])
 def test_converters_are_lint_clean_and_deterministic(spec: str, resolved: dict[str, Resolved], tmp_path: Path) -> None:
     import subprocess

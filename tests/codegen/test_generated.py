@@ -118,6 +118,7 @@ print(json.dumps(done))
 """
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_dsdl_compiles_with_pycyphal(tmp_path: Path) -> None:
     """Every generated DSDL type compiles with nunavut/pycyphal against the public regulated types."""
     pytest.importorskip("pycyphal")

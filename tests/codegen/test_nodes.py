@@ -91,6 +91,7 @@ def test_layout_and_determinism(spec_name: str, resolved: Resolved, files: dict[
         assert "\t" not in text and not any(line != line.rstrip() for line in text.splitlines()), path
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_same_output_in_another_process(spec_name: str, files: dict[str, str]) -> None:
     """No dependence on set order: another hash seed emits the same bytes."""
     code = ("import json, pathlib, sys; from sam_codegen.targets import nodes as emit_nodes; "
@@ -174,6 +175,7 @@ def test_sam_nodes_as_the_contract_lists() -> None:
     assert (p.type, p.default, p.minimum, p.maximum, p.unit) == ("double", 20.0, 0.0, 100.0, "%")
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 @pytest.mark.parametrize("which", ["files", "hostile"])
 def test_modules_compile_and_are_ruff_clean(which: str, resolved: Resolved, files: dict[str, str],
                                             tmp_path: Path) -> None:

@@ -206,6 +206,7 @@ def test_hostile_text_stays_inert(sam: Resolved, tmp_path: Path) -> None:
     assert {r.description for r in tables.PARAMETER_RULES} == {HOSTILE}
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_python_names_follow_pycyphal() -> None:
     """Attribute names are mangled exactly as nunavut's Python target does (keywords and builtins get `_`)."""
     names = ["rpm", "id", "type", "match", "case", "print", "self", "async", "max", "len", "Exception", "x_", "_x"]
@@ -220,6 +221,7 @@ def test_python_names_follow_pycyphal() -> None:
             assert py_attr(name) == language.filter_id(name), name
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 @pytest.mark.parametrize("which", ["sam", "rover"])
 def test_ruff_clean(which: str, request: pytest.FixtureRequest, tmp_path: Path) -> None:
     ruff = shutil.which("ruff") or str(Path(sys.executable).with_name("ruff"))
@@ -237,6 +239,7 @@ def test_ruff_clean(which: str, request: pytest.FixtureRequest, tmp_path: Path) 
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_same_output_in_another_process(sam_files: dict[str, str]) -> None:
     """No dependence on set or dict order: another process with another hash seed emits the same bytes."""
     code = ("import json, pathlib, sys; from sam_codegen.targets.python import convert as emit_python; "

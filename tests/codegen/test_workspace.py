@@ -312,6 +312,7 @@ _WITHOUT_RUNTIME = textwrap.dedent("""\
     """)
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 @pytest.mark.parametrize("command", ["sim", "bridge", "run"])
 def test_runtime_commands_without_the_runtime_extra(command: str, tmp_path: Path) -> None:
     proc = subprocess.run([sys.executable, "-c", _WITHOUT_RUNTIME, command, "--generated", str(REPO / "generated")],

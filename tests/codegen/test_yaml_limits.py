@@ -91,6 +91,7 @@ def _sam_codegen() -> list[str]:
     ("block", "".join("  " * i + "a:\n" for i in range(5000)) + "  " * 5000 + "b\n",
      f"{MAX_DEPTH + 1}:{2 * MAX_DEPTH + 1}", DEPTH_ERROR),
 ], ids=lambda v: v if isinstance(v, str) and len(v) < 10 else "")
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_cli_refuses_at_once(tmp_path: Path, name: str, text: str, at: str, message: str) -> None:
     spec = tmp_path / f"{name}.yaml"
     spec.write_text(text, encoding="utf-8")

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(1, str(Path(__file__).resolve().parents[1]))  # runtime_support imports helpers.*
 from ros_probe import ThreadedProbe, to_plain
 from runtime_support import command_plan
 

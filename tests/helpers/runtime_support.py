@@ -18,9 +18,11 @@ from typing import Any, TypeVar
 
 import pytest
 
+from helpers.isolation import isolated
+from helpers.ros_packages import chained_env
+
 REPO = Path(__file__).resolve().parents[2]
 HELPERS = Path(__file__).resolve().parent
-TEST_ROS_PREFIX = REPO / ".cache" / "ros-test-prefix"
 T = TypeVar("T")
 
 
@@ -29,8 +31,13 @@ UDP_LOCK = Path("/tmp") / "sam-runtime-tests-cyphal-udp.lock"
 
 @contextlib.contextmanager
 def cyphal_udp_lock(timeout: float = 600.0) -> Iterator[None]:
-    """Cyphal/UDP subjects are multicast groups shared by the whole machine (ROS_DOMAIN_ID does not separate
-    them): two runs of these tests at once would see each other's devices. Serialize them machine-wide."""
+    """Cyphal/UDP subjects are multicast groups shared by everything on one network (ROS_DOMAIN_ID does not
+    separate them). In a private network namespace (helpers.isolation: the normal case) nothing else shares it and
+    this is a no-op; where none could be made, two runs of these tests at once would see each other's devices:
+    serialize them machine-wide."""
+    if isolated():
+        yield
+        return
     with open(UDP_LOCK, "a+") as fh:
         deadline = time.monotonic() + timeout
         while True:
@@ -60,39 +67,33 @@ def generated_or_skip() -> Any:
 
 
 def ros_prefix_for(gen: Any) -> Path:
-    """A prefix where the generated ROS package is installed and current: the venv if it is there (nox and
-    `sam-codegen ros-install` put it there), else a test prefix under .cache (built once, ~30 s)."""
-    from sam_runtime.genpkg import ensure_ros_package
+    """Where the generated ROS packages are usable (a prefix for child_env): the venv when they are current there
+    (nox's tests session and `sam-codegen ros-install` put them there), else prefixes built for the tests
+    (helpers.ros_packages: once per package content, ~30 s)."""
+    from helpers.ros_packages import built_prefix
+    from sam_codegen.project.ros_install import ros_packages_in_order
 
-    venv = Path(sys.prefix).absolute()
     try:
-        return ensure_ros_package(gen, venv) if _installed_current(gen, venv) else ensure_ros_package(
-            gen, TEST_ROS_PREFIX)
+        return built_prefix(ros_packages_in_order(gen.ros_package_dir().parent))
     except Exception as ex:  # a build problem is the ROS build tests' business; here it is a skip reason
         pytest.skip(f"cannot build the generated ROS package: {type(ex).__name__}: {ex}")
 
 
-def _installed_current(gen: Any, prefix: Path) -> bool:
-    from sam_runtime.genpkg import same_interfaces
-
-    name = gen.tables().ROS_PACKAGE
-    return same_interfaces(gen.ros_package_dir(), prefix / "share" / name)
-
-
 def domain_id(offset: int) -> str:
-    """A ROS_DOMAIN_ID private to this test session (pid-derived, 1..101) so parallel runs do not cross-talk."""
-    return str(1 + (os.getpid() * 7 + offset * 13) % 101)
+    """The ROS_DOMAIN_ID of a test (1..101 by its offset, so the tests of one process never share one). In a private
+    network namespace no other run can see it; without one (helpers.isolation's fallback) the pid is mixed in so that
+    parallel runs on the machine do not cross-talk (they may still collide: 101 ids)."""
+    salt = 0 if isolated() else os.getpid() * 7
+    return str(1 + (salt + offset * 13) % 101)
 
 
 def child_env(prefix: Path, domain: str, extra: Mapping[str, str] | None = None) -> dict[str, str]:
-    from sam_codegen.project.ros_install import ros_runtime_env
-
     base = dict(os.environ)
     # Never inherit a Cyphal transport from the caller's shell: the tests choose it explicitly.
     for k in list(base):
         if k.startswith("UAVCAN__"):
             del base[k]
-    env = ros_runtime_env(prefix, base) if prefix != Path(sys.prefix).absolute() else base
+    env = chained_env(prefix, base)
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     env["ROS_DOMAIN_ID"] = domain
     env["PYTHONUNBUFFERED"] = "1"

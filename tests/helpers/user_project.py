@@ -7,11 +7,10 @@ import shutil
 import time
 from pathlib import Path
 
-from helpers.runtime_support import REPO, TEST_ROS_PREFIX
+from helpers.ros_packages import built_prefix
+from helpers.runtime_support import REPO
 
 SKIFF_SPEC = REPO / "tests" / "specs" / "skiff.yaml"
-# dinghy_msgs goes into the runtime tests' prefix too, stamped with its sources' hash, so a later session reuses it.
-TEST_ROS_BUILD = REPO / ".cache" / "ros-test-build"
 
 
 def make_project(root: Path) -> Path:
@@ -24,12 +23,14 @@ def make_project(root: Path) -> Path:
 def built_project(root: Path) -> tuple[Path, Path]:
     """A skiff project with generated/ built and dinghy_msgs installed: (project, ROS prefix)."""
     from sam_codegen.build import build
-    from sam_runtime.genpkg import GeneratedPackage, ensure_ros_package
+    from sam_codegen.project.ros_install import ros_packages_in_order
+    from sam_runtime.genpkg import GeneratedPackage
 
     project = make_project(root)
     build(project / "spec" / "interfaces.yaml", project / "generated")
     gen = GeneratedPackage(project / "generated")
-    prefix = ensure_ros_package(gen, TEST_ROS_PREFIX, build_root=TEST_ROS_BUILD)
+    # dinghy_msgs is built once per content (helpers.ros_packages), wherever the project's folder is.
+    prefix = built_prefix(ros_packages_in_order(gen.ros_package_dir().parent))
     gen.compile_dsdl()  # once here, so that the processes of a test start in seconds
     return project, prefix
 

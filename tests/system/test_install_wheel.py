@@ -9,6 +9,7 @@ About 3-4 minutes: the two installs come from pip's cache, ros-install builds di
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import re
@@ -26,6 +27,7 @@ import pytest
 pytest.importorskip("pycyphal")
 pytest.importorskip("rclpy")
 
+from helpers.isolation import machine_network
 from helpers.runtime_support import cyphal_udp_lock, domain_id, poll_until, read_json
 from helpers.user_project import make_project
 
@@ -45,7 +47,10 @@ INSTALL_LOCATION_WRITES = ("generated", ".cache", "build/ros", ".sam-codegen-cac
 
 def _run(cmd: Sequence[str | Path], *, cwd: Path, env: dict[str, str], timeout: float = STEP_TIMEOUT_S,
          ok: bool = True) -> subprocess.CompletedProcess[str]:
-    proc = subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    # pip may need the package index: the machine's network, not the test's private loopback (helpers.isolation).
+    with machine_network() if [str(c) for c in cmd[1:3]] == ["-m", "pip"] else contextlib.nullcontext():
+        proc = subprocess.run([str(c) for c in cmd], cwd=cwd, env=env, capture_output=True, text=True,
+                              timeout=timeout)
     if ok:
         assert proc.returncode == 0, f"{cmd} failed ({proc.returncode}):\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}"
     return proc

@@ -256,6 +256,7 @@ print(json.dumps({"out": str(out), "demo": demo.__file__}))
 """
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_concurrent_compiles_share_one_entry(tmp_path: Path, tiny_cyphal_path: Path) -> None:
     demo = _make_demo(tmp_path / "src")
     cache = tmp_path / "cache"

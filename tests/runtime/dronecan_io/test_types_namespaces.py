@@ -56,6 +56,7 @@ print(json.dumps(out))
 '''
 
 
+@pytest.mark.system  # starts a process: not in the unit tier
 def test_data_type_ids_decode_as_the_spec_chooses() -> None:
     trawler = generated_spec("trawler_v0")
     proc = subprocess.run([sys.executable, "-c", CHILD, str(trawler), str(REPO / "generated")],

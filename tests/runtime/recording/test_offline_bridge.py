@@ -22,6 +22,7 @@ def gen() -> Any:
     return generated_or_skip()
 
 
+@pytest.mark.ros  # the bridge builds the ROS messages: needs the built sam_msgs (not in the unit tier)
 def test_cyphal_transfers_become_what_the_bridge_publishes(gen: Any) -> None:
     bridge = OfflineBridge(gen)
     codec = gen.codec("cyphal")
@@ -36,6 +37,7 @@ def test_cyphal_transfers_become_what_the_bridge_publishes(gen: Any) -> None:
     assert imu["published"] == 2 and imu["dropped"] == {"unknown_source": 1, "lost": 3}
 
 
+@pytest.mark.ros  # the bridge builds the ROS messages: needs the built sam_msgs (not in the unit tier)
 def test_the_probe_tells_receive_time_fields(gen: Any) -> None:
     """/pressure is stamped with the receive time: the probe conversion differs; /imu carries the device's."""
     bridge = OfflineBridge(gen)
@@ -47,6 +49,7 @@ def test_the_probe_tells_receive_time_fields(gen: Any) -> None:
     assert imu.cdr == imu.cdr_later
 
 
+@pytest.mark.ros  # the bridge builds the ROS messages: needs the built sam_msgs (not in the unit tier)
 def test_dronecan_select_routes_by_source_and_field(gen: Any) -> None:
     import dronecan
     from dronecan import transport

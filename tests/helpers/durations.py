@@ -1,0 +1,85 @@
+"""Wall time per test folder from pytest's ``--durations=0`` output, as a markdown table (not part of CI).
+
+    python tests/helpers/durations.py before.log [after.log] [--top N]
+
+With two logs the table has a column for each. The times are pytest's per-phase durations (setup + call +
+teardown) summed: in a parallel run that is the work done, not the wall time (which pytest prints at the end).
+
+>>> rows = parse(["12.50s call     tests/system/test_a.py::test_x[1]",
+...               "0.50s setup    tests/system/test_a.py::test_x[1]",
+...               "3.00s call     codegen/model/x.py::sam_codegen.model.x", "garbage"])
+>>> sorted(rows.items())
+[('codegen/model/x.py::sam_codegen.model.x', 3.0), ('tests/system/test_a.py::test_x[1]', 13.0)]
+>>> by_folder(rows)
+{'codegen/model': (1, 3.0), 'tests/system': (1, 13.0)}
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from collections.abc import Iterable
+from pathlib import Path
+
+LINE = re.compile(r"^\s*(\d+(?:\.\d+)?)s\s+(setup|call|teardown)\s+(\S.*?)\s*$")
+
+
+def parse(lines: Iterable[str]) -> dict[str, float]:
+    """Seconds per test id (its phases summed)."""
+    out: dict[str, float] = {}
+    for line in lines:
+        m = LINE.match(line)
+        if m:
+            out[m.group(3)] = out.get(m.group(3), 0.0) + float(m.group(1))
+    return out
+
+
+def folder_of(test_id: str) -> str:
+    return str(Path(test_id.split("::", 1)[0]).parent)
+
+
+def by_folder(rows: dict[str, float]) -> dict[str, tuple[int, float]]:
+    """Folder -> (tests, seconds)."""
+    out: dict[str, tuple[int, float]] = {}
+    for test_id, seconds in rows.items():
+        n, total = out.get(folder_of(test_id), (0, 0.0))
+        out[folder_of(test_id)] = (n + 1, total + seconds)
+    return dict(sorted(out.items()))
+
+
+def table(logs: list[tuple[str, dict[str, float]]]) -> str:
+    folders = sorted({f for _, rows in logs for f in by_folder(rows)},
+                     key=lambda f: -max(by_folder(rows).get(f, (0, 0.0))[1] for _, rows in logs))
+    head = "| folder | " + " | ".join(f"{name}: tests | {name}: s" for name, _ in logs) + " |"
+    lines = [head, "|---|" + "---:|---:|" * len(logs)]
+    sums = [by_folder(rows) for _, rows in logs]
+    for f in folders:
+        cells = [f"{s.get(f, (0, 0.0))[0]} | {s.get(f, (0, 0.0))[1]:.0f}" for s in sums]
+        lines.append(f"| {f} | " + " | ".join(cells) + " |")
+    totals = [f"{sum(n for n, _ in s.values())} | {sum(t for _, t in s.values()):.0f}" for s in sums]
+    lines.append("| **all** | " + " | ".join(totals) + " |")
+    return "\n".join(lines)
+
+
+def slowest(rows: dict[str, float], n: int) -> str:
+    lines = ["| test | s |", "|---|---:|"]
+    lines += [f"| {t} | {s:.1f} |" for t, s in sorted(rows.items(), key=lambda kv: -kv[1])[:n]]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("logs", nargs="+", type=Path, help="pytest outputs with --durations=0 (before, after)")
+    parser.add_argument("--top", type=int, default=0, help="also list the N slowest tests of the last log")
+    args = parser.parse_args(argv)
+    logs = [(p.stem, parse(p.read_text(errors="replace").splitlines())) for p in args.logs]
+    print(table(logs))
+    if args.top:
+        print()
+        print(slowest(logs[-1][1], args.top))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
