@@ -98,6 +98,7 @@ class Waiter(threading.Thread):
             self.error = exc  # type: ignore[assignment]
 
 
+@pytest.mark.system  # the holder / the publisher is another process
 def test_a_waiter_says_for_whom_it_waits_then_what_the_holder_does(tmp_path: Path, holder: Holder,
                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(lock_module, "MIN_LINE_S", 0.0)  # the bounded rate is tested below, with a fake clock
@@ -123,6 +124,7 @@ def test_a_waiter_says_for_whom_it_waits_then_what_the_holder_does(tmp_path: Pat
     assert waiter.lines[-1].startswith("the test resource is free after ")
 
 
+@pytest.mark.system  # the holder / the publisher is another process
 def test_a_dead_holder_leaves_no_stale_lock(tmp_path: Path, holder: Holder) -> None:
     waiter = Waiter(ProjectLock(tmp_path / "resource.lock", "the test resource"))
     waiter.start()
@@ -137,6 +139,7 @@ def test_a_dead_holder_leaves_no_stale_lock(tmp_path: Path, holder: Holder) -> N
         assert not again.contended
 
 
+@pytest.mark.system  # the holder / the publisher is another process
 def test_a_wait_timeout_names_the_holder(tmp_path: Path, holder: Holder) -> None:
     with pytest.raises(LockTimeout) as info:
         with ProjectLock(tmp_path / "resource.lock", "the test resource", timeout=0.3):
@@ -148,6 +151,7 @@ def test_a_wait_timeout_names_the_holder(tmp_path: Path, holder: Holder) -> None
     assert holder.proc.poll() is None  # the holder goes on
 
 
+@pytest.mark.system  # the holder / the publisher is another process
 def test_a_stop_while_waiting_ends_the_wait(tmp_path: Path, holder: Holder) -> None:
     asked = []
 

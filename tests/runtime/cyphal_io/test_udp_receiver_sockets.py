@@ -80,6 +80,7 @@ async def _until(cond: Callable[[], bool], timeout: float = 20.0) -> None:
         await asyncio.sleep(0.01)
 
 
+@pytest.mark.system  # the holder / the publisher is another process
 def test_a_pycyphal_publisher_in_another_process_reaches_the_receiver() -> None:
     from pycyphal.transport import InputSessionSpecifier, MessageDataSpecifier, PayloadMetadata
     from pycyphal.transport.udp import UDPTransport
@@ -225,6 +226,7 @@ def _yakut() -> str | None:
     return exe if Path(exe).exists() else shutil.which("yakut")
 
 
+@pytest.mark.system  # the holder / the publisher is another process
 def test_yakut_pub_reaches_the_receiver() -> None:
     """yakut (its own venv: it pins pycyphal itself) publishes uavcan.primitive.scalar.Natural32 on a subject."""
     exe = _yakut()
