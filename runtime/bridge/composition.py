@@ -45,7 +45,10 @@ from sam_runtime.genpkg import GeneratedPackage
 
 __all__ = ["Bridge"]
 
-HOUSEKEEPING_PERIOD_S = 0.2
+# The housekeeping round (stack counters, the rate-limited log's pending counts, the link and silence checks, and
+# /diagnostics at its default period): one wake-up of the loop a second for all of them, as slow as their bounds
+# allow (the offline timeout and the silence graces are 3 s or more; the log sums per 10 s).
+HOUSEKEEPING_PERIOD_S = 1.0
 WIRE_PATHS = ("codec", "object")
 
 
@@ -243,7 +246,8 @@ class Bridge:
         health.attach(lifetime)
         inbound.attach()
         outbound.attach()
-        lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
+        if not 0 < self._diagnostics_period <= HOUSEKEEPING_PERIOD_S:  # (else each /diagnostics polls them)
+            lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
         if sel.protocol == "dronecan":

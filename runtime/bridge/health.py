@@ -107,8 +107,8 @@ class DeviceHealth:
         if restarted:
             rec.restarts += 1
             rec.alive_since = now  # a device that just booted gets its grace before it must publish
-        # last_seen last: /diagnostics is also built on rclpy's timer thread, and a record that reads alive must
-        # already carry this heartbeat's status and count.
+        # last_seen last: /diagnostics may also be built on rclpy's executor thread (an enable service's change),
+        # and a record that reads alive must already carry this heartbeat's status and count.
         rec.status, rec.count = st, rec.count + 1
         rec.last_seen = now
         self._arm(rec)

@@ -1,6 +1,7 @@
 """UAVCAN -> ROS mappings that get nothing from a device whose heartbeat is alive (rules: bridge.liveness),
-checked every 0.2 s; a mapping going silent, and the end of it, is logged once and handed to the handlers (the
-bridge publishes /diagnostics at once)."""
+checked once a second (the graces are 3 s or more: a finding comes within a second of its grace, and the
+check shares the bridge's one housekeeping wake-up a second); a mapping going silent, and the end of it, is
+logged once and handed to the handlers (the bridge publishes /diagnostics at once)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from sam_runtime.bridge.liveness import LivenessCheck, Silence
 
 __all__ = ["CHECK_PERIOD_S", "SilenceWatch"]
 
-CHECK_PERIOD_S = 0.2
+CHECK_PERIOD_S = 1.0
 
 
 class SilenceWatch:
