@@ -66,34 +66,47 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
 
 def diagnostic_array_cdr(snap: Mapping[str, Any], naming: Naming, stamp_ns: int) -> bytes:
     """The same message as :func:`diagnostic_array` (stamped ``stamp_ns``), serialized (CDR, little endian) for a
-    raw publish: the bridge publishes /diagnostics once a second with a few hundred values, and building them as
+    raw publish: the bridge publishes /diagnostics once a second with several hundred strings, and building them as
     rclpy message objects (each KeyValue's checked constructor, then rclpy's conversion to C) was most of its idle
-    CPU. Byte for byte what rclpy's serialize_message gives (tests/runtime/bridge/test_diagnostics_cdr.py)."""
+    CPU. rclpy's serialize_message gives the same bytes but the alignment padding (zero here), which deserialize to
+    the same message (tests/runtime/bridge/test_diagnostics_cdr.py). Most strings repeat from one message to the
+    next (names, keys, small values): their encoding is kept (:data:`_ENCODED`)."""
     sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
     sts = statuses(snap, naming)
     out = bytearray(_CDR_LE)
     out += _U32.pack(sec & 0xFFFFFFFF) + _U32.pack(nanosec) + _EMPTY_STRING + _U32.pack(len(sts))
+    encoded = _ENCODED
+    if len(encoded) > _ENCODED_MAX:  # (values that never repeat, such as ages and uptimes, are kept too: bounded)
+        encoded.clear()
     for level, name, msg, hw, values in sts:
         out.append(level)
-        for text in (name, msg, hw):
-            _cdr_string(out, text)
-        out += b"\0" * (-len(out) % 4) + _U32.pack(len(values))
+        strings = [name, msg, hw]
         for k, v in values.items():
-            _cdr_string(out, str(k))
-            _cdr_string(out, str(v))
+            strings.append(k if type(k) is str else str(k))
+            strings.append(v if type(v) is str else str(v))
+        for i, text in enumerate(strings):
+            if i == 3:  # the values' count, after hardware_id
+                out += _PADS[-len(out) & 3] + _U32.pack(len(values))
+            enc = encoded.get(text)
+            if enc is None:
+                raw = text.encode()
+                enc = encoded[text] = _U32.pack(len(raw) + 1) + raw + b"\0"
+            out += _PADS[-len(out) & 3]
+            out += enc
+        if len(strings) == 3:
+            out += _PADS[-len(out) & 3] + _U32.pack(0)
     return bytes(out)
 
 
 _CDR_LE = b"\x00\x01\x00\x00"  # the encapsulation header: plain CDR, little endian
 _U32 = struct.Struct("<I")
 _EMPTY_STRING = _U32.pack(1) + b"\0\0\0\0"  # header.frame_id "" (length 1: its NUL), padded to 4
-
-
-def _cdr_string(out: bytearray, text: str) -> None:
-    """A CDR string at 4-byte alignment (the offsets count from after the encapsulation header, 4 bytes long, so
-    the buffer's own offsets align the same): length with the NUL, UTF-8 bytes, NUL."""
-    raw = text.encode()
-    out += b"\0" * (-len(out) % 4) + _U32.pack(len(raw) + 1) + raw + b"\0"
+# CDR strings are 4-byte aligned; the offsets count from after the 4-byte encapsulation header, so the buffer's own
+# offsets align the same
+_PADS = (b"", b"\0", b"\0\0", b"\0\0\0")
+# text -> its CDR string (length with the NUL, UTF-8 bytes, NUL); cleared when it outgrows the bound
+_ENCODED: dict[str, bytes] = {}
+_ENCODED_MAX = 20_000
 
 
 def statuses(snap: Mapping[str, Any], naming: Naming) -> list[Status]:

@@ -145,3 +145,13 @@ def test_reporter_publishes_the_cdr_on_the_lifetimes_round() -> None:
                    inbound=None, outbound=None, silence=None, ros=ros, period=0.0)  # type: ignore[arg-type]
     off.attach()
     assert off.lifetime.schedule == {}  # /diagnostics off: no job
+
+
+def test_cdr_with_the_string_cache_cleared_between_messages(monkeypatch: pytest.MonkeyPatch) -> None:
+    from sam_runtime.bridge import diagnostics
+
+    monkeypatch.setattr(diagnostics, "_ENCODED_MAX", 5)  # cleared before every message, refilled within it
+    snap = _snapshot()
+    first = diagnostic_array_cdr(snap, NAMING, 7)
+    assert diagnostic_array_cdr(snap, NAMING, 7) == first
+    _same_as_rclpys(snap, 7)
