@@ -232,7 +232,7 @@ class Bridge:
         silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in sel.mappings
                                 if m.direction == UAVCAN_TO_ROS], health.devices,
                                alive_since=health.alive_since, last_message=inbound.last_message,
-                               listening_since=lambda: link.up_since)
+                               listening_since=lambda: link.up_since, last_heartbeat=health.last_heartbeat)
         self.reporter = reporter = Reporter(
             lifetime, self.namespace.status_name(self.name), sel.mappings, self.counters, backend=backend,
             health=health, link=link, inbound=inbound, outbound=outbound, silence=silence, ros=self.ros,

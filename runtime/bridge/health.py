@@ -173,6 +173,11 @@ class DeviceHealth:
             return None
         return rec.alive_since
 
+    def last_heartbeat(self, nid: int) -> float | None:
+        """When the node's last heartbeat arrived (the clock's time), or None when never heard."""
+        rec = self.records.get(nid)
+        return None if rec is None else rec.last_seen
+
     def uptime_of(self, nid: int) -> int | None:
         rec = self.records.get(nid)
         return None if rec is None else rec.status.uptime_s
