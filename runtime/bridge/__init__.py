@@ -91,13 +91,13 @@ reason                 when
 
 So per UAVCAN -> ROS mapping, once nothing is in flight and the sources sent again after a loss: the transfers
 its accepted sources sent == ``published + dropped_total - dropped.unknown_source``, and ``received`` (what
-reached the bridge) == ``published`` + the drops other than ``lost``. The causes below the bridge are
-pycyphal's counters of the subject, polled every 0.2 s and on every :meth:`Bridge.stats`, reported per
-mapping as ``cyphal.*``: ``errors`` (datagrams/frames that do not parse, transfers failing their CRC,
-multi-frame transfers with missing frames, duplicate or stale transfer ids - ``error.<kind>`` names them, per
-source node on UDP), ``deserialization_failures``, ``overruns`` (receive queue full), ``drops`` (the transport's
-own queue). They count frames from any sender, also ones that never were a valid transfer of an accepted
-source, so they are not added to ``dropped``; any of them, like any drop, makes the mapping WARN in
+reached the bridge) == ``published`` + the drops other than ``lost``. The causes below the bridge are pycyphal's
+counters of the subject, polled once a second (when /diagnostics is built) and on every :meth:`Bridge.stats`,
+reported per mapping as ``cyphal.*``: ``errors`` (datagrams/frames that do not parse, transfers failing their CRC,
+multi-frame transfers with missing frames, duplicate or stale transfer ids - ``error.<kind>`` names them, per source
+node on UDP), ``deserialization_failures``, ``overruns`` (receive queue full), ``drops`` (the transport's own
+queue). They count frames from any sender, also ones that never were a valid transfer of an accepted source, so they
+are not added to ``dropped``; any of them, like any drop, makes the mapping WARN in
 /diagnostics for 10 s. Saturated values are counted per field under ``saturated.<mapping>.<field>`` (the
 message is still published), rejected ones under ``rejected.<...>``.
 
@@ -126,11 +126,11 @@ message is still published), rejected ones under ``rejected.<...>``.
   ``uavcan.sub.<mapping>.id``/``.type`` and ``uavcan.pub.<mapping>.id``/``.type`` (a subject of several mappings:
   the first one's name) whose defaults are the spec's subject ids, overridable as usual (e.g.
   ``UAVCAN__SUB__IMU__ID``), and ``uavcan.node.id`` (sam_runtime.cyphal_io.ports).
-- A Cyphal transport that dies (pycyphal's CAN media close themselves for good on unrecoverable OS errors,
-  e.g. ENETDOWN when a SocketCAN interface goes down) is detected within 0.2 s and reopened with back-off
-  (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
-  /diagnostics shows the bridge at ERROR. Transient bus errors (a send raising) are counted and the next
-  message goes through.
+- A Cyphal transport that dies (pycyphal's CAN media close themselves for good on unrecoverable OS errors, e.g.
+  ENETDOWN when a SocketCAN interface goes down) is detected within 1 s (the housekeeping round) and reopened with
+  back-off (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
+  /diagnostics shows the bridge at ERROR. Transient bus errors (a send raising) are counted and the next message
+  goes through.
 - ROS QoS: each topic's from the spec (``qos``: sensor data best effort, commands and states reliable, ...).
   A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last, so DDS drops that
   subscriber's oldest samples (reliable topics) or never waits for it (best effort) instead of blocking the bridge.

@@ -45,7 +45,10 @@ from sam_runtime.genpkg import GeneratedPackage
 
 __all__ = ["Bridge"]
 
-HOUSEKEEPING_PERIOD_S = 0.2
+# The housekeeping round (stack counters, the rate-limited log's pending counts, the link and silence checks, and
+# /diagnostics at its default period): one wake-up of the loop a second for all of them, as slow as their bounds
+# allow (the offline timeout and the silence graces are 3 s or more; the log sums per 10 s).
+HOUSEKEEPING_PERIOD_S = 1.0
 WIRE_PATHS = ("codec", "object")
 
 
@@ -229,7 +232,7 @@ class Bridge:
         silence = SilenceWatch([(m.name, m.rate_hz, m.source_node_ids) for m in sel.mappings
                                 if m.direction == UAVCAN_TO_ROS], health.devices,
                                alive_since=health.alive_since, last_message=inbound.last_message,
-                               listening_since=lambda: link.up_since)
+                               listening_since=lambda: link.up_since, last_heartbeat=health.last_heartbeat)
         self.reporter = reporter = Reporter(
             lifetime, self.namespace.status_name(self.name), sel.mappings, self.counters, backend=backend,
             health=health, link=link, inbound=inbound, outbound=outbound, silence=silence, ros=self.ros,
@@ -243,7 +246,8 @@ class Bridge:
         health.attach(lifetime)
         inbound.attach()
         outbound.attach()
-        lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
+        if not 0 < self._diagnostics_period <= HOUSEKEEPING_PERIOD_S:  # (else each /diagnostics polls them)
+            lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
         if sel.protocol == "dronecan":

@@ -46,7 +46,6 @@ class MappingStats:
         self.dropped: collections.Counter[str] = collections.Counter()
         self.saturated: collections.Counter[str] = collections.Counter()
         self.rejected: collections.Counter[str] = collections.Counter()
-        self.last_published_monotonic: float | None = None
         self.last_drop_monotonic: float | None = None
 
     # converter interface
@@ -70,7 +69,12 @@ class MappingStats:
     def publish(self) -> None:
         with self._lock:
             self.published += 1
-            self.last_published_monotonic = time.monotonic()
+
+    def bridged(self) -> None:
+        """One message received and published (UAVCAN -> ROS's usual case: one lock instead of two)."""
+        with self._lock:
+            self.received += 1
+            self.published += 1
 
     def drop(self, reason: str, count: int = 1) -> None:
         if count <= 0:

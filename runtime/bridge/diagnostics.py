@@ -8,11 +8,13 @@ heartbeat is lost, STALE when never seen), and one for the bus's time (:func:`ti
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "diagnostic_array", "time_sync_status", "traffic_values"]
+__all__ = ["RECENT_DROP_WINDOW_S", "Naming", "Status", "diagnostic_array", "diagnostic_array_cdr", "statuses",
+           "time_sync_fields", "time_sync_status", "traffic_values"]
 
 RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
 _PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
@@ -45,16 +47,73 @@ def traffic_values(m: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+# One status before it becomes a message: (level 0-3, name, message, hardware_id, values).
+Status = tuple[int, str, str, str, dict[str, Any]]
+
+
 def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any:
+    """The snapshot as a diagnostic_msgs/DiagnosticArray (``stamp``: a builtin_interfaces/Time, or None)."""
     from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
     arr = DiagnosticArray()
-    arr.header.stamp = stamp
-    ok, warn, err, stale = (bytes([v]) for v in (0, 1, 2, 3))
-    proto = naming.protocol
+    if stamp is not None:
+        arr.header.stamp = stamp
+    arr.status = [DiagnosticStatus(level=bytes([level]), name=name, message=msg, hardware_id=hw,
+                                   values=[KeyValue(key=str(k), value=str(v)) for k, v in values.items()])
+                  for level, name, msg, hw, values in statuses(snap, naming)]
+    return arr
 
-    def kv(values: Mapping[str, Any]) -> list[Any]:
-        return [KeyValue(key=str(k), value=str(v)) for k, v in values.items()]
+
+def diagnostic_array_cdr(snap: Mapping[str, Any], naming: Naming, stamp_ns: int) -> bytes:
+    """The same message as :func:`diagnostic_array` (stamped ``stamp_ns``), serialized (CDR, little endian) for a
+    raw publish: the bridge publishes /diagnostics once a second with several hundred strings, and building them as
+    rclpy message objects (each KeyValue's checked constructor, then rclpy's conversion to C) was most of its idle
+    CPU. rclpy's serialize_message gives the same bytes but the alignment padding (zero here), which deserialize to
+    the same message (tests/runtime/bridge/test_diagnostics_cdr.py). Most strings repeat from one message to the
+    next (names, keys, small values): their encoding is kept (:data:`_ENCODED`)."""
+    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    sts = statuses(snap, naming)
+    out = bytearray(_CDR_LE)
+    out += _U32.pack(sec & 0xFFFFFFFF) + _U32.pack(nanosec) + _EMPTY_STRING + _U32.pack(len(sts))
+    encoded = _ENCODED
+    if len(encoded) > _ENCODED_MAX:  # (values that never repeat, such as ages and uptimes, are kept too: bounded)
+        encoded.clear()
+    for level, name, msg, hw, values in sts:
+        out.append(level)
+        strings = [name, msg, hw]
+        for k, v in values.items():
+            strings.append(k if type(k) is str else str(k))
+            strings.append(v if type(v) is str else str(v))
+        for i, text in enumerate(strings):
+            if i == 3:  # the values' count, after hardware_id
+                out += _PADS[-len(out) & 3] + _U32.pack(len(values))
+            enc = encoded.get(text)
+            if enc is None:
+                raw = text.encode()
+                enc = encoded[text] = _U32.pack(len(raw) + 1) + raw + b"\0"
+            out += _PADS[-len(out) & 3]
+            out += enc
+        if len(strings) == 3:
+            out += _PADS[-len(out) & 3] + _U32.pack(0)
+    return bytes(out)
+
+
+_CDR_LE = b"\x00\x01\x00\x00"  # the encapsulation header: plain CDR, little endian
+_U32 = struct.Struct("<I")
+_EMPTY_STRING = _U32.pack(1) + b"\0\0\0\0"  # header.frame_id "" (length 1: its NUL), padded to 4
+# CDR strings are 4-byte aligned; the offsets count from after the 4-byte encapsulation header, so the buffer's own
+# offsets align the same
+_PADS = (b"", b"\0", b"\0\0", b"\0\0\0")
+# text -> its CDR string (length with the NUL, UTF-8 bytes, NUL); cleared when it outgrows the bound
+_ENCODED: dict[str, bytes] = {}
+_ENCODED_MAX = 20_000
+
+
+def statuses(snap: Mapping[str, Any], naming: Naming) -> list[Status]:
+    """The statuses of the snapshot, in order: the bridge, each mapping, each device, the bus's time."""
+    out: list[Status] = []
+    ok, warn, err, stale = 0, 1, 2, 3
+    proto = naming.protocol
 
     b = snap["bridge"]
     link = b["link"]
@@ -62,14 +121,11 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
     bmsg = f"{len(snap['mappings'])} mappings, {total_drop} dropped"
     if not link["up"]:
         bmsg = f"{naming.label} link {link['state']}; " + bmsg
-    arr.status.append(DiagnosticStatus(
-        level=ok if link["up"] else err, name=naming.bridge, hardware_id=f"{proto} node {b['node_id']}",
-        message=bmsg,
-        values=kv({"node_id": b["node_id"], "transport": b["transport"], "uptime_s": b["uptime_s"],
-                   "dropped_total": total_drop, "link_up": link["up"], "link_state": link["state"],
-                   "link_outages": link["outages"], "link_down_s": link["down_s"],
-                   **{f"error.{k}": v for k, v in sorted(b["errors"].items())}}),
-    ))
+    out.append((ok if link["up"] else err, naming.bridge, bmsg, f"{proto} node {b['node_id']}",
+                {"node_id": b["node_id"], "transport": b["transport"], "uptime_s": b["uptime_s"],
+                 "dropped_total": total_drop, "link_up": link["up"], "link_state": link["state"],
+                 "link_outages": link["outages"], "link_down_s": link["down_s"],
+                 **{f"error.{k}": v for k, v in sorted(b["errors"].items())}}))
     for name, m in snap["mappings"].items():
         values: dict[str, Any] = {
             "direction": m["direction"], "topic": m["topic"], **_port(m), "port": m["port"],
@@ -112,10 +168,8 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
                 msg = live["message"] + ("" if msg == "ok" else f"; {msg}")
                 values.update(silent_s=live["silent_s"], grace_s=live["grace_s"],
                               nominal_rate_hz=live["nominal_rate_hz"])
-        arr.status.append(DiagnosticStatus(
-            level=level, name=f"{naming.bridge}/mapping/{name}",
-            hardware_id=" ".join(f"{k.replace('_id', '').replace('_', ' ')} {v}" for k, v in _port(m).items()),
-            message=msg, values=kv(values)))
+        out.append((level, f"{naming.bridge}/mapping/{name}", msg,
+                    " ".join(f"{k.replace('_id', '').replace('_', ' ')} {v}" for k, v in _port(m).items()), values))
     for name, d in snap["devices"].items():
         if not d["seen"]:
             level, msg = stale, "no heartbeat yet"
@@ -126,16 +180,21 @@ def diagnostic_array(snap: Mapping[str, Any], naming: Naming, stamp: Any) -> Any
         else:
             level = (ok, warn, err)[min(max(int(d["level"]), 0), 2)]
             msg = f"{d['health']} {d['mode']}"
-        arr.status.append(DiagnosticStatus(
-            level=level, name=f"{naming.bridge}/device/{name}", hardware_id=f"{proto} node {d['node_id']}",
-            message=msg, values=kv({k: v for k, v in d.items() if k not in ("seen", "level")})))
+        out.append((level, f"{naming.bridge}/device/{name}", msg, f"{proto} node {d['node_id']}",
+                    {k: v for k, v in d.items() if k not in ("seen", "level")}))
     ts = snap.get("time_sync")
     if ts is not None:
-        arr.status.append(time_sync_status(ts, naming, DiagnosticStatus, kv))
-    return arr
+        out.append(time_sync_fields(ts, naming))
+    return out
 
 
 def time_sync_status(ts: Mapping[str, Any], naming: Naming, status_cls: Any, kv: Any) -> Any:
+    """:func:`time_sync_fields` as ``status_cls(...)`` with ``kv(values)``."""
+    level, name, msg, hw, values = time_sync_fields(ts, naming)
+    return status_cls(level=bytes([level]), name=name, hardware_id=hw, message=msg, values=kv(values))
+
+
+def time_sync_fields(ts: Mapping[str, Any], naming: Naming) -> Status:
     """``<bridge>/time_sync``: the master (running: messages sent within 3 periods) and, per device, whether its
     stamps are synchronised, their counts and the median error receive time - stamp. OK while the master sends and
     every device's last stamp was synchronised; WARN otherwise (not yet, or not following); ERROR when the
@@ -170,5 +229,4 @@ def time_sync_status(ts: Mapping[str, Any], naming: Naming, status_cls: Any, kv:
         problems.append("not synchronised: " + ", ".join(unsynced))
     msg = "; ".join(problems) or (f"{len(ts['devices'])} devices synchronised" if master is not None else
                                   f"master off; {len(ts['devices'])} devices synchronised")
-    return status_cls(level=bytes([level]), name=f"{naming.bridge}/time_sync", hardware_id="time sync", message=msg,
-                      values=kv(values))
+    return level, f"{naming.bridge}/time_sync", msg, "time sync", values

@@ -107,8 +107,8 @@ class DeviceHealth:
         if restarted:
             rec.restarts += 1
             rec.alive_since = now  # a device that just booted gets its grace before it must publish
-        # last_seen last: /diagnostics is also built on rclpy's timer thread, and a record that reads alive must
-        # already carry this heartbeat's status and count.
+        # last_seen last: /diagnostics may also be built on rclpy's executor thread (an enable service's change),
+        # and a record that reads alive must already carry this heartbeat's status and count.
         rec.status, rec.count = st, rec.count + 1
         rec.last_seen = now
         self._arm(rec)
@@ -172,6 +172,11 @@ class DeviceHealth:
         if rec is None or self._clock() - rec.last_seen >= self.offline_timeout:
             return None
         return rec.alive_since
+
+    def last_heartbeat(self, nid: int) -> float | None:
+        """When the node's last heartbeat arrived (the clock's time), or None when never heard."""
+        rec = self.records.get(nid)
+        return None if rec is None else rec.last_seen
 
     def uptime_of(self, nid: int) -> int | None:
         rec = self.records.get(nid)

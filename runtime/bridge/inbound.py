@@ -89,6 +89,10 @@ class PortGroup:
     inlet: Inlet | None = None
     any_source: bool = False  # a mapping of the port accepts every node id (``any_node``)
 
+    # the port's only mapping when it takes every transfer of an accepted source (no select / elements to match):
+    # the one-mapping fast path (Inbound sets it)
+    single: InMapping | None = None
+
     @property
     def raw(self) -> bool:
         """Whether the port's transfers come as payload bytes (every mapping of a port takes the same path)."""
@@ -109,6 +113,7 @@ class Inbound:
         for g in groups:
             g.accepted_sources = frozenset(n for im in g.mappings for n in im.info.source_node_ids)
             g.any_source = any(getattr(im.info, "any_node", False) for im in g.mappings)
+            g.single = g.mappings[0] if len(g.mappings) == 1 and g.mappings[0].matches is None else None
         self._receive_ns: Callable[[], int] = ros.receive_ns
         # (mapping, source, stamp ns, receive ns) of every published message with a header: the time-sync watch
         self.on_stamp: Callable[[str, int, int, int], None] | None = None
@@ -182,9 +187,9 @@ class Inbound:
             group.inlet.malformed(src, f"{type(ex).__name__}: {ex}")
 
     def _bridge_transfer(self, group: PortGroup, msg: Any, src: int | None, tid: int, now: float) -> None:
-        rlog = self.lifetime.rlog
         known = src in group.accepted_sources or (group.any_source and src is not None)
         if not known:
+            rlog = self.lifetime.rlog
             for im in group.mappings:  # no mapping's device: each mapping of the port counts it
                 im.stats.receive()
                 im.stats.drop("unknown_source")
@@ -192,6 +197,10 @@ class Inbound:
                           "dropped a transfer from node %s (accepted: %s)", src, sorted(im.info.source_node_ids))
             return
         assert src is not None
+        single = group.single
+        if single is not None:  # the port's one mapping accepts src (known) and takes everything: no lists
+            self._one(group, single, msg, src, tid, now)
+            return
         takers = self._takers(group, msg, src)
         if takers is None:
             return
@@ -218,12 +227,76 @@ class Inbound:
             im = next(im for im in group.mappings if accepts(im.info, src))
             im.stats.receive()
             im.stats.drop("unselected")
-            rlog.note((im.info.name, "unselected"), logging.WARNING, "node %s sent a message no mapping of port %d "
-                      "selects (select / elements)", src, group.port_id)
+            self.lifetime.rlog.note((im.info.name, "unselected"), logging.WARNING,
+                                    "node %s sent a message no mapping of port %d selects (select / elements)", src,
+                                    group.port_id)
+
+    def _one(self, group: PortGroup, im: InMapping, msg: Any, src: int, tid: int, now: float) -> None:
+        """:meth:`_bridge_transfer` for a port whose one mapping takes the transfer (the same steps, without the
+        takers' and results' lists: the usual case, per message)."""
+        receive_ns = self._receive_ns()
+        error: Exception | None = None
+        if not im.switch.enabled:
+            out: Any = _DISABLED
+        else:
+            try:
+                out = im.to_ros(msg, receive_ns, im.stats)
+            except ValueError as ex:
+                if im.raw:
+                    self._malformed(group, src, ex)  # the whole payload is refused, before any counter moved
+                    return
+                out, error = None, ex
+            except Exception as ex:
+                out, error = None, ex
+        lost, lost_est = group.loss.track(src, tid, now)
+        self._account(im, src, tid, lost, lost_est, receive_ns, out, error)
 
     def _account(self, im: InMapping, src: int, tid: int, lost: int, lost_est: int, receive_ns: int, out: Any,
                  error: Exception | None) -> None:
         """Count, check the stamp of and publish one mapping's conversion of one transfer."""
+        st = im.stats
+        if lost or lost_est or error is not None or out is None or out is _DISABLED:
+            self._account_drops(im, src, tid, lost, lost_est, out, error)
+            if error is not None or out is None or out is _DISABLED:
+                return
+            received = True  # (counted with the drops)
+        else:
+            received = False  # counted with the publication (one lock: MappingStats.bridged)
+        if im.raw:
+            out, stamp = out  # the codec resolved the frame id and an unknown stamp already
+        elif im.has_header:
+            hdr = out.header
+            if not hdr.frame_id and im.info.frame_id:
+                hdr.frame_id = im.info.frame_id
+            if self.frame_prefix and hdr.frame_id:
+                hdr.frame_id = self.frame_prefix + hdr.frame_id
+            if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
+                hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
+            stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec
+        else:
+            stamp = -1
+        if stamp >= 0 and im.has_header:
+            last_stamps = im.last_stamp_ns
+            last = last_stamps.get(src)
+            last_stamps[src] = stamp
+            if last is not None and stamp < last:  # published anyway, in arrival order (see the docstring)
+                st.reorder()
+                self.lifetime.rlog.note((im.info.name, "out_of_order"), logging.WARNING,
+                                        "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
+                                        src, stamp * 1e-9, last * 1e-9)
+            if self.on_stamp is not None:
+                self.on_stamp(im.info.name, src, stamp, receive_ns)
+        if im.pacer is not None:
+            if not received:
+                st.receive()
+            im.pacer.offer(out)  # now, or when its slot comes (see the docstring)
+        else:
+            self._deliver(im, out, received)
+
+    def _account_drops(self, im: InMapping, src: int, tid: int, lost: int, lost_est: int, out: Any,
+                       error: Exception | None) -> None:
+        """The transfer's receipt and what did not become a publication: losses before it, and it when disabled,
+        failed or rejected."""
         rlog, st, name = self.lifetime.rlog, im.stats, im.info.name
         st.receive()
         if lost:
@@ -244,46 +317,26 @@ class Inbound:
             return
         if out is None:
             st.drop("rejected")
-            return
-        if im.raw:
-            out, stamp = out  # the codec resolved the frame id and an unknown stamp already
-        elif im.has_header:
-            hdr = out.header
-            if not hdr.frame_id and im.info.frame_id:
-                hdr.frame_id = im.info.frame_id
-            if self.frame_prefix and hdr.frame_id:
-                hdr.frame_id = self.frame_prefix + hdr.frame_id
-            if hdr.stamp.sec == 0 and hdr.stamp.nanosec == 0:
-                hdr.stamp.sec, hdr.stamp.nanosec = divmod(receive_ns, 1_000_000_000)
-            stamp = hdr.stamp.sec * 1_000_000_000 + hdr.stamp.nanosec
-        else:
-            stamp = -1
-        if im.has_header and stamp >= 0:
-            last = im.last_stamp_ns.get(src)
-            im.last_stamp_ns[src] = stamp
-            if last is not None and stamp < last:  # published anyway, in arrival order (see the docstring)
-                st.reorder()
-                rlog.note((name, "out_of_order"), logging.WARNING,
-                          "node %s: stamp %.6f s is older than the previous one (%.6f s); published",
-                          src, stamp * 1e-9, last * 1e-9)
-            if self.on_stamp is not None:
-                self.on_stamp(name, src, stamp, receive_ns)
-        if im.pacer is not None:
-            im.pacer.offer(out)  # now, or when its slot comes (see the docstring)
-        else:
-            self._deliver(im, out)
 
-    def _deliver(self, im: InMapping, out: Any) -> None:
-        """Publish one converted message (at once, or from the pacer's timer). Never raises."""
+    def _deliver(self, im: InMapping, out: Any, received: bool = True) -> None:
+        """Publish one converted message (at once, or from the pacer's timer; ``received``: its receipt is counted
+        already, else it is counted here). Never raises."""
         st = im.stats
         if not im.switch.enabled:  # held for its rate slot while the mapping was disabled
+            if not received:
+                st.receive()
             st.drop("disabled")
             return
         try:
             im.ros_publisher.publish(out)  # CDR bytes on the wire path: rclpy publishes them raw
         except Exception as ex:
+            if not received:
+                st.receive()
             st.drop("publish_error")
             self.lifetime.rlog.note((im.info.name, "publish_error"), logging.ERROR, "ROS publish failed: %s: %s",
                                     type(ex).__name__, ex)
             return
-        st.publish()
+        if received:
+            st.publish()
+        else:
+            st.bridged()

@@ -7,8 +7,10 @@ and the periodic work it needs; the composition root only creates the parts in o
 - Close: :attr:`Lifetime.closed` is set first (every part checks it before it hands on work), the periodic jobs
   are cancelled, then the close hooks of the started parts run in reverse order. A close hook that raises is
   logged; the others still run.
-- Periodic jobs run on the asyncio loop; one that raises is counted (``housekeeping_error``) and logged, and the
-  next round runs.
+- Periodic jobs run on the asyncio loop, one task per period (the jobs of one period share its wake-up), at fixed
+  deadlines (start + k x period: a job's own run time does not stretch the period; a round missed while the loop
+  was held up is skipped, not run twice in a row); one that raises is counted (``housekeeping_error``) and logged,
+  and the next round runs.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from sam_runtime.bridge.counters import log
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.tasks import cancel_and_wait
 
-__all__ = ["Hook", "Lifetime"]
+__all__ = ["Hook", "Lifetime", "next_round"]
 
 Hook = Callable[[], Awaitable[None] | None]
 
@@ -91,9 +93,17 @@ class Lifetime:
             log.warning("%d bridge tasks did not stop", len(stuck))
         self.rlog.flush(force=True)  # no count stays unlogged
 
+    @property
+    def schedule(self) -> dict[float, list[str]]:
+        """The periodic jobs' names by period (each period is one task, one wake-up per round)."""
+        return {period: [name for name, _ in jobs] for period, jobs in self._jobs.items()}
+
     async def _run_every(self, period: float, jobs: list[tuple[str, Callable[[], None]]]) -> None:
+        loop = asyncio.get_running_loop()
+        due = loop.time()
         while not self.closed:
-            await asyncio.sleep(period)
+            due = next_round(due, period, loop.time())
+            await asyncio.sleep(due - loop.time())
             for name, job in jobs:
                 if self.closed:
                     return
@@ -103,6 +113,19 @@ class Lifetime:
                     self.errors["housekeeping_error"] += 1
                     self.rlog.note(("bridge", "housekeeping_error"), logging.ERROR, "housekeeping (%s): %s: %s",
                                    name, type(ex).__name__, ex)
+
+
+def next_round(due: float, period: float, now: float) -> float:
+    """The deadline of the next round after the one ``due``: ``due + period``, or the first later multiple of the
+    period when the loop was held up past it (the rounds missed are skipped).
+
+    >>> next_round(10.0, 1.0, 10.02), next_round(10.0, 1.0, 11.5), next_round(10.0, 1.0, 13.0)
+    (11.0, 12.0, 14.0)
+    """
+    nxt = due + period
+    if nxt <= now:
+        nxt += (int((now - nxt) / period) + 1) * period
+    return nxt
 
 
 async def _call(hook: Hook) -> None:

@@ -2,10 +2,12 @@
 
 A backend says why its open link must be reopened (``link_problem()``: pycyphal's CAN media close themselves for
 good on unrecoverable OS errors such as ENETDOWN; a publish found its port closed). That is checked every
-``check_period`` (0.2 s). The backend is then closed and opened again, with back-off (0.5 s doubling to 2 s), until
-it works or the bridge closes; meanwhile the link is down (commands are dropped as ``link_down``, /diagnostics shows
-the bridge at ERROR). Handlers hear ``down`` and ``up`` at once. The outages are kept (the last 16 windows) for the
-loss accounting: transfers missed while the bridge was deaf are estimated apart (:mod:`.loss`).
+``check_period`` (1 s: one wake-up a second shared with the other housekeeping jobs; a dead link is a fault path,
+found within a second; a command sent meanwhile is counted as ``publish_error`` or ``link_down``). The backend is
+then closed and opened again, with back-off (0.5 s doubling to 2 s), until it works or the bridge closes; meanwhile
+the link is down (commands are dropped as ``link_down``, /diagnostics shows the bridge at ERROR). Handlers hear
+``down`` and ``up`` at once. The outages are kept (the last 16 windows) for the loss accounting: transfers missed
+while the bridge was deaf are estimated apart (:mod:`.loss`).
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from sam_runtime.common.tasks import cancel_and_wait
 
 __all__ = ["CHECK_PERIOD_S", "REOPEN_BACKOFF_S", "LinkSupervisor"]
 
-CHECK_PERIOD_S = 0.2
+CHECK_PERIOD_S = 1.0
 REOPEN_BACKOFF_S = (0.5, 2.0)
 
 

@@ -7,7 +7,11 @@ NOMINAL device. :class:`LivenessCheck` flags it: for each accepted source whose 
 longer than the mapping's grace (:func:`grace_s`: at least 3 s, the Cyphal heartbeat timeout, and at least 5
 nominal periods) counted from the latest of: the last message, the moment the device's heartbeat (re)appeared,
 the moment the bridge started listening. A device that is not alive is not flagged here: its own status is
-ERROR already. ROS -> UAVCAN mappings are not watched: commands come when ROS nodes send them.
+ERROR already. Nor is one that went quiet altogether (powered off): its heartbeat and its data stop together, and
+the bridge learns that the heartbeat is gone only at the offline timeout (3 s), which may come after the grace
+counted from the last message; so the silence counts only when a heartbeat came later than one nominal period
+after the last message (a live device's heartbeat comes at least once a second, well within the grace).
+ROS -> UAVCAN mappings are not watched: commands come when ROS nodes send them.
 
 Pure logic on monotonic times passed in (no clock, no I/O), so the rules are tested without waiting.
 """
@@ -67,7 +71,7 @@ class Silence:
 
 
 def silence_of(now: float, *, rate_hz: float, alive_since: float | None, last_message: float | None,
-               listening_since: float) -> tuple[float, float] | None:
+               listening_since: float, last_heartbeat: float | None = None) -> tuple[float, float] | None:
     """(silent_s, grace_s) of one source when it is silent too long while alive, else None.
 
     >>> silence_of(10.0, rate_hz=10.0, alive_since=None, last_message=None, listening_since=0.0) is None
@@ -78,13 +82,20 @@ def silence_of(now: float, *, rate_hz: float, alive_since: float | None, last_me
     True
     >>> silence_of(10.0, rate_hz=10.0, alive_since=8.0, last_message=1.0, listening_since=0.0) is None
     True
+    >>> silence_of(10.0, rate_hz=10.0, alive_since=2.0, last_message=6.9, listening_since=0.0, last_heartbeat=9.5)
+    (3.0999999999999996, 3.0)
+    >>> silence_of(10.0, rate_hz=10.0, alive_since=2.0, last_message=6.9, listening_since=0.0, last_heartbeat=6.95)
     """
     if alive_since is None:
         return None
     grace = grace_s(rate_hz)
     since = max(alive_since, listening_since, -math.inf if last_message is None else last_message)
     silent = now - since
-    return (silent, grace) if silent > grace else None
+    if silent <= grace:
+        return None
+    if last_heartbeat is not None and last_message is not None and last_heartbeat <= last_message + 1.0 / rate_hz:
+        return None  # no heartbeat since its data stopped: it went quiet altogether (see the module docstring)
+    return silent, grace
 
 
 class LivenessCheck:
@@ -101,8 +112,9 @@ class LivenessCheck:
         self.findings: dict[str, Silence | None] = {name: None for name, _, _ in self._mappings}
 
     def update(self, now: float, *, alive_since: Callable[[int], float | None],
-               last_message: Callable[[str, int], float | None],
-               listening_since: float) -> list[tuple[str, Silence | None, Silence | None]]:
+               last_message: Callable[[str, int], float | None], listening_since: float,
+               last_heartbeat: Callable[[int], float | None] | None = None
+               ) -> list[tuple[str, Silence | None, Silence | None]]:
         """Evaluate every mapping; returns the changes as (mapping, before, now) where one of them is None
         (a mapping went silent, or got messages again / its device went away)."""
         changes = []
@@ -111,7 +123,8 @@ class LivenessCheck:
             for nid in sources:
                 last = last_message(name, nid)
                 res = silence_of(now, rate_hz=rate, alive_since=alive_since(nid), last_message=last,
-                                 listening_since=listening_since)
+                                 listening_since=listening_since,
+                                 last_heartbeat=None if last_heartbeat is None else last_heartbeat(nid))
                 if res is not None:
                     found = Silence(name, nid, self._names.get(nid, f"node {nid}"), res[0], res[1], rate,
                                     None if last is None else now - last)

@@ -1,6 +1,10 @@
 """The bridge's counters and states: a JSON-serialisable snapshot (:meth:`Reporter.snapshot`, the bridge's
 ``stats()``) and /diagnostics (diagnostic_msgs/DiagnosticArray, :mod:`.diagnostics`) once per period and at once
-when a device, a mapping's silence or the link changes state (:meth:`Reporter.publish_now`)."""
+when a device, a mapping's silence or the link changes state (:meth:`Reporter.publish_now`).
+
+The period's /diagnostics is a job of the bridge's lifetime on the asyncio loop (at the default 1 s, in the one
+housekeeping round a second: no timer of its own on the rclpy executor, whose thread then sleeps until a command
+comes), serialized straight to CDR (:func:`~.diagnostics.diagnostic_array_cdr`) and published raw."""
 
 from __future__ import annotations
 
@@ -13,7 +17,7 @@ from typing import Any
 from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.counters import MappingStats
-from sam_runtime.bridge.diagnostics import Naming, diagnostic_array
+from sam_runtime.bridge.diagnostics import Naming, diagnostic_array, diagnostic_array_cdr
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
 from sam_runtime.bridge.layout import destinations_of, port_id_of
@@ -47,8 +51,10 @@ class Reporter:
         self.time_sync: Any = None  # the time-sync master and stamp watch (sam_runtime.bridge.time_sync)
 
     def attach(self) -> None:
-        """The /diagnostics publisher and its timer once the ROS node exists."""
+        """The /diagnostics publisher once the ROS node exists, and its period on the loop."""
         self.lifetime.add_hooks("diagnostics", start=self._start)
+        if self.period > 0:
+            self.lifetime.every(self.period, "diagnostics", self.publish_now)
 
     def _start(self) -> None:
         if self.period <= 0:
@@ -56,19 +62,19 @@ class Reporter:
         from diagnostic_msgs.msg import DiagnosticArray
 
         self._publisher = self.ros.node.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, 10)
-        self.ros.node.create_timer(self.period, self.publish_now)
 
     @property
     def rlog(self) -> RateLimitedLog:
         return self.lifetime.rlog
 
     def publish_now(self) -> None:
-        """Publish /diagnostics (the rclpy timer, and on a state change; rclpy's publish is thread-safe). Never
-        raises."""
+        """Publish /diagnostics (the period's job on the loop, and on a state change, also from the rclpy thread:
+        rclpy's publish is thread-safe). Never raises."""
         if self._publisher is None or self.lifetime.closed:
             return
         try:
-            self._publisher.publish(self.diagnostics_message())
+            self._publisher.publish(diagnostic_array_cdr(self.snapshot(), self.naming,
+                                                         self.ros.clock.now().nanoseconds))
         except Exception as ex:
             self.lifetime.errors["diagnostics_error"] += 1
             self.rlog.note(("diagnostics", "error"), logging.ERROR, "diagnostics: %s: %s", type(ex).__name__, ex)

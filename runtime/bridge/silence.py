@@ -1,6 +1,7 @@
 """UAVCAN -> ROS mappings that get nothing from a device whose heartbeat is alive (rules: bridge.liveness),
-checked every 0.2 s; a mapping going silent, and the end of it, is logged once and handed to the handlers (the
-bridge publishes /diagnostics at once)."""
+checked once a second (the graces are 3 s or more: a finding comes within a second of its grace, and the
+check shares the bridge's one housekeeping wake-up a second); a mapping going silent, and the end of it, is
+logged once and handed to the handlers (the bridge publishes /diagnostics at once)."""
 
 from __future__ import annotations
 
@@ -14,20 +15,23 @@ from sam_runtime.bridge.liveness import LivenessCheck, Silence
 
 __all__ = ["CHECK_PERIOD_S", "SilenceWatch"]
 
-CHECK_PERIOD_S = 0.2
+CHECK_PERIOD_S = 1.0
 
 
 class SilenceWatch:
     """:param mappings: (name, nominal rate [Hz], accepted source node ids) per UAVCAN -> ROS mapping.
     :param alive_since: a node's heartbeat (re)appeared at (monotonic s), None if it is not alive.
     :param last_message: (mapping, node id) -> when its last transfer arrived (monotonic s), or None.
-    :param listening_since: since when the bridge listens (its link last opened; monotonic s)."""
+    :param listening_since: since when the bridge listens (its link last opened; monotonic s).
+    :param last_heartbeat: when a node's last heartbeat arrived (monotonic s), None if never heard."""
 
     def __init__(self, mappings: Iterable[tuple[str, float, Iterable[int]]], device_names: Mapping[int, str], *,
                  alive_since: Callable[[int], float | None], last_message: Callable[[str, int], float | None],
-                 listening_since: Callable[[], float]) -> None:
+                 listening_since: Callable[[], float], last_heartbeat: Callable[[int], float | None] | None = None
+                 ) -> None:
         self.liveness = LivenessCheck(mappings, device_names)
         self._alive_since, self._last_message, self._listening_since = alive_since, last_message, listening_since
+        self._last_heartbeat = last_heartbeat
         self._handlers: list[Callable[[], None]] = []
 
     def attach(self, lifetime: Lifetime) -> None:
@@ -42,7 +46,8 @@ class SilenceWatch:
 
     def check(self) -> None:
         changes = self.liveness.update(time.monotonic(), alive_since=self._alive_since,
-                                      last_message=self._last_message, listening_since=self._listening_since())
+                                      last_message=self._last_message, listening_since=self._listening_since(),
+                                      last_heartbeat=self._last_heartbeat)
         for name, before, found in changes:
             if found is not None:
                 log.warning("%s: %s", name, found.message())

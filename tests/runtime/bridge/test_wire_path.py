@@ -16,6 +16,8 @@ from types import SimpleNamespace as NS
 from typing import Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sam_runtime.bridge.backend import BelowBridge
 from sam_runtime.bridge.counters import MappingStats
@@ -89,6 +91,57 @@ def test_raw_inbound_a_refused_payload_is_counted_below_and_leaves_no_gap() -> N
     assert inlet.refused == [(11, "ValueError: array length prefix 9 > capacity 3")]
     assert inlet.below.snapshot()[0] == {"deserialization_failures": 1}
     assert len(published) == 2
+
+
+_KIND = st.sampled_from([b"ok:0", b"ok:3000000000", b"ok:1000000000", b"bad:", b"reject:", b"boom:"])
+
+
+@settings(max_examples=120, deadline=None)
+@given(transfers=st.lists(st.tuples(_KIND, st.sampled_from([11, 11, 11, 42, None]), st.integers(0, 40),
+                                    st.booleans(), st.booleans()), max_size=30))
+def test_one_mapping_fast_path_accounts_as_the_general_path(transfers: list[tuple[bytes, Any, int, bool, bool]]
+                                                            ) -> None:
+    """A port's one mapping that takes every transfer runs Inbound's one-mapping path (no takers' list); the same
+    transfers through the general path give the same counters, publications, refusals and logs: sources, losses,
+    stamps, rejections, codec and publish failures, a disabled mapping. Both count each transfer that reached the
+    bridge once, as published or as one drop (received + published under one lock when it is published)."""
+    runs = []
+    for fast in (True, False):
+        inbound, on_transfer, published, im, inlet = _inbound()
+        group = inbound.groups[1100]
+        assert group.single is im
+        if not fast:
+            group.single = None
+        pub_fail = [False]
+
+        def publish(out: Any, pub_fail: list[bool] = pub_fail, published: list[Any] = published) -> None:
+            if pub_fail[0]:
+                raise RuntimeError("rmw")
+            published.append(out)
+
+        im.ros_publisher = NS(publish=publish)
+        to_ros = im.to_ros
+
+        def convert(payload: bytes, receive_ns: int, stats: Any, to_ros: Any = to_ros) -> Any:
+            if payload.startswith(b"boom"):
+                raise KeyError("a converter bug")
+            return to_ros(payload, receive_ns, stats)
+
+        im.to_ros = convert
+        t = 0.0
+        for payload, src, tid, enabled, fail in transfers:
+            t += 0.01
+            im.switch.enabled = enabled or payload.startswith(b"ok:1")
+            pub_fail[0] = fail and payload.endswith(b"0")
+            on_transfer(payload, src, tid, t)
+        snap = im.stats.snapshot()
+        snap.pop("last_drop_age_s")  # (a time)
+        # every transfer that reached the bridge is published or dropped, once (the losses came before it)
+        drops = snap["dropped"]
+        assert snap["received"] == snap["published"] + sum(drops.values()) - drops.get("lost", 0)
+        assert snap["received"] + len(inlet.refused) == len(transfers) and snap["published"] == len(published)
+        runs.append((snap, published, inlet.refused, dict(inbound.lifetime.rlog.lines)))
+    assert runs[0] == runs[1]
 
 
 def test_raw_inbound_selection_by_payload() -> None:
