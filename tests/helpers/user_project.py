@@ -29,8 +29,10 @@ def built_project(root: Path) -> tuple[Path, Path]:
     project = make_project(root)
     build(project / "spec" / "interfaces.yaml", project / "generated")
     gen = GeneratedPackage(project / "generated")
-    # dinghy_msgs is built once per content (helpers.ros_packages), wherever the project's folder is.
-    prefix = built_prefix(ros_packages_in_order(gen.ros_package_dir().parent))
+    # dinghy_msgs is built once per content (helpers.ros_packages), wherever the project's folder is. Its folder is
+    # found without importing the project's tables: another module's skiff project on the same worker may have
+    # imported its own copy of the package already (GeneratedPackage refuses a shadowing copy).
+    prefix = built_prefix(ros_packages_in_order(gen.root / "ros"))
     gen.compile_dsdl()  # once here, so that the processes of a test start in seconds
     return project, prefix
 
