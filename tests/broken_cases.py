@@ -1517,7 +1517,22 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      service: /bms/update_battery',
         '      service: bms update',
         (
-            "auv_services.yaml:93:5: error: service name 'bms update' of service mapping 'update_battery' is not a valid ROS name (expected /segment[/segment...], each a letter or underscore then letters, digits, underscores)",
+            "auv_services.yaml:93:5: error: service name 'bms update' of service mapping 'update_battery' is not a valid ROS name: segment 'bms update' has a character other than letters, digits and '_' (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
+        ),
+    ),
+    Case(
+        # Issue 27: one name rule for topics, duties and service mappings; a relative name is valid (no error).
+        'svc_map_relative_service_name',
+        '      service: /bms/update_battery',
+        '      service: core/update_battery',
+        (),
+    ),
+    Case(
+        'svc_map_private_service_name',
+        '      service: /bms/update_battery',
+        '      service: ~/update_battery',
+        (
+            "auv_services.yaml:93:5: error: service name '~/update_battery' of service mapping 'update_battery' is not a valid ROS name: private names ('~') are not supported (expected an absolute name /segment/... or a relative one segment/... (resolved under the namespace), each segment a letter or underscore then letters, digits, underscores)",
         ),
     ),
     Case(

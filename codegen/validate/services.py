@@ -20,13 +20,13 @@ from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import SERVICE_ID_MAX, VENDOR_SERVICE_IDS, V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.ros_names import NAME_RULES, ros_name_problem
 from sam_codegen.model.spec import DsdlStruct, Field, FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import (
     ROS_FIELD_NAME,
     ROS_FLOAT_BITS,
     ROS_INT_RANGES,
     ROS_MESSAGE_NAME,
-    ROS_TOPIC_NAME,
     DsdlType,
     RosType,
 )
@@ -187,9 +187,12 @@ class ServiceValidator:
             what = f"service mapping {m.name!r}"
             if not re.fullmatch(r"[a-z][a-z0-9_]*", m.name) or not python_safe(m.name):
                 self.error(m.pos, f"service mapping name {m.name!r} is not valid", "lower_case identifier")
-            if not ROS_TOPIC_NAME.fullmatch(m.service):
-                self.error(m.pos, f"service name {m.service!r} of {what} is not a valid ROS name",
-                           "/segment[/segment...], each a letter or underscore then letters, digits, underscores")
+            # One name rule for topics, device duties and service mappings (model/ros_names): a relative name
+            # resolves under the run's namespace as the duties' do.
+            problem = ros_name_problem(m.service)
+            if problem is not None:
+                self.error(m.pos, f"service name {m.service!r} of {what} is not a valid ROS name: {problem}",
+                           NAME_RULES)
             elif m.service in names:
                 self.error(m.pos, f"service {m.service} of {what} is already served by service mapping "
                            f"{names[m.service]!r}", "one mapping per ROS service")
