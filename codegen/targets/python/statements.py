@@ -32,6 +32,7 @@ from sam_codegen.conversion_plan import (
     is_int_dsdl,
 )
 from sam_codegen.model.spec import Scalar
+from sam_codegen.model.text import cut_utf8_expr
 from sam_codegen.model.types import DsdlType
 from sam_codegen.render.pysource import py_literal, typed_literal
 
@@ -165,6 +166,11 @@ class CutUtf8(Statement):
     cap: int
     key: str
     reject: bool
+
+    @property
+    def cut(self) -> str:
+        """The cut, as the bridge's service mappings make it too (one rule: sam_codegen.model.text)."""
+        return cut_utf8_expr(self.var, self.cap)
 
 
 @dataclass(frozen=True)

@@ -35,6 +35,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+from sam_codegen.model.text import cut_utf8, encode_text
 from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
@@ -90,10 +91,11 @@ def _convert(links: Sequence[Any], source: Any, towards_uavcan: bool, saturated:
             out[link.target] = value
         elif link.kind == "text":
             if towards_uavcan:
-                data = str(raw).encode()
-                if len(data) > link.hi:
+                data = encode_text(str(raw))
+                if len(data) > link.hi:  # cut at a character boundary, as the topic mappings' converters do
                     saturated.append(link.target)
-                out[link.target] = data[: int(link.hi)]
+                    data = cut_utf8(data, int(link.hi))
+                out[link.target] = data
             else:
                 text = bytes(int(b) for b in raw).decode(errors="replace") if not isinstance(raw, str) else raw
                 if math.isfinite(link.hi) and len(text) > link.hi:

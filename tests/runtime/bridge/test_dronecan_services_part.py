@@ -15,6 +15,10 @@ import math
 from types import SimpleNamespace as NS
 from typing import Any
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from sam_codegen.model.text import cut_utf8, cut_utf8_expr
 from sam_runtime.bridge.backends.dronecan_services import DroneCanServices, from_uavcan, to_uavcan
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.common.rate_log import RateLimitedLog
@@ -136,3 +140,26 @@ def test_link_down_fails_the_call() -> None:
     call = mod.Call()
     part.send(MAPPING, 30, {}, call)  # backend.node is None
     assert call.done.is_set() and call.reason == "link_down" and call.failure == "the DroneCAN link is down"
+
+
+def test_service_text_is_cut_at_a_character_boundary_as_topics_cut_it() -> None:
+    """Issue 27 (class 6): 'éééé' into 7 bytes is 3 characters (6 bytes), never 'ééé' + a lone 0xC3; the rule is
+    the one the generated topic converters inline (sam_codegen.model.text.cut_utf8_expr), checked on many texts."""
+    mapping = NS(**{**vars(MAPPING), "request": (_link("tag", "label", "text", hi=7),)})
+    saturated: list[str] = []
+    assert to_uavcan(mapping, NS(label="éééé"), saturated) == {"tag": "ééé".encode()}
+    assert saturated == ["tag"]
+
+    @settings(max_examples=300, deadline=None)
+    @given(st.text(), st.integers(0, 40))
+    def agree(text: str, cap: int) -> None:
+        data = text.encode(errors="replace")
+        generated = eval(cut_utf8_expr("data", cap), {}, {"data": data})  # the topic converters' statement
+        cut = to_uavcan(NS(**{**vars(MAPPING), "request": (_link("tag", "label", "text", hi=cap),)}),
+                        NS(label=text), [])["tag"]
+        assert cut == generated == cut_utf8(data, cap)
+        assert len(cut) <= cap and data.startswith(cut)
+        assert len(data) - len(cut) < 4 or len(cut) > cap - 4  # only the last, partial character goes
+        cut.decode()  # valid UTF-8: no lone lead byte
+
+    agree()
