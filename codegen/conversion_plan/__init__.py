@@ -60,6 +60,7 @@ from sam_codegen.conversion_plan.operations import (
     TimestampFromRos,
     TimestampToRos,
     Utf8Length,
+    Wrap,
 )
 from sam_codegen.conversion_plan.value_ranges import (
     FLOAT16_MAX,
@@ -116,6 +117,7 @@ __all__ = [
     "TimestampToRos",
     "Utf8Length",
     "ValueRange",
+    "Wrap",
     "dsdl_range",
     "expr_target",
     "float32_overflow",

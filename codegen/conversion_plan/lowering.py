@@ -36,6 +36,7 @@ from sam_codegen.conversion_plan.operations import (
     TimestampFromRos,
     TimestampToRos,
     Utf8Length,
+    Wrap,
 )
 from sam_codegen.conversion_plan.value_ranges import (
     FLOAT32_MAX,
@@ -54,7 +55,7 @@ from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, Step
 
 
 def range_ops(value_is_float: bool, value_range: ValueRange | None, target: DsdlType,
-              limits: tuple[Scalar, Scalar] | None, reject: bool) -> list[Op]:
+              limits: tuple[Scalar, Scalar] | None, reject: bool, wrap: bool = False) -> list[Op]:
     """What makes a value acceptable to a DSDL scalar of type `target`, after the `limits` if any.
 
     `value_range` is the finite range the value is known to lie in (None: unknown); a float value may also be NaN
@@ -93,6 +94,8 @@ def range_ops(value_is_float: bool, value_range: ValueRange | None, target: Dsdl
                 out.append(Round())
             else:  # only what rounds into the range is rounded: round() would raise on inf
                 out.append(Clamp("round", lo, hi, reject))
+        elif beyond and wrap:  # the line's `on_out_of_range: wrap` (validated: an integer value)
+            out.append(Wrap(target.bits, target.kind == "int"))
         elif beyond:
             out.append(Clamp("integer",
                              lo if value_range is None or value_range[0] < lo else None,
@@ -150,7 +153,7 @@ def expr_target(t: DsdlType | RosType) -> DsdlType:
     return DsdlType("int" if lo < 0 else "uint", (hi - lo).bit_length())
 
 
-def lower_expr(tree: ENode, target: DsdlType, reject: bool) -> list[Op]:
+def lower_expr(tree: ENode, target: DsdlType, reject: bool, wrap: bool = False) -> list[Op]:
     """An expression into a target scalar: evaluated, a NaN result dropped, then into the target's range.
 
     >>> from sam_codegen.model.expr import EField
@@ -163,7 +166,7 @@ def lower_expr(tree: ENode, target: DsdlType, reject: bool) -> list[Op]:
         return ops
     if tree.kind == "float":
         ops.append(RejectNaN())
-    ops += [op for op in range_ops(tree.kind == "float", tree.range, target, None, reject)
+    ops += [op for op in range_ops(tree.kind == "float", tree.range, target, None, reject, wrap)
             if not isinstance(op, RejectNaN)]
     return ops
 
@@ -173,7 +176,7 @@ def _lower_to_ros(s: Step, reject: bool) -> list[Op]:
         if s.uavcan_path:  # a ROS -> UAVCAN expression: nothing to say towards ROS
             return []
         assert s.expr is not None
-        return lower_expr(s.expr, expr_target(s.ros_type), reject)
+        return lower_expr(s.expr, expr_target(s.ros_type), reject, s.wrap)
     if s.kind == "value":
         return [SetConstant(s.value)]  # type: ignore[arg-type]
     uav = s.uavcan_type
@@ -208,7 +211,7 @@ def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
     assert uav is not None
     if s.kind == "expr":
         assert s.expr is not None
-        return lower_expr(s.expr, uav, reject)
+        return lower_expr(s.expr, uav, reject, s.wrap)
     if s.kind == "time":
         lo, hi = uav.range
         return [TimestampFromRos(hi if TIME_US_MAX_FROM_ROS > hi else None, lo if TIME_US_MIN < lo else None,
@@ -234,7 +237,7 @@ def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
             return [*ops, *transform, *_convert(ros_base, uav.base_name),
                     *range_ops(value_is_float, value_range, uav, None, reject)]
         return [*transform, *_convert(ros_base, uav.base_name),
-                *range_ops(value_is_float, value_range, uav, s.limits, reject)]
+                *range_ops(value_is_float, value_range, uav, s.limits, reject, s.wrap)]
     # array: the length first, then the elements
     elem = uav.element
     value_is_float, value_range = ros_value(ros_base, transformed)
@@ -266,7 +269,7 @@ def lower_mapping(rm: ResolvedMapping) -> MappingPlan:
     if rm.has_header and not rm.stamp_from_source:
         ros_fields.append(FieldSet((("header", None), ("stamp", None)), RosType("builtin_interfaces/Time"),
                                    ReceiveTime()))
-    if rm.has_header and m.frame_id is not None:
+    if rm.has_header and m.frame_id:  # frame_id '': the message's own empty one, no frame prefix before it
         ros_fields.append(FieldSet((("header", None), ("frame_id", None)), RosType("string"),
                                    StaticFrameId(m.frame_id)))
     required: list[RequireItem | RequireLength] = []

@@ -84,6 +84,15 @@ class Clamp:
 
 
 @dataclass(frozen=True)
+class Wrap:
+    """An integer into an integer target of `bits` bits, stored modulo 2**bits as C stores it (`on_out_of_range:
+    wrap` on the line, issue 27): two's complement for a signed target; nothing is counted (the spec asked for it)."""
+
+    bits: int
+    signed: bool
+
+
+@dataclass(frozen=True)
 class Round:
     """A float into an integer known to be in range: rounded half to even, nothing to check."""
 
@@ -232,10 +241,10 @@ class ElementMapping:
     uavcan_element: str  # the UAVCAN element type's full name
 
 
-Op = (Convert | Scale | Offset | RejectNaN | Limits | Clamp | Round | Table | TimestampToRos | TimestampFromRos
+Op = (Convert | Scale | Offset | RejectNaN | Limits | Clamp | Wrap | Round | Table | TimestampToRos | TimestampFromRos
       | DecodeUtf8 | EncodeUtf8 | Utf8Length | Pad | FixedLength | MaxLength | SetConstant | Evaluate | ElementMapping)
 EXPRESSION_OPS = (Convert, Scale, Offset)  # pure arithmetic on the value; everything else may drop or fix it
-CHECK_OPS = (RejectNaN, Limits, Clamp, Round)
+CHECK_OPS = (RejectNaN, Limits, Clamp, Wrap, Round)
 
 
 @dataclass(frozen=True)

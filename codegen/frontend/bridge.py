@@ -8,7 +8,7 @@ from sam_codegen.frontend.expr_parser import ExprSyntaxError, parse_expr
 from sam_codegen.frontend.reading import Reader, map_items, number, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.routing import node_ids_or_any
 from sam_codegen.frontend.traffic import TRAFFIC_KEYS, parse_traffic
-from sam_codegen.frontend.yaml_source import YNode, YScalar
+from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
 from sam_codegen.model.expr import ExprSource, PNum, UavcanExpr
 from sam_codegen.model.spec import (
@@ -51,9 +51,16 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
         path = scalar(node, str, what, diag)
         return FieldLink(ros_path, path, pos=pos) if path is not None else None
     r = Reader(node, what, diag, ("from", "scale", "offset", "table", "value", "limits", "round", "expr", "each",
-                                  "fields", "ignore", "uavcan_values"))
+                                  "fields", "ignore", "uavcan_values", "on_out_of_range"))
     if not r.ok:
         return None
+    wrap = _line_wrap(r, what, diag)
+    for key in ("each", "value"):
+        if wrap and r.node(key) is not None:
+            diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range 'wrap' of {what}: wrap applies to an integer "
+                       f"field as it is or an `expr`, not to a line with {key!r}",
+                       "wrap on the element mapping's own lines" if key == "each" else "no wrap on a constant")
+            return None
     if any(r.node(key) is not None for key in ("each", "fields", "ignore", "uavcan_values")):
         return element_link(ros_path, pos, r, mapping, diag, _link)
     if r.node("expr") is not None:
@@ -64,7 +71,7 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
                        "'expr' alone (it says the whole conversion)")
             return None
         expr = _expression(r.node("expr"), f"the expression of {what}", diag)
-        return FieldLink(ros_path, pos=pos, expr=expr) if expr is not None else None
+        return FieldLink(ros_path, pos=pos, expr=expr, wrap=wrap) if expr is not None else None
     uavcan_path = r.get("from", str, None)
     scale = number(r.node("scale"), f"'scale' of {what}", diag)
     offset = number(r.node("offset"), f"'offset' of {what}", diag)
@@ -103,7 +110,20 @@ def _link(ros_path: str, pos: Pos, node: YNode, mapping: str, diag: Diagnostics)
         else:
             limits = (values[0], values[1])
     return FieldLink(ros_path, uavcan_path, scale, offset, table, table_default, value, limits,  # type: ignore[arg-type]
-                     pos, bool(r.get("round", bool, False)))
+                     pos, bool(r.get("round", bool, False)), wrap=wrap)
+
+
+def _line_wrap(r: Reader, what: str, diag: Diagnostics) -> bool:
+    """A line's own `on_out_of_range`: only `wrap` (C's modulo 2**bits store), opted into line by line; saturate
+    and reject are the whole mapping's."""
+    policy = r.get("on_out_of_range", str, None)
+    if policy is None:
+        return False
+    if policy != "wrap":
+        diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range {policy!r} of {what}: a line takes only `wrap`",
+                   "wrap (modulo 2**bits, as C stores), or saturate / reject for the whole mapping")
+        return False
+    return True
 
 
 _MAPPING_KEYS = (
@@ -130,7 +150,11 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
                    f"{UAVCAN_TO_ROS} or {ROS_TO_UAVCAN}")
         direction = None
     policy = r.get("on_out_of_range", str, "saturate")
-    if policy not in ("saturate", "reject"):
+    if policy == "wrap":  # never a whole mapping's: it reverses a thruster at 200000 rpm into an int18
+        diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range 'wrap' of {what} is per line, not per mapping",
+                   "`{from: ..., on_out_of_range: wrap}` or `{expr: ..., on_out_of_range: wrap}` on the lines "
+                   "that must wrap; saturate or reject here")
+    elif policy not in ("saturate", "reject"):
         diag.error(r.key_pos("on_out_of_range"), f"on_out_of_range {policy!r} of {what} is unknown",
                    "saturate or reject")
     source_node_ids, any_node, any_pos = node_ids_or_any(r, "source_node_ids", what, diag)
@@ -165,9 +189,21 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
             uavcan_values[path] = value
     uavcan_exprs: list[UavcanExpr] = []
     for path, key_pos, value_node in map_items(r.node("uavcan_exprs"), f"uavcan_exprs of {what}", diag):
+        wrap = False
+        if isinstance(value_node, YMap):  # `{expr: "...", on_out_of_range: wrap}`
+            er = Reader(value_node, f"UAVCAN field {path!r} in uavcan_exprs of {what}", diag,
+                        ("expr", "on_out_of_range"))
+            if not er.ok:
+                continue
+            wrap = _line_wrap(er, f"UAVCAN field {path!r} in uavcan_exprs of {what}", diag)
+            expr_node = er.node("expr")
+            if expr_node is None:
+                diag.error(key_pos, f"missing field 'expr' in UAVCAN field {path!r} in uavcan_exprs of {what}")
+                continue
+            value_node = expr_node
         expr = _expression(value_node, f"the expression of UAVCAN field {path!r} in uavcan_exprs of {what}", diag)
         if expr is not None:
-            uavcan_exprs.append(UavcanExpr(path, expr, key_pos))
+            uavcan_exprs.append(UavcanExpr(path, expr, key_pos, wrap))
     ros_defaults = [p for p, _ in str_list(r.node("ros_defaults"), f"ros_defaults of {what}", diag)]
     mapping = Mapping(
         name, direction or UAVCAN_TO_ROS, r.get("topic", str) or "", 0 if dronecan else r.get("subject_id", int) or 0,

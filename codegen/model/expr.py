@@ -10,6 +10,9 @@ Invariants:
 - int arithmetic is exact (no wrap); float arithmetic is IEEE binary64; `/` always gives a float (x / 0 is +-inf,
   0 / 0 NaN); `>>` is an arithmetic shift (floor); trunc() and round() (half to even) take a float into an int64, a
   NaN dropping the message and what lies beyond int64 (infinities too) following the mapping's on_out_of_range.
+- float32(x) computes x as C does with `float` operands (issue 27): every float field and constant in x is rounded to
+  binary32, every float operation's result too (+ - * / and what mixes an int into a float: the int converted to
+  binary32 first); integer sub-expressions stay exact. Its value is a float (a binary32 one).
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ BINARY_OPS = {"+": "add", "-": "sub", "*": "mul", "/": "div", "<<": "shl", ">>":
               "==": "eq", "!=": "ne", "<": "lt", "<=": "le", ">": "gt", ">=": "ge", "and": "and", "or": "or"}
 SPELLING = {name: text for text, name in BINARY_OPS.items()}
 COMPARISONS = ("eq", "ne", "lt", "le", "gt", "ge")
-FUNCTIONS = {"min": 2, "max": 2, "trunc": 1, "round": 1, "int": 1, "abs": 1}
+FUNCTIONS = {"min": 2, "max": 2, "trunc": 1, "round": 1, "int": 1, "abs": 1, "float32": 1}
 
 
 # ---- parse tree ------------------------------------------------------------------------------------------------
@@ -91,6 +94,7 @@ class UavcanExpr:
     uavcan_path: str
     expr: ExprSource
     pos: Pos
+    wrap: bool = False  # `{expr: ..., on_out_of_range: wrap}`: stored modulo 2**bits (FieldLink.wrap)
 
 
 def names_of(node: PNode) -> list[str]:
@@ -156,6 +160,22 @@ class ECall:
 
 
 ENode = EConst | EField | EUnary | EBinary | ECall
+
+
+def uses_function(node: ENode, func: str) -> bool:
+    """Whether the typed tree calls `func` anywhere (float32: the generated support module then defines f32)."""
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ECall):
+            if n.func == func:
+                return True
+            stack += n.args
+        elif isinstance(n, EUnary):
+            stack.append(n.arg)
+        elif isinstance(n, EBinary):
+            stack += [n.left, n.right]
+    return False
 
 
 def fields_of(node: ENode) -> list[EField]:

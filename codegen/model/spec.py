@@ -331,6 +331,9 @@ class FieldLink:
     limits: tuple[float, float] | None = None
     pos: Pos = NOWHERE
     round: bool = False  # a UAVCAN float into a ROS integer: rounded half to even
+    # `on_out_of_range: wrap` on this line (issue 27): an integer beyond the target stored modulo 2**bits, as C
+    # stores it; the mapping's saturate / reject stays for every other line
+    wrap: bool = False
     expr: ExprSource | None = None  # `{expr: "..."}`: the ROS field computed from UAVCAN fields (model.expr)
     # An element mapping (`ros_array: {each: uavcan_array, fields: {...}}`): arrays of composites converted element
     # by element, `element_links` relative to the elements (validate.element_mappings); `each` the UAVCAN array.

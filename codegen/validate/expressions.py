@@ -142,6 +142,8 @@ class _Checker:
             return ECall("int", args, "int", (0, 1))
         for a, pa in zip(args, p.args, strict=True):
             self.number(a, pa, spell(a))
+        if p.func == "float32":  # C's float arithmetic (model.expr): a float, rounded to binary32
+            return ECall("float32", args, "float")
         if p.func in ("trunc", "round"):
             if args[0].kind != "float":
                 raise ExprError(f"{p.func}() takes a float, {spell(args[0])} is an int already", p.col)

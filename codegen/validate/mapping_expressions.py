@@ -10,7 +10,7 @@ from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS, DsdlStruct, Fie
 from sam_codegen.model.types import DsdlType, RosType
 from sam_codegen.validate.expressions import ExprError, check_expr, check_target
 from sam_codegen.validate.mapping_paths import MappingPaths, Reported
-from sam_codegen.validate.mapping_rules import RuleError, Step, format_path, parse_path
+from sam_codegen.validate.mapping_rules import RuleError, Step, format_path, parse_path, wrap_problem
 
 __all__ = ["MappingExpressions"]
 
@@ -50,7 +50,7 @@ class MappingExpressions(MappingPaths):
                                      f"{what}, field {link.ros_path!r}")
         if step is None:
             return None
-        return Step("expr", tuple(ros_path), ros_type, pos=link.pos, exact=False, expr=step.expr)
+        return Step("expr", tuple(ros_path), ros_type, pos=link.pos, exact=False, expr=step.expr, wrap=link.wrap)
 
     def resolve_uavcan_exprs(self, mapping: Mapping, ros_message: RosMessage, struct: DsdlStruct, what: str,
                              linked: list[Step]) -> list[Step]:
@@ -80,6 +80,11 @@ class MappingExpressions(MappingPaths):
                     self.error(entry.pos, f"UAVCAN field {entry.uavcan_path!r} is both mapped and in uavcan_exprs "
                                f"in {what}", "one of them")
                     continue
-                steps.append(Step("expr", (), RosType("float64"), tuple(path), target, pos=entry.pos, exact=False,
-                                  expr=step.expr))
+                resolved = Step("expr", (), RosType("float64"), tuple(path), target, pos=entry.pos, exact=False,
+                                expr=step.expr, wrap=entry.wrap)
+                problem = wrap_problem(resolved, to_ros=False)
+                if problem is not None:
+                    self.error(entry.pos, f"{what}, UAVCAN field {entry.uavcan_path!r}: {problem}")
+                    continue
+                steps.append(resolved)
         return steps

@@ -177,6 +177,7 @@ class Step:
     # the target, uavcan_path empty; to UAVCAN (uavcan_exprs): uavcan_path the target, ros_path empty.
     expr: ENode | None = None
     elements: ResolvedMapping | None = None  # kind "elements": the element mapping (validate.element_mappings)
+    wrap: bool = False  # `on_out_of_range: wrap` on the line: an integer beyond the target stored modulo 2**bits
 
     @property
     def ros(self) -> str:
@@ -336,3 +337,44 @@ def check_arrays(ros: RosType, uav: DsdlType, link: FieldLink) -> bool:
     if ros.array == "bounded" and (ros.capacity or 0) < (uav.capacity or 0):
         raise RuleError(f"ROS {ros} is shorter than UAVCAN {uav}; a bounded array keeps its bound")
     return True
+
+
+def wrap_problem(step: Step, to_ros: bool) -> str | None:
+    """Why a line's `on_out_of_range: wrap` cannot apply to `step` (its target written `to_ros` or to UAVCAN),
+    None when it can (or the line does not wrap). Wrap stores an integer modulo 2**bits of an integer target, as C
+    does; it needs an integer value (an integer field as it is, or an `expr` of integer result) that can pass the
+    target's range."""
+    if not step.wrap:
+        return None
+    target = step.ros_type if to_ros else step.uavcan_type
+    if isinstance(target, RosType):
+        target_range = None if target.array else ROS_INT_RANGES.get(target.base)
+        if target.base in ("byte", "char"):
+            target_range = None
+    else:
+        target_range = (None if target is None or target.array or target.kind not in ("int", "uint")
+                        else (int(target.range[0]), int(target.range[1])))
+    if target_range is None:
+        return f"on_out_of_range: wrap stores an integer modulo 2**bits; {target} is no integer scalar"
+    if step.kind == "expr" and step.expr is not None:
+        if step.expr.kind != "int":
+            return (f"on_out_of_range: wrap takes an integer value; the expression gives a {step.expr.kind} "
+                    "(write trunc() or round())")
+        value_range = step.expr.range or (-(2**63), 2**63 - 1)
+    elif step.kind == "number" and step.scale is None and step.offset is None:
+        source = step.uavcan_type if to_ros else step.ros_type
+        if isinstance(source, RosType):
+            value_range = ROS_INT_RANGES.get(source.base)  # type: ignore[assignment]
+        else:
+            value_range = (None if source is None or source.kind not in ("int", "uint")  # type: ignore[assignment]
+                           else (int(source.range[0]), int(source.range[1])))
+        if value_range is None:
+            return f"on_out_of_range: wrap takes an integer value; {source} is not an integer (a float needs an expr " \
+                   "with trunc() or round())"
+    else:
+        return (f"on_out_of_range: wrap applies to an integer field as it is or an `expr`, not to a line with "
+                f"{'scale or offset' if step.kind == 'number' else step.kind}")
+    lo, hi = int(value_range[0]), int(value_range[1])
+    if target_range[0] <= lo and hi <= target_range[1]:
+        return f"on_out_of_range: wrap has nothing to wrap: the value ({lo}..{hi}) always fits {target}"
+    return None

@@ -51,6 +51,7 @@ from sam_codegen.validate.mapping_rules import (
     format_path,
     missing_table_keys,
     parse_path,
+    wrap_problem,
 )
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
@@ -145,6 +146,8 @@ class MappingValidator(MappingExpressions, MappingCoverage):
             return None
         has_header = any(f.name == "header" and isinstance(f.type, RosType) and f.type.base == HEADER
                          for f in ros_message.fields)
+        if has_header and self.header_left_default(mapping, what):
+            has_header = False  # the bridge writes no stamp and no frame id: the C++'s untouched header
         links = self.mapped_links(mapping, what, struct, ros_message, has_header)
         if links is None:
             return None
@@ -160,17 +163,29 @@ class MappingValidator(MappingExpressions, MappingCoverage):
             self.check_coverage(resolved, what)
         return resolved
 
+    def header_left_default(self, mapping: Mapping, what: str) -> bool:
+        """Whether a UAVCAN -> ROS mapping leaves its message's header at its default (`ros_defaults: [header]`:
+        zero stamp, empty frame id, as a C++ bridge that never touches it); a frame_id beside it is an error."""
+        if mapping.direction != UAVCAN_TO_ROS or "header" not in mapping.ros_defaults:
+            return False
+        if mapping.frame_id is not None:
+            self.error(mapping.pos, f"{what} leaves its header at its default (ros_defaults: [header]) but gives "
+                       f"frame_id {mapping.frame_id!r}", "either the frame_id or header in ros_defaults")
+        return True
+
     def mapped_links(self, mapping: Mapping, what: str, struct: DsdlStruct, ros_message: RosMessage,
                      has_header: bool) -> list[FieldLink] | None:
         """The mapping's field lines (`fields: auto` spelled out), after checking its frame_id; None (reported)
         when `fields: auto` does not fit the types."""
         s = self.spec
-        if mapping.frame_id is not None and mapping.frame_id not in s.frames:
+        # '' is the explicit empty frame id (a bridge that never sets one): written as nothing, never prefixed
+        if mapping.frame_id and mapping.frame_id not in s.frames:
             self.error(mapping.pos, f"frame_id {mapping.frame_id!r} of {what} is not a declared frame",
-                       "one of " + ", ".join(s.frames))
+                       "one of " + ", ".join(s.frames) + ", or '' for an empty frame id")
         if mapping.direction == UAVCAN_TO_ROS and has_header and mapping.frame_id is None:
             self.error(mapping.pos, f"{what} publishes {ros_message.full_name}, which has a header: it needs "
-                       "a frame_id")
+                       "a frame_id", "a declared frame, `frame_id: ''` for an empty one, or `ros_defaults: "
+                       "[header]` to leave the header at its default")
         links = auto_links(struct, mapping.pos) if mapping.auto else mapping.links
         if mapping.auto and not self.v0 and ros_message.derived_from != struct.name:
             self.error(mapping.pos, f"{what} uses `fields: auto`, which needs a ROS message derived from "
@@ -271,7 +286,8 @@ class MappingValidator(MappingExpressions, MappingCoverage):
             ros_path = parse_path(link.ros_path)
             ros_type = self.ros_leaf(ros_message, ros_path)
             if link.expr is not None:
-                return self.resolve_expr_link(link, link.expr, ros_path, ros_type, struct, mapping, what)
+                step = self.resolve_expr_link(link, link.expr, ros_path, ros_type, struct, mapping, what)
+                return self.checked_wrap(step, mapping)
             if link.each is not None:  # an array of composites, element by element
                 return resolve_elements(self, link, ros_path, ros_type, struct, mapping, what)
             if link.value is not None:
@@ -311,14 +327,24 @@ class MappingValidator(MappingExpressions, MappingCoverage):
                 kind, exact = check_scalar(ros_type, uav_type, link)
             if kind == "table" and mapping.direction == UAVCAN_TO_ROS and link.table_default is None:
                 self.check_table_covers(uav_type, link, what)
-            return Step(kind, tuple(ros_path), ros_type, tuple(uav_path), uav_type, link.scale, link.offset,
-                        tuple(sorted((link.table or {}).items())), link.table_default, None, link.limits, exact,
-                        link.pos)
+            return self.checked_wrap(
+                Step(kind, tuple(ros_path), ros_type, tuple(uav_path), uav_type, link.scale, link.offset,
+                     tuple(sorted((link.table or {}).items())), link.table_default, None, link.limits, exact,
+                     link.pos, wrap=link.wrap), mapping)
         except Reported:
             return None
         except RuleError as exc:
             self.error(link.pos, f"{what}, field {link.ros_path!r}: {exc}")
             return None
+
+    @staticmethod
+    def checked_wrap(step: Step | None, mapping: Mapping) -> Step | None:
+        """`step`, unless its line's `on_out_of_range: wrap` cannot apply (raised: reported with the line)."""
+        if step is not None:
+            problem = wrap_problem(step, to_ros=mapping.direction == UAVCAN_TO_ROS)
+            if problem is not None:
+                raise RuleError(problem)
+        return step
 
     def check_table_covers(self, uav: DsdlType, link: FieldLink, what: str) -> None:
         """A UAVCAN -> ROS table must say what every value the device may send becomes; a value it misses

@@ -83,7 +83,7 @@ def test_precedence_and_spelling(text: str, spelled: str) -> None:
     ("(a + b", "expected ')', found the end", 6),
     ("a b", "unexpected 'b' after a complete expression", 2),
     ("", "the expression is empty", 0),
-    ("sqrt(a)", "unknown function 'sqrt' (expected one of abs, int, max, min, round, trunc)", 0),
+    ("sqrt(a)", "unknown function 'sqrt' (expected one of abs, float32, int, max, min, round, trunc)", 0),
     ("min(a)", "min() takes 2 arguments, not 1", 0),
     ("a + ", "expected a field, a number or '(', found the end", 3),
     ("x % 2", "unexpected '%' (write trunc() or a shift)", 2),

@@ -43,6 +43,7 @@ from sam_codegen.conversion_plan import (
     TimestampFromRos,
     TimestampToRos,
     Utf8Length,
+    Wrap,
     lower_link,
     lower_mapping,
 )
@@ -150,6 +151,9 @@ def describe_link(link: LinkPlan) -> str:
     if link.has(Limits, Clamp):  # values beyond the limits or the target's range
         policy = "out of range rejected" if link.reject else "saturating"
         notes = [f"{notes[0]}, {policy}"] if notes else [policy]
+    wrap = link.first(Wrap)
+    if isinstance(wrap, Wrap):
+        notes.append(_wrapping(wrap))
     for op in ops:
         if isinstance(op, Pad):
             notes.append(f"padded to {op.size}")
@@ -172,7 +176,15 @@ def describe_expression(link: LinkPlan, op: Evaluate) -> str:
                      + _policy(link, "saturated"))
     if link.has(Clamp):  # into the target's range, worded as every other link's
         notes.append("out of range rejected" if link.reject else "saturating")
+    wrap = link.first(Wrap)
+    if isinstance(wrap, Wrap):
+        notes.append(_wrapping(wrap))
     return f"= {spell(op.tree)} → {target}" + (f" ({', '.join(notes)})" if notes else "")
+
+
+def _wrapping(op: Wrap) -> str:
+    """`on_out_of_range: wrap`, said as what it does (the docs warn the reader as the README does)."""
+    return f"WRAPS modulo 2^{op.bits} beyond the range{' (two’s complement)' if op.signed else ''}, never saturates"
 
 
 def _calls(node: ENode) -> set[str]:

@@ -19,6 +19,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from sam_codegen.model.expr import uses_function
 from sam_codegen.render.templating import render
 from sam_codegen.targets.python.elements import element_function_names
 from sam_codegen.targets.python.factories import dsdl_factory, ros_factory
@@ -91,6 +92,19 @@ def _convert_context(resolved: Resolved) -> dict[str, Any]:
     }
 
 
+def uses_float32(resolved: Resolved) -> bool:
+    """Whether an expression of the spec calls float32() (the support module then defines f32; a spec that
+    does not gets the module it always had)."""
+    pending = [s for rm in [*resolved.mappings, *resolved.dronecan_mappings] for s in rm.steps]
+    while pending:
+        step = pending.pop()
+        if step.expr is not None and uses_function(step.expr, "float32"):
+            return True
+        if step.elements is not None:
+            pending += step.elements.steps
+    return False
+
+
 def emit(resolved: Resolved) -> dict[str, str]:
     """Render the bridge package: {path under generated/: text}."""
     spec = resolved.spec
@@ -100,6 +114,7 @@ def emit(resolved: Resolved) -> dict[str, str]:
     return {
         f"{root}/__init__.py": render("python/__init__.py.j2", **common),
         f"{root}/tables.py": render("python/tables.py.j2", **common, **tables_context(resolved)),
-        f"{root}/conversion_support.py": render("python/conversion_support.py.j2", **common),
+        f"{root}/conversion_support.py": render("python/conversion_support.py.j2", **common,
+                                               float32=uses_float32(resolved)),
         f"{root}/convert.py": render("python/convert.py.j2", **common, **_convert_context(resolved)),
     }

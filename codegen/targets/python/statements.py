@@ -28,6 +28,7 @@ from sam_codegen.conversion_plan import (
     Scale,
     TimestampFromRos,
     TimestampToRos,
+    Wrap,
     dsdl_range,
     is_int_dsdl,
 )
@@ -225,7 +226,22 @@ def check_statements(var: str, ops: list[Op] | tuple[Op, ...], key: str) -> list
                                        Policy(key, op.reject)))
         elif isinstance(op, Clamp):
             out.append(_clamp_statement(var, op, Policy(key, op.reject)))
+        elif isinstance(op, Wrap):
+            out.append(Assign(var, wrap_expr(var, op)))
     return out
+
+
+def wrap_expr(var: str, op: Wrap) -> str:
+    """`var` (an int) modulo 2**bits, two's complement for a signed target, as C stores it.
+
+    >>> wrap_expr("v", Wrap(8, False)), wrap_expr("v", Wrap(18, True))
+    ('v & 255', '((v + 131072) & 262143) - 131072')
+    """
+    mask = (1 << op.bits) - 1
+    if not op.signed:
+        return f"{var} & {mask}"
+    half = 1 << (op.bits - 1)
+    return f"(({var} + {half}) & {mask}) - {half}"
 
 
 def _clamp_statement(var: str, op: Clamp, policy: Policy) -> Bound:
