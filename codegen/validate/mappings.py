@@ -171,6 +171,10 @@ class MappingValidator(MappingExpressions, MappingCoverage):
         if mapping.frame_id is not None:
             self.error(mapping.pos, f"{what} leaves its header at its default (ros_defaults: [header]) but gives "
                        f"frame_id {mapping.frame_id!r}", "either the frame_id or header in ros_defaults")
+        for link in mapping.links:
+            if link.ros_path == "header" or link.ros_path.startswith("header."):
+                self.error(link.pos, f"{what} leaves its header at its default (ros_defaults: [header]) but "
+                           f"writes {link.ros_path!r}", "either the line or header in ros_defaults")
         return True
 
     def mapped_links(self, mapping: Mapping, what: str, struct: DsdlStruct, ros_message: RosMessage,

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = ["check_destinations", "codec_gaps", "find_converter", "in_groups", "missing_codecs", "nominal_rates",
-           "out_mappings"]
+           "out_mappings", "writes_header"]
 
 
 def find_converter(convert: Any, m: Any, which: int) -> Callable[..., Any]:
@@ -69,7 +69,13 @@ def nominal_rates(tables: TablesModule, devices: Sequence[Any] | None = None) ->
             for p in d.publishes if getattr(p, "rate_hz", None)}
 
 
-def _has_header(ros_cls: Any) -> bool:
+def writes_header(ros_cls: Any, m: Any = None) -> bool:
+    """Whether the bridge stamps and frames the message's header. Not when the spec leaves it at its default
+    (`ros_defaults: [header]`, issue 27: zero stamp, empty frame id, as the C++ it replaces): the one way a
+    UAVCAN -> ROS mapping into a message with a header has no frame_id (validation refuses any other; an empty
+    frame id is '')."""
+    if m is not None and getattr(m, "frame_id", "") is None:
+        return False
     return "header" in getattr(ros_cls, "get_fields_and_field_types", dict)()
 
 
@@ -111,12 +117,12 @@ def in_groups(gen: Any, convert: Any, counters: Mapping[str, MappingStats],
         ros_cls = gen.ros_class(m.topic)
         if codec is not None:
             group.mappings.append(InMapping(m, codec.CODECS[m.name][0], counters[m.name], ros_cls,
-                                            has_header=_has_header(ros_cls), matches=wire_matches.get(m.name),
+                                            has_header=writes_header(ros_cls, m), matches=wire_matches.get(m.name),
                                             raw=True))
             continue
         match = matches.get(m.name)
         group.mappings.append(InMapping(m, find_converter(convert, m, 0), counters[m.name], ros_cls,
-                                        has_header=_has_header(ros_cls),
+                                        has_header=writes_header(ros_cls, m),
                                         matches=None if match is None or match.__name__ == "_always" else match))
     return list(groups.values())
 

@@ -45,7 +45,8 @@ from sam_codegen.validate.resolve import validate
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {**tc.SPECS, "barge": Path(__file__).resolve().parents[1] / "specs" / "barge.yaml",
          "relay": Path(__file__).resolve().parents[1] / "specs" / "relay.yaml",
-         "dredger": Path(__file__).resolve().parents[1] / "specs" / "dredger.yaml"}
+         "dredger": Path(__file__).resolve().parents[1] / "specs" / "dredger.yaml",
+         "retrofit": Path(__file__).resolve().parents[1] / "specs" / "retrofit.yaml"}
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "python" / "python" / "sam_bridge" / "codec.py.golden"
 UPDATE = os.environ.get("SAM_UPDATE_GOLDEN") == "1"
 WORKER_ENV = "SAM_CODEC_WORKER"

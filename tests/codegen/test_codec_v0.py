@@ -48,7 +48,8 @@ SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "sp
          "power_v0": ROOT / "tests" / "specs" / "power_v0.yaml",
          "power_prefix_v0": ROOT / "tests" / "specs" / "power_prefix_v0.yaml",
          "lolo_v0": ROOT / "tests" / "specs" / "lolo_v0.yaml",
-         "hopper_v0": ROOT / "tests" / "specs" / "hopper_v0.yaml"}
+         "hopper_v0": ROOT / "tests" / "specs" / "hopper_v0.yaml",
+         "retrofit": ROOT / "tests" / "specs" / "retrofit.yaml"}
 GOLDEN = ROOT / "tests" / "golden" / "python_v0"
 WORKER_ENV = "SAM_CODEC_V0_WORKER"
 WORKER = os.environ.get(WORKER_ENV)

@@ -1,0 +1,107 @@
+# ruff: noqa: E501  (a table of exact diagnostics, one per line, as tests/broken_cases.py)
+"""Broken specs of issue 27's constructs: each case breaks tests/specs/retrofit.yaml one way and names the exact
+errors (as tests/broken_cases.py); a case with no errors is a spelling the spec accepts."""
+
+from __future__ import annotations
+
+from broken_cases import Case
+
+RETROFIT_CASES: tuple[Case, ...] = (
+    # ---- class 1: no frame, no header
+    Case('frame_none_is_a_frame_name', "      frame_id: ''\n      fields:\n        temperature: {expr: \"float32(temperature_k",
+         "      frame_id: none\n      fields:\n        temperature: {expr: \"float32(temperature_k",
+        (
+            "retrofit.yaml:58:5: error: frame_id 'none' of mapping 'thermo' is not a declared frame (expected one of base_link, or '' for an empty frame id)",
+        ),
+    ),
+    Case('header_default_with_frame',
+         '      ros_defaults: [header]',
+         '      frame_id: base_link\n      ros_defaults: [header]',
+        (
+            "retrofit.yaml:68:5: error: mapping 'thermo_raw' leaves its header at its default (ros_defaults: [header]) but gives frame_id 'base_link' (expected either the frame_id or header in ros_defaults)",
+        ),
+    ),
+    Case('header_without_frame',
+         "      frame_id: ''\n      fields:\n        temperature: {expr: \"float32(temperature_k",
+         "      fields:\n        temperature: {expr: \"float32(temperature_k",
+        (
+            "retrofit.yaml:58:5: error: mapping 'thermo' publishes sensor_msgs/Temperature, which has a header: it needs a frame_id (expected a declared frame, `frame_id: ''` for an empty one, or `ros_defaults: [header]` to leave the header at its default)",
+        ),
+    ),
+    Case('header_default_and_stamp_written',
+         '        temperature: temperature_k\n',
+         '        temperature: temperature_k\n        header.stamp: raw\n',
+        (
+            "retrofit.yaml:75:9: error: mapping 'thermo_raw' leaves its header at its default (ros_defaults: [header]) but writes 'header.stamp' (expected either the line or header in ros_defaults)",
+        ),
+    ),
+    # ---- class 2: float32() and wrap
+    Case('float32_of_a_bool', '"trunc(float32(r * 80)) >> 3"', '"trunc(float32(r > 80)) >> 3"',
+        (
+            "retrofit.yaml:92:31: error: mapping 'light', UAVCAN field 'red': r > 80 is a bool, not a number (write int(r > 80) for 0 or 1)",
+        ),
+    ),
+    Case('float32_two_arguments', '"trunc(float32(r * 80)) >> 3"', '"trunc(float32(r, 80)) >> 3"',
+        (
+            "retrofit.yaml:92:21: error: the expression of UAVCAN field 'red' in uavcan_exprs of mapping 'light': float32() takes 1 argument, not 2",
+        ),
+    ),
+    Case('float32_into_an_integer', '"trunc(float32(r * 80)) >> 3"', '"float32(r * 80)"',
+        (
+            "retrofit.yaml:92:15: error: mapping 'light', UAVCAN field 'red': red is uint8, the expression gives a float (write trunc(...) or round(...))",
+        ),
+    ),
+    Case('wrap_per_mapping', '      destination_node_id: 11\n', '      destination_node_id: 11\n      on_out_of_range: wrap\n',
+        (
+            "retrofit.yaml:90:7: error: on_out_of_range 'wrap' of mapping 'light' is per line, not per mapping (expected `{from: ..., on_out_of_range: wrap}` or `{expr: ..., on_out_of_range: wrap}` on the lines that must wrap; saturate or reject here)",
+        ),
+    ),
+    Case('saturate_per_line', '{expr: "trunc(float32(g * 255 / a))", on_out_of_range: wrap}',
+         '{expr: "trunc(float32(g * 255 / a))", on_out_of_range: saturate}',
+        (
+            "retrofit.yaml:93:54: error: on_out_of_range 'saturate' of UAVCAN field 'green' in uavcan_exprs of mapping 'light': a line takes only `wrap` (expected wrap (modulo 2**bits, as C stores), or saturate / reject for the whole mapping)",
+        ),
+    ),
+    Case('wrap_of_a_float_expr', 'variance: {expr: "float32(raw * 0.1)"}',
+         'variance: {expr: "float32(raw * 0.1)", on_out_of_range: wrap}',
+        (
+            "retrofit.yaml:75:9: error: mapping 'thermo_raw', field 'variance': on_out_of_range: wrap stores an integer modulo 2**bits; float64 is no integer scalar",
+        ),
+    ),
+    Case('wrap_into_a_float_field', '        temperature: temperature_k\n',
+         '        temperature: {from: temperature_k, on_out_of_range: wrap}\n',
+        (
+            "retrofit.yaml:74:9: error: mapping 'thermo_raw', field 'temperature': on_out_of_range: wrap stores an integer modulo 2**bits; float64 is no integer scalar",
+        ),
+    ),
+    Case('wrap_nothing_to_wrap', 'data: {expr: "raw + 100", on_out_of_range: wrap}',
+         'data: {expr: "raw >> 11", on_out_of_range: wrap}',
+        (
+            "retrofit.yaml:83:9: error: mapping 'thermo_count', field 'data': on_out_of_range: wrap has nothing to wrap: the value (-64..63) always fits int8",
+        ),
+    ),
+    Case('wrap_of_a_rounded_float', 'data: {expr: "trunc(float32(static_temperature * 3.3))", on_out_of_range: wrap}',
+         'data: {from: static_temperature, round: true, on_out_of_range: wrap}',
+        (
+            "retrofit.yaml:119:9: error: DroneCAN mapping 'air_level', field 'data': on_out_of_range: wrap takes an integer value; float16 is not an integer (a float needs an expr with trunc() or round())",
+        ),
+    ),
+    Case('wrap_on_a_value', 'data: {expr: "raw + 100", on_out_of_range: wrap}',
+         'data: {value: 3, on_out_of_range: wrap}',
+        (
+            "retrofit.yaml:83:26: error: on_out_of_range 'wrap' of field 'data' of mapping 'thermo_count': wrap applies to an integer field as it is or an `expr`, not to a line with 'value' (expected no wrap on a constant)",
+        ),
+    ),
+    Case('wrap_typo', 'data: {expr: "raw + 100", on_out_of_range: wrap}',
+         'data: {expr: "raw + 100", on_out_of_range: wrapped}',
+        (
+            "retrofit.yaml:83:35: error: on_out_of_range 'wrapped' of field 'data' of mapping 'thermo_count': a line takes only `wrap` (expected wrap (modulo 2**bits, as C stores), or saturate / reject for the whole mapping)",
+        ),
+    ),
+    Case('uavcan_expr_without_expr', '{expr: "round(float32(b * 100 - 50))", on_out_of_range: wrap}',
+         '{on_out_of_range: wrap}',
+        (
+            "retrofit.yaml:94:9: error: missing field 'expr' in UAVCAN field 'blue' in uavcan_exprs of mapping 'light'",
+        ),
+    ),
+)
