@@ -1565,7 +1565,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      timeout: 0.5',
         '      timeout: 0.5\n      retries: 3',
         (
-            "auv_services.yaml:99:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values, service_id)",
+            "auv_services.yaml:99:7: error: unknown field 'retries' in service mapping 'update_battery' (expected one of service, type, data_type, protocol, destination_node_id, timeout, request, response, uavcan_values, service_id, response_defaults)",
         ),
     ),
     Case(

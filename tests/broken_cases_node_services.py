@@ -22,7 +22,7 @@ NODE_SERVICE_CASES: tuple[Case, ...] = (
         _BRIDGE,
         _BRIDGE + '  node_services:\n    get_node_info: {name: info}\n',
         (
-            "auv_services.yaml:82:21: error: unknown field 'name' in node service 'get_node_info' (expected one of service, type, timeout)",
+            "auv_services.yaml:82:21: error: unknown field 'name' in node service 'get_node_info' (expected one of service, type, timeout, response_defaults)",
         ),
     ),
     Case(

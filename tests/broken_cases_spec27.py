@@ -4,6 +4,8 @@ errors (as tests/broken_cases.py); a case with no errors is a spelling the spec 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from broken_cases import Case
 
 RETROFIT_CASES: tuple[Case, ...] = (
@@ -102,6 +104,88 @@ RETROFIT_CASES: tuple[Case, ...] = (
          '{on_out_of_range: wrap}',
         (
             "retrofit.yaml:94:9: error: missing field 'expr' in UAVCAN field 'blue' in uavcan_exprs of mapping 'light'",
+        ),
+    ),
+)
+
+
+
+@dataclass(frozen=True)
+class Edits:
+    """A case of several edits of the base spec (each `old` replaced once), with its exact errors."""
+
+    name: str
+    edits: tuple[tuple[str, str], ...]
+    errors: tuple[str, ...]
+
+
+# ---- class 4: nested service response fields, none left unwritten (tests/specs/auv_services.yaml)
+_STATUS_MSG = ("messages:\n  NodeStatus:\n    fields:\n      - {name: uptime_sec, type: uint32}\n"
+               "      - {name: health, type: uint8}\n      - {name: mode, type: uint8}\n"
+               "      - {name: vendor_specific_status_code, type: uint16}\nservices:\n")
+# the duty's default srv name, declared by the spec: its own is used (README "Device duties")
+_NODE_INFO_SRV = ("  UavcanGetNodeInfo:\n    request:\n      - {name: node_id, type: uint16}\n    response:\n"
+                  "      - {name: success, type: bool}\n      - {name: message, type: string}\n"
+                  "      - {name: name, type: string}\n      - {name: status, type: NodeStatus}\n")
+_BRIDGE = "bridge:\n  name: bridge\n  node_id: 100\n"
+_FLAT_STATUS = ("      - {name: uptime_sec, type: uint32}\n      - {name: health, type: uint8}\n"
+                "      - {name: mode, type: uint8}\n")
+_STATUS_LINES = "        uptime_sec: status.uptime_sec\n        health: status.health\n        mode: status.mode\n"
+
+SERVICE27_CASES: tuple[Edits, ...] = (
+    # the issue's failing example: a duty given the spec's own srv with a nested `status` writes it (no error)
+    Edits('duty_nested_status', (('services:\n', _STATUS_MSG + _NODE_INFO_SRV),), ()),
+    Edits('duty_field_nothing_writes',
+          (('services:\n', _STATUS_MSG + _NODE_INFO_SRV + "      - {name: battery, type: float32}\n"),),
+        (
+            "auv_services.yaml:47:9: error: ROS response field 'battery' (float32) of lolo_msgs/UavcanGetNodeInfo is written by nothing in node service 'get_node_info' (expected a field the duty writes (success, name, uptime_sec, health, mode, vendor_specific_status_code, software_version_major, software_version_minor, hardware_version_major, hardware_version_minor, software_vcs_revision_id, unique_id), or `response_defaults: [battery]` to keep its default)",
+        ),
+    ),
+    Edits('duty_response_defaults', ((_BRIDGE, _BRIDGE + "  node_services:\n    get_node_info: {type: GetNodeInfo, "
+                                                         "response_defaults: [software_major, software_minor]}\n"),),
+          ()),
+    Edits('duty_response_defaults_missing', ((_BRIDGE, _BRIDGE + "  node_services:\n    get_node_info: "
+                                                                 "{type: GetNodeInfo}\n"),),
+        (
+            "auv_services.yaml:82:21: error: ROS response field 'software_major' (uint8) of lolo_msgs/GetNodeInfo is written by nothing in node service 'get_node_info' (expected a field the duty writes (success, name, uptime_sec, health, mode, vendor_specific_status_code, software_version_major, software_version_minor, hardware_version_major, hardware_version_minor, software_vcs_revision_id, unique_id), or `response_defaults: [software_major]` to keep its default)",
+            "auv_services.yaml:82:21: error: ROS response field 'software_minor' (uint8) of lolo_msgs/GetNodeInfo is written by nothing in node service 'get_node_info' (expected a field the duty writes (success, name, uptime_sec, health, mode, vendor_specific_status_code, software_version_major, software_version_minor, hardware_version_major, hardware_version_minor, software_vcs_revision_id, unique_id), or `response_defaults: [software_minor]` to keep its default)",
+        ),
+    ),
+    Edits('mapping_nested_ros_response',
+          ((_FLAT_STATUS, "      - {name: status, type: NodeStatus}\n"), ('services:\n', _STATUS_MSG),
+           (_STATUS_LINES, "        status.uptime_sec: status.uptime_sec\n        status.health: status.health\n"
+                           "        status.mode: status.mode\n        status.vendor_specific_status_code: "
+                           "status.vendor_specific_status_code\n")), ()),
+    Edits('mapping_nested_left_unwritten',
+          ((_FLAT_STATUS, "      - {name: status, type: NodeStatus}\n"), ('services:\n', _STATUS_MSG),
+           (_STATUS_LINES, "        status.uptime_sec: status.uptime_sec\n")),
+        (
+            "auv_services.yaml:110:5: error: ROS response field 'status.health' (uint8) of lolo_msgs/GetNodeInfo is written by nothing in service mapping 'get_node_info' (expected a `response` line, or `response_defaults: [status.health]` to keep its default)",
+            "auv_services.yaml:110:5: error: ROS response field 'status.mode' (uint8) of lolo_msgs/GetNodeInfo is written by nothing in service mapping 'get_node_info' (expected a `response` line, or `response_defaults: [status.mode]` to keep its default)",
+            "auv_services.yaml:110:5: error: ROS response field 'status.vendor_specific_status_code' (uint16) of lolo_msgs/GetNodeInfo is written by nothing in service mapping 'get_node_info' (expected a `response` line, or `response_defaults: [status.vendor_specific_status_code]` to keep its default)",
+        ),
+    ),
+    Edits('mapping_field_nothing_writes', (('        status: success\n', ''),),
+        (
+            "auv_services.yaml:93:5: error: ROS response field 'status' (uint8) of lolo_msgs/UpdateBattery is written by nothing in service mapping 'update_battery' (expected a `response` line, or `response_defaults: [status]` to keep its default)",
+        ),
+    ),
+    Edits('mapping_response_defaults', (('        status: success\n', '      response_defaults: [status]\n'),), ()),
+    Edits('mapping_response_defaults_unknown',
+          (('        status: success\n', '        status: success\n      response_defaults: [state]\n'),),
+        (
+            "auv_services.yaml:93:5: error: response_defaults of service mapping 'update_battery': 'state' is not a field of the response of lolo_msgs/UpdateBattery (expected success, status)",
+        ),
+    ),
+    Edits('mapping_response_defaults_written',
+          (('        status: success\n', '        status: success\n      response_defaults: [status]\n'),),
+        (
+            "auv_services.yaml:93:5: error: ROS response field 'status' is in response_defaults of service mapping 'update_battery' but it is written (expected response_defaults lists only fields nothing writes)",
+        ),
+    ),
+    Edits('mapping_nested_unknown', (('        status: success\n', '        status.code: success\n'),),
+        (
+            "auv_services.yaml:104:9: error: 'status.code' of service mapping 'update_battery' is not a field of the srv response (expected success, status)",
         ),
     ),
 )

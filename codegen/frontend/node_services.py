@@ -20,7 +20,7 @@ has its own used (and checked as a `type:`), so SMARC's srv files can be copied 
 
 from __future__ import annotations
 
-from sam_codegen.frontend.reading import Reader, number
+from sam_codegen.frontend.reading import Reader, number, str_list
 from sam_codegen.frontend.yaml_source import YNode, YScalar
 from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.spec import Bridge, Field, NodeService, RosService
@@ -30,7 +30,7 @@ __all__ = ["DEFAULT_SRVS", "DUTIES", "parse_node_services", "with_duty_srvs"]
 
 DUTIES = ("get_node_info", "restart_node", "get_transport_stats")
 _DEFAULT_TIMEOUT_S = 1.0
-_KEYS = ("service", "type", "timeout")
+_KEYS = ("service", "type", "timeout", "response_defaults")
 
 # The default srv types (SMARC's uavcan_ros_bridge names them so), node id 16 bits (Cyphal/UDP node ids exceed 255).
 _COMMON = [("success", "bool", "false when the device did not answer or is no device of this bridge's protocol"),
@@ -99,8 +99,9 @@ def parse_node_services(node: YNode | None, bridge_pos: Pos, package: str, diag:
         full = default.type
         if type_ is not None:
             full = type_.replace("/srv/", "/") if "/" in type_ else f"{package}/{type_}"
+        defaults = tuple(p for p, _ in str_list(r.node("response_defaults"), f"response_defaults of {what}", diag))
         out.append(NodeService(duty, True, service or default.service, full, timeout, entry.pos,
-                               r.key_pos("type") if type_ is not None else entry.pos, type_ is not None))
+                               r.key_pos("type") if type_ is not None else entry.pos, type_ is not None, defaults))
     return out
 
 

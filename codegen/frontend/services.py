@@ -7,7 +7,7 @@ Structure only (keys, value kinds, a positive timeout); what the names refer to 
 from __future__ import annotations
 
 from sam_codegen.frontend.bridge import parse_link
-from sam_codegen.frontend.reading import Reader, map_items, number, scalar
+from sam_codegen.frontend.reading import Reader, map_items, number, scalar, str_list
 from sam_codegen.frontend.yaml_source import YNode
 from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.spec import PROTOCOLS, FieldLink, Scalar, ServiceMapping
@@ -16,7 +16,7 @@ __all__ = ["DEFAULT_TIMEOUT_S", "parse_service_mapping"]
 
 DEFAULT_TIMEOUT_S = 1.0  # dronecan's own default request timeout
 _KEYS = ("service", "type", "data_type", "protocol", "destination_node_id", "timeout", "request", "response",
-         "uavcan_values", "service_id")
+         "uavcan_values", "service_id", "response_defaults")
 
 
 def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -> ServiceMapping | None:
@@ -54,4 +54,6 @@ def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -
     field = destination if isinstance(destination, str) else None
     return ServiceMapping(name, service, type_.replace("/srv/", "/"), data_type,
                           0 if field is not None else int(destination), timeout, links["request"], links["response"],
-                          uavcan_values, protocol, pos, field, service_id)
+                          uavcan_values, protocol, pos, field, service_id,
+                          response_defaults=tuple(p for p, _ in str_list(r.node("response_defaults"),
+                                                                         f"response_defaults of {what}", diag)))

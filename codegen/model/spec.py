@@ -445,6 +445,9 @@ class ServiceMapping:
     service_id: int | None = None
     # a device duty of `bridge.node_services` (get_node_info...): any device of the bridge's protocol, by node id
     duty: str | None = None
+    # ROS response fields (or what nothing writes under one) meant to keep the srv's defaults (issue 27: any other
+    # field no line writes is an error, never a silent zero)
+    response_defaults: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -461,6 +464,7 @@ class NodeService:
     pos: Pos = NOWHERE
     type_pos: Pos = NOWHERE
     type_given: bool = False  # `type:` written (else the default name, which the spec may declare itself)
+    response_defaults: tuple[str, ...] = ()  # the srv's response fields the duty leaves at their defaults
 
 
 @dataclass(frozen=True)

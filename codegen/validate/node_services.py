@@ -27,7 +27,8 @@ from sam_codegen.model.diagnostics import Diagnostics
 from sam_codegen.model.ros_names import ros_name_problem
 from sam_codegen.model.spec import NodeService, RosService, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import ROS_INT_RANGES, RosType
-from sam_codegen.validate.services import ResolvedServiceMapping, ServiceLink
+from sam_codegen.validate.service_coverage import Lookup, check_response_written, response_leaf, response_leaves
+from sam_codegen.validate.services import ResolvedServiceMapping, ServiceLink, bridge_written
 
 __all__ = ["DUTY_FIELDS", "DUTY_TYPES", "resolve_node_services"]
 
@@ -90,8 +91,8 @@ def _duty_protocols(spec: Spec) -> list[str]:
     return [p for p in ("dronecan", "cyphal") if p in found]
 
 
-def resolve_node_services(spec: Spec, diag: Diagnostics, signed: Callable[[str], V0Struct | None]
-                          ) -> list[ResolvedServiceMapping]:
+def resolve_node_services(spec: Spec, diag: Diagnostics, signed: Callable[[str], V0Struct | None],
+                          lookup: Lookup = lambda name: None) -> list[ResolvedServiceMapping]:
     """`signed`: the V0Catalog's ``signed`` (a DroneCAN type's data type id and signature)."""
     if spec.bridge is None:
         return []
@@ -115,18 +116,21 @@ def resolve_node_services(spec: Spec, diag: Diagnostics, signed: Callable[[str],
         if srv is None:
             diag.error(ns.type_pos, f"unknown service type {ns.type!r} of {what}", "a type of `services` (pkg/Name)")
             continue
-        response = _response_fields(ns, srv, what, diag)
+        response = _response_fields(ns, srv, what, diag, lookup)
         if response is None:
             continue
         for protocol in _duty_protocols(spec):
-            resolved = _mapping(ns, srv, protocol, response, signed)
+            resolved = _mapping(ns, srv, protocol, response, signed, lookup)
             if resolved is not None:
                 out.append(resolved)
     return out
 
 
-def _response_fields(ns: NodeService, srv: RosService, what: str, diag: Diagnostics) -> list[str] | None:
-    """The known response fields the srv has (checked); None after reporting a problem."""
+def _response_fields(ns: NodeService, srv: RosService, what: str, diag: Diagnostics, lookup: Lookup
+                     ) -> list[str] | None:
+    """The known response fields the srv has, nested ones by their path (`status.uptime_sec`: a srv whose
+    response holds a message of them), checked; every other leaf must be in the duty's response_defaults (issue
+    27: never a silent zero); None after reporting a problem."""
     node_id = next((f for f in srv.request if f.name == "node_id"), None)
     ok = True
     if node_id is None or not isinstance(node_id.type, RosType) or node_id.type.array \
@@ -137,24 +141,31 @@ def _response_fields(ns: NodeService, srv: RosService, what: str, diag: Diagnost
     known = DUTY_FIELDS[ns.duty]
     found = []
     names = {f.name for f in srv.response}
-    for f in srv.response:
-        name = "success" if f.name == "ok" and "success" not in names else f.name  # SMARC's `bool ok`
-        if name not in known:
+    for path, _, _ in response_leaves(srv, lookup):
+        f = response_leaf(srv, path, lookup)
+        assert f is not None
+        name = "success" if path == "ok" and "success" not in names else f.name  # SMARC's `bool ok`
+        if name not in known or (name == "success" and "." in path):
             continue
         kind = known[name][0]
         assert isinstance(f.type, RosType)
         if not _fits(kind, f.type):
             diag.error(f.pos if f.pos.line else ns.type_pos,
-                       f"response field {f.name!r} ({f.type}) of {srv.full_name} cannot hold {name} of {what}",
+                       f"response field {path!r} ({f.type}) of {srv.full_name} cannot hold {name} of {what}",
                        _EXPECTED[kind])
             ok = False
             continue
-        found.append(f.name)
+        found.append(path)
+    if ok and not check_response_written(diag, ns.type_pos, srv, set(found) | bridge_written(srv, duty=True),
+                                         ns.response_defaults, what,
+                                         "a field the duty writes (" + ", ".join(known) + ")", lookup,
+                                         at_field=not ns.type_pos.line):
+        ok = False
     return found if ok else None
 
 
 def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
-             signed: Callable[[str], V0Struct | None]) -> ResolvedServiceMapping | None:
+             signed: Callable[[str], V0Struct | None], lookup: Lookup) -> ResolvedServiceMapping | None:
     data_type, service_id = DUTY_TYPES[(ns.duty, protocol)]
     struct = None
     if protocol == "dronecan":
@@ -164,8 +175,8 @@ def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
         service_id = struct.data_type_id
     known = DUTY_FIELDS[ns.duty]
     response = []
-    for name in fields:
-        key = "success" if name == "ok" else name
+    for name in fields:  # a path: `status.uptime_sec` is uptime_sec
+        key = "success" if name == "ok" else name.rsplit(".", 1)[-1]
         kind, dronecan_source, cyphal_source = known[key]
         source = dronecan_source if protocol == "dronecan" else cyphal_source
         if source == "status":  # Cyphal ExecuteCommand: status 0 is success
@@ -175,8 +186,8 @@ def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
         else:
             lo, hi = (-float("inf"), float("inf"))
             if kind == "int":
-                f = next(f for f in srv.response if f.name == name)
-                assert isinstance(f.type, RosType)
+                f = response_leaf(srv, name, lookup)
+                assert f is not None and isinstance(f.type, RosType)
                 lo, hi = ROS_INT_RANGES[f.type.base]
             response.append(ServiceLink(name, source, kind, None, None, None, lo, hi))
     request: list[ServiceLink] = []

@@ -369,7 +369,7 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     check_panic_duty(spec, v.diag)
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
     service_mappings = services.resolve_mappings()
-    service_mappings += resolve_node_services(spec, v.diag, v0.signed)  # the device duties (validate.node_services)
+    service_mappings += resolve_node_services(spec, v.diag, v0.signed, ros.get)  # the duties (validate.node_services)
     check_routing(spec, v.diag)  # `any` node ids, `shares_data_type` (validate.routing)
     for error in v0.errors:
         v.error(Pos(spec.file), f"a DroneCAN standard definition cannot be read: {error}")

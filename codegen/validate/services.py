@@ -31,9 +31,10 @@ from sam_codegen.model.types import (
     RosType,
 )
 from sam_codegen.validate.cyphal_services import resolve_cyphal_mapping
+from sam_codegen.validate.service_coverage import check_response_written, response_leaf
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
-__all__ = ["ResolvedServiceMapping", "ServiceLink", "ServiceValidator"]
+__all__ = ["ResolvedServiceMapping", "ServiceLink", "ServiceValidator", "bridge_written"]
 
 _F32_MAX = 3.4028234663852886e38
 _V0_FIELD_NAME = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
@@ -87,6 +88,14 @@ def _v0_kind(t: DsdlType) -> str | None:
     return {"int": "int", "uint": "int", "float": "float", "bool": "bool"}.get(t.kind)
 
 
+def bridge_written(srv: RosService, duty: bool = False) -> set[str]:
+    """The response fields the bridge writes itself: a bool `success` (a duty's `ok` too) and a string `message`,
+    its answer to a call that failed (sam_codegen.targets.python.services)."""
+    types = {f.name: str(f.type) for f in srv.response}
+    out = {name for name in ("success", *(("ok",) if duty else ())) if types.get(name) == "bool"}
+    return out | ({"message"} if types.get("message") == "string" else set())
+
+
 class ServiceValidator:
     def __init__(self, spec: Spec, ros: RosCatalog, catalog: V0Catalog, diag: Diagnostics,
                  dsdl: DsdlCatalog | None = None) -> None:
@@ -94,6 +103,7 @@ class ServiceValidator:
         self.dsdl = dsdl if dsdl is not None else DsdlCatalog(spec)  # Cyphal service mappings' types
         self.nested: Callable[[str], DsdlStruct | None] = catalog.get  # a nested type by name: the mapping's protocol's
         self.bad: set[str] = set()  # srv and v0 service types reported broken
+        self.srv: RosService | None = None  # the srv of the mapping being resolved (nested response paths)
 
     def error(self, pos: Pos, message: str, expected: str | None = None) -> None:
         self.diag.error(pos, message, expected)
@@ -249,6 +259,7 @@ class ServiceValidator:
     def links(self, m: ServiceMapping, what: str, srv: RosService, request_fields: list[Field],
               response_fields: list[Field], type_name: str) -> tuple[list[ServiceLink], list[ServiceLink]] | None:
         """The request links (every UAVCAN request field, in order) and the response links of a mapping."""
+        self.srv = srv
         ros_req = {f.name: f for f in srv.request}
         ros_res = {f.name: f for f in srv.response}
         uav_req = {f.name: f for f in request_fields if f.name}
@@ -300,6 +311,11 @@ class ServiceValidator:
                 response.append(found)
         if not ok:
             return None
+        # every response field written (the lines; `success` / `message`, which a failure writes) or kept
+        written = {r.target for r in response} | bridge_written(srv)
+        if not check_response_written(self.diag, m.pos, srv, written, m.response_defaults, what, "a `response` line",
+                                      self.ros.get):
+            return None
         return [request[n] for n in uav_req], response
 
     def link(self, link: FieldLink, what: str, part: str, ros: dict, uavcan: dict, to_uavcan: bool
@@ -310,6 +326,8 @@ class ServiceValidator:
                        "`offset` or `value`", "no table, limits or round in a service mapping")
             return None
         ros_field = ros.get(link.ros_path)
+        if ros_field is None and not to_uavcan and "." in link.ros_path and self.srv is not None:
+            ros_field = response_leaf(self.srv, link.ros_path, self.ros.get)  # `status.uptime_sec`
         if ros_field is None:
             self.error(link.pos, f"{link.ros_path!r} of {what} is not a field of the srv {part}",
                        ", ".join(ros) or "none: the srv's " + part + " is empty")
@@ -358,7 +376,7 @@ class ServiceValidator:
         assert target_kind is not None
         if to_uavcan:
             return ServiceLink(uav_field.name, ros_field.name, target_kind, None, link.scale, link.offset, lo, hi)
-        return ServiceLink(ros_field.name, link.uavcan_path, target_kind, None, link.scale, link.offset, lo, hi)
+        return ServiceLink(link.ros_path, link.uavcan_path, target_kind, None, link.scale, link.offset, lo, hi)
 
     def uavcan_field(self, path: str, fields: dict, nested: bool) -> Field | None:
         """The field a UAVCAN path names: a field of the request or response, or with `nested` (responses) a

@@ -40,7 +40,7 @@ from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 
-__all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "to_uavcan"]
+__all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "set_field", "to_uavcan"]
 
 WARN_AFTER_PROBLEM_S = 10.0
 _EXECUTOR_THREADS = 4
@@ -105,6 +105,15 @@ def _convert(links: Sequence[Any], source: Any, towards_uavcan: bool, saturated:
         else:
             out[link.target] = _number(link, float(raw), towards_uavcan, saturated)
     return out
+
+
+def set_field(message: Any, path: str, value: Any) -> None:
+    """Set a response field by its path: `status.uptime_sec` is a field of the response's message field `status`
+    (issue 27: a nested response field is written, never left at zero)."""
+    *parents, name = path.split(".")
+    for parent in parents:
+        message = getattr(message, parent)
+    setattr(message, name, value)
 
 
 def to_uavcan(mapping: Any, request: Any, saturated: list[str]) -> dict[str, Any]:
@@ -281,7 +290,7 @@ class ServiceMappingsRos:
         if call.failure is not None or call.values is None:
             return self._fail(m, response, call.reason or "failed", call.failure or "no answer", nid)
         for name, value in call.values.items():
-            setattr(response, name, value)
+            set_field(response, name, value)
         with self._lock:
             st.counts["answered"] += 1
             st.latency_ms_last = round((time.monotonic() - started) * 1000.0, 3)
