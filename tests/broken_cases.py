@@ -274,7 +274,7 @@ CASES: tuple[Case, ...] = (
         'frame_id: base_link',
         'frame_id: odom',
         (
-            "minimal.yaml:45:5: error: frame_id 'odom' of mapping 'level' is not a declared frame (expected one of base_link)",
+            "minimal.yaml:45:5: error: frame_id 'odom' of mapping 'level' is not a declared frame (expected one of base_link, or '' for an empty frame id)",
         ),
     ),
     Case(
@@ -1381,7 +1381,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '  update_battery:\n    description: Update',
         (
             "auv_services.yaml:32:3: error: 'update_battery' is not a valid ROS service name (expected CamelCase, e.g. UpdateBattery)",
-            "auv_services.yaml:93:5: error: unknown service type 'lolo_msgs/UpdateBattery' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
+            "auv_services.yaml:93:5: error: unknown service type 'lolo_msgs/UpdateBattery' of service mapping 'update_battery' (expected a type of `services` or `external_services` (pkg/Name))",
         ),
     ),
     Case(
@@ -1421,7 +1421,7 @@ SERVICE_CASES: tuple[Case, ...] = (
         '      type: lolo_msgs/UpdateBattery',
         '      type: lolo_msgs/UpdateBatt',
         (
-            "auv_services.yaml:93:5: error: unknown service type 'lolo_msgs/UpdateBatt' of service mapping 'update_battery' (expected a type of `services` (pkg/Name))",
+            "auv_services.yaml:93:5: error: unknown service type 'lolo_msgs/UpdateBatt' of service mapping 'update_battery' (expected a type of `services` or `external_services` (pkg/Name))",
         ),
     ),
     Case(

@@ -70,7 +70,7 @@ NODE_SERVICE_CASES: tuple[Case, ...] = (
         _BRIDGE,
         _BRIDGE + '  node_services:\n    get_node_info: {type: NodeInfo}\n',
         (
-            "auv_services.yaml:82:21: error: unknown service type 'lolo_msgs/NodeInfo' of node service 'get_node_info' (expected a type of `services` (pkg/Name))",
+            "auv_services.yaml:82:21: error: unknown service type 'lolo_msgs/NodeInfo' of node service 'get_node_info' (expected a type of `services` or `external_services` (pkg/Name))",
         ),
     ),
     Case(
@@ -87,7 +87,7 @@ NODE_SERVICE_CASES: tuple[Case, ...] = (
         '  UavcanGetTransportStats:\n    request:\n      - {name: node_id, type: uint8}\n    response:\n      - {name: success, type: bool}\n      - {name: message, type: string}\n      - {name: transfers_tx, type: float64}\n',
         (
             "auv_services.yaml:65:9: error: response field 'transfers_tx' (float64) of lolo_msgs/UavcanGetTransportStats cannot hold transfers_tx of node service 'get_transport_stats' (expected an integer)",
-            "auv_services.yaml:126:5: error: unknown service type 'lolo_msgs/GetTransportStats' of service mapping 'get_transport_stats' (expected a type of `services` (pkg/Name))",
+            "auv_services.yaml:126:5: error: unknown service type 'lolo_msgs/GetTransportStats' of service mapping 'get_transport_stats' (expected a type of `services` or `external_services` (pkg/Name))",
         ),
     ),
 )

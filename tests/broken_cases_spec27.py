@@ -106,6 +106,51 @@ RETROFIT_CASES: tuple[Case, ...] = (
             "retrofit.yaml:94:9: error: missing field 'expr' in UAVCAN field 'blue' in uavcan_exprs of mapping 'light'",
         ),
     ),
+    # ---- class 3: service types of another package, srv constants
+    Case('external_service_without_package', '  uavcan_ros_msgs/UavcanGetNodeInfo:\n', '  UavcanGetNodeInfo:\n',
+        (
+            "retrofit.yaml:136:3: error: external service 'UavcanGetNodeInfo' needs its package (expected pkg/Name)",
+        ),
+    ),
+    Case('external_service_of_own_package', '  uavcan_ros_msgs/UavcanGetNodeInfo:\n',
+         '  retrofit_msgs/UavcanGetNodeInfo:\n',
+        (
+            "retrofit.yaml:136:3: error: external service 'retrofit_msgs/UavcanGetNodeInfo' is of the spec's own package retrofit_msgs (expected a srv of `services` (bare name))",
+        ),
+    ),
+    Case('srv_constant_bad_name', '{name: MODE_ZERO, type: uint8, value: 1}', '{name: mode_zero, type: uint8, value: 1}',
+        (
+            "retrofit.yaml:128:9: error: 'mode_zero' is not a valid ROS constant name in service type retrofit_msgs/Calibrate (expected UPPER_CASE)",
+        ),
+    ),
+    Case('srv_constant_twice', '{name: MODE_SPAN, type: uint8, value: 2}', '{name: MODE_ZERO, type: uint8, value: 2}',
+        (
+            "retrofit.yaml:129:9: error: 'MODE_ZERO' is declared twice in service type retrofit_msgs/Calibrate (constants and request share one namespace) (expected a name of its own)",
+        ),
+    ),
+    Case('srv_constant_not_primitive', '{name: MODE_SPAN, type: uint8, value: 2}',
+         '{name: MODE_SPAN, type: std_msgs/Header, value: 2}',
+        (
+            'retrofit.yaml:129:9: error: constant MODE_SPAN of service type retrofit_msgs/Calibrate must have a primitive type, not std_msgs/Header',
+        ),
+    ),
+    Case('srv_constant_out_of_range', '{name: MODE_SPAN, type: uint8, value: 2}', '{name: MODE_SPAN, type: uint8, value: 300}',
+        (
+            'retrofit.yaml:129:9: error: constant MODE_SPAN = 300 does not fit uint8 (expected an integer in [0, 255])',
+        ),
+    ),
+    Case('duty_external_type_unknown', '{type: uavcan_ros_msgs/UavcanGetNodeInfo, response_defaults',
+         '{type: uavcan_ros_msgs/GetNodeInfo, response_defaults',
+        (
+            "retrofit.yaml:124:21: error: unknown service type 'uavcan_ros_msgs/GetNodeInfo' of node service 'get_node_info' (expected a type of `services` or `external_services` (pkg/Name))",
+        ),
+    ),
+    Case('duty_external_field_unwritten', 'response_defaults: [vendor_note]}', 'response_defaults: []}',
+        (
+            "retrofit.yaml:124:21: error: ROS response field 'vendor_note' (string) of uavcan_ros_msgs/UavcanGetNodeInfo is written by nothing in node service 'get_node_info' (expected a field the duty writes (success, name, uptime_sec, health, mode, vendor_specific_status_code, software_version_major, software_version_minor, hardware_version_major, hardware_version_minor, software_vcs_revision_id, unique_id), or `response_defaults: [vendor_note]` to keep its default)",
+        ),
+    ),
+
 )
 
 

@@ -56,7 +56,7 @@ __all__ = ["QOS_DEPTH_MAX", "load_spec_file", "parse_qos", "parse_spec", "scalar
 _TOP_KEYS = (
     "spec_version", "vehicle", "ros", "cyphal", "external_messages", "messages", "dsdl_types", "dronecan_types",
     "frames", "transforms", "topics", "parameters", "parameter_rules", "devices", "layouts", "bridge", "nodes",
-    "bus", "dronecan_namespaces", "services",
+    "bus", "dronecan_namespaces", "services", "external_services",
 )
 
 
@@ -241,6 +241,19 @@ def _ros_services(top: Reader, package: str, diag: Diagnostics) -> dict[str, Ros
             diag.error(pos, f"service type {key!r} is declared in package {package}: give its bare name", "Name")
             continue
         srv = parse_ros_service(key, pos, node, package, diag)
+        services[srv.full_name] = srv
+    # `external_services`: srvs of other packages that existing clients are built against (as external_messages):
+    # generated under generated/ros/<pkg>/ exactly as declared, named pkg/Name
+    for key, pos, node in map_items(top.node("external_services"), "external_services", diag):
+        pkg = key.split("/", 1)[0] if "/" in key else ""
+        if not pkg or key.count("/") != 1:
+            diag.error(pos, f"external service {key!r} needs its package", "pkg/Name")
+            continue
+        if pkg == package:
+            diag.error(pos, f"external service {key!r} is of the spec's own package {package}",
+                       "a srv of `services` (bare name)")
+            continue
+        srv = parse_ros_service(key, pos, node, pkg, diag, external=True)
         services[srv.full_name] = srv
     return services
 

@@ -149,10 +149,12 @@ def parse_dsdl_service(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Ds
     return DsdlService(key, halves[0], halves[1], text_of(r, "description"), pos)
 
 
-def parse_ros_service(key: str, pos: Pos, node: YNode, package: str, diag: Diagnostics) -> RosService:
-    """A `services:` entry: a .srv of the spec's package (bare name) with `request` and `response` field lists."""
+def parse_ros_service(key: str, pos: Pos, node: YNode, package: str, diag: Diagnostics,
+                      external: bool = False) -> RosService:
+    """A `services:` entry: a .srv of the spec's package (bare name) with `request` and `response` field lists and
+    `constants`; with `external`, an `external_services` entry of `package` (another package's srv)."""
     what = f"service type {key!r}"
-    r = Reader(node, what, diag, ("description", "request", "response"))
+    r = Reader(node, what, diag, ("description", "request", "response", "constants"))
 
     def parse(text: str) -> Any:
         return parse_ros_type(text, package)
@@ -160,6 +162,7 @@ def parse_ros_service(key: str, pos: Pos, node: YNode, package: str, diag: Diagn
     for part in ("request", "response"):
         if r.ok and r.node(part) is None:
             diag.error(pos, f"missing field {part!r} in {what}", "a list of fields (an empty list for none)")
-    return RosService(package, key, _fields(r.node("request"), f"the request of {what}", parse, diag),
+    return RosService(package, key.rsplit("/", 1)[-1],
+                      _fields(r.node("request"), f"the request of {what}", parse, diag),
                       _fields(r.node("response"), f"the response of {what}", parse, diag),
-                      text_of(r, "description"), pos)
+                      text_of(r, "description"), pos, _constants(r.node("constants"), what, parse, diag), external)

@@ -407,7 +407,8 @@ class DsdlService:
 
 @dataclass(frozen=True)
 class RosService:
-    """A ROS 2 service type of the spec's package (`services:`): a .srv with a request and a response."""
+    """A ROS 2 service type of the spec's package (`services:`), or of another package (`external_services:`,
+    `external`): a .srv with a request and a response, and constants."""
 
     package: str
     name: str
@@ -415,6 +416,8 @@ class RosService:
     response: list[Field]
     description: str = ""
     pos: Pos = NOWHERE
+    constants: list[Constant] = field(default_factory=list)  # emitted at the top of the request (issue 27)
+    external: bool = False  # `external_services`: a srv of another package, generated as that package (issue 27)
 
     @property
     def full_name(self) -> str:

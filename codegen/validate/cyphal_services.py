@@ -25,7 +25,8 @@ def resolve_cyphal_mapping(v: Any, m: ServiceMapping, what: str) -> tuple[Any, l
     s = v.spec
     srv = s.services.get(m.type)
     if srv is None:
-        v.error(m.pos, f"unknown service type {m.type!r} of {what}", "a type of `services` (pkg/Name)")
+        v.error(m.pos, f"unknown service type {m.type!r} of {what}",
+                "a type of `services` or `external_services` (pkg/Name)")
     found = v.dsdl.service(m.data_type)
     service_id = m.service_id
     if found is None:

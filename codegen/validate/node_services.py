@@ -114,7 +114,8 @@ def resolve_node_services(spec: Spec, diag: Diagnostics, signed: Callable[[str],
         taken[ns.service] = what
         srv = spec.services.get(ns.type)
         if srv is None:
-            diag.error(ns.type_pos, f"unknown service type {ns.type!r} of {what}", "a type of `services` (pkg/Name)")
+            diag.error(ns.type_pos, f"unknown service type {ns.type!r} of {what}",
+                       "a type of `services` or `external_services` (pkg/Name)")
             continue
         response = _response_fields(ns, srv, what, diag, lookup)
         if response is None:

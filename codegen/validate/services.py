@@ -23,6 +23,7 @@ from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.ros_names import NAME_RULES, ros_name_problem
 from sam_codegen.model.spec import DsdlStruct, Field, FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import (
+    ROS_CONSTANT_NAME,
     ROS_FIELD_NAME,
     ROS_FLOAT_BITS,
     ROS_INT_RANGES,
@@ -32,7 +33,7 @@ from sam_codegen.model.types import (
 )
 from sam_codegen.validate.cyphal_services import resolve_cyphal_mapping
 from sam_codegen.validate.service_coverage import check_response_written, response_leaf
-from sam_codegen.validate.values import check_dsdl_value, python_safe
+from sam_codegen.validate.values import check_dsdl_value, check_ros_value, python_safe
 
 __all__ = ["ResolvedServiceMapping", "ServiceLink", "ServiceValidator", "bridge_written"]
 
@@ -117,8 +118,8 @@ class ServiceValidator:
             if not ROS_MESSAGE_NAME.fullmatch(srv.name):
                 self.error(srv.pos, f"{srv.name!r} is not a valid ROS service name", "CamelCase, e.g. UpdateBattery")
                 self.bad.add(srv.full_name)
-            if srv.name in messages or any(srv.name == f"{m}Request" or srv.name == f"{m}Response"
-                                           for m in messages):
+            if not srv.external and (srv.name in messages or any(
+                    srv.name == f"{m}Request" or srv.name == f"{m}Response" for m in messages)):
                 self.error(srv.pos, f"{what} has the name of a message of the package", "a name of its own")
                 self.bad.add(srv.full_name)
             for part, fields in (("request", srv.request), ("response", srv.response)):
@@ -137,7 +138,27 @@ class ServiceValidator:
                         self.error(f.pos, f"unknown ROS type {f.type.base!r} in the {part} of {what}",
                                    "a primitive, a message of this spec or an installed ROS message")
                         self.bad.add(srv.full_name)
+            self.check_srv_constants(srv, what, {f.name for f in srv.request})
         return sorted(self.spec.services.values(), key=lambda s: s.name)
+
+    def check_srv_constants(self, srv: RosService, what: str, request_names: set[str]) -> None:
+        """A srv's constants (emitted in its request, as rosidl reads them): as a message's."""
+        seen: set[str] = set()
+        for c in srv.constants:
+            assert isinstance(c.type, RosType)
+            if not ROS_CONSTANT_NAME.fullmatch(c.name):
+                self.error(c.pos, f"{c.name!r} is not a valid ROS constant name in {what}", "UPPER_CASE")
+                self.bad.add(srv.full_name)
+            elif c.name in seen or c.name in request_names:
+                self.error(c.pos, f"{c.name!r} is declared twice in {what} (constants and request share one "
+                           "namespace)", "a name of its own")
+                self.bad.add(srv.full_name)
+            seen.add(c.name)
+            if not c.type.is_primitive or c.type.array:
+                self.error(c.pos, f"constant {c.name} of {what} must have a primitive type, not {c.type}")
+                self.bad.add(srv.full_name)
+            else:
+                check_ros_value(self.diag, c.type, c.value, c.pos, f"constant {c.name}")
 
     def check_v0_service_types(self) -> None:
         """The id and the response of the spec's DroneCAN service types (the request is checked with the
@@ -228,7 +249,8 @@ class ServiceValidator:
                        "the DroneCAN type's data type id (no service_id), or protocol: cyphal")
         srv = s.services.get(m.type)
         if srv is None:
-            self.error(m.pos, f"unknown service type {m.type!r} of {what}", "a type of `services` (pkg/Name)")
+            self.error(m.pos, f"unknown service type {m.type!r} of {what}",
+                       "a type of `services` or `external_services` (pkg/Name)")
         struct = self.catalog.get(m.data_type)
         if struct is None:
             self.error(m.pos, f"unknown DroneCAN type {m.data_type!r} of {what}",

@@ -5,7 +5,8 @@ object path told the same (sam_runtime.bridge.wiring): no process, no ROS packag
 - `frame_id: ''`: the message's frame id is empty, also under a frame prefix (REP 105 tools key on the empty one);
   the stamp is the receive time as for every header;
 - `ros_defaults: [header]`: the header stays at its default, zero stamp and empty frame id, under a prefix too;
-- the generated docs say both, and say what a wrapping line does.
+- the generated docs say both, and say what a wrapping line does;
+- class 3: a service type of another package (`external_services`) with constants, generated as that package.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import pytest
 
 from sam_codegen.frontend.loader import load_spec_file
 from sam_codegen.targets import docs
+from sam_codegen.targets import ros as ros_target
 from sam_codegen.targets.python import convert
 from sam_codegen.targets.wire import codec, codec_v0
 from sam_codegen.validate.resolve import Resolved, validate
@@ -109,3 +111,20 @@ def test_docs_say_it(resolved: Resolved) -> None:
     assert "`''` (empty)" in text
     assert "WRAPS modulo 2^18 beyond the range (two’s complement), never saturates" in text  # the thruster
     assert r"= trunc(float32(r \* 80)) &gt;&gt; 3 → uint8" in text
+
+
+def test_a_service_type_of_another_package_with_constants(resolved: Resolved) -> None:
+    """Class 3: `external_services` is generated as its own package (exactly as declared, constants at the top of
+    the request as rosidl reads them), built before the packages that need it, and the duty answers with it; the
+    spec's own srv takes constants too."""
+    files = ros_target.emit(resolved)
+    assert files["ros/uavcan_ros_msgs/srv/UavcanGetNodeInfo.srv"].splitlines()[2:5] == [
+        "uint8 HEALTH_OK=0", "uint8 HEALTH_WARNING=1", "uint16 node_id"]
+    assert "ros/retrofit_msgs/srv/UavcanGetNodeInfo.srv" not in files  # the duty's default srv is not generated
+    assert "<name>uavcan_ros_msgs</name>" in files["ros/uavcan_ros_msgs/package.xml"]
+    assert "srv/UavcanGetNodeInfo.srv" in files["ros/uavcan_ros_msgs/CMakeLists.txt"]
+    assert "srv/UavcanGetNodeInfo.srv" not in files["ros/retrofit_msgs/CMakeLists.txt"]
+    assert "uint8 MODE_ZERO=1\nuint8 MODE_SPAN=2\nuint8 mode\n---\n" in files["ros/retrofit_msgs/srv/Calibrate.srv"]
+    assert set(ros_target.build_order(resolved)) == {"retrofit_msgs", "uavcan_ros_msgs"}
+    duties = {m.srv.full_name for m in resolved.service_mappings if m.mapping.duty == "get_node_info"}
+    assert duties == {"uavcan_ros_msgs/UavcanGetNodeInfo"}
