@@ -79,7 +79,7 @@ CASES: tuple[Case, ...] = (
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
         (
-            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes, bus, dronecan_namespaces, services)",
+            "minimal.yaml:3:1: error: unknown field 'topic' in the spec (expected one of spec_version, vehicle, ros, cyphal, external_messages, messages, dsdl_types, dronecan_types, frames, transforms, topics, parameters, parameter_rules, devices, layouts, bridge, nodes, bus, dronecan_namespaces, services, external_services)",
         ),
     ),
     Case(
