@@ -118,7 +118,7 @@ RETROFIT_CASES: tuple[Case, ...] = (
             "retrofit.yaml:136:3: error: external service 'retrofit_msgs/UavcanGetNodeInfo' is of the spec's own package retrofit_msgs (expected a srv of `services` (bare name))",
         ),
     ),
-    Case('srv_constant_bad_name', '{name: MODE_ZERO, type: uint8, value: 1}', '{name: mode_zero, type: uint8, value: 1}',
+    Case('srv_constant_bad_name', '{name: MODE_ZERO, type: uint8, value: 1}\n', '{name: mode_zero, type: uint8, value: 1}\n',
         (
             "retrofit.yaml:128:9: error: 'mode_zero' is not a valid ROS constant name in service type retrofit_msgs/Calibrate (expected UPPER_CASE)",
         ),
@@ -231,6 +231,35 @@ SERVICE27_CASES: tuple[Edits, ...] = (
     Edits('mapping_nested_unknown', (('        status: success\n', '        status.code: success\n'),),
         (
             "auv_services.yaml:104:9: error: 'status.code' of service mapping 'update_battery' is not a field of the srv response (expected success, status)",
+        ),
+    ),
+)
+
+
+# ---- class 3: a DroneCAN service response's constants (tests/specs/retrofit.yaml)
+V0_RESPONSE_CASES: tuple[Case, ...] = (
+    Case('v0_response_constant_bad_name', '{name: RESULT_BUSY, type: uint8, value: 3}',
+         '{name: 3BUSY, type: uint8, value: 3}',
+        (
+            "retrofit.yaml:161:9: error: '3BUSY' is not a valid DroneCAN constant name in the response of DroneCAN type retrofit.power.Calibrate (expected a letter, then letters, digits and underscores; not a Python keyword)",
+        ),
+    ),
+    Case('v0_response_constant_twice', '{name: RESULT_BUSY, type: uint8, value: 3}',
+         '{name: RESULT_OK, type: uint8, value: 3}',
+        (
+            "retrofit.yaml:161:9: error: 'RESULT_OK' appears twice in the response of DroneCAN type retrofit.power.Calibrate",
+        ),
+    ),
+    Case('v0_response_constant_named_as_a_field', '{name: RESULT_BUSY, type: uint8, value: 3}',
+         '{name: result, type: uint8, value: 3}',
+        (
+            "retrofit.yaml:161:9: error: 'result' appears twice in the response of DroneCAN type retrofit.power.Calibrate",
+        ),
+    ),
+    Case('v0_response_constant_out_of_range', '{name: RESULT_BUSY, type: uint8, value: 3}',
+         '{name: RESULT_BUSY, type: uint8, value: 256}',
+        (
+            'retrofit.yaml:161:9: error: constant RESULT_BUSY of DroneCAN type retrofit.power.Calibrate = 256 does not fit uint8 (expected an integer in [0, 255])',
         ),
     ),
 )

@@ -103,7 +103,8 @@ def parse_dsdl_struct(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Dsd
 
 def parse_dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V0Struct:
     what = f"DroneCAN type {key!r}"
-    r = Reader(node, what, diag, ("id", "description", "fields", "constants", "request", "response"))
+    r = Reader(node, what, diag, ("id", "description", "fields", "constants", "request", "response",
+                                  "response_constants"))
     # A service type has `request` and `response` (its two halves, `---` between them in DSDL), not `fields`.
     service = r.node("request") is not None or r.node("response") is not None
     if service and r.node("fields") is not None:
@@ -118,12 +119,17 @@ def parse_dronecan_type(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> V
     fields = [f for f in layout if f.name]
     response_layout = _fields(r.node("response"), f"the response of {what}", parse_v0_type, diag) if service else []
     response = [f for f in response_layout if f.name]
+    if not service and r.node("response_constants") is not None:
+        diag.error(r.key_pos("response_constants"), f"{what} is a message type: it has no response",
+                   "`constants`, or `request` and `response` for a service type")
     return V0Struct(
         key, fields, _constants(r.node("constants"), what, parse_v0_type, diag, bool_bits=True),
         text_of(r, "description"),
         pos=pos, layout=layout if len(fields) < len(layout) else [], data_type_id=r.get("id", int, None),
         service=service, response=response,
         response_layout=response_layout if len(response) < len(response_layout) else [],
+        response_constants=_constants(r.node("response_constants"), f"the response of {what}", parse_v0_type, diag,
+                                      bool_bits=True) if service else [],
     )
 
 

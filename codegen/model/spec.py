@@ -118,6 +118,8 @@ class V0Struct(DsdlStruct):
     # response_layout, empty when it has none), as the part after `---` of its definition.
     response: list[Field] = field(default_factory=list)
     response_layout: list[Field] = field(default_factory=list)
+    # the response's constants (`response_constants`, issue 27), emitted after `---`; `constants` are the request's
+    response_constants: list[Constant] = field(default_factory=list)
 
     @property
     def declared_response(self) -> list[Field]:

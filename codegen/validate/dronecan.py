@@ -149,6 +149,16 @@ class DronecanValidator:
                     self.error(f.pos, f"{f.name!r} appears twice in {what}")
                     bad = True
                 seen.add(f.name)
+            response_seen = {f.name for f in struct.response}  # the response's names (validate.services)
+            for c in struct.response_constants:
+                if not V0_FIELD_NAME.fullmatch(c.name) or not python_safe(c.name):
+                    self.error(c.pos, f"{c.name!r} is not a valid DroneCAN constant name in the response of {what}",
+                               "a letter, then letters, digits and underscores; not a Python keyword")
+                    bad = True
+                elif c.name in response_seen:
+                    self.error(c.pos, f"{c.name!r} appears twice in the response of {what}")
+                    bad = True
+                response_seen.add(c.name)
             for f in struct.fields:
                 t = f.type
                 assert isinstance(t, DsdlType)
@@ -166,7 +176,7 @@ class DronecanValidator:
                 elif nested.service:
                     self.error(f.pos, f"{t.composite} in {what} is a service type", "a message type")
                     bad = True
-            for c in struct.constants:
+            for c in [*struct.constants, *struct.response_constants]:
                 assert isinstance(c.type, DsdlType)
                 check_dsdl_value(self.diag, c.type, c.value, c.pos, f"constant {c.name} of {what}", v0=True)
             if bad:

@@ -11,7 +11,7 @@ from types import SimpleNamespace
 
 import pytest
 from broken_cases import Case
-from broken_cases_spec27 import RETROFIT_CASES, SERVICE27_CASES, Edits
+from broken_cases_spec27 import RETROFIT_CASES, SERVICE27_CASES, V0_RESPONSE_CASES, Edits
 from helpers.spec_errors import spec_errors
 
 from sam_codegen.frontend.loader import load_spec_file
@@ -29,10 +29,11 @@ def test_base_spec_is_valid() -> None:
 
 
 def test_cases_are_distinct() -> None:
-    assert len({c.name for c in RETROFIT_CASES}) == len(RETROFIT_CASES)
+    cases = [*RETROFIT_CASES, *V0_RESPONSE_CASES, *SERVICE27_CASES]
+    assert len({c.name for c in cases}) == len(cases)
 
 
-@pytest.mark.parametrize("case", RETROFIT_CASES, ids=lambda c: c.name)
+@pytest.mark.parametrize("case", [*RETROFIT_CASES, *V0_RESPONSE_CASES], ids=lambda c: c.name)
 def test_broken_spec(case: Case, tmp_path: Path) -> None:
     assert BASE.count(case.old) == 1, f"case {case.name} no longer applies to retrofit.yaml"
     path = tmp_path / "retrofit.yaml"

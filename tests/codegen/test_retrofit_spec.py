@@ -6,7 +6,8 @@ object path told the same (sam_runtime.bridge.wiring): no process, no ROS packag
   the stamp is the receive time as for every header;
 - `ros_defaults: [header]`: the header stays at its default, zero stamp and empty frame id, under a prefix too;
 - the generated docs say both, and say what a wrapping line does;
-- class 3: a service type of another package (`external_services`) with constants, generated as that package.
+- class 3: a service type of another package (`external_services`) with constants, generated as that package;
+  a DroneCAN service response with constants, read back by dronecan.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from types import ModuleType, SimpleNamespace
 import pytest
 
 from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.targets import docs
+from sam_codegen.targets import docs, dsdl_v0
 from sam_codegen.targets import ros as ros_target
 from sam_codegen.targets.python import convert
 from sam_codegen.targets.wire import codec, codec_v0
@@ -128,3 +129,18 @@ def test_a_service_type_of_another_package_with_constants(resolved: Resolved) ->
     assert set(ros_target.build_order(resolved)) == {"retrofit_msgs", "uavcan_ros_msgs"}
     duties = {m.srv.full_name for m in resolved.service_mappings if m.mapping.duty == "get_node_info"}
     assert duties == {"uavcan_ros_msgs/UavcanGetNodeInfo"}
+
+
+def test_a_dronecan_service_response_with_constants(resolved: Resolved, tmp_path: Path) -> None:
+    """Class 3: a v0 service type's `response_constants` are emitted after `---`; dronecan's own parser reads them
+    (and the request's `constants`) and computes the signature the generator wrote."""
+    dsdl = pytest.importorskip("dronecan.dsdl")
+    for path, text in dsdl_v0.emit(resolved).items():
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / path).write_text(text, encoding="utf-8")
+    (found,) = (t for t in dsdl.parse_namespaces([str(tmp_path / "dsdl_v0" / "retrofit")])
+                if t.full_name == "retrofit.power.Calibrate")
+    assert [(c.name, c.value) for c in found.request_constants] == [("MODE_ZERO", 1)]
+    assert [(c.name, c.value) for c in found.response_constants] == [("RESULT_OK", 0), ("RESULT_BUSY", 3)]
+    (declared,) = (s for s in resolved.dronecan_types if s.name == "retrofit.power.Calibrate")
+    assert found.get_data_type_signature() == declared.signature
