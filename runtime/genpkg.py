@@ -248,7 +248,7 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
                        cancelled: Callable[[], bool] | None = None) -> Path:
     """Build and install every ROS package under ``<generated>/ros`` (the spec's own and any other it generates, in
     dependency order) into ``prefix`` (default: ``sys.prefix``, the venv), each unless an install of the same sources
-    is already there. Returns the prefix.
+    is already there or in the venv. Returns the prefix.
 
     The build folders are ``<build_root>/<package>-<hash>`` (default build_root: ``ros-build`` in the user's cache
     directory); an install is stamped with its sources' hash, so a changed spec triggers a rebuild and an unchanged
@@ -266,7 +266,14 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
         packages = ros_packages_in_order(own.parent)
     except RosBuildError as ex:
         raise GeneratedPackageError(str(ex)) from None
-    stale = [p for p in packages if not is_current(p, prefix)]
+    venv = Path(sys.prefix).absolute()
+
+    def current(pkg_dir: Path, digest: str | None = None) -> bool:
+        # A package current in the venv serves a run with another prefix too: the children's environment has the
+        # venv behind the prefix (sam_codegen.project.ros_install.ros_runtime_env), so it is not built again there.
+        return is_current(pkg_dir, prefix, digest) or (prefix != venv and is_current(pkg_dir, venv, digest))
+
+    stale = [p for p in packages if not current(p)]
     if not stale:  # the usual case, without touching the lock
         return prefix
     root = Path(build_root) if build_root is not None else user_cache_dir() / "ros-build"
@@ -274,7 +281,7 @@ def ensure_ros_package(gen: GeneratedPackage, prefix: Path | None = None, *, log
         for pkg_dir in packages:  # again, under the lock: another process may have installed them meanwhile
             name = pkg_dir.name
             digest = ros_package_hash(pkg_dir)
-            if is_current(pkg_dir, prefix, digest):
+            if current(pkg_dir, digest):
                 if pkg_dir in stale and log is not None:
                     holder = f" by pid {lock.held_by.pid}" if lock.held_by is not None else ""
                     log(f"ROS package {name} was installed into {prefix} meanwhile{holder}: reused")
