@@ -75,6 +75,14 @@ CASES: tuple[Case, ...] = (
         ),
     ),
     Case(
+        'dsdl_array_capacity_beyond_transfer',
+        '      - {name: open_pct, type: uint8}',
+        '      - {name: open_pct, type: uint8}\n      - {name: blob, type: "uint8[<=1000000000]"}',
+        (
+            "minimal.yaml:22:22: error: array capacity 1,000,000,000 of 'uint8[<=1000000000]' is more than a transfer can carry (at most 65,535 elements)",
+        ),
+    ),
+    Case(
         'unknown_top_field',
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
@@ -754,6 +762,14 @@ CASES: tuple[Case, ...] = (
 
 # DroneCAN cases: each breaks tests/specs/minimal_v0.yaml one way (tests/test_v0_bad_specs.py runs them).
 V0_CASES: tuple[Case, ...] = (
+    Case(
+        'v0_array_capacity_beyond_transfer',
+        '      - {name: pump_id, type: uint4}',
+        '      - {name: pump_id, type: uint4}\n      - {name: blob, type: "uint8[<100000]"}',
+        (
+            "minimal_v0.yaml:17:22: error: array capacity 99,999 of 'uint8[<100000]' is more than a transfer can carry (at most 65,535 elements)",
+        ),
+    ),
     Case(
         'v0_bool_constant_not_a_bit',
         '  skiff.Bilge:\n    id: 20120\n',
