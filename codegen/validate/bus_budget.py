@@ -123,7 +123,7 @@ def cyphal_frame_split(payload_bytes: int, mtu: int = CLASSIC_MTU) -> tuple[tupl
     a capacity of millions of elements must cost no more than one of ten.
 
     >>> cyphal_frame_split(7), cyphal_frame_split(47), cyphal_frame_split(10 ** 9)
-    (((8, 1),), ((8, 7),), ((8, 142857143),))
+    (((8, 1),), ((8, 7),), ((8, 142857143), (2, 1)))
     """
     if payload_bytes < 0 or mtu not in (CLASSIC_MTU, FD_MTU):
         raise ValueError(f"payload {payload_bytes} bytes, MTU {mtu}")
@@ -139,7 +139,7 @@ def dronecan_frame_split(payload_bytes: int) -> tuple[tuple[int, int], ...]:
     """The classic CAN frames of one DroneCAN transfer as (data length, how many) pairs (see cyphal_frame_split).
 
     >>> dronecan_frame_split(7), dronecan_frame_split(8), dronecan_frame_split(10 ** 9)
-    (((8, 1),), ((8, 1), (4, 1)), ((8, 142857143), (3, 1)))
+    (((8, 1),), ((8, 1), (4, 1)), ((8, 142857143), (2, 1)))
     """
     if payload_bytes < 0:
         raise ValueError(f"payload length must be >= 0, got {payload_bytes}")
