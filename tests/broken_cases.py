@@ -83,6 +83,30 @@ CASES: tuple[Case, ...] = (
         ),
     ),
     Case(
+        'parameter_default_nan',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}',
+        '  /warn_level: {type: double, unit: m, default: .nan, min: 0.0, max: 10.0}',
+        (
+            "minimal.yaml:28:40: error: default NaN of parameter '/warn_level' is not a valid value (expected a number; or `allow_nan: true` when NaN is a meaningful value of this parameter)",
+        ),
+    ),
+    Case(
+        'parameter_bound_nan',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: .nan, max: 10.0}',
+        (
+            "minimal.yaml:28:59: error: min of parameter '/warn_level' must be finite",
+        ),
+    ),
+    Case(
+        'parameter_allow_nan_not_double',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}',
+        '  /warn_level: {type: integer, unit: m, default: 1, min: 0, max: 10, allow_nan: true}',
+        (
+            "minimal.yaml:28:70: error: parameter '/warn_level': allow_nan applies only to a double parameter, not integer",
+        ),
+    ),
+    Case(
         'unknown_top_field',
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',

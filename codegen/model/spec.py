@@ -224,6 +224,7 @@ class Parameter:
     description: str = ""
     section: str = ""
     pos: Pos = NOWHERE
+    allow_nan: bool = False  # NaN is a meaningful value (`allow_nan: true`); else a NaN default is refused
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ messages are derived before any check looks a ROS type up, so every check sees t
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -263,6 +264,8 @@ class _Validator:
             if left is None or right is None or left.type not in ("double", "integer") \
                     or right.type not in ("double", "integer"):
                 continue
+            if any(isinstance(p.default, float) and math.isnan(p.default) for p in (left, right)):
+                continue  # a NaN default (`allow_nan: true`: e.g. "no limit") is ordered against nothing
             ok = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
                   ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}[rule.op](left.default, right.default)
             if not ok:

@@ -11,6 +11,7 @@ import pytest
 from broken_cases import CASES, Case
 from helpers.spec_errors import spec_errors
 
+from sam_codegen.build import generate
 from sam_codegen.cli import main
 from sam_codegen.frontend.loader import MAX_SPEC_BYTES
 from sam_codegen.model.diagnostics import MAX_SHOWN
@@ -117,3 +118,17 @@ def test_errors_stop_after_a_cap_with_a_count(tmp_path: Path, capsys: pytest.Cap
     assert err[-1].startswith("sam-codegen: 121 errors in the spec;")
     assert main(["validate", "--spec", str(path)]) == 1
     assert capsys.readouterr().err.splitlines()[-1] == "... and 71 more errors"
+
+
+def test_a_parameter_may_allow_nan(tmp_path: Path) -> None:
+    """Issue 29 item 10: `allow_nan: true` lets a double parameter default to NaN (no rule orders it); the generated
+    modules spell it as an expression (`nan` or `_NAN` alone would be a NameError when the node starts)."""
+    old = "  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}"
+    path = tmp_path / "minimal.yaml"
+    path.write_text(BASE.replace(old, old.replace("1.0,", ".nan,").replace("}", ", allow_nan: true}")),
+                    encoding="utf-8")
+    files = generate(path)
+    for name in ("python/buoy_bridge/tables.py", "python/buoy_nodes/logger.py"):
+        assert "default=float('nan')," in files[name], name
+        compile(files[name], name, "exec")
+    assert "warn_level: .nan" in files["params/buoy.params.yaml"]
