@@ -98,7 +98,8 @@ def qos_args(qos: Qos) -> str:
 
 def _value_literal(p: Parameter) -> str:
     if p.type == "double":  # NaN only with `allow_nan: true`; spelled as an expression, `nan` is no Python name
-        return py_number(p.default) if math.isnan(float(p.default)) else float_literal(float(p.default))
+        value = float(p.default)
+        return py_number(value) if math.isnan(value) else float_literal(value)
     return py_str(p.default) if p.type == "string" else repr(p.default)
 
 
