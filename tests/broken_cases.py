@@ -107,6 +107,22 @@ CASES: tuple[Case, ...] = (
         ),
     ),
     Case(
+        'pass_nan_on_a_uavcan_to_ros_mapping',
+        '      source_node_ids: [10]\n',
+        '      source_node_ids: [10]\n      pass_nan: true\n',
+        (
+            "minimal.yaml:50:7: error: mapping 'level' goes UAVCAN->ROS: pass_nan is for commands (ros_to_uavcan); a UAVCAN->ROS mapping passes a float NaN on as it is (expected no pass_nan here)",
+        ),
+    ),
+    Case(
+        'pass_nan_not_a_bool',
+        '      destination_node_id: 11\n',
+        '      destination_node_id: 11\n      pass_nan: sometimes\n',
+        (
+            "minimal.yaml:59:17: error: 'pass_nan' of mapping 'valve' must be bool, found str 'sometimes' (expected bool)",
+        ),
+    ),
+    Case(
         'unknown_top_field',
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
@@ -119,7 +135,7 @@ CASES: tuple[Case, ...] = (
         '      subject_id: 100\n',
         '      subject_id: 100\n      subjectid: 100\n',
         (
-            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
@@ -913,7 +929,7 @@ V0_CASES: tuple[Case, ...] = (
         '      data_type: skiff.Bilge\n',
         '      data_type: skiff.Bilge\n      subject_id: 7\n',
         (
-            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, shares_data_type, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, shares_data_type, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
@@ -979,7 +995,7 @@ V0_CASES: tuple[Case, ...] = (
         '      source_node_ids: [10]\n      fields:\n        data: level_mm\n  dronecan',
         '      source_node_ids: [10]\n      select: {level_mm: 1}\n      fields:\n        data: level_mm\n  dronecan',
         (
-            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
@@ -1759,7 +1775,7 @@ ROUTING_CASES: tuple[Case, ...] = (
         '      subject_id: 700\n',
         '      subject_id: 700\n      shares_data_type: true\n',
         (
-            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
+            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
