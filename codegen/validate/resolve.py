@@ -237,14 +237,23 @@ class _Validator:
                 self.error(frame.pos, f"frame {frame.name!r} is not a valid TF frame id", "an identifier")
             if frame.parent is not None and frame.parent not in s.frames:
                 self.error(frame.pos, f"frame {frame.name!r} has unknown parent {frame.parent!r}")
+        # Each frame is walked up once: a frame whose ancestry reaches a loop (or one known to) is in error, one
+        # that reaches a root (or a frame known to) is not; a chain of N frames costs N steps, not N^2 / 2.
+        loops: dict[str, bool] = {}
         for frame in s.frames.values():
-            seen, cur = {frame.name}, frame.parent
-            while cur is not None and cur in s.frames:
-                if cur in seen:
-                    self.error(frame.pos, f"frame {frame.name!r} is its own ancestor")
-                    break
-                seen.add(cur)
+            path: list[str] = []
+            on_path: set[str] = set()
+            cur: str | None = frame.name
+            while cur is not None and cur in s.frames and cur not in loops and cur not in on_path:
+                path.append(cur)
+                on_path.add(cur)
                 cur = s.frames[cur].parent
+            looped = cur in on_path or (cur is not None and loops.get(cur, False))
+            for name in path:
+                loops[name] = looped
+        for frame in s.frames.values():
+            if loops[frame.name]:
+                self.error(frame.pos, f"frame {frame.name!r} is its own ancestor")
         for t in s.transforms:
             for name in (t.parent, t.child):
                 if name not in s.frames:
