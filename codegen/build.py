@@ -6,8 +6,10 @@ import contextlib
 import gc
 import os
 import shutil
+import signal
 import tempfile
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -131,6 +133,32 @@ def _pydsdl_diagnostic(resolved: Resolved, exc: pydsdl.FrontendError, dsdl_dir: 
     return Diagnostic(pos, f"DSDL type {name or '?'} is rejected by pydsdl: {exc.text}")
 
 
+class Terminated(SystemExit):
+    """SIGTERM arrived during a build: raised where the build was, so that its temporary folders are removed."""
+
+
+@contextlib.contextmanager
+def terminate_cleanly() -> Iterator[None]:
+    """While the block runs, SIGTERM raises Terminated (exit status 143) instead of ending the process at once, so
+    that `with tempfile.TemporaryDirectory()` and the staging folder's clean-up run: a build killed by SIGTERM left
+    its DSDL copies in /dev/shm/sam-dsdl-*. SIGINT already raises KeyboardInterrupt. Only in the main thread and
+    only over the default action: a program that handles SIGTERM itself (the main job) keeps its handler."""
+    if threading.current_thread() is not threading.main_thread() \
+            or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        yield
+        return
+
+    def raise_terminated(signum: int, _frame: object) -> None:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a second SIGTERM ends the process as it always did
+        raise Terminated(128 + signum)
+
+    signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def generate(spec_path: Path, *, report: Callable[[str], None] | None = None) -> dict[str, str]:
     """Every generated file as {path relative to generated/: text}; raises SpecError. ``report`` gets the bus budget:
     one line per layout, then a `file:line:col: warning: ...` line for each layout above its warning threshold."""
@@ -139,7 +167,8 @@ def generate(spec_path: Path, *, report: Callable[[str], None] | None = None) ->
     was_enabled = gc.isenabled()
     gc.disable()
     try:
-        return _generate(spec_path, report)
+        with terminate_cleanly():
+            return _generate(spec_path, report)
     finally:
         if was_enabled:
             gc.enable()
@@ -251,7 +280,7 @@ def build(spec_path: Path, out_dir: Path, *, check: bool = False,
     check_out_dir(Path(spec_path).resolve(), out_dir)
     files = generate(spec_path, report=report)  # as given: the spec's diagnostics name it the way the user did
     try:
-        with optional_lock(_generated_lock(out_dir, check, say, wait_timeout, cancelled)):
+        with terminate_cleanly(), optional_lock(_generated_lock(out_dir, check, say, wait_timeout, cancelled)):
             try:
                 stale = compare(files, out_dir)
             except OSError as exc:

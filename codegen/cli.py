@@ -62,10 +62,10 @@ def _cmd_build(args: argparse.Namespace) -> int:
         stale = build(ws.spec, ws.generated, check=args.check, report=budget.append, say=_say,
                       wait_timeout=args.wait_timeout)
     except SpecError as exc:
-        for diagnostic in exc.diagnostics:
-            print(diagnostic, file=sys.stderr)
+        for line in exc.lines():
+            print(line, file=sys.stderr)
         count = len(exc.diagnostics)
-        print(f"sam-codegen: {count} error{'s' if count != 1 else ''} in the spec; {out} left unchanged",
+        print(f"sam-codegen: {count:,} error{'s' if count != 1 else ''} in the spec; {out} left unchanged",
               file=sys.stderr)
         return 1
     if args.check:
@@ -93,8 +93,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     try:
         validate(load_spec_file(ws.spec))
     except SpecError as exc:
-        for diagnostic in exc.diagnostics:
-            print(diagnostic, file=sys.stderr)
+        for line in exc.lines():
+            print(line, file=sys.stderr)
         return 1
     print(f"sam-codegen: {_shown(ws.spec, Path.cwd().resolve())} is valid")
     return 0

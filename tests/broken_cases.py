@@ -75,6 +75,54 @@ CASES: tuple[Case, ...] = (
         ),
     ),
     Case(
+        'dsdl_array_capacity_beyond_transfer',
+        '      - {name: open_pct, type: uint8}',
+        '      - {name: open_pct, type: uint8}\n      - {name: blob, type: "uint8[<=1000000000]"}',
+        (
+            "minimal.yaml:22:22: error: array capacity 1,000,000,000 of 'uint8[<=1000000000]' is more than a transfer can carry (at most 65,535 elements)",
+        ),
+    ),
+    Case(
+        'parameter_default_nan',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}',
+        '  /warn_level: {type: double, unit: m, default: .nan, min: 0.0, max: 10.0}',
+        (
+            "minimal.yaml:28:40: error: default NaN of parameter '/warn_level' is not a valid value (expected a number; or `allow_nan: true` when NaN is a meaningful value of this parameter)",
+        ),
+    ),
+    Case(
+        'parameter_bound_nan',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: .nan, max: 10.0}',
+        (
+            "minimal.yaml:28:59: error: min of parameter '/warn_level' must be finite",
+        ),
+    ),
+    Case(
+        'parameter_allow_nan_not_double',
+        '  /warn_level: {type: double, unit: m, default: 1.0, min: 0.0, max: 10.0}',
+        '  /warn_level: {type: integer, unit: m, default: 1, min: 0, max: 10, allow_nan: true}',
+        (
+            "minimal.yaml:28:70: error: parameter '/warn_level': allow_nan applies only to a double parameter, not integer",
+        ),
+    ),
+    Case(
+        'pass_nan_on_a_uavcan_to_ros_mapping',
+        '      source_node_ids: [10]\n',
+        '      source_node_ids: [10]\n      pass_nan: true\n',
+        (
+            "minimal.yaml:50:7: error: mapping 'level' goes UAVCAN->ROS: pass_nan is for commands (ros_to_uavcan); a UAVCAN->ROS mapping passes a float NaN on as it is (expected no pass_nan here)",
+        ),
+    ),
+    Case(
+        'pass_nan_not_a_bool',
+        '      destination_node_id: 11\n',
+        '      destination_node_id: 11\n      pass_nan: sometimes\n',
+        (
+            "minimal.yaml:59:17: error: 'pass_nan' of mapping 'valve' must be bool, found str 'sometimes' (expected bool)",
+        ),
+    ),
+    Case(
         'unknown_top_field',
         'spec_version: 1',
         'spec_version: 1\ntopic: {}',
@@ -87,7 +135,7 @@ CASES: tuple[Case, ...] = (
         '      subject_id: 100\n',
         '      subject_id: 100\n      subjectid: 100\n',
         (
-            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal.yaml:48:7: error: unknown field 'subjectid' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
@@ -755,6 +803,14 @@ CASES: tuple[Case, ...] = (
 # DroneCAN cases: each breaks tests/specs/minimal_v0.yaml one way (tests/test_v0_bad_specs.py runs them).
 V0_CASES: tuple[Case, ...] = (
     Case(
+        'v0_array_capacity_beyond_transfer',
+        '      - {name: pump_id, type: uint4}',
+        '      - {name: pump_id, type: uint4}\n      - {name: blob, type: "uint8[<100000]"}',
+        (
+            "minimal_v0.yaml:17:22: error: array capacity 99,999 of 'uint8[<100000]' is more than a transfer can carry (at most 65,535 elements)",
+        ),
+    ),
+    Case(
         'v0_bool_constant_not_a_bit',
         '  skiff.Bilge:\n    id: 20120\n',
         '  skiff.Bilge:\n    id: 20120\n    constants:\n      - {name: OPEN, type: bool, value: 0}\n'
@@ -873,7 +929,7 @@ V0_CASES: tuple[Case, ...] = (
         '      data_type: skiff.Bilge\n',
         '      data_type: skiff.Bilge\n      subject_id: 7\n',
         (
-            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, shares_data_type, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal_v0.yaml:60:7: error: unknown field 'subject_id' in DroneCAN mapping 'bilge' (expected one of direction, topic, data_type, select, source_node_ids, destination_node_ids, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, shares_data_type, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
@@ -939,7 +995,7 @@ V0_CASES: tuple[Case, ...] = (
         '      source_node_ids: [10]\n      fields:\n        data: level_mm\n  dronecan',
         '      source_node_ids: [10]\n      select: {level_mm: 1}\n      fields:\n        data: level_mm\n  dronecan',
         (
-            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
+            "minimal_v0.yaml:54:7: error: unknown field 'select' in mapping 'level' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(
@@ -1734,7 +1790,7 @@ ROUTING_CASES: tuple[Case, ...] = (
         '      subject_id: 700\n',
         '      subject_id: 700\n      shares_data_type: true\n',
         (
-            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service)",
+            "seiner.yaml:78:7: error: unknown field 'shares_data_type' in mapping 'winch' (expected one of direction, topic, subject_id, source_node_ids, destination_node_id, frame_id, fields, ignore, uavcan_values, on_out_of_range, uavcan_exprs, ros_defaults, max_rate_hz, deadline, enabled, enable_service, pass_nan)",
         ),
     ),
     Case(

@@ -23,6 +23,7 @@ from sam_codegen.conversion_plan.lowering import (
     lower_expr,
     lower_link,
     lower_mapping,
+    passes_nan,
     range_ops,
     ros_value,
 )
@@ -126,6 +127,7 @@ __all__ = [
     "lower_expr",
     "lower_link",
     "lower_mapping",
+    "passes_nan",
     "range_ops",
     "ros_range",
     "ros_value",

@@ -49,17 +49,19 @@ from sam_codegen.conversion_plan.value_ranges import (
     ros_range,
 )
 from sam_codegen.model.expr import ENode
-from sam_codegen.model.spec import Scalar
+from sam_codegen.model.spec import ROS_TO_UAVCAN, Mapping, Scalar
 from sam_codegen.model.types import ROS_FLOAT_BITS, ROS_INT_RANGES, DsdlType, RosType
 from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, Step
 
 
 def range_ops(value_is_float: bool, value_range: ValueRange | None, target: DsdlType,
-              limits: tuple[Scalar, Scalar] | None, reject: bool, wrap: bool = False) -> list[Op]:
+              limits: tuple[Scalar, Scalar] | None, reject: bool, wrap: bool = False, *,
+              reject_nan: bool = False) -> list[Op]:
     """What makes a value acceptable to a DSDL scalar of type `target`, after the `limits` if any.
 
     `value_range` is the finite range the value is known to lie in (None: unknown); a float value may also be NaN
-    or infinite. Nothing is planned for what cannot happen.
+    or infinite. Nothing is planned for what cannot happen. NaN is rejected on its way into an integer or a limited
+    field (it fits neither), and into a float field too with `reject_nan` (a command: NaN is not a setpoint).
 
     >>> range_ops(False, (0, 255), DsdlType("uint", 8), None, False)
     []
@@ -75,7 +77,7 @@ def range_ops(value_is_float: bool, value_range: ValueRange | None, target: Dsdl
         return out
     integer = is_int_dsdl(target)
     nonfinite = value_is_float
-    if value_is_float and (integer or limits is not None):
+    if value_is_float and (integer or limits is not None or reject_nan):
         out.append(RejectNaN())
     if limits is not None:
         low, high = (float(v) if not integer or not float(v).is_integer() else int(v) for v in limits)
@@ -153,8 +155,10 @@ def expr_target(t: DsdlType | RosType) -> DsdlType:
     return DsdlType("int" if lo < 0 else "uint", (hi - lo).bit_length())
 
 
-def lower_expr(tree: ENode, target: DsdlType, reject: bool, wrap: bool = False) -> list[Op]:
-    """An expression into a target scalar: evaluated, a NaN result dropped, then into the target's range.
+def lower_expr(tree: ENode, target: DsdlType, reject: bool, wrap: bool = False, *, pass_nan: bool = False
+               ) -> list[Op]:
+    """An expression into a target scalar: evaluated, a NaN result dropped (passed on into a float field of a
+    command mapping with `pass_nan`), then into the target's range.
 
     >>> from sam_codegen.model.expr import EField
     >>> lower_expr(EField((("p", None),), "p", DsdlType("int", 7), "int", (-64, 63)), DsdlType("uint", 5), False)[1:]
@@ -164,7 +168,7 @@ def lower_expr(tree: ENode, target: DsdlType, reject: bool, wrap: bool = False) 
     ops: list[Op] = [Evaluate(tree, as_float)]
     if tree.kind == "bool":
         return ops
-    if tree.kind == "float":
+    if tree.kind == "float" and not (pass_nan and target.kind == "float"):
         ops.append(RejectNaN())
     ops += [op for op in range_ops(tree.kind == "float", tree.range, target, None, reject, wrap)
             if not isinstance(op, RejectNaN)]
@@ -206,12 +210,13 @@ def _lower_to_ros(s: Step, reject: bool) -> list[Op]:
     return ops
 
 
-def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
+def _lower_to_uavcan(s: Step, reject: bool, pass_nan: bool) -> list[Op]:
+    """A ROS -> UAVCAN link (a command): a float NaN is rejected unless the mapping says `pass_nan` (issue 29)."""
     uav = s.uavcan_type
     assert uav is not None
     if s.kind == "expr":
         assert s.expr is not None
-        return lower_expr(s.expr, uav, reject, s.wrap)
+        return lower_expr(s.expr, uav, reject, s.wrap, pass_nan=pass_nan)
     if s.kind == "time":
         lo, hi = uav.range
         return [TimestampFromRos(hi if TIME_US_MAX_FROM_ROS > hi else None, lo if TIME_US_MIN < lo else None,
@@ -237,7 +242,7 @@ def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
             return [*ops, *transform, *_convert(ros_base, uav.base_name),
                     *range_ops(value_is_float, value_range, uav, None, reject)]
         return [*transform, *_convert(ros_base, uav.base_name),
-                *range_ops(value_is_float, value_range, uav, s.limits, reject, s.wrap)]
+                *range_ops(value_is_float, value_range, uav, s.limits, reject, s.wrap, reject_nan=not pass_nan)]
     # array: the length first, then the elements
     elem = uav.element
     value_is_float, value_range = ros_value(ros_base, transformed)
@@ -249,16 +254,25 @@ def _lower_to_uavcan(s: Step, reject: bool) -> list[Op]:
             ops.append(FixedLength(cap, reject))
     elif s.ros_type.array == "dynamic" or (s.ros_type.capacity or 0) > cap:
         ops.append(MaxLength(cap, ros_fixed, reject))
-    return [*ops, *range_ops(value_is_float, value_range, elem, None, reject)]
+    return [*ops, *range_ops(value_is_float, value_range, elem, None, reject, reject_nan=not pass_nan)]
 
 
-def lower_link(step: Step, direction: PlanDirection, mapping: str, reject: bool) -> LinkPlan:
-    """The operations of one link in one direction (`mapping`: the mapping's name, for the stats key)."""
+def lower_link(step: Step, direction: PlanDirection, mapping: str, reject: bool, pass_nan: bool = False) -> LinkPlan:
+    """The operations of one link in one direction (`mapping`: the mapping's name, for the stats key; `pass_nan`:
+    the mapping's, ROS -> UAVCAN only)."""
     if step.kind == "elements":
         return lower_elements(step, direction, mapping, reject)
     if direction == TO_ROS:
         return LinkPlan(step, TO_ROS, f"{mapping}.{step.ros}", tuple(_lower_to_ros(step, reject)), reject)
-    return LinkPlan(step, TO_UAVCAN, f"{mapping}.{step.uavcan}", tuple(_lower_to_uavcan(step, reject)), reject)
+    return LinkPlan(step, TO_UAVCAN, f"{mapping}.{step.uavcan}", tuple(_lower_to_uavcan(step, reject, pass_nan)),
+                    reject)
+
+
+def passes_nan(m: Mapping) -> bool:
+    """Whether the mapping's ROS -> UAVCAN converter lets a float NaN through: only a command mapping rejects it (a
+    UAVCAN -> ROS mapping's reverse converter, which the simulated devices use, keeps a sensor's NaN, e.g. "no
+    bottom lock"), and only unless it says `pass_nan: true`."""
+    return m.pass_nan or m.direction != ROS_TO_UAVCAN
 
 
 def lower_mapping(rm: ResolvedMapping) -> MappingPlan:
@@ -281,7 +295,7 @@ def lower_mapping(rm: ResolvedMapping) -> MappingPlan:
     return MappingPlan(
         name=m.name, direction=m.direction, reject=reject, ros_fields=tuple(ros_fields),
         to_ros=tuple(lower_link(s, TO_ROS, m.name, reject) for s in rm.steps if s.ros_path),
-        to_uavcan=tuple(lower_link(s, TO_UAVCAN, m.name, reject) for s in rm.steps if s.uavcan_path),
+        to_uavcan=tuple(lower_link(s, TO_UAVCAN, m.name, reject, passes_nan(m)) for s in rm.steps if s.uavcan_path),
         uavcan_fields=tuple([*(FieldSet(p, t, SetConstant(v)) for p, t, v in rm.uavcan_values),
                              *(FieldSet(p, t, SetConstant(v, select=True)) for p, t, v in rm.select)]),
         required=tuple(required),

@@ -128,13 +128,13 @@ def _line_wrap(r: Reader, what: str, diag: Diagnostics) -> bool:
 
 _MAPPING_KEYS = (
     "direction", "topic", "subject_id", "source_node_ids", "destination_node_id", "frame_id",
-    "fields", "ignore", "uavcan_values", "on_out_of_range", "uavcan_exprs", "ros_defaults", *TRAFFIC_KEYS,
+    "fields", "ignore", "uavcan_values", "on_out_of_range", "uavcan_exprs", "ros_defaults", *TRAFFIC_KEYS, "pass_nan",
 )
 # A DroneCAN message is keyed by its data type (no subject id) and broadcast (destinations, not one destination).
 _DRONECAN_MAPPING_KEYS = (
     "direction", "topic", "data_type", "select", "source_node_ids", "destination_node_ids", "frame_id",
     "fields", "ignore", "uavcan_values", "on_out_of_range", "uavcan_exprs", "ros_defaults",
-    "shares_data_type", *TRAFFIC_KEYS,
+    "shares_data_type", *TRAFFIC_KEYS, "pass_nan",
 )
 
 
@@ -211,7 +211,11 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
         policy if policy in ("saturate", "reject") else "saturate", pos, protocol, data_type, destination_node_ids,
         select, select_pos, any_node, any_pos, bool(dronecan and r.get("shares_data_type", bool, False)),
         **vars(parse_traffic(r, what, direction, diag)), uavcan_exprs=uavcan_exprs, ros_defaults=ros_defaults,
+        pass_nan=bool(r.get("pass_nan", bool, False)),
     )
+    if direction == UAVCAN_TO_ROS and r.node("pass_nan") is not None:
+        diag.error(r.key_pos("pass_nan"), f"{what} goes UAVCAN->ROS: pass_nan is for commands (ros_to_uavcan); a "
+                   "UAVCAN->ROS mapping passes a float NaN on as it is", "no pass_nan here")
     destination = "destination_node_ids" if dronecan else "destination_node_id"
     if direction == UAVCAN_TO_ROS and r.node(destination) is not None:
         diag.error(r.key_pos(destination), f"{what} goes UAVCAN->ROS: it has sources, not a destination",

@@ -8,6 +8,8 @@ mappings are known; the TF topics the nodes' transforms imply join the declared 
 
 from __future__ import annotations
 
+import os
+import stat
 from dataclasses import replace
 from pathlib import Path
 
@@ -266,10 +268,43 @@ def _with_effective_qos(topic: Topic, bridged: set[str]) -> Topic:
     return replace(topic, qos=qos, qos_origin=origin)
 
 
+# The largest spec file read: SAM's is 43 KB, a generated spec of 1000 types under 1 MB. A bound keeps `--spec
+# /dev/zero` (or a runaway generator's output) from filling memory before the YAML reader's own bounds can act.
+MAX_SPEC_BYTES = 8 * 1024 * 1024
+
+_FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
 def load_spec_file(path: Path) -> Spec:
     """Read and structurally parse a spec file (no cross-reference checks)."""
+    return parse_spec(load_yaml(read_spec_text(path), str(path)), str(path))
+
+
+def read_spec_text(path: Path) -> str:
+    """The text of a spec file: a regular file of at most MAX_SPEC_BYTES bytes in UTF-8; else a SpecError that says
+    what the path is. Opened without blocking, so that a FIFO is refused instead of waiting for a writer."""
+    def refuse(why: str, expected: str | None = None) -> SpecError:
+        return SpecError([Diagnostic(Pos(str(path)), f"cannot read the spec: {why}", expected)])
+
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecError([Diagnostic(Pos(str(path)), f"cannot read the spec: {exc}")]) from None
-    return parse_spec(load_yaml(text, str(path)), str(path))
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        raise refuse(str(exc)) from None
+    try:
+        mode = os.fstat(fd).st_mode
+        kind = next((what for test, what in _FILE_KINDS if test(mode)), None)
+        if kind is not None or not stat.S_ISREG(mode):
+            raise refuse(f"it is {kind or 'not a regular file'}", "a regular file holding the YAML spec")
+        with os.fdopen(fd, "rb", closefd=False) as handle:
+            data = handle.read(MAX_SPEC_BYTES + 1)  # a file that grows meanwhile is still read no further
+    except OSError as exc:
+        raise refuse(str(exc)) from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_SPEC_BYTES:
+        raise refuse(f"it is larger than {MAX_SPEC_BYTES:,} bytes", "a spec of at most 8 MiB")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise refuse(str(exc)) from None

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from sam_codegen.frontend.reading import Reader, kind_of, number, scalar, seq_items, str_list, text_of, vector3
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar
 from sam_codegen.model.diagnostics import Diagnostics, Pos
@@ -25,7 +27,7 @@ __all__ = ["QOS_DEPTH_MAX", "parse_frame", "parse_node", "parse_parameter", "par
 def parse_parameter(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Parameter | None:
     """A parameter, or None when it has no usable type or default (reported)."""
     what = f"parameter {key!r}"
-    r = Reader(node, what, diag, ("type", "unit", "default", "min", "max", "description", "section"))
+    r = Reader(node, what, diag, ("type", "unit", "default", "min", "max", "description", "section", "allow_nan"))
     type_ = r.get("type", str)
     kinds: dict[str, tuple[type, ...]] = {
         "double": (int, float), "integer": (int,), "bool": (bool,), "string": (str,),
@@ -40,6 +42,9 @@ def parse_parameter(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Param
     maximum = number(r.node("max"), f"max of {what}", diag)
     if (minimum is not None or maximum is not None) and type_ not in ("double", "integer"):
         diag.error(pos, f"{what} of type {type_} cannot have a range")
+    allow_nan = bool(r.get("allow_nan", bool, False))
+    if not _nan_rules_hold(r, what, type_, default, allow_nan, diag):
+        return None
     if minimum is not None and maximum is not None and minimum > maximum:
         diag.error(r.key_pos("min"), f"{what}: min {minimum} is above max {maximum}")
     if isinstance(default, (int, float)) and not isinstance(default, bool):
@@ -51,7 +56,24 @@ def parse_parameter(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Param
     return Parameter(
         key, type_, float(default) if type_ == "double" else default, r.get("unit", str, ""),
         minimum, maximum, text_of(r, "description"), str(r.get("section", (str, int, float), "")), pos,
+        allow_nan=allow_nan,
     )
+
+
+def _nan_rules_hold(r: Reader, what: str, type_: str, default: Scalar | None, allow_nan: bool,
+                    diag: Diagnostics) -> bool:
+    """NaN is never a parameter value unless the parameter says `allow_nan: true`: a NaN default passes every range
+    check (each comparison is false) and would switch off whatever check reads it (a NaN min_battery_percent: no
+    low-battery abort, ever). (A NaN range bound is refused by `number`: it must be finite.) False when refused."""
+    ok = True
+    if allow_nan and type_ != "double":
+        diag.error(r.key_pos("allow_nan"), f"{what}: allow_nan applies only to a double parameter, not {type_}")
+        ok = False
+    if isinstance(default, float) and math.isnan(default) and not allow_nan:
+        diag.error(r.key_pos("default"), f"default NaN of {what} is not a valid value",
+                   "a number; or `allow_nan: true` when NaN is a meaningful value of this parameter")
+        ok = False
+    return ok
 
 
 _QOS_KEYS = ("reliability", "durability", "depth")

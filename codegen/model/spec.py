@@ -226,6 +226,7 @@ class Parameter:
     description: str = ""
     section: str = ""
     pos: Pos = NOWHERE
+    allow_nan: bool = False  # NaN is a meaningful value (`allow_nan: true`); else a NaN default is refused
 
 
 @dataclass(frozen=True)
@@ -384,6 +385,9 @@ class Mapping:
     # their type's default (0, false, empty) on purpose (every other ROS field must be written).
     uavcan_exprs: list[UavcanExpr] = field(default_factory=list)
     ros_defaults: list[str] = field(default_factory=list)
+    # ROS -> UAVCAN: a float NaN command is rejected (counted as `not_a_number`) unless the mapping says
+    # `pass_nan: true`, for a device that reads NaN as a command of its own ("hold", "no setpoint").
+    pass_nan: bool = False
 
     @property
     def enable_service_name(self) -> str:

@@ -285,6 +285,21 @@ def split_composite_name(name: str) -> tuple[str, int, int]:
     return match["full"], int(match["maj"]), int(match["min"])
 
 
+# The most elements a Cyphal or DroneCAN array of the spec may hold. A transfer carries at most the largest extent
+# the tool accepts (65,535 bytes, `extent`), so no array of whole-byte elements can be longer on the bus; DroneCAN
+# has no extent, but a transfer of 65,535 bytes is already ~9,400 classic CAN frames. Checked when the type is read,
+# so that no later stage (the bus budget, the codecs, pydsdl) ever sees a capacity of 10^9.
+MAX_ARRAY_CAPACITY = 65535
+
+
+def _check_capacity(text: str, capacity: int) -> None:
+    if capacity < 1:
+        raise ValueError(f"array capacity of {text!r} must be at least 1")
+    if capacity > MAX_ARRAY_CAPACITY:
+        raise ValueError(f"array capacity {capacity:,} of {text!r} is more than a transfer can carry "
+                         f"(at most {MAX_ARRAY_CAPACITY:,} elements)")
+
+
 def parse_dsdl_type(text: str) -> DsdlType:
     """Parse a DSDL field type.
 
@@ -328,8 +343,7 @@ def parse_dsdl_type(text: str) -> DsdlType:
         raise ValueError("void cannot be an array element")
     bounded = array_text.startswith("<=")
     capacity = int(array_text[2:] if bounded else array_text)
-    if capacity < 1:
-        raise ValueError(f"array capacity of {text!r} must be at least 1")
+    _check_capacity(text, capacity)
     return DsdlType(kind, bits, composite, "bounded" if bounded else "fixed", capacity, cast == "truncated")
 
 
@@ -396,8 +410,7 @@ def parse_v0_type(text: str) -> DsdlType:
         capacity, mode = int(array[1:]) - 1, "bounded"
     else:
         capacity, mode = int(array), "fixed"
-    if capacity < 1:
-        raise ValueError(f"array capacity of {text!r} must be at least 1")
+    _check_capacity(text, capacity)
     return DsdlType(kind, bits, composite, mode, capacity, cast == "truncated")  # type: ignore[arg-type]
 
 

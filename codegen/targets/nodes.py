@@ -27,7 +27,7 @@ from typing import Any
 
 from sam_codegen.model.frames import quat_from_rpy
 from sam_codegen.model.spec import Parameter, Qos, Spec
-from sam_codegen.render.filters import natural_key, one_line, py_str
+from sam_codegen.render.filters import natural_key, one_line, py_number, py_str
 from sam_codegen.render.pysource import float_literal
 from sam_codegen.render.templating import environment, render
 from sam_codegen.validate.nodes import (
@@ -97,8 +97,9 @@ def qos_args(qos: Qos) -> str:
 
 
 def _value_literal(p: Parameter) -> str:
-    if p.type == "double":
-        return float_literal(float(p.default))
+    if p.type == "double":  # NaN only with `allow_nan: true`; spelled as an expression, `nan` is no Python name
+        value = float(p.default)
+        return py_number(value) if math.isnan(value) else float_literal(value)
     return py_str(p.default) if p.type == "string" else repr(p.default)
 
 

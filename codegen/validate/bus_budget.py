@@ -118,6 +118,37 @@ def fd_frame_bits(data_bytes: int, *, worst_case: bool = False) -> tuple[int, in
     return arbitration + 12, data  # + ACK 2, EOF 7, IFS 3 at the nominal rate
 
 
+def cyphal_frame_split(payload_bytes: int, mtu: int = CLASSIC_MTU) -> tuple[tuple[int, int], ...]:
+    """The frames of one Cyphal/CAN transfer as (data length, how many) pairs, computed, never listed one by one:
+    a capacity of millions of elements must cost no more than one of ten.
+
+    >>> cyphal_frame_split(7), cyphal_frame_split(47), cyphal_frame_split(10 ** 9)
+    (((8, 1),), ((8, 7),), ((8, 142857143), (2, 1)))
+    """
+    if payload_bytes < 0 or mtu not in (CLASSIC_MTU, FD_MTU):
+        raise ValueError(f"payload {payload_bytes} bytes, MTU {mtu}")
+    pad = (lambda n: n) if mtu == CLASSIC_MTU else fd_frame_length
+    per_frame = mtu - 1
+    if payload_bytes <= per_frame:
+        return ((pad(payload_bytes + 1), 1),)
+    full, rest = divmod(payload_bytes + 2, per_frame)
+    return ((mtu, full),) + (((pad(rest + 1), 1),) if rest else ())
+
+
+def dronecan_frame_split(payload_bytes: int) -> tuple[tuple[int, int], ...]:
+    """The classic CAN frames of one DroneCAN transfer as (data length, how many) pairs (see cyphal_frame_split).
+
+    >>> dronecan_frame_split(7), dronecan_frame_split(8), dronecan_frame_split(10 ** 9)
+    (((8, 1),), ((8, 1), (4, 1)), ((8, 142857143), (2, 1)))
+    """
+    if payload_bytes < 0:
+        raise ValueError(f"payload length must be >= 0, got {payload_bytes}")
+    if payload_bytes <= 7:
+        return ((payload_bytes + 1, 1),)
+    full, rest = divmod(payload_bytes + 2, 7)
+    return ((8, full),) + (((rest + 1, 1),) if rest else ())
+
+
 def cyphal_frame_lengths(payload_bytes: int, mtu: int = CLASSIC_MTU) -> list[int]:
     """Data lengths (tail byte and CAN FD padding included) of the frames of one Cyphal/CAN transfer.
 
@@ -285,22 +316,29 @@ class Transfer:
     what: str = ""  # why it is sent: a port, a mapping's command, liveness
 
     def frame_lengths(self, bus: Bus) -> list[int]:
+        """Every frame's data length, one by one (for tests and small payloads; the budget uses frame_split)."""
+        return [n for n, count in self.frame_split(bus) for _ in range(count)]
+
+    def frame_split(self, bus: Bus) -> tuple[tuple[int, int], ...]:
         if self.protocol == "dronecan":
-            return dronecan_frame_lengths(self.payload_bytes)
-        return cyphal_frame_lengths(self.payload_bytes, FD_MTU if bus.fd else CLASSIC_MTU)
+            return dronecan_frame_split(self.payload_bytes)
+        return cyphal_frame_split(self.payload_bytes, FD_MTU if bus.fd else CLASSIC_MTU)
+
+    def frame_count(self, bus: Bus) -> int:
+        return sum(count for _, count in self.frame_split(bus))
 
     def frames_per_s(self, bus: Bus) -> float:
-        return self.rate_hz * len(self.frame_lengths(bus))
+        return self.rate_hz * self.frame_count(bus)
 
     def bus_seconds_per_s(self, bus: Bus, *, worst_case: bool = False) -> float:
         """The share of the bus's time this message takes (1.0 = the whole bus)."""
         total = 0.0
-        for n in self.frame_lengths(bus):
+        for n, count in self.frame_split(bus):
             if bus.data_bitrate is not None and self.protocol == "cyphal":
                 nominal, data = fd_frame_bits(n, worst_case=worst_case)
-                total += nominal / bus.bitrate + data / bus.data_bitrate
+                total += count * (nominal / bus.bitrate + data / bus.data_bitrate)
             else:  # a classic frame (DroneCAN is classic on an FD bus too)
-                total += classic_frame_bits(n, worst_case=worst_case) / bus.bitrate
+                total += count * classic_frame_bits(n, worst_case=worst_case) / bus.bitrate
         return self.rate_hz * total
 
 

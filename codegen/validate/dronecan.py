@@ -30,6 +30,7 @@ from sam_codegen.validate.dronecan_namespaces import check_namespaces, clash_mes
 from sam_codegen.validate.mapping_rules import ResolvedMapping
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.routing import check_shared_broadcasts, routed_node_ids
+from sam_codegen.validate.type_graph import dsdl_children, type_graph
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
 V0_NODE_IDS = range(1, 126)  # 0 is anonymous, 126 and 127 are kept for maintenance tools
@@ -187,28 +188,21 @@ class DronecanValidator:
                 self.catalog.signature(struct.name)
 
     def check_type_cycles(self) -> None:
-        too_deep: list[str] = []
-
-        def visit(name: str, stack: tuple[str, ...]) -> bool:
-            struct = self.spec.dronecan_types.get(name)
-            if struct is None:
-                return False
-            if name in stack:
-                self.error(struct.pos, f"DroneCAN type {name} contains itself: {' -> '.join((*stack, name))}")
-                return True
-            if len(stack) == _MAX_NESTING:
-                if not too_deep:  # one error is enough: a chain of N types would give N - 32
-                    too_deep.append(name)
-                    self.error(self.spec.dronecan_types[stack[0]].pos, f"DroneCAN type {stack[0]} nests types more "
-                               f"than {_MAX_NESTING} levels deep ({stack[0]} -> {stack[1]} -> ... -> {name})",
-                               f"at most {_MAX_NESTING} levels of types inside types")
-                return True
-            return any(visit(f.type.composite, (*stack, name)) for f in struct.fields
-                       if isinstance(f.type, DsdlType) and f.type.composite)
-
-        for name in self.spec.dronecan_types:
-            if visit(name, ()):
-                self.bad_types.add(name)
+        """Types inside types: no cycle, at most _MAX_NESTING levels; one pass over them (validate.type_graph: a walk
+        of every path was exponential). A type on a cycle, too deep, or holding such a type is bad."""
+        types = self.spec.dronecan_types
+        graph = type_graph(types, lambda name: dsdl_children(types.get(name)))
+        for component in graph.cycles:
+            name = component[0]
+            self.error(types[name].pos, f"DroneCAN type {name} contains itself: {' -> '.join(graph.cycle_from(name))}")
+        too_deep = {name for name in types if graph.height[name] > _MAX_NESTING}
+        deep = next((name for name in types if name in too_deep), None)
+        if deep is not None:  # one error is enough: a chain of N types would give N - 32
+            chain = graph.chain(deep, _MAX_NESTING + 1)
+            self.error(types[deep].pos, f"DroneCAN type {deep} nests types more than {_MAX_NESTING} levels deep "
+                       f"({deep} -> {chain[1]} -> ... -> {chain[-1]})",
+                       f"at most {_MAX_NESTING} levels of types inside types")
+        self.bad_types |= graph.reaches(set(graph.cyclic) | too_deep)
 
     # ---- devices -------------------------------------------------------------------------------------------
     def check_devices(self) -> None:

@@ -7,6 +7,7 @@ messages are derived before any check looks a ROS type up, so every check sees t
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +40,7 @@ from sam_codegen.validate.panic_duty import check_panic_duty
 from sam_codegen.validate.routing import check_routing
 from sam_codegen.validate.services import ResolvedServiceMapping, ServiceValidator
 from sam_codegen.validate.topics_message import topics_message
+from sam_codegen.validate.type_graph import check_type_sizes, ros_children, type_graph
 from sam_codegen.validate.values import CAN_NODE_IDS, SUBJECT_IDS, check_dsdl_value, check_ros_value, python_safe
 
 _FRAME_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -215,29 +217,18 @@ class _Validator:
         return sorted(messages.values(), key=lambda m: m.name)
 
     def check_message_cycles(self, messages: dict[str, RosMessage]) -> None:
-        too_deep: list[str] = []
-
-        def visit(name: str, stack: tuple[str, ...]) -> None:
-            message = messages.get(name)
-            if message is None:
-                return
-            if name in stack:
-                self.error(message.pos, f"message {name} contains itself: {' -> '.join((*stack, name))}")
-                return
-            if len(stack) == _MAX_NESTING:
-                if not too_deep:  # one error is enough: a chain of N messages would give N - 32
-                    too_deep.append(name)
-                    self.error(messages[stack[0]].pos, f"message {stack[0]} nests messages more than "
-                               f"{_MAX_NESTING} levels deep ({stack[0]} -> {stack[1]} -> ... -> {name})",
-                               f"at most {_MAX_NESTING} levels of messages inside messages")
-                return
-            for f in message.fields:
-                assert isinstance(f.type, RosType)
-                if not f.type.is_primitive:
-                    visit(f.type.base, (*stack, name))
-
-        for name in messages:
-            visit(name, ())
+        """Messages inside messages: no cycle, at most _MAX_NESTING levels; one pass over them (validate.type_graph:
+        a walk of every path was exponential)."""
+        graph = type_graph(messages, lambda name: ros_children(messages.get(name)))
+        for component in graph.cycles:
+            name = component[0]
+            self.error(messages[name].pos, f"message {name} contains itself: {' -> '.join(graph.cycle_from(name))}")
+        deep = next((name for name in messages if graph.height[name] > _MAX_NESTING), None)
+        if deep is not None:  # one error is enough: a chain of N messages would give N - 32
+            chain = graph.chain(deep, _MAX_NESTING + 1)
+            self.error(messages[deep].pos, f"message {deep} nests messages more than {_MAX_NESTING} levels deep "
+                       f"({deep} -> {chain[1]} -> ... -> {chain[-1]})",
+                       f"at most {_MAX_NESTING} levels of messages inside messages")
 
     def check_frames_and_parameters(self) -> None:
         s = self.spec
@@ -246,14 +237,23 @@ class _Validator:
                 self.error(frame.pos, f"frame {frame.name!r} is not a valid TF frame id", "an identifier")
             if frame.parent is not None and frame.parent not in s.frames:
                 self.error(frame.pos, f"frame {frame.name!r} has unknown parent {frame.parent!r}")
+        # Each frame is walked up once: a frame whose ancestry reaches a loop (or one known to) is in error, one
+        # that reaches a root (or a frame known to) is not; a chain of N frames costs N steps, not N^2 / 2.
+        loops: dict[str, bool] = {}
         for frame in s.frames.values():
-            seen, cur = {frame.name}, frame.parent
-            while cur is not None and cur in s.frames:
-                if cur in seen:
-                    self.error(frame.pos, f"frame {frame.name!r} is its own ancestor")
-                    break
-                seen.add(cur)
+            path: list[str] = []
+            on_path: set[str] = set()
+            cur: str | None = frame.name
+            while cur is not None and cur in s.frames and cur not in loops and cur not in on_path:
+                path.append(cur)
+                on_path.add(cur)
                 cur = s.frames[cur].parent
+            looped = cur in on_path or (cur is not None and loops.get(cur, False))
+            for name in path:
+                loops[name] = looped
+        for frame in s.frames.values():
+            if loops[frame.name]:
+                self.error(frame.pos, f"frame {frame.name!r} is its own ancestor")
         for t in s.transforms:
             for name in (t.parent, t.child):
                 if name not in s.frames:
@@ -273,6 +273,8 @@ class _Validator:
             if left is None or right is None or left.type not in ("double", "integer") \
                     or right.type not in ("double", "integer"):
                 continue
+            if any(isinstance(p.default, float) and math.isnan(p.default) for p in (left, right)):
+                continue  # a NaN default (`allow_nan: true`: e.g. "no limit") is ordered against nothing
             ok = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
                   ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}[rule.op](left.default, right.default)
             if not ok:
@@ -346,6 +348,9 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     ros = RosCatalog(spec, ros_share_dirs, derived)
     v = _Validator(spec, ros, dsdl, diag, failed_messages)
     v.check_header()
+    # Before anything expands a type (the checks below, the converters, pydsdl): a type of 2^30 fields is fatal.
+    if not check_type_sizes(spec, ros, dsdl, v0, diag):
+        diag.check()
     for struct in spec.dsdl_types.values():
         v.check_dsdl_struct(struct)
     for service in spec.dsdl_services.values():  # each half as a struct (an error of the name is reported once)

@@ -23,7 +23,7 @@ log = logging.getLogger("sam_runtime.bridge")
 
 DEFAULT_LOG_INTERVAL_S = DEFAULT_INTERVAL_S
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
-                "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected",
+                "not_a_number", "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected",
                 "rate_limited", "coalesced", "expired", "disabled")
 # Drops the spec asked for (max_rate_hz, a disabled mapping): counted like the others, but no sign of trouble, so
 # they do not make the mapping WARN on /diagnostics (an expired command does: it waited too long somewhere).
@@ -47,6 +47,7 @@ class MappingStats:
         self.saturated: collections.Counter[str] = collections.Counter()
         self.rejected: collections.Counter[str] = collections.Counter()
         self.last_drop_monotonic: float | None = None
+        self._nan_rejects = 0  # rejections for NaN whose drop is still to be counted (see drop)
 
     # converter interface
     def saturate(self, key: str) -> None:
@@ -60,6 +61,16 @@ class MappingStats:
             self.rejected[str(key)] += 1
         if self._log is not None:
             self._log.note((self.name, "rejected"), logging.WARNING, "rejected a message for %s", key)
+
+    def reject_nan(self, key: str) -> None:
+        """A message rejected because a value was NaN (a NaN command, a NaN into an integer): counted under
+        `rejected.<key>` as every rejection, and its drop, which the bridge counts as "rejected" right after the
+        converter returned None, as `not_a_number` instead (a mapping converts on one thread at a time)."""
+        with self._lock:
+            self.rejected[str(key)] += 1
+            self._nan_rejects += 1
+        if self._log is not None:
+            self._log.note((self.name, "not_a_number"), logging.WARNING, "rejected a message: %s is NaN", key)
 
     # bridge interface
     def receive(self) -> None:
@@ -80,7 +91,13 @@ class MappingStats:
         if count <= 0:
             return
         with self._lock:
-            self.dropped[reason] += count
+            if reason == "rejected" and self._nan_rejects:
+                taken = min(count, self._nan_rejects)
+                self._nan_rejects -= taken
+                self.dropped["not_a_number"] += taken
+                count -= taken
+            if count:
+                self.dropped[reason] += count
             if reason not in INTENDED_DROPS:
                 self.last_drop_monotonic = time.monotonic()
 

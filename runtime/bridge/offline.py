@@ -156,6 +156,9 @@ class _Scratch:
     def reject(self, key: str) -> None:
         pass
 
+    def reject_nan(self, key: str) -> None:
+        pass
+
 
 class _Ros:
     """What Inbound asks of the ROS side: publishers and the receive clock."""

@@ -43,9 +43,10 @@ from sam_runtime.cli_support import (
 from sam_runtime.common.ros_namespace import ros_namespace
 from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
 from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError
-from sam_runtime.recording.reading import read_recording
+from sam_runtime.recording.reading import Recording, read_recording, recording_file_problem
 from sam_runtime.recording.recorder import METADATA_NAME, Recorder, RecorderConfig
 from sam_runtime.recording.replay import SPEEDS, replay
+from sam_runtime.recording.schemas import TRANSFER_TYPE
 from sam_runtime.recording.target import RecordingTargetError, check_target
 
 __all__ = ["EXIT_DIFFERENT", "record_main", "replay_main"]
@@ -125,12 +126,28 @@ def _replay_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _why_no_transfers(rec: Recording) -> str:
+    """Why a recording gives the replay nothing to feed, as the end of `<file> ...`: the cause it can name."""
+    raw = [c for c in rec.channels.values() if rec.schemas.get(c.schema_id) is not None
+           and rec.schemas[c.schema_id].name == TRANSFER_TYPE]
+    if raw:
+        lost = f"; {rec.damage()} could not be read" if rec.damaged else ""
+        cut = f"; it is cut short ({rec.stopped_by})" if rec.stopped_by and not rec.complete else ""
+        return f"has a bus channel but no UAVCAN transfer in it{lost}{cut}"
+    if rec.damaged or (rec.stopped_by and not rec.messages):
+        parts = [f"{rec.damage()} could not be read" if rec.damaged else "",
+                 f"it is cut short ({rec.stopped_by})" if rec.stopped_by and not rec.complete else ""]
+        return f"holds no readable UAVCAN transfers: {'; '.join(p for p in parts if p)}"
+    return "holds no UAVCAN transfers (recorded with --no-bus?)"
+
+
 def replay_main(argv: Sequence[str] | None = None) -> int:
     args = _replay_parser().parse_args(argv)
     require_runtime("run")
     setup_logging(args.log_level)
-    if not args.file.is_file():
-        print(f"sam-replay: {args.file}: no such file", file=sys.stderr)
+    problem = recording_file_problem(args.file)
+    if problem is not None:
+        print(f"sam-replay: {args.file}: {problem}", file=sys.stderr)
         return EXIT_USAGE
     if args.out is not None:
         try:
@@ -146,9 +163,10 @@ def replay_main(argv: Sequence[str] | None = None) -> int:
             else:
                 gen = generated_package(args)
             rec = read_recording(args.file)
+            if rec.damaged:  # skipped, counted, said: what could be read is replayed
+                print(f"note: {args.file} has damaged records, skipped: {rec.damage()}", file=sys.stderr)
             if not rec.transfers():
-                print(f"sam-replay: {args.file} holds no UAVCAN transfers (recorded with --no-bus?)",
-                      file=sys.stderr)
+                print(f"sam-replay: {args.file} {_why_no_transfers(rec)}", file=sys.stderr)
                 return EXIT_ERROR
             meta = rec.metadata.get(METADATA_NAME, {})
             layout = args.layout or meta.get("layout") or None

@@ -3,9 +3,11 @@
 Invariants:
 
 - :func:`read_recording` refuses a file that does not begin as an MCAP (ValueError), then streams it record by
-  record (mcap's ``StreamReader``: no summary or footer needed) and stops at the first record it cannot read: a cut
-  file yields every message of every complete chunk, in file order, and ``Recording.complete`` says whether the
-  file ended with its footer.
+  record (no summary or footer needed), each record parsed by mcap's record classes from its own bytes: a record
+  whose body is damaged is skipped and counted in ``Recording.damaged`` (its length prefix still says where the next
+  one starts), and the reading stops only where a record runs past the end of the file. A cut file yields every
+  message of every complete chunk, in file order, and ``Recording.complete`` says whether the file ended with its
+  footer.
 - :func:`rosbag2_folder` makes a folder that rosbags' rosbag2 ``Reader`` opens (it reads only rosbag2 folders with
   a ``metadata.yaml``, and only MCAP files with a footer): the recording itself (a symbolic link) when complete,
   else a complete copy of everything readable (as ``mcap recover`` does); the metadata lists the ROS topics (CDR)
@@ -14,8 +16,10 @@ Invariants:
 
 from __future__ import annotations
 
+import io
 import json
 import os
+import stat
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +27,7 @@ from typing import Any
 
 from sam_runtime.recording.schemas import TRANSFER_TYPE, Transfer, decode_transfer
 
-__all__ = ["MCAP_MAGIC", "RecordedMessage", "Recording", "read_recording", "rosbag2_folder"]
+__all__ = ["MCAP_MAGIC", "RecordedMessage", "Recording", "read_recording", "recording_file_problem", "rosbag2_folder"]
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
@@ -48,6 +52,11 @@ class Recording:
     metadata: dict[str, dict[str, str]] = field(default_factory=dict)
     complete: bool = False  # the file ended with its footer
     stopped_by: str | None = None  # why reading stopped early (a cut file)
+    damaged: Counter[str] = field(default_factory=Counter)  # record kind -> records skipped as unreadable
+
+    def damage(self) -> str:
+        """The damaged records skipped, as words: `2 attachment records` ('' when none)."""
+        return ", ".join(f"{n} {kind} record{'s' if n != 1 else ''}" for kind, n in sorted(self.damaged.items()))
 
     def schema_of(self, topic: str) -> Any:
         ch = next((c for c in self.channels.values() if c.topic == topic), None)
@@ -71,37 +80,97 @@ class Recording:
         return [(m, decode_transfer(m.data)) for m in self.messages if m.topic in raw]
 
 
+def recording_file_problem(path: Path) -> str | None:
+    """What keeps `path` from being a recording to read, in words (`no such file`, `is a directory, not a
+    recording`, ...); None for a regular file. A directory or /dev/zero is not "no such file"."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "no such file"
+    except OSError as exc:
+        return f"cannot be read: {exc.strerror or exc}"
+    if stat.S_ISREG(mode):
+        return None
+    kinds = ((stat.S_ISDIR, "a directory"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+             (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"))
+    kind = next((what for test, what in kinds if test(mode)), "not a regular file")
+    return f"is {kind}, not a recording (expected an MCAP file, as `sam-codegen run --record FILE.mcap` writes)"
+
+
 def read_recording(path: Path) -> Recording:
     """Everything readable in the file (see the module docstring)."""
-    from mcap.records import Attachment, Channel, Footer, Message, Metadata, Schema
-    from mcap.stream_reader import StreamReader
+    from mcap.data_stream import ReadDataStream
+    from mcap.opcode import Opcode
+    from mcap.records import Attachment, Channel, Chunk, Footer, Message, Metadata, Schema
+    from mcap.stream_reader import breakup_chunk
 
+    readers: dict[int, Any] = {Opcode.SCHEMA: Schema.read, Opcode.CHANNEL: Channel.read, Opcode.CHUNK: Chunk.read,
+                               Opcode.ATTACHMENT: Attachment.read, Opcode.METADATA: Metadata.read,
+                               Opcode.FOOTER: Footer.read}
     rec = Recording()
     topic_of: dict[int, str] = {}
+
+    def take(r: Any) -> None:
+        if isinstance(r, Schema):
+            rec.schemas[r.id] = r
+        elif isinstance(r, Channel):
+            rec.channels[r.id] = r
+            topic_of[r.id] = r.topic
+        elif isinstance(r, Message):
+            rec.messages.append(RecordedMessage(topic_of.get(r.channel_id, ""), r.log_time,
+                                                r.publish_time, bytes(r.data), r.sequence))
+        elif isinstance(r, Attachment):
+            rec.attachments[r.name] = bytes(r.data)
+        elif isinstance(r, Metadata):
+            rec.metadata[r.name] = dict(r.metadata)
+
     with open(path, "rb") as fh:
         if fh.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
             raise ValueError(f"{path} is not an MCAP file")
-        fh.seek(0)
-        try:
-            for r in StreamReader(fh, skip_magic=False, emit_chunks=False).records:
-                if isinstance(r, Schema):
-                    rec.schemas[r.id] = r
-                elif isinstance(r, Channel):
-                    rec.channels[r.id] = r
-                    topic_of[r.id] = r.topic
-                elif isinstance(r, Message):
-                    rec.messages.append(RecordedMessage(topic_of.get(r.channel_id, ""), r.log_time,
-                                                        r.publish_time, bytes(r.data), r.sequence))
-                elif isinstance(r, Attachment):
-                    rec.attachments[r.name] = bytes(r.data)
-                elif isinstance(r, Metadata):
-                    rec.metadata[r.name] = dict(r.metadata)
-                elif isinstance(r, Footer):
-                    rec.complete = True
-                    break  # only the closing magic follows
-        except Exception as ex:  # a cut file ends inside a record: everything before it is kept
-            rec.stopped_by = f"{type(ex).__name__}: {ex}".rstrip(": ")
+        # Record by record, each parsed from its own bytes (opcode, length, body): a record whose body is damaged
+        # is skipped and counted, and cannot shift where the next one starts. Only a length that runs past the end
+        # of the file (a cut file) stops the reading: everything before it is kept.
+        while True:
+            prefix = fh.read(9)
+            if len(prefix) < 9:
+                rec.stopped_by = "the file ends inside a record" if prefix else "the file ends without a footer"
+                break
+            opcode, length = prefix[0], int.from_bytes(prefix[1:], "little")
+            body = fh.read(length) if length <= _MAX_RECORD_BYTES else b""
+            if len(body) < length:
+                rec.stopped_by = f"the file ends inside a {_record_kind(opcode)} record"
+                break
+            read = readers.get(opcode)
+            if opcode == Opcode.MESSAGE:
+                read = lambda stream, n=length: Message.read(stream, n)  # noqa: E731  (its data runs to the end)
+            if read is None:
+                continue  # indexes, statistics, the header: nothing a recording's reader needs
+            try:
+                stream = ReadDataStream(io.BytesIO(body))
+                record = read(stream)
+                records = breakup_chunk(record) if isinstance(record, Chunk) else [record]
+            except Exception:  # a damaged record: its length still says where the next one starts
+                rec.damaged[_record_kind(opcode)] += 1
+                continue
+            for r in records:
+                take(r)
+            if isinstance(record, Footer):
+                rec.complete = True
+                break  # only the closing magic follows
     return rec
+
+
+# mcap's own reader refuses records above 4 GiB; a length beyond it is damage, not a record to read.
+_MAX_RECORD_BYTES = 4 * 2 ** 30
+
+
+def _record_kind(opcode: int) -> str:
+    from mcap.opcode import Opcode
+
+    try:
+        return Opcode(opcode).name.lower()
+    except ValueError:
+        return f"opcode 0x{opcode:02x}"
 
 
 def rosbag2_folder(mcap_path: Path, folder: Path) -> Path:

@@ -151,6 +151,21 @@ def test_cyphal_single_frame_staticpressure_at_20_hz() -> None:
     assert t.bus_seconds_per_s(FD) == pytest.approx(20 * (48 / 1e6 + (32 + 56) / 4e6))
 
 
+def test_a_huge_payload_is_budgeted_arithmetically() -> None:
+    """Issue 29 item 9: a payload of 10^9 bytes (a `uint8[<=1000000000]`) is 1.4 * 10^8 frames; listing them one by
+    one raised MemoryError. The split is computed: the same figures as the frame-by-frame rule for small payloads."""
+    for protocol in ("cyphal", "dronecan"):
+        for n in (0, 7, 8, 62, 63, 64, 121, 500):
+            t = Transfer("x", 1.0, n, protocol)
+            for bus in (CLASSIC, FD):
+                assert t.frame_count(bus) == len(t.frame_lengths(bus)), (protocol, n)
+        huge = Transfer("x", 10.0, 10 ** 9, protocol)
+        assert huge.frame_count(CLASSIC) == -(-(10 ** 9 + 2) // 7)
+        assert huge.frames_per_s(CLASSIC) == 10 * huge.frame_count(CLASSIC)
+        assert huge.bus_seconds_per_s(CLASSIC) > 1000  # far over any bus, and said so without materialising a list
+    assert Transfer("x", 1.0, 10 ** 9, "cyphal").frame_count(FD) == -(-(10 ** 9 + 2) // 63)
+
+
 def test_cyphal_multi_frame_rawimu_at_100_hz() -> None:
     t = Transfer("sam.sensor.RawIMU.0.1", 100.0, 120, "cyphal")
     # Classic: 120 + 2 CRC = 122 bytes, 7 a frame: 17 full frames and 3 bytes + tail in the last.

@@ -590,9 +590,9 @@ if WORKER:
                 ThrusterAngles(thruster_vertical_radians=1e6, thruster_horizontal_radians=-math.inf), stats)
             assert (out.vertical_radians, out.horizontal_radians) == (65504.0, -65504.0)
             assert stats.saturated == {"thrust_vector.vertical_radians": 1, "thrust_vector.horizontal_radians": 1}
-            out = convert.thrust_vector_to_uavcan(ThrusterAngles(thruster_vertical_radians=math.nan), stats)
-            assert math.isnan(dsdl_wire(out).vertical_radians)  # NaN is a float16 value: it passes
-            assert not stats.rejected
+            # NaN is a float16 value, but no setpoint: a NaN command is rejected and counted (issue 29)
+            assert convert.thrust_vector_to_uavcan(ThrusterAngles(thruster_vertical_radians=math.nan), stats) is None
+            assert stats.rejected == {"thrust_vector.vertical_radians": 1}
 
         def test_battery_units_and_constants() -> None:
             stats = convert.ConversionStats()

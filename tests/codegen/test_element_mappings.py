@@ -177,8 +177,8 @@ if not WORKER and not CYPHAL_WORKER:
 
         build(SPEC, tmp_path / "generated")
         docs = (tmp_path / "generated" / "docs" / "interfaces.md").read_text(encoding="utf-8")
-        assert ("| `commands[].value` | → | `commands[].command_value` | float32 → float16 (narrowed, saturating) |"
-                in docs)
+        assert ("| `commands[].value` | → | `commands[].command_value` | float32 → float16 (narrowed, saturating, "
+                "NaN rejected) |" in docs)
         assert "element by element, power\\_msgs/Command → uavcan.equipment.actuator.Command (over 15 elements cut" \
             in docs
         assert "each element's header: the message's stamp and frame id" in docs

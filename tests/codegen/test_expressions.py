@@ -169,6 +169,17 @@ class _Rejected(Exception):
     pass
 
 
+def _ieee_min_max(func: str, p: Any, q: Any) -> Any:
+    """IEEE 754-2019 minimum / maximum: NaN if either is NaN; -0 below +0."""
+    if math.isnan(p) or math.isnan(q):
+        return math.nan
+    if p == q == 0:
+        negative = [v for v in (p, q) if math.copysign(1.0, v) < 0]
+        positive = [v for v in (p, q) if math.copysign(1.0, v) > 0]
+        return (negative or positive)[0] if func == "min" else (positive or negative)[0]
+    return min(p, q) if func == "min" else max(p, q)
+
+
 def reference(node: ENode, env: dict[str, Any], reject: bool, saturated: list[str]) -> Any:
     """The typed tree's semantics (model.expr's docstring), evaluated directly."""
     if isinstance(node, EConst):
@@ -190,6 +201,8 @@ def reference(node: ENode, env: dict[str, Any], reject: bool, saturated: list[st
                 saturated.append("k")
                 return INT64[1] if v > 0 else INT64[0]
             return math.trunc(v) if node.func == "trunc" else round(v)
+        if node.func in ("min", "max") and any(a.kind == "float" for a in node.args):
+            return _ieee_min_max(node.func, *args)
         return {"min": min, "max": max, "abs": abs, "int": int}[node.func](*args)
     assert isinstance(node, EBinary)
     left = reference(node.left, env, reject, saturated)
@@ -217,6 +230,9 @@ class _Stats:
     def reject(self, key: str) -> None:
         self.rejected.append(key)
 
+    def reject_nan(self, key: str) -> None:
+        self.rejected.append(key)
+
 
 def run_generated(node: ENode, env: dict[str, Any], reject: bool) -> tuple[Any, _Stats]:
     """The statements ExpressionWriter emits, rendered by statements.j2 into a function and run."""
@@ -227,18 +243,18 @@ def run_generated(node: ENode, env: dict[str, Any], reject: bool) -> tuple[Any, 
     body = environment().from_string('{% import "python/statements.j2" as s %}{{ s.function(f) }}').render(f=draft)
     assert max(len(line) for line in body.splitlines()) <= 110, body  # long expressions are split into locals
     namespace: dict[str, Any] = {}
-    divide = _support_divide()
-    exec(body, {"_support": type("S", (), {"divide": staticmethod(divide)})}, namespace)
+    support = _support_helpers()
+    exec(body, {"_support": type("S", (), {name: staticmethod(f) for name, f in support.items()})}, namespace)
     stats = _Stats()
     return namespace["f"](env, stats), stats
 
 
 @functools.cache
-def _support_divide() -> Any:
+def _support_helpers() -> dict[str, Any]:
     source = environment().get_template("python/conversion_support.py.j2").render(spec_name="t", vehicle="t")
     namespace: dict[str, Any] = {}
     exec(compile(source, "conversion_support.py", "exec"), namespace)
-    return namespace["divide"]
+    return {name: namespace[name] for name in ("divide", "maximum", "minimum")}
 
 
 EXPRESSIONS = ["a * r >> 3", "trunc(x * s) >> 2", "round(x / y) - a", "min(trunc(x), a) + max(b, 3)",

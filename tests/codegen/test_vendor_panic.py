@@ -153,6 +153,9 @@ class _Stats:
     def reject(self, key: str) -> None:  # pragma: no cover - the Panic mappings never reject
         raise AssertionError(key)
 
+    def reject_nan(self, key: str) -> None:  # pragma: no cover - the Panic mappings never reject
+        raise AssertionError(key)
+
 
 def _cdr_string(text: str) -> bytes:
     data = text.encode() + b"\0"

@@ -4,6 +4,9 @@ letter case, minor versions) hold across batch boundaries."""
 
 from __future__ import annotations
 
+import os
+import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -133,3 +136,37 @@ def test_batches_cover_every_type(tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     monkeypatch.setattr(build, "DSDL_BATCH", 100)
     generate(SPECS / "rover.yaml")
     assert len(calls) == 1  # a spec of up to DSDL_BATCH types is one call
+
+
+def test_sigterm_during_a_build_leaves_no_dsdl_copies(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 29 item 11: a build killed by SIGTERM while pydsdl read its copies left /dev/shm/sam-dsdl-* behind.
+    SIGTERM now raises Terminated where the build is, and the temporary folder goes. (The signal is sent only once
+    the handler is in place: with the default action it would end the test process.)"""
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr(build, "_scratch_dir", lambda: str(scratch))
+    seen: list[Path] = []
+
+    def killed_while_reading(_resolved: object, tree: Path, files: dict[str, str], *_args: object) -> None:
+        for path, text in files.items():  # the copies pydsdl would read
+            (tree / path).parent.mkdir(parents=True, exist_ok=True)
+            (tree / path).write_text(text, encoding="utf-8")
+        seen.extend(scratch.iterdir())
+        if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+            raise AssertionError("SIGTERM would end the build without removing its DSDL copies")
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)  # the signal is handled at the next bytecode: never reached
+        raise AssertionError("SIGTERM was not handled")
+
+    monkeypatch.setattr(build, "_read_dsdl", killed_while_reading)
+    previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        with pytest.raises(build.Terminated) as info:
+            build.build(SPECS / "minimal.yaml", tmp_path / "generated")
+        assert info.value.code == 128 + signal.SIGTERM
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # restored
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert [p.name.startswith("sam-dsdl-") for p in seen] == [True]
+    assert list(scratch.iterdir()) == []
+    assert not (tmp_path / "generated").exists()

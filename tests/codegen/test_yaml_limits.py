@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -282,3 +283,87 @@ def test_types_chained_in_flat_yaml_are_an_error(tmp_path: Path, spec: str, sect
     assert [str(d).replace(str(path), spec) for d in caught.value.diagnostics] == [error]
     path.write_text(_chain((SPECS / spec).read_text(encoding="utf-8"), section, name, first, 32), encoding="utf-8")
     validate(load_spec_file(path))  # 32 levels are allowed
+
+
+# ---- types doubling at each level: every check linear, the flattened size bounded ---------------------------------
+
+def _doubling(base: str, section: str, name: str, first: str, count: int, head: str = "") -> str:
+    """`count` types, each holding two fields of the previous one: 2^(count-1) paths, 2 * count fields."""
+    types = f"  {name.format(0)}:\n{head}    fields:\n      - {{name: a, type: {first}}}\n"
+    types += "".join(f"  {name.format(i)}:\n{head}    fields:\n      - {{name: a, type: {name.format(i - 1)}}}\n"
+                     f"      - {{name: b, type: {name.format(i - 1)}}}\n" for i in range(1, count))
+    assert f"\n{section}:\n" in base
+    return base.replace(f"\n{section}:\n", f"\n{section}:\n{types}", 1)
+
+
+@pytest.mark.parametrize(("spec", "section", "name", "first", "head", "error"), [
+    ("minimal.yaml", "messages", "M{}", "int32", "    description: x.\n",
+     "minimal.yaml:76:3: error: message buoy_msgs/M14 flattens to 16,384 fields"),
+    ("minimal.yaml", "dsdl_types", "buoy.T{}.0.1", "uint8", "    sealed: true\n",
+     "minimal.yaml:82:3: error: DSDL type buoy.T14.0.1 flattens to 16,384 fields"),
+    ("minimal_v0.yaml", "dronecan_types", "skiff.T{}", "uint8", "",
+     "minimal_v0.yaml:67:3: error: DroneCAN type skiff.T14 flattens to 16,384 fields"),
+], ids=["ros", "dsdl", "dronecan"])
+def test_types_doubling_are_refused_in_linear_time(tmp_path: Path, spec: str, section: str, name: str, first: str,
+                                                   head: str, error: str) -> None:
+    """Issue 29 item 8: 30 types each holding two fields of the previous one, used by no topic. The cycle check
+    walked every path (2^29; 22 levels took 17 s) and pydsdl's bit-length sets recurse the same way: each type is now
+    visited once, and one that flattens to more than MAX_FLAT_FIELDS fields is an exact error before anything
+    expands it. 13 levels (4,096 fields) are a valid spec."""
+    base = (SPECS / spec).read_text(encoding="utf-8")
+    path = tmp_path / spec
+    path.write_text(_doubling(base, section, name, first, 30, head), encoding="utf-8")
+    start = time.process_time()
+    with pytest.raises(SpecError) as caught:
+        validate(load_spec_file(path))
+    assert time.process_time() - start < 5.0  # CPU time: the machine's load does not count
+    assert [str(d).replace(str(path), spec) for d in caught.value.diagnostics] == [
+        f"{error} (its nested types and fixed arrays of composites expanded), more than the limit of 10,000 "
+        "(expected fewer copies of nested types; an array of primitives counts as one field)"]
+    path.write_text(_doubling(base, section, name, first, 13, head), encoding="utf-8")
+    start = time.process_time()
+    validate(load_spec_file(path))
+    assert time.process_time() - start < 5.0
+
+
+def test_fixed_arrays_of_composites_count_their_elements(tmp_path: Path) -> None:
+    """A fixed array multiplies its element's fields (the codecs expand it); an array of primitives counts one."""
+    path = tmp_path / "minimal.yaml"
+    types = ("  buoy.A.0.1:\n    sealed: true\n    fields:\n      - {name: x, type: 'uint8[65535]'}\n"
+             "      - {name: y, type: 'float32[<=100]'}\n"
+             "  buoy.B.0.1:\n    sealed: true\n    fields:\n      - {name: a, type: 'buoy.A.0.1[5001]'}\n")
+    path.write_text(MINIMAL.replace("\ndsdl_types:\n", f"\ndsdl_types:\n{types}", 1), encoding="utf-8")
+    with pytest.raises(SpecError) as caught:
+        validate(load_spec_file(path))
+    assert [str(d).replace(str(path), "minimal.yaml").split(" (")[0] for d in caught.value.diagnostics] == [
+        "minimal.yaml:18:3: error: DSDL type buoy.B.0.1 flattens to 10,002 fields"]
+
+
+def test_message_cycles_are_found_in_one_pass(tmp_path: Path) -> None:
+    """A cycle of two messages and a message holding it: one error per cycle, the shortest cycle named."""
+    types = ("  A:\n    description: x.\n    fields:\n      - {name: b, type: buoy_msgs/B}\n"
+             "  B:\n    description: x.\n    fields:\n      - {name: a, type: buoy_msgs/A}\n"
+             "      - {name: c, type: int8}\n"
+             "  C:\n    description: x.\n    fields:\n      - {name: a, type: buoy_msgs/A}\n")
+    path = tmp_path / "minimal.yaml"
+    path.write_text(MINIMAL.replace("\nmessages:\n", f"\nmessages:\n{types}", 1), encoding="utf-8")
+    with pytest.raises(SpecError) as caught:
+        validate(load_spec_file(path))
+    assert [str(d).replace(str(path), "minimal.yaml") for d in caught.value.diagnostics] == [
+        "minimal.yaml:7:3: error: message buoy_msgs/A contains itself: buoy_msgs/A -> buoy_msgs/B -> buoy_msgs/A"]
+
+
+def test_frame_ancestry_is_checked_in_linear_time(tmp_path: Path) -> None:
+    """Each frame walked its whole ancestry (a chain of N frames: N^2 / 2 steps, 20,000 frames ~2 * 10^8): now each
+    frame is walked once. Loops are still found, and every frame that reaches one is named."""
+    chain = "".join(f"  f{i}: {{parent: f{i - 1}}}\n" for i in range(1, 20_000))
+    loop = "  a: {parent: b}\n  b: {parent: a}\n  c: {parent: a}\n"
+    path = tmp_path / "minimal.yaml"
+    path.write_text(MINIMAL.replace("  base_link: {}\n", f"  base_link: {{}}\n  f0: {{}}\n{chain}{loop}", 1),
+                    encoding="utf-8")
+    start = time.process_time()
+    with pytest.raises(SpecError) as caught:
+        validate(load_spec_file(path))
+    assert time.process_time() - start < 20.0  # CPU time; the quadratic walk alone took minutes
+    assert [d.message for d in caught.value.diagnostics] == [
+        "frame 'a' is its own ancestor", "frame 'b' is its own ancestor", "frame 'c' is its own ancestor"]

@@ -36,7 +36,7 @@ def _percent(fraction: float) -> str:
 
 
 def _message(t: Transfer, budget: LayoutBudget) -> str:
-    frames = len(t.frame_lengths(budget.bus))
+    frames = t.frame_count(budget.bus)
     hz = f"{t.rate_hz:g} Hz"
     return f"{t.type} at {hz}: {t.payload_bytes} B, {frames} frame{'s' if frames != 1 else ''}"
 

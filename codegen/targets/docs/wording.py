@@ -154,6 +154,8 @@ def describe_link(link: LinkPlan) -> str:
     wrap = link.first(Wrap)
     if isinstance(wrap, Wrap):
         notes.append(_wrapping(wrap))
+    if link.has(RejectNaN) and not to_ros and uav.element.kind == "float" and not link.has(Limits):
+        notes.append("NaN rejected")  # a command: NaN is no setpoint (`pass_nan: true` lets it through)
     for op in ops:
         if isinstance(op, Pad):
             notes.append(f"padded to {op.size}")
@@ -197,10 +199,11 @@ def _calls(node: ENode) -> set[str]:
     return set()
 
 
-def describe_step(step: Step, direction: str, on_out_of_range: str) -> str:
+def describe_step(step: Step, direction: str, on_out_of_range: str, pass_nan: bool = False) -> str:
     """The conversion of one field link in words, in the direction the bridge runs it (its plan, described)."""
     plan_direction: PlanDirection = "to_ros" if direction == UAVCAN_TO_ROS else "to_uavcan"
-    return describe_link(lower_link(step, plan_direction, "", on_out_of_range == "reject"))
+    return describe_link(lower_link(step, plan_direction, "", on_out_of_range == "reject",
+                                    pass_nan or direction == UAVCAN_TO_ROS))
 
 
 def field_rows(rm: ResolvedMapping) -> list[dict[str, object]]:

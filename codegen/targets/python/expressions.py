@@ -151,4 +151,9 @@ class ExpressionWriter:
             convert = "int" if node.func == "trunc" else "round"  # int() truncates toward zero
             self.statements.append(Bound(var, checks, self.key, self.reject, f"{var} = {convert}({var})"))
             return var
-        return f"{node.func}(" + ", ".join(self.fit([self.write(a) for a in node.args])) + ")"
+        func = node.func
+        if func in ("max", "min") and any(a.kind == "float" for a in node.args):
+            # IEEE 754-2019 maximum/minimum: a NaN argument gives NaN whichever its place (Python's max() and min()
+            # keep their first argument against a NaN), and the NaN result is then rejected and counted.
+            func = "_support.maximum" if func == "max" else "_support.minimum"
+        return f"{func}(" + ", ".join(self.fit([self.write(a) for a in node.args])) + ")"

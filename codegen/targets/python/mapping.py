@@ -44,6 +44,7 @@ from sam_codegen.conversion_plan import (
     Utf8Length,
     lower_link,
     lower_mapping,
+    passes_nan,
 )
 from sam_codegen.model.expr import fields_of
 from sam_codegen.model.types import DsdlType, RosType
@@ -135,7 +136,7 @@ class MappingEmitter:
         found = self._links.get((id(s), direction))
         if found is not None and found.step == s:
             return found
-        return lower_link(s, direction, self.name, self.reject)
+        return lower_link(s, direction, self.name, self.reject, passes_nan(self.mapping))
 
     # -- UAVCAN -> ROS ---------------------------------------------------------------------------------------
     def to_ros(self) -> FunctionDraft:
@@ -298,9 +299,9 @@ class MappingEmitter:
                 statements.append(FixLength(var, op.size, dsdl_literal(0, elem_uav), key, op.reject))
             elif isinstance(op, MaxLength):  # a longer fixed ROS array: only non-zero elements count
                 statements.append(CutToMaxLength(var, op.capacity, key, op.reject, op.padded))
-        helper = pys.array_check_helper(var, link, elem_uav)
-        if helper is not None:
-            statements.append(helper)
+        for helper in (pys.array_nan_helper(var, link, elem_uav), pys.array_check_helper(var, link, elem_uav)):
+            if helper is not None:
+                statements.append(helper)
         return var
 
     def evaluate(self, link: LinkPlan, op: Evaluate, target: str, read: Callable[[tuple], str], names: LocalNames,

@@ -39,6 +39,7 @@ from sam_codegen.render.pysource import py_literal, typed_literal
 
 __all__ = ["Assign", "Bound", "CutToMaxLength", "CutUtf8", "FindItem", "FixLength", "HelperCall", "NanReject",
            "PadArray", "Policy", "RequireMinLength", "Statement", "TableLookup", "TimeToRos", "array_check_helper",
+           "array_nan_helper",
            "bound_statement", "check_statements", "dsdl_literal", "float32_helper", "timestamp_from_ros",
            "timestamp_to_ros", "to_ros_expr", "to_uavcan_expr"]
 
@@ -262,6 +263,8 @@ def _clamp_statement(var: str, op: Clamp, policy: Policy) -> Bound:
 def array_check_helper(var: str, link: LinkPlan, elem: DsdlType) -> HelperCall | None:
     """The conversion_support.py.j2 call that does a ROS -> UAVCAN array link's element checks, if it has any."""
     checks = [op for op in link.ops if isinstance(op, (RejectNaN, Round, Limits, Clamp))]
+    if elem.kind == "float":  # NaN is array_nan_helper's
+        checks = [op for op in checks if not isinstance(op, RejectNaN)]
     if not checks:
         return None
     key, reject = repr(link.key), str(link.reject)
@@ -273,6 +276,13 @@ def array_check_helper(var: str, link: LinkPlan, elem: DsdlType) -> HelperCall |
         helper = "_support.clamp_floats" if elem.bits == 16 else "_support.clamp_finite_floats"
         args = [var, _num(dsdl_range(elem)[1]), "stats", key, reject]  # type: ignore[index]
     return HelperCall(var, helper, tuple(args))
+
+
+def array_nan_helper(var: str, link: LinkPlan, elem: DsdlType) -> HelperCall | None:
+    """The call that rejects a ROS -> UAVCAN float array holding a NaN, when the link rejects NaN (a command)."""
+    if elem.kind != "float" or not any(isinstance(op, RejectNaN) for op in link.ops):
+        return None
+    return HelperCall(var, "_support.reject_nan_floats", (var, "stats", repr(link.key)))
 
 
 def float32_helper(var: str, link: LinkPlan) -> HelperCall:

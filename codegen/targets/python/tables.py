@@ -9,11 +9,12 @@ convert_v0.used_types) and import nothing of it. Every spec text reaches the out
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
 from sam_codegen.model.spec import UAVCAN_TO_ROS, Mapping, Port, Qos, V0Struct
-from sam_codegen.render.filters import py_str
+from sam_codegen.render.filters import py_number, py_str
 from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
 from sam_codegen.targets import dsdl_v0
 from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
@@ -89,7 +90,10 @@ def cyphal_context(resolved: Resolved) -> dict[str, Any]:
         parameters.append({
             "name": py_str(param.name), "type": py_str(param.type),
             # text is the template's to wrap; other values are literals already
-            "default_text": default if isinstance(default, str) else None, "default": py_literal(default),
+            "default_text": default if isinstance(default, str) else None,
+            # NaN (`allow_nan: true`) as an expression: the module has no _NAN constant for py_literal to name
+            "default": py_number(default) if isinstance(default, float) and math.isnan(default)
+            else py_literal(default),
             "minimum": py_literal(None if param.minimum is None else float(param.minimum)),
             "maximum": py_literal(None if param.maximum is None else float(param.maximum)),
             "unit": py_str(param.unit), "description": param.description,

@@ -518,7 +518,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         us = 0
     latitude_deg_1e8 = latitude / 1e-08
     if latitude_deg_1e8 != latitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.latitude_deg_1e8')
+        stats.reject_nan('gps_fix.latitude_deg_1e8')
         return None
     if latitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.latitude_deg_1e8')
@@ -530,7 +530,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         latitude_deg_1e8 = round(latitude_deg_1e8)
     longitude_deg_1e8 = longitude / 1e-08
     if longitude_deg_1e8 != longitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.longitude_deg_1e8')
+        stats.reject_nan('gps_fix.longitude_deg_1e8')
         return None
     if longitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.longitude_deg_1e8')
@@ -542,7 +542,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         longitude_deg_1e8 = round(longitude_deg_1e8)
     height_ellipsoid_mm = altitude / 0.001
     if height_ellipsoid_mm != height_ellipsoid_mm:  # NaN
-        stats.reject('gps_fix.height_ellipsoid_mm')
+        stats.reject_nan('gps_fix.height_ellipsoid_mm')
         return None
     if height_ellipsoid_mm >= 67108863.5:
         stats.saturate('gps_fix.height_ellipsoid_mm')
@@ -724,7 +724,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         temperature_2 = -65504.0
     state_of_charge_pct = percentage / 0.01
     if state_of_charge_pct != state_of_charge_pct:  # NaN
-        stats.reject('battery_state.state_of_charge_pct')
+        stats.reject_nan('battery_state.state_of_charge_pct')
         return None
     if state_of_charge_pct >= 127.5:
         stats.saturate('battery_state.state_of_charge_pct')
@@ -1068,6 +1068,9 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
     vertical_radians = thruster_vertical_radians
+    if vertical_radians != vertical_radians:  # NaN
+        stats.reject_nan('thrust_vector.vertical_radians')
+        return None
     if vertical_radians > 65504.0:
         stats.saturate('thrust_vector.vertical_radians')
         vertical_radians = 65504.0
@@ -1075,6 +1078,9 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         stats.saturate('thrust_vector.vertical_radians')
         vertical_radians = -65504.0
     horizontal_radians = thruster_horizontal_radians
+    if horizontal_radians != horizontal_radians:  # NaN
+        stats.reject_nan('thrust_vector.horizontal_radians')
+        return None
     if horizontal_radians > 65504.0:
         stats.saturate('thrust_vector.horizontal_radians')
         horizontal_radians = 65504.0
@@ -1117,6 +1123,9 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
     weight_1_offset_radians_2 = weight_1_offset_radians
+    if weight_1_offset_radians_2 != weight_1_offset_radians_2:  # NaN
+        stats.reject_nan('ballast.weight_1_offset_radians')
+        return None
     if weight_1_offset_radians_2 > 65504.0:
         stats.saturate('ballast.weight_1_offset_radians')
         weight_1_offset_radians_2 = 65504.0
@@ -1124,6 +1133,9 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         stats.saturate('ballast.weight_1_offset_radians')
         weight_1_offset_radians_2 = -65504.0
     weight_2_offset_radians_2 = weight_2_offset_radians
+    if weight_2_offset_radians_2 != weight_2_offset_radians_2:  # NaN
+        stats.reject_nan('ballast.weight_2_offset_radians')
+        return None
     if weight_2_offset_radians_2 > 65504.0:
         stats.saturate('ballast.weight_2_offset_radians')
         weight_2_offset_radians_2 = 65504.0
@@ -1161,7 +1173,7 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: string beyond the buffer or without its NUL')
     percent_2 = percent
     if percent_2 != percent_2:  # NaN
-        stats.reject('longitudinal_weight.percent')
+        stats.reject_nan('longitudinal_weight.percent')
         return None
     if percent_2 < 0.0:
         stats.saturate('longitudinal_weight.percent')
@@ -1200,7 +1212,7 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
         raise WireError('CDR: string beyond the buffer or without its NUL')
     percent_2 = percent
     if percent_2 != percent_2:  # NaN
-        stats.reject('buoyancy_piston.percent')
+        stats.reject_nan('buoyancy_piston.percent')
         return None
     if percent_2 < 0.0:
         stats.saturate('buoyancy_piston.percent')

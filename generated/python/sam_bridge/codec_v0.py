@@ -601,7 +601,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         us = 0
     latitude_deg_1e8 = latitude / 1e-08
     if latitude_deg_1e8 != latitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.latitude_deg_1e8')
+        stats.reject_nan('gps_fix.latitude_deg_1e8')
         return None
     if latitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.latitude_deg_1e8')
@@ -613,7 +613,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         latitude_deg_1e8 = round(latitude_deg_1e8)
     longitude_deg_1e8 = longitude / 1e-08
     if longitude_deg_1e8 != longitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.longitude_deg_1e8')
+        stats.reject_nan('gps_fix.longitude_deg_1e8')
         return None
     if longitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.longitude_deg_1e8')
@@ -625,7 +625,7 @@ def gps_fix_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         longitude_deg_1e8 = round(longitude_deg_1e8)
     height_ellipsoid_mm = altitude / 0.001
     if height_ellipsoid_mm != height_ellipsoid_mm:  # NaN
-        stats.reject('gps_fix.height_ellipsoid_mm')
+        stats.reject_nan('gps_fix.height_ellipsoid_mm')
         return None
     if height_ellipsoid_mm >= 67108863.5:
         stats.saturate('gps_fix.height_ellipsoid_mm')
@@ -821,7 +821,7 @@ def battery_state_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         temperature_2 = -65504.0
     state_of_charge_pct = percentage / 0.01
     if state_of_charge_pct != state_of_charge_pct:  # NaN
-        stats.reject('battery_state.state_of_charge_pct')
+        stats.reject_nan('battery_state.state_of_charge_pct')
         return None
     if state_of_charge_pct >= 127.5:
         stats.saturate('battery_state.state_of_charge_pct')
@@ -1178,6 +1178,9 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
     commands_actuator_id_0_command_value = thruster_vertical_radians
+    if commands_actuator_id_0_command_value != commands_actuator_id_0_command_value:  # NaN
+        stats.reject_nan('thrust_vector.commands[actuator_id=0].command_value')
+        return None
     if commands_actuator_id_0_command_value > 65504.0:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
         commands_actuator_id_0_command_value = 65504.0
@@ -1185,6 +1188,9 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
         commands_actuator_id_0_command_value = -65504.0
     commands_actuator_id_1_command_value = thruster_horizontal_radians
+    if commands_actuator_id_1_command_value != commands_actuator_id_1_command_value:  # NaN
+        stats.reject_nan('thrust_vector.commands[actuator_id=1].command_value')
+        return None
     if commands_actuator_id_1_command_value > 65504.0:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
         commands_actuator_id_1_command_value = 65504.0
@@ -1242,6 +1248,9 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     if length and (size < offset + 4 + length or cdr[offset + 3 + length] != 0):
         raise WireError('CDR: string beyond the buffer or without its NUL')
     commands_actuator_id_2_command_value = weight_1_offset_radians
+    if commands_actuator_id_2_command_value != commands_actuator_id_2_command_value:  # NaN
+        stats.reject_nan('ballast.commands[actuator_id=2].command_value')
+        return None
     if commands_actuator_id_2_command_value > 65504.0:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
         commands_actuator_id_2_command_value = 65504.0
@@ -1249,6 +1258,9 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
         commands_actuator_id_2_command_value = -65504.0
     commands_actuator_id_3_command_value = weight_2_offset_radians
+    if commands_actuator_id_3_command_value != commands_actuator_id_3_command_value:  # NaN
+        stats.reject_nan('ballast.commands[actuator_id=3].command_value')
+        return None
     if commands_actuator_id_3_command_value > 65504.0:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
         commands_actuator_id_3_command_value = 65504.0
@@ -1303,7 +1315,7 @@ def longitudinal_weight_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> byte
         raise WireError('CDR: string beyond the buffer or without its NUL')
     commands_actuator_id_4_command_value = percent
     if commands_actuator_id_4_command_value != commands_actuator_id_4_command_value:  # NaN
-        stats.reject('longitudinal_weight.commands[actuator_id=4].command_value')
+        stats.reject_nan('longitudinal_weight.commands[actuator_id=4].command_value')
         return None
     if commands_actuator_id_4_command_value < 0.0:
         stats.saturate('longitudinal_weight.commands[actuator_id=4].command_value')
@@ -1364,7 +1376,7 @@ def buoyancy_piston_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | 
         raise WireError('CDR: string beyond the buffer or without its NUL')
     commands_actuator_id_5_command_value = percent
     if commands_actuator_id_5_command_value != commands_actuator_id_5_command_value:  # NaN
-        stats.reject('buoyancy_piston.commands[actuator_id=5].command_value')
+        stats.reject_nan('buoyancy_piston.commands[actuator_id=5].command_value')
         return None
     if commands_actuator_id_5_command_value < 0.0:
         stats.saturate('buoyancy_piston.commands[actuator_id=5].command_value')
@@ -1399,7 +1411,7 @@ def thruster_1_feedback_wire_to_ros(
     u_rpm = (((_t1 >> 10 & 0xff) | (_t1 >> 2 & 0xff) << 8 | (_t1 & 0x3) << 16) ^ 0x20000) - 0x20000
     temperature_c = u_temperature - 273.15
     if temperature_c != temperature_c:  # NaN
-        stats.reject('thruster_1_feedback.temperature_c')
+        stats.reject_nan('thruster_1_feedback.temperature_c')
         return None
     if temperature_c >= 255.5:
         stats.saturate('thruster_1_feedback.temperature_c')
@@ -1481,7 +1493,7 @@ def thruster_2_feedback_wire_to_ros(
     u_rpm = (((_t1 >> 10 & 0xff) | (_t1 >> 2 & 0xff) << 8 | (_t1 & 0x3) << 16) ^ 0x20000) - 0x20000
     temperature_c = u_temperature - 273.15
     if temperature_c != temperature_c:  # NaN
-        stats.reject('thruster_2_feedback.temperature_c')
+        stats.reject_nan('thruster_2_feedback.temperature_c')
         return None
     if temperature_c >= 255.5:
         stats.saturate('thruster_2_feedback.temperature_c')

@@ -9,7 +9,7 @@ Standard library only.
 from __future__ import annotations
 
 __all__ = ["ConversionStats", "WireError", "clamp_finite_floats", "clamp_floats", "clamp_ints", "divide",
-           "round_ints"]
+           "maximum", "minimum", "reject_nan_floats", "round_ints"]
 
 _INF = float("inf")
 
@@ -28,6 +28,10 @@ class ConversionStats:
 
     def reject(self, key: str) -> None:
         self.rejected[key] = self.rejected.get(key, 0) + 1
+
+    def reject_nan(self, key: str) -> None:
+        """A message rejected because a value was NaN (the bridge counts its drop as `not_a_number`)."""
+        self.reject(key)
 
 
 class WireError(ValueError):
@@ -88,7 +92,7 @@ def round_ints(
     saturated = False
     for x in values:
         if x != x:
-            stats.reject(key)
+            stats.reject_nan(key)
             return None
         if x >= hi + 0.5:
             out.append(hi)
@@ -104,6 +108,39 @@ def round_ints(
             return None
         stats.saturate(key)
     return out
+
+
+def reject_nan_floats(values: list[float], stats: ConversionStats, key: str) -> list[float] | None:
+    """The elements of a command, or None (counted) when one is NaN: NaN is no setpoint."""
+    for x in values:
+        if x != x:
+            stats.reject_nan(key)
+            return None
+    return values
+
+
+def maximum(a: float, b: float) -> float:
+    """max() of a mapping expression as IEEE 754-2019 `maximum`: NaN when either argument is NaN (Python's
+    max() keeps its first argument against a NaN, so max(1, NaN) was 1 and max(NaN, 1) NaN), +0 above -0."""
+    if a != a or b != b:
+        return _INF - _INF
+    if a == b:  # equal: for two zeros, +0 above -0
+        return b if _negative_zero(a) else a
+    return a if a > b else b
+
+
+def minimum(a: float, b: float) -> float:
+    """min() of a mapping expression as IEEE 754-2019 `minimum`: NaN when either argument is NaN, -0 below
+    +0."""
+    if a != a or b != b:
+        return _INF - _INF
+    if a == b:  # equal: for two zeros, -0 below +0
+        return b if _negative_zero(b) else a
+    return a if a < b else b
+
+
+def _negative_zero(x: float) -> bool:
+    return x == 0 and repr(float(x))[0] == "-"  # (math.copysign without importing math)
 
 
 def divide(a: float, b: float) -> float:

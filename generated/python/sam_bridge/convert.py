@@ -956,7 +956,7 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> sam.sensor.GNSS
         us = 0
     latitude_deg_1e8 = src.latitude / 1e-08
     if latitude_deg_1e8 != latitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.latitude_deg_1e8')
+        stats.reject_nan('gps_fix.latitude_deg_1e8')
         return None
     if latitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.latitude_deg_1e8')
@@ -968,7 +968,7 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> sam.sensor.GNSS
         latitude_deg_1e8 = round(latitude_deg_1e8)
     longitude_deg_1e8 = src.longitude / 1e-08
     if longitude_deg_1e8 != longitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.longitude_deg_1e8')
+        stats.reject_nan('gps_fix.longitude_deg_1e8')
         return None
     if longitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.longitude_deg_1e8')
@@ -980,7 +980,7 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> sam.sensor.GNSS
         longitude_deg_1e8 = round(longitude_deg_1e8)
     height_ellipsoid_mm = src.altitude / 0.001
     if height_ellipsoid_mm != height_ellipsoid_mm:  # NaN
-        stats.reject('gps_fix.height_ellipsoid_mm')
+        stats.reject_nan('gps_fix.height_ellipsoid_mm')
         return None
     if height_ellipsoid_mm >= 67108863.5:
         stats.saturate('gps_fix.height_ellipsoid_mm')
@@ -1105,7 +1105,7 @@ def battery_state_to_uavcan(src: BatteryState, stats: ConversionStats) -> sam.po
         temperature = -65504.0
     state_of_charge_pct = src.percentage / 0.01
     if state_of_charge_pct != state_of_charge_pct:  # NaN
-        stats.reject('battery_state.state_of_charge_pct')
+        stats.reject_nan('battery_state.state_of_charge_pct')
         return None
     if state_of_charge_pct >= 127.5:
         stats.saturate('battery_state.state_of_charge_pct')
@@ -1385,6 +1385,9 @@ def thrust_vector_to_uavcan(
     sam_msgs/ThrusterAngles -> sam.actuator.ThrustVector.0.1
     """
     vertical_radians = src.thruster_vertical_radians
+    if vertical_radians != vertical_radians:  # NaN
+        stats.reject_nan('thrust_vector.vertical_radians')
+        return None
     if vertical_radians > 65504.0:
         stats.saturate('thrust_vector.vertical_radians')
         vertical_radians = 65504.0
@@ -1392,6 +1395,9 @@ def thrust_vector_to_uavcan(
         stats.saturate('thrust_vector.vertical_radians')
         vertical_radians = -65504.0
     horizontal_radians = src.thruster_horizontal_radians
+    if horizontal_radians != horizontal_radians:  # NaN
+        stats.reject_nan('thrust_vector.horizontal_radians')
+        return None
     if horizontal_radians > 65504.0:
         stats.saturate('thrust_vector.horizontal_radians')
         horizontal_radians = 65504.0
@@ -1426,6 +1432,9 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> sam.actuato
     sam_msgs/BallastAngles -> sam.actuator.BallastAngles.0.1
     """
     weight_1_offset_radians = src.weight_1_offset_radians
+    if weight_1_offset_radians != weight_1_offset_radians:  # NaN
+        stats.reject_nan('ballast.weight_1_offset_radians')
+        return None
     if weight_1_offset_radians > 65504.0:
         stats.saturate('ballast.weight_1_offset_radians')
         weight_1_offset_radians = 65504.0
@@ -1433,6 +1442,9 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> sam.actuato
         stats.saturate('ballast.weight_1_offset_radians')
         weight_1_offset_radians = -65504.0
     weight_2_offset_radians = src.weight_2_offset_radians
+    if weight_2_offset_radians != weight_2_offset_radians:  # NaN
+        stats.reject_nan('ballast.weight_2_offset_radians')
+        return None
     if weight_2_offset_radians > 65504.0:
         stats.saturate('ballast.weight_2_offset_radians')
         weight_2_offset_radians = 65504.0
@@ -1469,7 +1481,7 @@ def longitudinal_weight_to_uavcan(
     """
     percent = src.percent
     if percent != percent:  # NaN
-        stats.reject('longitudinal_weight.percent')
+        stats.reject_nan('longitudinal_weight.percent')
         return None
     if percent < 0.0:
         stats.saturate('longitudinal_weight.percent')
@@ -1504,7 +1516,7 @@ def buoyancy_piston_to_uavcan(
     """
     percent = src.percent
     if percent != percent:  # NaN
-        stats.reject('buoyancy_piston.percent')
+        stats.reject_nan('buoyancy_piston.percent')
         return None
     if percent < 0.0:
         stats.saturate('buoyancy_piston.percent')

@@ -311,7 +311,7 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> Any | None:
         us = 0
     latitude_deg_1e8 = src.latitude / 1e-08
     if latitude_deg_1e8 != latitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.latitude_deg_1e8')
+        stats.reject_nan('gps_fix.latitude_deg_1e8')
         return None
     if latitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.latitude_deg_1e8')
@@ -323,7 +323,7 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> Any | None:
         latitude_deg_1e8 = round(latitude_deg_1e8)
     longitude_deg_1e8 = src.longitude / 1e-08
     if longitude_deg_1e8 != longitude_deg_1e8:  # NaN
-        stats.reject('gps_fix.longitude_deg_1e8')
+        stats.reject_nan('gps_fix.longitude_deg_1e8')
         return None
     if longitude_deg_1e8 >= 68719476735.5:
         stats.saturate('gps_fix.longitude_deg_1e8')
@@ -335,7 +335,7 @@ def gps_fix_to_uavcan(src: NavSatFix, stats: ConversionStats) -> Any | None:
         longitude_deg_1e8 = round(longitude_deg_1e8)
     height_ellipsoid_mm = src.altitude / 0.001
     if height_ellipsoid_mm != height_ellipsoid_mm:  # NaN
-        stats.reject('gps_fix.height_ellipsoid_mm')
+        stats.reject_nan('gps_fix.height_ellipsoid_mm')
         return None
     if height_ellipsoid_mm >= 67108863.5:
         stats.saturate('gps_fix.height_ellipsoid_mm')
@@ -447,7 +447,7 @@ def battery_state_to_uavcan(src: BatteryState, stats: ConversionStats) -> Any | 
         temperature = -65504.0
     state_of_charge_pct = src.percentage / 0.01
     if state_of_charge_pct != state_of_charge_pct:  # NaN
-        stats.reject('battery_state.state_of_charge_pct')
+        stats.reject_nan('battery_state.state_of_charge_pct')
         return None
     if state_of_charge_pct >= 127.5:
         stats.saturate('battery_state.state_of_charge_pct')
@@ -700,6 +700,9 @@ def thrust_vector_to_uavcan(src: ThrusterAngles, stats: ConversionStats) -> Any 
     sam_msgs/ThrusterAngles -> uavcan.equipment.actuator.ArrayCommand
     """
     commands_actuator_id_0_command_value = src.thruster_vertical_radians
+    if commands_actuator_id_0_command_value != commands_actuator_id_0_command_value:  # NaN
+        stats.reject_nan('thrust_vector.commands[actuator_id=0].command_value')
+        return None
     if commands_actuator_id_0_command_value > 65504.0:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
         commands_actuator_id_0_command_value = 65504.0
@@ -707,6 +710,9 @@ def thrust_vector_to_uavcan(src: ThrusterAngles, stats: ConversionStats) -> Any 
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
         commands_actuator_id_0_command_value = -65504.0
     commands_actuator_id_1_command_value = src.thruster_horizontal_radians
+    if commands_actuator_id_1_command_value != commands_actuator_id_1_command_value:  # NaN
+        stats.reject_nan('thrust_vector.commands[actuator_id=1].command_value')
+        return None
     if commands_actuator_id_1_command_value > 65504.0:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
         commands_actuator_id_1_command_value = 65504.0
@@ -757,6 +763,9 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> Any | None:
     sam_msgs/BallastAngles -> uavcan.equipment.actuator.ArrayCommand
     """
     commands_actuator_id_2_command_value = src.weight_1_offset_radians
+    if commands_actuator_id_2_command_value != commands_actuator_id_2_command_value:  # NaN
+        stats.reject_nan('ballast.commands[actuator_id=2].command_value')
+        return None
     if commands_actuator_id_2_command_value > 65504.0:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
         commands_actuator_id_2_command_value = 65504.0
@@ -764,6 +773,9 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> Any | None:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
         commands_actuator_id_2_command_value = -65504.0
     commands_actuator_id_3_command_value = src.weight_2_offset_radians
+    if commands_actuator_id_3_command_value != commands_actuator_id_3_command_value:  # NaN
+        stats.reject_nan('ballast.commands[actuator_id=3].command_value')
+        return None
     if commands_actuator_id_3_command_value > 65504.0:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
         commands_actuator_id_3_command_value = 65504.0
@@ -810,7 +822,7 @@ def longitudinal_weight_to_uavcan(src: PercentStamped, stats: ConversionStats) -
     """
     commands_actuator_id_4_command_value = src.percent
     if commands_actuator_id_4_command_value != commands_actuator_id_4_command_value:  # NaN
-        stats.reject('longitudinal_weight.commands[actuator_id=4].command_value')
+        stats.reject_nan('longitudinal_weight.commands[actuator_id=4].command_value')
         return None
     if commands_actuator_id_4_command_value < 0.0:
         stats.saturate('longitudinal_weight.commands[actuator_id=4].command_value')
@@ -860,7 +872,7 @@ def buoyancy_piston_to_uavcan(src: PercentStamped, stats: ConversionStats) -> An
     """
     commands_actuator_id_5_command_value = src.percent
     if commands_actuator_id_5_command_value != commands_actuator_id_5_command_value:  # NaN
-        stats.reject('buoyancy_piston.commands[actuator_id=5].command_value')
+        stats.reject_nan('buoyancy_piston.commands[actuator_id=5].command_value')
         return None
     if commands_actuator_id_5_command_value < 0.0:
         stats.saturate('buoyancy_piston.commands[actuator_id=5].command_value')
@@ -893,7 +905,7 @@ def thruster_1_feedback_to_ros(src: Any, receive_ns: int, stats: ConversionStats
     """
     temperature_c = src.temperature - 273.15
     if temperature_c != temperature_c:  # NaN
-        stats.reject('thruster_1_feedback.temperature_c')
+        stats.reject_nan('thruster_1_feedback.temperature_c')
         return None
     if temperature_c >= 255.5:
         stats.saturate('thruster_1_feedback.temperature_c')
@@ -955,7 +967,7 @@ def thruster_2_feedback_to_ros(src: Any, receive_ns: int, stats: ConversionStats
     """
     temperature_c = src.temperature - 273.15
     if temperature_c != temperature_c:  # NaN
-        stats.reject('thruster_2_feedback.temperature_c')
+        stats.reject_nan('thruster_2_feedback.temperature_c')
         return None
     if temperature_c >= 255.5:
         stats.saturate('thruster_2_feedback.temperature_c')

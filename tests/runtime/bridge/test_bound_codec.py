@@ -26,6 +26,9 @@ class _Stats:
     def reject(self, key: str) -> None:
         pass
 
+    def reject_nan(self, key: str) -> None:
+        pass
+
 
 def _converts(module: Any, to_ros: Any, payload: bytes) -> bool:
     try:

@@ -158,6 +158,24 @@ def test_a_failing_ros_callback_is_counted_and_never_raises() -> None:
     assert om.stats.snapshot()["received"] == 2
 
 
+def test_a_nan_command_is_dropped_as_not_a_number() -> None:
+    """Issue 29 item 5: a converter that rejects a command for NaN (``stats.reject_nan``) has its drop counted as
+    ``not_a_number``, beside ``rejected.<mapping>.<field>``; any other rejection stays ``rejected``."""
+    out, om = _outbound(queue_size=8)
+
+    def convert(msg: Any, stats: Any) -> Any:
+        (stats.reject_nan if msg != msg else stats.reject)("m.angle")
+        return None
+
+    om.to_uavcan = convert
+    out.on_ros([om], float("nan"))
+    out.on_ros([om], 1e9)
+    out.on_ros([om], float("nan"))
+    snapshot = om.stats.snapshot()
+    assert snapshot["dropped"] == {"not_a_number": 2, "rejected": 1}
+    assert snapshot["rejected_fields"] == {"m.angle": 3} and snapshot["received"] == 3
+
+
 def test_handoff_drained_at_close_counts_shutdown() -> None:
     """What the rclpy thread handed off last, still in the deque when the bridge closes: shutdown."""
     out, om = _outbound(queue_size=8)

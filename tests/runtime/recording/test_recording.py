@@ -22,7 +22,9 @@ from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from sam_codegen.catalogs.ros import ros_share_dirs
-from sam_runtime.recording.reading import read_recording, rosbag2_folder
+from sam_runtime.cli_support import EXIT_ERROR, EXIT_USAGE
+from sam_runtime.main_job.record_replay import replay_main
+from sam_runtime.recording.reading import MCAP_MAGIC, read_recording, rosbag2_folder
 from sam_runtime.recording.replay import field_differences, replay
 from sam_runtime.recording.schemas import (
     CYPHAL_TOPIC,
@@ -38,6 +40,7 @@ from sam_runtime.recording.target import RecordingTargetError, check_target
 from sam_runtime.recording.writer import RecordingWriter
 
 JAZZY = get_typestore(Stores.ROS2_JAZZY)
+GENERATED = Path(__file__).resolve().parents[3] / "generated"
 IMU = "sensor_msgs/msg/Imu"
 
 
@@ -264,3 +267,73 @@ def test_replay_at_the_recorded_pace_takes_the_recorded_time(tmp_path: Path) -> 
     assert paced.recorded_span_s == pytest.approx(0.5)
     assert paced.replay_s >= 0.45  # never faster than recorded (a loaded machine may make it slower)
     assert replay(path, [_FakeConverter({})], speed="max").replay_s < paced.replay_s
+
+
+def _damage_attachments(path: Path) -> int:
+    """Overwrite the name length of every attachment record with 2^32 - 1 (a flipped field inside the record, its
+    own length prefix intact); returns how many were damaged."""
+    data = bytearray(path.read_bytes())
+    pos, damaged = len(MCAP_MAGIC), 0
+    while pos + 9 <= len(data):
+        opcode, length = data[pos], int.from_bytes(data[pos + 1:pos + 9], "little")
+        if opcode == 0x09:  # Attachment: log_time u64, create_time u64, name (u32 length + bytes), ...
+            data[pos + 9 + 16:pos + 9 + 20] = b"\xff\xff\xff\xff"
+            damaged += 1
+        if opcode == 0x02:  # the footer
+            break
+        pos += 9 + length
+    path.write_bytes(bytes(data))
+    return damaged
+
+
+def test_damaged_attachment_records_are_skipped_and_counted(tmp_path: Path) -> None:
+    """Issue 29 item 12: two damaged attachment records (before the data, where the recorder writes them) stopped
+    the reading there, and replay said the file held no UAVCAN transfers (recorded with --no-bus?) while `plot` read
+    its 2,955. Each record is parsed from its own bytes: the damaged ones are skipped and counted, the rest read."""
+    path = tmp_path / "damaged.mcap"
+    w = _write(path, 200)
+    w.add_attachment("dsdl/uavcan/node/Heartbeat.1.0.dsdl", b"# another\n")
+    w.close()
+    assert _damage_attachments(path) == 2
+    rec = read_recording(path)
+    assert rec.damaged == {"attachment": 2} and rec.damage() == "2 attachment records"
+    assert rec.complete and rec.stopped_by is None
+    assert len(rec.transfers()) == 200 and len(rec.by_topic()["/imu"]) == 200
+    assert rec.attachments == {}
+
+
+@pytest.mark.parametrize(("make", "error"), [
+    (lambda tmp: tmp, "is a directory, not a recording"),
+    (lambda tmp: Path("/dev/zero"), "is a character device, not a recording"),
+    (lambda tmp: tmp / "nope.mcap", "no such file"),
+], ids=["directory", "dev_zero", "missing"])
+def test_replay_names_what_the_path_is(tmp_path: Path, capsys: pytest.CaptureFixture[str], make: Any,
+                                       error: str) -> None:
+    """A directory or /dev/zero was reported as "no such file"."""
+    path = make(tmp_path)
+    assert replay_main([str(path)]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.startswith(f"sam-replay: {path}: {error}") and "Traceback" not in err
+
+
+def test_replay_says_why_a_recording_gives_it_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The cause replay names: damaged records that held the bus, not --no-bus."""
+    path = tmp_path / "damaged.mcap"
+    w = RecordingWriter(path)
+    w.add_attachment("dsdl/sam/sensor/RawIMU.0.1.dsdl", b"# a definition\n")
+    w.add_channel("/imu", IMU, "ros2msg", ros2msg_definition(IMU, ros_share_dirs()))
+    w.write("/imu", _imu_cdr(1), 1_000_000_001)
+    w.close()
+    _damage_attachments(path)
+    assert replay_main([str(path), "--generated", str(GENERATED)]) == EXIT_ERROR
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"note: {path} has damaged records, skipped: 1 attachment record",
+                   f"sam-replay: {path} holds no readable UAVCAN transfers: 1 attachment record could not be read"]
+    intact = tmp_path / "ros_only.mcap"
+    w = RecordingWriter(intact)
+    w.add_channel("/imu", IMU, "ros2msg", ros2msg_definition(IMU, ros_share_dirs()))
+    w.write("/imu", _imu_cdr(1), 1_000_000_001)
+    w.close()
+    assert replay_main([str(intact), "--generated", str(GENERATED)]) == EXIT_ERROR
+    assert capsys.readouterr().err.splitlines() == [
+        f"sam-replay: {intact} holds no UAVCAN transfers (recorded with --no-bus?)"]
