@@ -163,6 +163,9 @@ class Stats:
     def reject(self, key: str) -> None:
         self.rejected.append(key)
 
+    def reject_nan(self, key: str) -> None:  # a NaN is counted apart from an out-of-range reject
+        self.rejected.append(key)
+
 
 def _light(codec: ModuleType, bits: tuple[int, int, int, int]) -> str:
     cdr = b"\x00\x01\x00\x00" + struct.pack("<4I", *bits)
