@@ -10,6 +10,13 @@ found by the gaps in that source's transfer ids (any protocol that numbers trans
   (``lost_link_down``): the gap modulo 32 plus the multiple of 32 closest to rate x elapsed time; otherwise, if
   fewer than 16 transfers were due (no wrap possible) and the gap fits, the gap is exact (``lost``).
 
+A transfer id further ahead than the time since the source's previous transfer allows (beyond
+:func:`~sam_runtime.common.transfer_ids.plausible_gap`; 64-bit ids only: a 5-bit gap is at most 15, one frame can
+add at most 14 there) is no loss: a restart with another counter, or a spoof with the device's node id. It is a
+``jump`` (its transfer is dropped and counted as ``transfer_id_jump``) and the source's sequence stays where it was,
+so that one frame can neither add 2**40 to ``lost`` nor make the real device's next transfers look old; the
+transfer right after a jump that continues it (a restarted device's second transfer) starts the new sequence.
+
 Pure logic on the times and ids passed in; the rest of the bridge is reached through the callables given.
 """
 
@@ -17,9 +24,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
 
-__all__ = ["TRANSFER_ID_TIMEOUT_S", "TransferLoss"]
+from sam_runtime.common.transfer_ids import plausible_gap
+
+__all__ = ["JUMP", "TRANSFER_ID_TIMEOUT_S", "TransferLoss"]
 
 TRANSFER_ID_TIMEOUT_S = 2.0  # Cyphal's default transfer-id timeout (DroneCAN's is the same)
+JUMP = -1  # TransferLoss.track's "lost" for a transfer-id jump
 
 
 class TransferLoss:
@@ -35,6 +45,8 @@ class TransferLoss:
     [(0, 0), (0, 0), (2, 0), (0, 0), (0, 0)]
     >>> loss.last_message(11), loss.last_message(12)
     (0.1, None)
+    >>> loss.track(11, 2**40, 0.11), loss.track(11, 11, 0.12)  # a spoof: no loss, the real stream goes on
+    ((-1, 0), (0, 0))
     """
 
     def __init__(self, port_id: int, nominal_rates: Mapping[tuple[int, int], float], modulo: Callable[[], int],
@@ -48,6 +60,7 @@ class TransferLoss:
         self._on_restart = on_restart
         self.last_tid: dict[int, tuple[int, float]] = {}  # source -> (transfer id, monotonic s)
         self.rate: dict[int, tuple[float, int, float]] = {}  # source -> (since, count, rate)
+        self._jumped: dict[int, int] = {}  # source -> the transfer id its last jump went to
 
     def last_message(self, src: int) -> float | None:
         """When the last transfer of ``src`` arrived (monotonic s), or None."""
@@ -56,13 +69,24 @@ class TransferLoss:
 
     def track(self, src: int, tid: int, now: float) -> tuple[int, int]:
         """(lost, estimated): transfers lost before this one from ``src`` (a gap in its transfer ids), and, for
-        wrapping ids only, an estimate of those missed while the bridge's own link was down."""
+        wrapping ids only, an estimate of those missed while the bridge's own link was down. A jump (see the
+        module's docstring) returns (:data:`JUMP`, 0): the caller drops its transfer."""
         prev = self.last_tid.get(src)
-        self.last_tid[src] = (tid, now)
         if prev is None:
+            self.last_tid[src] = (tid, now)
             return 0, 0
         modulo = self._modulo()
         d = (tid - prev[0]) % modulo
+        if modulo >= 2**32 and 1 < d < modulo // 2 and d - 1 > plausible_gap(now - prev[1]):
+            jumped = self._jumped.get(src)
+            self._jumped[src] = tid
+            if jumped is None or (tid - jumped) % modulo != 1:
+                return JUMP, 0
+            self._on_restart(src)  # it goes on from its jump: a restart with another counter (nothing lost)
+            d = 1
+        if self._jumped:
+            self._jumped.pop(src, None)
+        self.last_tid[src] = (tid, now)
         if modulo < 2**32 and now - prev[1] > TRANSFER_ID_TIMEOUT_S:  # the ids may have wrapped meanwhile
             res = self._wrapped_gap(src, prev[1], now, d, modulo)
             self.rate.pop(src, None)
