@@ -45,6 +45,7 @@ from sam_runtime.cyphal_io.udp_receiver import (
     ANONYMOUS_MULTIFRAME,
     FRAME_INDEX_LIMIT,
     MAX_FRAME_INDEX,
+    MAX_SLOTS,
     WRONG_SUBJECT,
     SubjectPort,
     single_frame_datagram,
@@ -296,7 +297,7 @@ _GAPS = st.sampled_from([0.0, 0.001, 0.3, 1.0, 2.5])
 def _episode(draw: Callable[..., Any], hostile: bool = True) -> list[bytes]:
     """A few datagrams: a transfer (maybe multi-frame, maybe mangled) or a broken datagram. Not ``hostile``:
     whole transfers only, their frames in any order, transfer ids that do not jump (where this receiver is
-    pycyphal; the hostile cases are tests/runtime/cyphal_io/test_rx_fuzz.py's)."""
+    pycyphal; the hostile cases are the fuzz target's, below)."""
     kind = draw(st.sampled_from(["transfer", "transfer", "transfer", "frame", "garbage", "mangled"])
                 if hostile else st.just("transfer"))
     src = draw(_SOURCES)
@@ -379,3 +380,80 @@ def test_the_transfer_id_timeout_is_pycyphals() -> None:
     from sam_runtime.cyphal_io.udp_receiver import TRANSFER_ID_TIMEOUT_S
 
     assert TRANSFER_ID_TIMEOUT_S == UDPInputSession.DEFAULT_TRANSFER_ID_TIMEOUT
+
+
+# ------------------------------------------------------------------------------------------------ the fuzz target
+# Issue 29: the receive path under hostile datagrams, in-process (no socket), derandomized. A real device (node 21)
+# sends its transfers, single- and multi-frame, one every 10 ms; between them come hostile datagrams: anything of
+# the property test's episodes (any node, garbage, mangled headers, partial transfers), and aimed at the device:
+# its node id with a broken transfer CRC (also with the id it sends next), valid transfers whose id jumped far
+# ahead or went back, partial transfers from many node ids. Never raises; every datagram is counted once; the
+# device loses nothing; the reassembly slots stay bounded; after the junk and a transfer-id timeout every source's
+# good transfers are taken again.
+_DEVICE = 21
+
+
+@st.composite
+def _aimed(draw: Callable[..., Any], next_tid: int) -> list[bytes]:
+    kind = draw(st.sampled_from(["bad_crc", "bad_crc_multi", "jump", "back", "partials", "header_crc"]))
+    if kind == "bad_crc":
+        tid = draw(st.sampled_from([next_tid, next_tid + 1, next_tid + 7, 2**40]))
+        good = _single(draw(st.binary(max_size=20)), src=_DEVICE, tid=tid)
+        return [good[:-1] + bytes([good[-1] ^ draw(st.integers(1, 255))])]
+    if kind == "bad_crc_multi":  # a whole multi-frame transfer with a broken CRC, of another transfer id
+        tid = draw(st.sampled_from([next_tid + 1, next_tid + 5, 2**40]))
+        dgs = _transfer(draw(st.binary(min_size=50, max_size=90)), mtu=40, src=_DEVICE, tid=tid)
+        dgs[-1] = dgs[-1][:-1] + bytes([dgs[-1][-1] ^ 0x33])
+        return dgs
+    if kind == "jump":
+        return [_single(b"spoof", src=_DEVICE, tid=next_tid + draw(st.sampled_from([2**40, 2**63, 10**6])))]
+    if kind == "back":
+        return [_single(b"old", src=_DEVICE, tid=max(0, next_tid - draw(st.integers(1, 50))))]
+    if kind == "partials":  # first frames of transfers that never end, from many node ids
+        first = draw(st.integers(200, 60000))
+        return [_transfer(bytes(80), mtu=40, src=first + i, tid=i)[0] for i in range(draw(st.integers(1, 90)))]
+    good = _single(b"x", src=_DEVICE, tid=next_tid)
+    return [good[:22] + bytes([good[22] ^ 0x01]) + good[23:]]  # the header CRC broken
+
+
+@st.composite
+def _hostile_run(draw: Callable[..., Any]) -> tuple[list[tuple[bytes, int]], list[int]]:
+    """The datagrams with their times, and the transfer ids the device sent."""
+    out, sent, ns, tid = [], [], T0_NS, 5000
+    for _ in range(draw(st.integers(1, 12))):
+        payload = draw(st.binary(max_size=100))
+        for d in _transfer(payload, mtu=draw(st.sampled_from([40, 1200])), src=_DEVICE, tid=tid):
+            out.append((d, ns))
+        sent.append(tid)
+        tid += 1
+        junk = draw(st.one_of(_episode(), _aimed(tid)))
+        for d in junk:
+            ns += 100_000
+            out.append((d, ns))
+        ns += 10_000_000
+    return out, sent
+
+
+@given(_hostile_run())
+@settings(max_examples=150, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+def test_fuzz_hostile_datagrams_beside_a_real_device(run: tuple[list[tuple[bytes, int]], list[int]]) -> None:
+    datagrams, sent = run
+    got: list[tuple[int | None, int]] = []
+    port = SubjectPort(_Receiver(), SUBJECT, EXTENT,  # type: ignore[arg-type]
+                       lambda payload, src, tid, stamp: got.append((src, tid)))
+    for data, ns in datagrams:
+        port.feed(data, ns)
+        assert port.partial_transfers <= MAX_SLOTS
+    assert [tid for src, tid in got if src == _DEVICE and tid in sent] == sent  # nothing of the device lost
+    # every datagram counted once: a frame (anonymous ones too: their refusals are counted on top), own, or refused
+    refused = sum(n for k, n in port.refused.items() if k not in (ANONYMOUS_MULTIFRAME, ANONYMOUS_INTEGRITY))
+    assert port.frames + port.own_frames + refused == len(datagrams)
+    assert port.errors == sum(port.refused.values()) + sum(
+        sum(e.values()) for e in port.errors_per_source.values())
+    # after the junk and a transfer-id timeout, good transfers from every source are taken again
+    ns = datagrams[-1][1] + 2_500_000_000
+    got.clear()
+    for i, src in enumerate((11, 12, 13, _DEVICE)):
+        for d in _transfer(bytes(range(60)), mtu=40 if i % 2 else 1200, src=src, tid=i):
+            port.feed(d, ns)
+    assert got == [(11, 0), (12, 1), (13, 2), (_DEVICE, 3)]
