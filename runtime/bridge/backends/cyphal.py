@@ -252,6 +252,7 @@ class CyphalBackend(Backend):
         self._hb_sub: Any = None  # a pycyphal Subscriber, or on Cyphal/UDP the heartbeat's port of the loop receiver
         self._loop_rx: Any = None  # on Cyphal/UDP: the transport's UDPLoopReceiver
         self._overflows_seen = 0
+        self._not_subscribed_seen = 0
         self._suspect: str | None = None
         self._modulo = 2**64
         self._poll_lock = threading.Lock()
@@ -378,7 +379,7 @@ class CyphalBackend(Backend):
             node.close()
             raise
         self._node = node
-        self._loop_rx, self._overflows_seen = loop_rx, 0
+        self._loop_rx, self._overflows_seen, self._not_subscribed_seen = loop_rx, 0, 0
         self._suspect = None
 
     async def close(self) -> None:
@@ -450,6 +451,11 @@ class CyphalBackend(Backend):
                 self._errors["cyphal.udp_rx_overflow"] += delta
                 self._rlog.note(("cyphal", "udp_rx_overflow"), logging.WARNING,
                                 "%d datagrams dropped by the kernel (receive buffer full)", delta, count=delta)
+            if loop_rx is not None and loop_rx.not_subscribed > self._not_subscribed_seen:
+                # Datagrams to the port for no subscribed subject (unicast, stray groups): counted (issue 29)
+                delta = loop_rx.not_subscribed - self._not_subscribed_seen
+                self._not_subscribed_seen = loop_rx.not_subscribed
+                self._errors["cyphal.udp_not_subscribed"] += delta
             for sub in self._subs:
                 subscriber = sub.subscriber
                 if subscriber is None:

@@ -249,8 +249,8 @@ def test_transfer_crc_missing_frames_duplicates_and_transfer_ids() -> None:
         "MULTIFRAME_EMPTY_FRAME": 1, "MULTIFRAME_EOT_MISPLACED": 1, "MULTIFRAME_EOT_INCONSISTENT": 1}
     assert [t[:3] for t in got.transfers] == [(payload, 11, 11), (b"dup", 11, 12)]
     # 10's slot and the two unfinished ones (31, 32) end after the transfer-id timeout, counted
-    late = _timed([_frame(b"x", tid=40, index=0, eot=False)], [3.0])
-    got = _with_port(_timed(dgs) + [(late[0][0], _timed(dgs)[-1][1] + late[0][1] - T0_NS)])
+    timed = _timed(dgs)
+    got = _with_port([*timed, (_frame(b"x", tid=40, index=0, eot=False), timed[-1][1] + 3_000_000_000)])
     errs = got.stats.reassembly_errors_per_source_node_id[11]
     assert errs["TRANSFER_EXPIRED"] == 3
 
