@@ -269,6 +269,8 @@ class SubjectPort:
             elif not self._take(st, tid, now_ns):
                 self._error(src, _UNEXPECTED_TID)
                 return
+            if st.slots and st.tid == tid + 1:
+                self._superseded(st, tid)
             self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], src, tid, now_ns)
             return
         self._reassemble(src, tid, index, index_eot >= _EOT, data[_HEADER_SIZE:], now_ns)
@@ -281,7 +283,8 @@ class SubjectPort:
         elapsed = now_ns - st.ts_ns
         if tid >= st.tid:
             if tid - st.tid > JUMP_SLACK and tid - st.tid > JUMP_SLACK + elapsed // _NS_PER_PLAUSIBLE_TID and \
-                    elapsed <= self.transfer_id_timeout_ns:
+                    elapsed <= self.transfer_id_timeout_ns and \
+                    getattr(self._receiver, "last_overflow_ns", 0) < st.ts_ns:  # (a kernel drop explains a gap)
                 return True  # delivered, the state kept
         elif elapsed <= self.transfer_id_timeout_ns:
             return False  # a duplicate, or a transfer id that went back (pycyphal: UNEXPECTED_TRANSFER_ID)
@@ -352,7 +355,15 @@ class SubjectPort:
         elif not self._take(st, tid, slot.ts_ns):
             self._error(src, _UNEXPECTED_TID)
             return
+        if st.slots and st.tid == tid + 1:
+            self._superseded(st, tid)
         self._deliver(whole[:-_CRC_SIZE], src, tid, slot.ts_ns)
+
+    def _superseded(self, st: _Source, tid: int) -> None:
+        """The source's transfer ``tid`` was taken: its unfinished older ones can no longer be (pycyphal counts
+        them as missing frames when the next transfer starts)."""
+        for slot in [s for s in st.slots if s.tid < tid]:
+            self._discard(slot, _MISSING_FRAMES)
 
     def _discard(self, slot: _Slot, error: str | None) -> None:
         del self._slots[slot.key]
@@ -396,6 +407,9 @@ class UDPLoopReceiver:
         self.local_node_id = local_node_id
         self.overflows = 0  # datagrams the kernel dropped (receive buffer full): SO_RXQ_OVFL
         self.not_subscribed = 0  # datagrams read for no subscribed subject (the ports count the rest)
+        # When the kernel last dropped datagrams (monotonic ns; 0: never): a gap in a source's transfer ids across
+        # it is a loss, however far ahead (SubjectPort._take)
+        self.last_overflow_ns = 0
         self.failure: str | None = None  # why the socket stopped (the link supervisor reopens the transport)
         self._loop = asyncio.get_running_loop()
         self._ports: dict[bytes, SubjectPort] = {}
@@ -486,6 +500,7 @@ class UDPLoopReceiver:
         if grew:
             self._kernel_drops = total
             self.overflows += grew
+            self.last_overflow_ns = time.monotonic_ns()
 
     def _fail(self, ex: OSError) -> None:
         self.failure = f"Cyphal/UDP receive on {self.local_ip}: {type(ex).__name__}: {ex}"

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import collections
 import logging
+import math
 import os
 import socket
 import threading
@@ -284,6 +285,11 @@ class CyphalBackend(Backend):
     @property
     def transfer_id_modulo(self) -> int:
         return self._modulo
+
+    @property
+    def last_rx_overflow(self) -> float:
+        rx = self._loop_rx
+        return rx.last_overflow_ns * 1e-9 if rx is not None and rx.last_overflow_ns else -math.inf
 
     def suspect(self, reason: str) -> None:
         self._suspect = reason
