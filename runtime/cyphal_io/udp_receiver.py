@@ -108,6 +108,9 @@ NOT_SUBSCRIBED = "NOT_SUBSCRIBED"  # UDPLoopReceiver.refused: a datagram to a gr
 # its fragments until it ends, expires after the transfer-id timeout, or is evicted, oldest first: all counted).
 SLOTS_PER_SOURCE = 4
 MAX_SLOTS = 64
+# Sources whose errors are counted apart (pycyphal's per-source statistics); the errors of further ones are summed
+# by kind (``SubjectPort.unattributed``), so that made-up node ids cannot grow the counters and the reports.
+MAX_ERROR_SOURCES = 32
 _NS_PER_PLAUSIBLE_TID = round(1e9 / MAX_PLAUSIBLE_RATE_HZ)
 
 
@@ -179,6 +182,8 @@ class SubjectPort:
         self.transfers = self.frames = self.errors = self.payload_bytes = 0
         self.own_frames = 0
         self.refused: dict[str, int] = {}  # datagrams no source is blamed for, by kind (in ``errors`` too)
+        # errors of sources beyond the first MAX_ERROR_SOURCES with errors, by kind (in ``errors`` too)
+        self.unattributed: dict[str, int] = {}
         self.errors_per_source: dict[int, dict[str, int]] = {}
         self.handler_failures = 0
         self._sources: dict[int, _Source] = {}
@@ -214,6 +219,8 @@ class SubjectPort:
             transfers=self.transfers, frames=self.frames, payload_bytes=self.payload_bytes, errors=self.errors,
             drops=0, reassembly_errors_per_source_node_id=per_src)
         out.reassembly_errors = dict(list(self.refused.items()))
+        for kind, n in list(self.unattributed.items()):
+            out.reassembly_errors[kind] = out.reassembly_errors.get(kind, 0) + n
         return out
 
     def close(self) -> None:
@@ -323,6 +330,7 @@ class SubjectPort:
                 self._discard(next(iter(slots.values())), TRANSFER_EVICTED)
             slot = slots[(src, tid)] = _Slot(src, tid, now_ns)
             st.slots.append(slot)
+            self._sources[src] = st  # (again: the discards above may have forgotten a source never taken)
         payloads = slot.payloads
         # A frame that contradicts the slot's frames is counted and dropped, the slot kept: it may be a hostile
         # sender's (pycyphal drops the transfer).
@@ -367,7 +375,10 @@ class SubjectPort:
 
     def _discard(self, slot: _Slot, error: str | None) -> None:
         del self._slots[slot.key]
-        self._sources[slot.src].slots.remove(slot)
+        st = self._sources[slot.src]
+        st.slots.remove(slot)
+        if not st.slots and st.tid < 0:  # a source never taken leaves nothing behind (many made-up node ids)
+            del self._sources[slot.src]
         if error is not None:
             self._error(slot.src, error)
 
@@ -379,6 +390,9 @@ class SubjectPort:
         self.errors += 1
         errs = self.errors_per_source.get(src)
         if errs is None:
+            if len(self.errors_per_source) >= MAX_ERROR_SOURCES:  # node ids made up by the thousand: not kept
+                self.unattributed[error] = self.unattributed.get(error, 0) + 1
+                return
             errs = self.errors_per_source[src] = {}
         errs[error] = errs.get(error, 0) + 1
 

@@ -44,6 +44,7 @@ from sam_runtime.cyphal_io.udp_receiver import (
     ANONYMOUS_INTEGRITY,
     ANONYMOUS_MULTIFRAME,
     FRAME_INDEX_LIMIT,
+    MAX_ERROR_SOURCES,
     MAX_FRAME_INDEX,
     MAX_SLOTS,
     WRONG_SUBJECT,
@@ -448,8 +449,9 @@ def test_fuzz_hostile_datagrams_beside_a_real_device(run: tuple[list[tuple[bytes
     # every datagram counted once: a frame (anonymous ones too: their refusals are counted on top), own, or refused
     refused = sum(n for k, n in port.refused.items() if k not in (ANONYMOUS_MULTIFRAME, ANONYMOUS_INTEGRITY))
     assert port.frames + port.own_frames + refused == len(datagrams)
-    assert port.errors == sum(port.refused.values()) + sum(
+    assert port.errors == sum(port.refused.values()) + sum(port.unattributed.values()) + sum(
         sum(e.values()) for e in port.errors_per_source.values())
+    assert len(port.errors_per_source) <= MAX_ERROR_SOURCES
     # after the junk and a transfer-id timeout, good transfers from every source are taken again
     ns = datagrams[-1][1] + 2_500_000_000
     got.clear()
