@@ -316,14 +316,15 @@ class SubjectPort:
             self._error(src, _UNEXPECTED_TID)  # of a transfer taken already, or older
             return
         slots = self._slots
-        # Expiry, oldest first: a transfer whose frames stopped is dropped after the transfer-id timeout.
-        while slots:
-            oldest = next(iter(slots.values()))
-            if now_ns - oldest.born_ns <= self.transfer_id_timeout_ns:
-                break
-            self._discard(oldest, TRANSFER_EXPIRED)
         slot = slots.get((src, tid))
         if slot is None:
+            # Expiry, oldest first, when a slot is made: a transfer whose frames stopped is dropped after the
+            # transfer-id timeout.
+            while slots:
+                oldest = next(iter(slots.values()))
+                if now_ns - oldest.born_ns <= self.transfer_id_timeout_ns:
+                    break
+                self._discard(oldest, TRANSFER_EXPIRED)
             if len(st.slots) >= SLOTS_PER_SOURCE:  # pycyphal: a new transfer id restarts its one slot
                 self._discard(st.slots[0], _MISSING_FRAMES)
             if len(slots) >= MAX_SLOTS:
@@ -353,8 +354,11 @@ class SubjectPort:
         if slot.max_index is None or not all(payloads):
             return
         whole = b"".join(payloads)
-        self._discard(slot, None)
+        del slots[slot.key]
+        st.slots.remove(slot)
         if len(whole) <= _CRC_SIZE or crc32c_register(whole) != CRC32C_RESIDUE:
+            if not st.slots and st.tid < 0:  # a source never taken leaves nothing behind
+                del self._sources[src]
             self._error(src, _INTEGRITY)  # and the source's state stays as it was
             return
         if tid == st.tid:
