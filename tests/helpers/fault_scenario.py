@@ -268,8 +268,10 @@ def _imu_port(bridge: Any) -> Any:
 
 
 def _port_counts(port: Any) -> dict[str, Any]:
-    return {"frames": port.frames, "own_frames": port.own_frames, "refused": dict(port.refused),
-            "errors": port.errors, "partial_transfers": port.partial_transfers}
+    # (getattr: the same scenario measures the receiver before issue 29, which had no refusals or slots to count)
+    return {"frames": port.frames, "own_frames": getattr(port, "own_frames", 0),
+            "refused": dict(getattr(port, "refused", {})), "errors": port.errors,
+            "partial_transfers": getattr(port, "partial_transfers", len(getattr(port, "_sources", ())))}
 
 
 async def main_udp_hostile(args: argparse.Namespace) -> dict[str, Any]:
