@@ -170,7 +170,10 @@ async def _dronecan_scenario(gen: Any, iface: str) -> dict[str, Any]:
             return d["published"] - before["published"] >= DC_STEPS and \
                 bridge.stats()["bridge"]["errors"].get("dronecan.bad_packet", 0) >= counts["junk_packets"]
 
-        await until(settled, 20, "the IMU's transfers published and the junk packets counted")
+        try:  # (on a timeout the test still prints what was counted, then fails on it)
+            await until(settled, 20, "the IMU's transfers published and the junk packets counted")
+        except AssertionError:
+            pass
         await asyncio.sleep(0.3)  # (a hostile frame still in flight would be counted within it; none is expected)
         after = _imu(bridge)
         st1 = bridge.stats()
