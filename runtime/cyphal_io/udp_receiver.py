@@ -17,6 +17,16 @@ most of the bridge's CPU, idle or not. :class:`UDPLoopReceiver` does the same re
   takes a fast path (the state is two numbers), and the payload goes to the handler as bytes, with no frame or
   transfer object between.
 
+Where pycyphal's state machine can be steered by a hostile sender with a device's node id, this one differs on
+purpose (issue 29): only a transfer that passed its CRC moves the source's expected transfer id; a transfer id
+further ahead than the time since the source's last one allows (sam_runtime.common.transfer_ids; unless the
+kernel dropped datagrams meanwhile) is delivered without becoming the expected one (the bridge counts it as a
+jump); each multi-frame transfer has a slot of its own (source, transfer id), which frames of other transfers do
+not end and a contradicting frame does not spoil, at most :data:`SLOTS_PER_SOURCE` per source and :data:`MAX_SLOTS`
+per subject (the oldest evicted), each expiring after the transfer-id timeout. Every datagram is counted: a frame,
+or a refusal by kind (:attr:`SubjectPort.refused`), or the node's own; the receiver counts those to no subscribed
+subject (:attr:`UDPLoopReceiver.not_subscribed`).
+
 Where pycyphal raises instead of counting, the receiver counts: a header with a priority above 7 or a service
 transfer from an anonymous node (pycyphal logs a traceback from its reader thread and counts nothing), and a frame
 index past :data:`MAX_FRAME_INDEX` (pycyphal would grow its fragment list up to the index, 2**31 entries for a

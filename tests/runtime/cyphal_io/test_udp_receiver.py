@@ -7,9 +7,12 @@ the same frames, errors and error kinds per source. The sequences are made with 
 (``UDPFrame.compile_header_and_payload``, ``serialize_transfer``) and broken on purpose: header CRC, version,
 truncation, transfer CRC, duplicated / reordered / missing frames, transfer ids going back, the transfer-id
 timeout, anonymous and interleaved sources, payloads beyond the extent, other subjects' and services' frames, the
-node's own frames. The one difference is deliberate and checked: a datagram that makes pycyphal's parser raise
+node's own frames. The differences are deliberate and checked: a datagram that makes pycyphal's parser raise
 (priority above 7; a service frame from an anonymous node), which pycyphal logs with a traceback from its reader
-thread and counts nowhere, is one more error here.
+thread and counts nowhere, is one more error here, as are the datagrams pycyphal skips uncounted (another
+subject's, anonymous multi-frame or broken ones); and where a hostile sender could steer pycyphal's state (issue
+29: broken CRCs, transfer-id jumps, frames of other transfers, partial transfers from many node ids) this receiver
+keeps the real device's stream, which the fuzz target at the end checks.
 """
 
 from __future__ import annotations
