@@ -84,6 +84,10 @@ reason                 when
 ``coalesced``          ROS -> UAVCAN: likewise for a command
 ``expired``            ROS -> UAVCAN: a command older than the mapping's ``deadline`` when it would have been sent
 ``disabled``           the mapping was disabled (``enabled: false`` in the spec, or its SetBool service)
+``transfer_id_jump``   a transfer whose id is further ahead of its source's previous one than the time between
+                       them allows (issue 29; 64-bit ids): a restart with another counter or a spoof. Not
+                       published, not counted as ``lost``, the source's sequence kept (see :mod:`.loss`)
+``bad_cdr``            ROS -> UAVCAN, wire path: a command whose bytes the generated codec refuses as CDR
 ``lost_link_down``     Cyphal/CAN only, an estimate: transfers of an accepted source missed while the bridge's
                        own Cyphal link was down (see :mod:`.loss`: the transfer-id gap modulo 32 plus the
                        multiple of 32 closest to the source's rate x the time without data)

@@ -29,6 +29,7 @@ without the core declaring anything again.
 from __future__ import annotations
 
 import abc
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -180,6 +181,13 @@ class Backend(abc.ABC):
     @abc.abstractmethod
     def transfer_id_modulo(self) -> int:
         """Transfer ids of a source wrap at this value (Cyphal/UDP 2**64, Cyphal/CAN and DroneCAN 32)."""
+
+    @property
+    def last_rx_overflow(self) -> float:
+        """When (monotonic s) the kernel last dropped received frames for a full buffer, as far as the stack can
+        tell (-inf: never, or it cannot tell). A transfer-id gap across such a drop is a loss however large
+        (:mod:`.loss`)."""
+        return -math.inf
 
     def poll_statistics(self) -> None:  # noqa: B027  (optional: a stack without counters has nothing to poll)
         """Bring every inlet's ``below`` up to date (thread-safe; logs what was discarded at a bounded rate)."""

@@ -216,7 +216,8 @@ class Bridge:
 
         def loss(port_id: int) -> TransferLoss:
             return TransferLoss(port_id, rates, lambda: backend.transfer_id_modulo, health.uptime_of,
-                                lambda: link.outage_windows, self._forget_stamps)
+                                lambda: link.outage_windows, self._forget_stamps,
+                                last_overflow=lambda: backend.last_rx_overflow)
 
         self.inbound = inbound = Inbound(lifetime, in_groups(self.gen, convert, self.counters, loss, sel.mappings,
                                                              codec), self.ros, backend)

@@ -22,8 +22,9 @@ __all__ = ["DEFAULT_LOG_INTERVAL_S", "DROP_REASONS", "INTENDED_DROPS", "MappingS
 log = logging.getLogger("sam_runtime.bridge")
 
 DEFAULT_LOG_INTERVAL_S = DEFAULT_INTERVAL_S
-DROP_REASONS = ("unknown_source", "rejected", "convert_error", "handler_error", "publish_error", "not_sent",
-                "not_a_number", "queue_full", "link_down", "shutdown", "lost", "lost_link_down", "unselected",
+DROP_REASONS = ("unknown_source", "rejected", "convert_error", "bad_cdr", "handler_error", "publish_error",
+                "not_sent", "not_a_number", "queue_full", "link_down", "shutdown", "lost", "lost_link_down",
+                "transfer_id_jump", "unselected",
                 "rate_limited", "coalesced", "expired", "disabled")
 # Drops the spec asked for (max_rate_hz, a disabled mapping): counted like the others, but no sign of trouble, so
 # they do not make the mapping WARN on /diagnostics (an expired command does: it waited too long somewhere).

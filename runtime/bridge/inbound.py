@@ -5,6 +5,8 @@ thread-safe).
 
 Several mappings may share one port (one subscription): each gets every transfer and counts it. Drops per mapping:
 ``unknown_source``, ``lost`` / ``lost_link_down`` (counted when the next transfer of the source arrives),
+``transfer_id_jump`` (a transfer id further ahead than the time since the source's last transfer allows: a restart
+or a spoof, see :mod:`.loss`; the transfer is not published),
 ``convert_error``, ``rejected``, ``publish_error``, ``handler_error`` (a bug in this path; never raised into the
 backend's receive loop), ``unselected`` (DroneCAN: a broadcast from an accepted device that no mapping of the port
 selects, e.g. an esc.Status with an ESC index no mapping reads; counted on the first mapping accepting the device).
@@ -42,7 +44,7 @@ from typing import Any
 from sam_runtime.bridge.backend import Backend, Inlet
 from sam_runtime.bridge.counters import MappingStats, count_handler_error, count_superseded
 from sam_runtime.bridge.lifetime import Lifetime
-from sam_runtime.bridge.loss import TransferLoss
+from sam_runtime.bridge.loss import JUMP, TransferLoss
 from sam_runtime.bridge.rate_limit import Pacer
 from sam_runtime.bridge.switches import MappingSwitch
 
@@ -257,7 +259,7 @@ class Inbound:
         st = im.stats
         if lost or lost_est or error is not None or out is None or out is _DISABLED:
             self._account_drops(im, src, tid, lost, lost_est, out, error)
-            if error is not None or out is None or out is _DISABLED:
+            if error is not None or out is None or out is _DISABLED or lost == JUMP:
                 return
             received = True  # (counted with the drops)
         else:
@@ -299,6 +301,11 @@ class Inbound:
         failed or rejected."""
         rlog, st, name = self.lifetime.rlog, im.stats, im.info.name
         st.receive()
+        if lost == JUMP:  # a restart with another counter, or a spoof: not published, and no loss (see .loss)
+            st.drop("transfer_id_jump")
+            rlog.note((name, "transfer_id_jump"), logging.WARNING, "node %s: transfer id %d is further ahead than "
+                      "the time since its previous transfer allows (a restart or a spoof): dropped", src, tid)
+            return
         if lost:
             st.drop("lost", lost)
             rlog.note((name, "lost"), logging.WARNING, "%d transfers from node %s never arrived "

@@ -138,6 +138,17 @@ class Outbound:
                 continue
             try:
                 obj = om.to_uavcan(msg, st)
+            except ValueError as ex:
+                if not om.raw:
+                    st.drop("convert_error")
+                    rlog.note((om.info.name, "convert_error"), logging.ERROR, "conversion failed: %s: %s",
+                              type(ex).__name__, ex)
+                    continue
+                # the wire codec refused the CDR bytes (a WireError: truncated, not plain CDR, a bound exceeded):
+                # bad input from the ROS side, not a bug (issue 29)
+                st.drop("bad_cdr")
+                rlog.note((om.info.name, "bad_cdr"), logging.WARNING, "a command that is not valid CDR: %s", ex)
+                continue
             except Exception as ex:
                 st.drop("convert_error")
                 rlog.note((om.info.name, "convert_error"), logging.ERROR, "conversion failed: %s: %s",

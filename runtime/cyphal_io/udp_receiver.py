@@ -17,6 +17,16 @@ most of the bridge's CPU, idle or not. :class:`UDPLoopReceiver` does the same re
   takes a fast path (the state is two numbers), and the payload goes to the handler as bytes, with no frame or
   transfer object between.
 
+Where pycyphal's state machine can be steered by a hostile sender with a device's node id, this one differs on
+purpose (issue 29): only a transfer that passed its CRC moves the source's expected transfer id; a transfer id
+further ahead than the time since the source's last one allows (sam_runtime.common.transfer_ids; unless the
+kernel dropped datagrams meanwhile) is delivered without becoming the expected one (the bridge counts it as a
+jump); each multi-frame transfer has a slot of its own (source, transfer id), which frames of other transfers do
+not end and a contradicting frame does not spoil, at most :data:`SLOTS_PER_SOURCE` per source and :data:`MAX_SLOTS`
+per subject (the oldest evicted), each expiring after the transfer-id timeout. Every datagram is counted: a frame,
+or a refusal by kind (:attr:`SubjectPort.refused`), or the node's own; the receiver counts those to no subscribed
+subject (:attr:`UDPLoopReceiver.not_subscribed`).
+
 Where pycyphal raises instead of counting, the receiver counts: a header with a priority above 7 or a service
 transfer from an anonymous node (pycyphal logs a traceback from its reader thread and counts nothing), and a frame
 index past :data:`MAX_FRAME_INDEX` (pycyphal would grow its fragment list up to the index, 2**31 entries for a
@@ -44,6 +54,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from sam_runtime.common.transfer_ids import JUMP_SLACK, MAX_PLAUSIBLE_RATE_HZ
 from sam_runtime.cyphal_io.crc32c import RESIDUE as CRC32C_RESIDUE
 from sam_runtime.cyphal_io.crc32c import crc32c_register
 
@@ -89,6 +100,28 @@ _EMPTY_FRAME = "MULTIFRAME_EMPTY_FRAME"
 _EOT_MISPLACED = "MULTIFRAME_EOT_MISPLACED"
 _EOT_INCONSISTENT = "MULTIFRAME_EOT_INCONSISTENT"
 FRAME_INDEX_LIMIT = "FRAME_INDEX_LIMIT"  # not pycyphal's (see the module's docstring)
+# Not pycyphal's either (issue 29): partial transfers dropped for their age or for room; and the datagrams refused
+# before a source can be trusted (``SubjectPort.refused``; pycyphal counts the first three as errors, the others not).
+TRANSFER_EXPIRED = "TRANSFER_EXPIRED"
+TRANSFER_EVICTED = "TRANSFER_EVICTED"
+TRUNCATED = "TRUNCATED_HEADER"
+HEADER_CRC = "HEADER_CRC"
+HEADER_VERSION = "HEADER_VERSION"
+BAD_PRIORITY = "BAD_PRIORITY"
+ANONYMOUS_SERVICE = "ANONYMOUS_SERVICE"
+WRONG_SUBJECT = "WRONG_SUBJECT"
+ANONYMOUS_MULTIFRAME = "ANONYMOUS_MULTIFRAME"
+ANONYMOUS_INTEGRITY = "ANONYMOUS_INTEGRITY"
+NOT_SUBSCRIBED = "NOT_SUBSCRIBED"  # UDPLoopReceiver.refused: a datagram to a group no port subscribed (or unicast)
+# Reassembly bounds: a source has one transfer in flight per subject (a few while frames are late); the slots of a
+# subject, every source's, are capped so that partial transfers from many node ids cannot grow memory (each holds
+# its fragments until it ends, expires after the transfer-id timeout, or is evicted, oldest first: all counted).
+SLOTS_PER_SOURCE = 4
+MAX_SLOTS = 64
+# Sources whose errors are counted apart (pycyphal's per-source statistics); the errors of further ones are summed
+# by kind (``SubjectPort.unattributed``), so that made-up node ids cannot grow the counters and the reports.
+MAX_ERROR_SOURCES = 32
+_NS_PER_PLAUSIBLE_TID = round(1e9 / MAX_PLAUSIBLE_RATE_HZ)
 
 
 def subject_group(subject_id: int) -> bytes:
@@ -112,24 +145,41 @@ def single_frame_datagram(source_node_id: int | None, subject_id: int, transfer_
 
 
 class _Source:
-    """One source node's state: pycyphal's TransferReassembler in plain slots. ``ts_ns``: monotonic time of the
-    last first frame (the transfer's timestamp, and the reference of the transfer-id timeout); ``payloads``: the
-    fragments of the transfer being reassembled (empty bytes: not received yet)."""
+    """One source node's accepted state: ``tid`` the transfer id expected next (the last accepted one + 1),
+    ``ts_ns`` the monotonic time of the last accepted transfer (the reference of the transfer-id timeout and of
+    the plausible jump), ``slots`` its transfers being reassembled (oldest first, at most :data:`SLOTS_PER_SOURCE`).
+    Only a transfer that passed its CRC changes ``tid`` and ``ts_ns`` (issue 29)."""
 
-    __slots__ = ("max_index", "payloads", "tid", "ts_ns")
+    __slots__ = ("slots", "tid", "ts_ns")
 
     def __init__(self) -> None:
-        self.tid = 0
+        self.tid = -1  # nothing accepted yet: any transfer id is taken
         self.ts_ns = 0
+        self.slots: list[_Slot] = []
+
+
+class _Slot:
+    """One multi-frame transfer being reassembled: its fragments (empty bytes: not received yet), the index of its
+    last frame once known, the time of its first frame (the transfer's timestamp) and of its creation (expiry)."""
+
+    __slots__ = ("born_ns", "key", "max_index", "payloads", "src", "tid", "ts_ns")
+
+    def __init__(self, src: int, tid: int, now_ns: int) -> None:
+        self.src, self.tid, self.key = src, tid, (src, tid)
         self.payloads: list[bytes] = []
         self.max_index: int | None = None
+        self.ts_ns = self.born_ns = now_ns
 
 
 class SubjectPort:
     """One subscribed subject: its handler, its per-source states and pycyphal's counters of an input session.
 
     ``specifier`` and ``payload_metadata`` as a pycyphal input session's (so the node's ``uavcan.node.port.List``
-    lists the subject); :meth:`sample_statistics` gives pycyphal's ``PromiscuousUDPInputSessionStatistics``."""
+    lists the subject); :meth:`sample_statistics` gives pycyphal's ``PromiscuousUDPInputSessionStatistics``, with
+    ``reassembly_errors`` (kind -> count) added for the datagrams refused before any source could be trusted.
+
+    Every datagram fed is counted once: ``frames`` (it reached a source's state machine: anonymous ones too), a
+    kind of :attr:`refused` (also in ``errors``), or ``own_frames`` (this node's own, looped back)."""
 
     def __init__(self, receiver: UDPLoopReceiver, subject_id: int, extent_bytes: int, handler: Handler) -> None:
         from pycyphal.transport import InputSessionSpecifier, MessageDataSpecifier, PayloadMetadata
@@ -140,9 +190,14 @@ class SubjectPort:
         self.handler = handler
         self.transfer_id_timeout_ns = round(TRANSFER_ID_TIMEOUT_S * 1e9)
         self.transfers = self.frames = self.errors = self.payload_bytes = 0
+        self.own_frames = 0
+        self.refused: dict[str, int] = {}  # datagrams no source is blamed for, by kind (in ``errors`` too)
+        # errors of sources beyond the first MAX_ERROR_SOURCES with errors, by kind (in ``errors`` too)
+        self.unattributed: dict[str, int] = {}
         self.errors_per_source: dict[int, dict[str, int]] = {}
         self.handler_failures = 0
         self._sources: dict[int, _Source] = {}
+        self._slots: dict[tuple[int, int], _Slot] = {}  # every source's, oldest first (expiry, the cap)
         self._receiver: UDPLoopReceiver | None = receiver
         self._local_node_id = receiver.local_node_id
 
@@ -156,18 +211,27 @@ class SubjectPort:
             raise ValueError(f"Invalid value for transfer-ID timeout [second]: {value}")
         self.transfer_id_timeout_ns = round(value * 1e9)
 
+    @property
+    def partial_transfers(self) -> int:
+        """Multi-frame transfers being reassembled now (at most :data:`MAX_SLOTS`)."""
+        return len(self._slots)
+
     def sample_statistics(self) -> Any:
-        """pycyphal's PromiscuousUDPInputSessionStatistics, its error kinds TransferReassembler.Error members."""
+        """pycyphal's PromiscuousUDPInputSessionStatistics, its error kinds TransferReassembler.Error members
+        (or this module's names for the kinds pycyphal has not), plus ``reassembly_errors``."""
         from pycyphal.transport.commons.high_overhead_transport import TransferReassembler
-        from pycyphal.transport.udp import PromiscuousUDPInputSessionStatistics
 
         kinds = TransferReassembler.Error.__members__
         # Copies built from atomic dict copies: another thread may sample while the loop counts.
         per_src: dict[int, dict[Any, int]] = {src: {kinds.get(k, k): n for k, n in list(errs.items())}
                                               for src, errs in list(self.errors_per_source.items())}
-        return PromiscuousUDPInputSessionStatistics(
+        out = _statistics_class()(
             transfers=self.transfers, frames=self.frames, payload_bytes=self.payload_bytes, errors=self.errors,
             drops=0, reassembly_errors_per_source_node_id=per_src)
+        out.reassembly_errors = dict(list(self.refused.items()))
+        for kind, n in list(self.unattributed.items()):
+            out.reassembly_errors[kind] = out.reassembly_errors.get(kind, 0) + n
+        return out
 
     def close(self) -> None:
         receiver, self._receiver = self._receiver, None
@@ -179,98 +243,171 @@ class SubjectPort:
         """One datagram that came to this subject's group (pycyphal: ``UDPFrame.parse`` in the reader thread,
         then ``UDPInputSession.receive`` on the loop)."""
         if len(data) < _HEADER.size:
-            self.errors += 1  # pycyphal: parse() -> None, counted by receive()
+            self._refuse(TRUNCATED)  # pycyphal: parse() -> None, counted by receive()
             return
         version, prio, src, _dst, dsn, tid, index_eot, _user = _HEADER.unpack_from(data)
         # The header CRC: CRC-16/CCITT-FALSE (pycyphal's CRC16CCITT) is binascii's CRC-CCITT from 0xFFFF; the
         # residue of a header with its big-endian CRC is 0 (over what there is of the 24 bytes, as pycyphal).
-        if version != _VERSION or binascii.crc_hqx(data[:_HEADER_SIZE], 0xFFFF):
-            self.errors += 1
+        if binascii.crc_hqx(data[:_HEADER_SIZE], 0xFFFF):
+            self._refuse(HEADER_CRC)
             return
-        if prio > 7 or (dsn & _SNM and src == _ANONYMOUS):
-            self.errors += 1  # pycyphal raises in parse() (Priority(), UDPFrame.__post_init__): see the docstring
+        if version != _VERSION:
+            self._refuse(HEADER_VERSION)
+            return
+        if prio > 7:
+            self._refuse(BAD_PRIORITY)  # pycyphal raises in parse() (Priority()): see the module's docstring
             return
         if dsn != self.subject_id:  # a service frame, or another subject's (pycyphal: skipped, not counted)
+            self._refuse(ANONYMOUS_SERVICE if dsn & _SNM and src == _ANONYMOUS else WRONG_SUBJECT)
             return
         if src == self._local_node_id:  # our own publication looped back (pycyphal: skipped, not counted)
+            self.own_frames += 1
             return
         self.frames += 1
         index = index_eot & _INDEX_MASK
-        eot = index_eot >= _EOT
-        if src == _ANONYMOUS:  # TransferReassembler.construct_anonymous_transfer: stateless, no error counted
-            if index == 0 and eot and len(data) > _HEADER_SIZE + _CRC_SIZE and \
+        if src == _ANONYMOUS:  # TransferReassembler.construct_anonymous_transfer: stateless
+            if index == 0 and index_eot >= _EOT and len(data) > _HEADER_SIZE + _CRC_SIZE and \
                     crc32c_register(data[_HEADER_SIZE:]) == CRC32C_RESIDUE:
                 self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], None, tid, now_ns)
+            else:  # pycyphal drops these uncounted
+                self._refuse(ANONYMOUS_MULTIFRAME if index or index_eot < _EOT else ANONYMOUS_INTEGRITY)
             return
-        st = self._sources.get(src)
-        if st is None:
-            st = self._sources[src] = _Source()
-            self.errors_per_source.setdefault(src, {})
-        if index == 0 and eot and not st.payloads:
-            # The fast path: a single-frame transfer with nothing pending (process_frame's steps, in order).
-            if tid > st.tid or (tid != st.tid and now_ns - st.ts_ns > self.transfer_id_timeout_ns):
-                st.tid = tid  # a restart with nothing to discard: no error
-            if tid != st.tid:
+        if index == 0 and index_eot >= _EOT:
+            # A single-frame transfer: its CRC first, so that a broken one changes nothing (issue 29).
+            if len(data) < _HEADER_SIZE + _CRC_SIZE or crc32c_register(data[_HEADER_SIZE:]) != CRC32C_RESIDUE:
+                self._error(src, _INTEGRITY)
+                return
+            st = self._sources.get(src)
+            if st is None:
+                st = self._sources[src] = _Source()
+            if tid == st.tid:  # the next one
+                st.tid = tid + 1
+                st.ts_ns = now_ns
+            elif not self._take(st, tid, now_ns):
                 self._error(src, _UNEXPECTED_TID)
                 return
-            st.ts_ns = now_ns
-            st.tid = tid + 1
-            if len(data) >= _HEADER_SIZE + _CRC_SIZE and \
-                    crc32c_register(data[_HEADER_SIZE:]) == CRC32C_RESIDUE:
-                self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], src, tid, now_ns)
-            else:
-                self._error(src, _INTEGRITY)
+            if st.slots and st.tid == tid + 1:
+                self._superseded(st, tid)
+            self._deliver(data[_HEADER_SIZE:-_CRC_SIZE], src, tid, now_ns)
             return
-        self._reassemble(st, src, tid, index, eot, data[_HEADER_SIZE:], now_ns)
+        self._reassemble(src, tid, index, index_eot >= _EOT, data[_HEADER_SIZE:], now_ns)
 
-    def _reassemble(self, st: _Source, src: int, tid: int, index: int, eot: bool, payload: bytes,
-                    now_ns: int) -> None:
-        """TransferReassembler.process_frame, step by step."""
-        if not (index == 0 and eot) and not payload:
+    def _take(self, st: _Source, tid: int, now_ns: int) -> bool:
+        """Whether a whole transfer ``tid`` from the source of ``st`` is delivered (a duplicate or an old one is
+        not, within the transfer-id timeout); its id becomes the source's expected one unless it jumped further
+        ahead than the time since the last one allows (:func:`sam_runtime.common.transfer_ids.plausible_gap`):
+        that one is delivered (the bridge counts it as a jump) and the real device's next transfer still taken."""
+        elapsed = now_ns - st.ts_ns
+        if tid >= st.tid:
+            if tid - st.tid > JUMP_SLACK and tid - st.tid > JUMP_SLACK + elapsed // _NS_PER_PLAUSIBLE_TID and \
+                    elapsed <= self.transfer_id_timeout_ns and \
+                    getattr(self._receiver, "last_overflow_ns", 0) < st.ts_ns:  # (a kernel drop explains a gap)
+                return True  # delivered, the state kept
+        elif elapsed <= self.transfer_id_timeout_ns:
+            return False  # a duplicate, or a transfer id that went back (pycyphal: UNEXPECTED_TRANSFER_ID)
+        st.tid = tid + 1
+        st.ts_ns = now_ns
+        return True
+
+    def _reassemble(self, src: int, tid: int, index: int, eot: bool, payload: bytes, now_ns: int) -> None:
+        """A frame of a multi-frame transfer: into the slot of (source, transfer id). A slot is a transfer's own:
+        frames of other transfer ids (a hostile sender's) neither restart nor end it, and only a whole transfer
+        that passed its CRC moves the source's expected transfer id."""
+        if not payload:
             self._error(src, _EMPTY_FRAME)
             return
         if index > MAX_FRAME_INDEX:
             self._error(src, FRAME_INDEX_LIMIT)
             return
-        if tid > st.tid or (index == 0 and tid != st.tid and now_ns - st.ts_ns > self.transfer_id_timeout_ns):
-            self._restart(st, src, tid, _MISSING_FRAMES if st.payloads else None)
-        if tid != st.tid:
-            self._error(src, _UNEXPECTED_TID)
+        st = self._sources.get(src)
+        if st is None:
+            st = self._sources[src] = _Source()
+        elif tid < st.tid and now_ns - st.ts_ns <= self.transfer_id_timeout_ns:
+            self._error(src, _UNEXPECTED_TID)  # of a transfer taken already, or older
             return
-        payloads = st.payloads
+        slots = self._slots
+        slot = slots.get((src, tid))
+        if slot is None:
+            # Expiry, oldest first, when a slot is made: a transfer whose frames stopped is dropped after the
+            # transfer-id timeout.
+            while slots:
+                oldest = next(iter(slots.values()))
+                if now_ns - oldest.born_ns <= self.transfer_id_timeout_ns:
+                    break
+                self._discard(oldest, TRANSFER_EXPIRED)
+            if len(st.slots) >= SLOTS_PER_SOURCE:  # pycyphal: a new transfer id restarts its one slot
+                self._discard(st.slots[0], _MISSING_FRAMES)
+            if len(slots) >= MAX_SLOTS:
+                self._discard(next(iter(slots.values())), TRANSFER_EVICTED)
+            slot = slots[(src, tid)] = _Slot(src, tid, now_ns)
+            st.slots.append(slot)
+            self._sources[src] = st  # (again: the discards above may have forgotten a source never taken)
+        payloads = slot.payloads
+        # A frame that contradicts the slot's frames is counted and dropped, the slot kept: it may be a hostile
+        # sender's (pycyphal drops the transfer).
         if eot:
-            if st.max_index is not None and st.max_index != index:
-                self._restart(st, src, tid + 1, _EOT_INCONSISTENT)
+            if slot.max_index is not None and slot.max_index != index:
+                self._error(src, _EOT_INCONSISTENT)
                 return
-            st.max_index = index
-        if st.max_index is not None and max(index, len(payloads) - 1) > st.max_index:
-            self._restart(st, src, tid + 1, _EOT_MISPLACED)
+            if len(payloads) - 1 > index:
+                self._error(src, _EOT_MISPLACED)
+                return
+            slot.max_index = index
+        elif slot.max_index is not None and index >= slot.max_index:
+            self._error(src, _EOT_MISPLACED)
             return
         if index == 0:
-            st.ts_ns = now_ns
+            slot.ts_ns = now_ns
         while len(payloads) <= index:
             payloads.append(b"")
         payloads[index] = payload
-        if st.max_index is None or (st.max_index > 0 and not all(payloads)):
+        if slot.max_index is None or not all(payloads):
             return
         whole = b"".join(payloads)
-        size_ok = len(whole) > _CRC_SIZE if len(payloads) > 1 else len(whole) >= _CRC_SIZE
-        ok = size_ok and crc32c_register(whole) == CRC32C_RESIDUE
-        stamp_ns = st.ts_ns
-        self._restart(st, src, tid + 1, None if ok else _INTEGRITY)
-        if ok:
-            self._deliver(whole[:-_CRC_SIZE], src, tid, stamp_ns)
+        del slots[slot.key]
+        st.slots.remove(slot)
+        if len(whole) <= _CRC_SIZE or crc32c_register(whole) != CRC32C_RESIDUE:
+            if not st.slots and st.tid < 0:  # a source never taken leaves nothing behind
+                del self._sources[src]
+            self._error(src, _INTEGRITY)  # and the source's state stays as it was
+            return
+        if tid == st.tid:
+            st.tid = tid + 1
+            st.ts_ns = slot.ts_ns
+        elif not self._take(st, tid, slot.ts_ns):
+            self._error(src, _UNEXPECTED_TID)
+            return
+        if st.slots and st.tid == tid + 1:
+            self._superseded(st, tid)
+        self._deliver(whole[:-_CRC_SIZE], src, tid, slot.ts_ns)
 
-    def _restart(self, st: _Source, src: int, tid: int, error: str | None) -> None:
+    def _superseded(self, st: _Source, tid: int) -> None:
+        """The source's transfer ``tid`` was taken: its unfinished older ones can no longer be (pycyphal counts
+        them as missing frames when the next transfer starts)."""
+        for slot in [s for s in st.slots if s.tid < tid]:
+            self._discard(slot, _MISSING_FRAMES)
+
+    def _discard(self, slot: _Slot, error: str | None) -> None:
+        del self._slots[slot.key]
+        st = self._sources[slot.src]
+        st.slots.remove(slot)
+        if not st.slots and st.tid < 0:  # a source never taken leaves nothing behind (many made-up node ids)
+            del self._sources[slot.src]
         if error is not None:
-            self._error(src, error)
-        st.tid = tid
-        st.max_index = None
-        st.payloads = []
+            self._error(slot.src, error)
+
+    def _refuse(self, kind: str) -> None:
+        self.errors += 1
+        self.refused[kind] = self.refused.get(kind, 0) + 1
 
     def _error(self, src: int, error: str) -> None:
         self.errors += 1
-        errs = self.errors_per_source[src]
+        errs = self.errors_per_source.get(src)
+        if errs is None:
+            if len(self.errors_per_source) >= MAX_ERROR_SOURCES:  # node ids made up by the thousand: not kept
+                self.unattributed[error] = self.unattributed.get(error, 0) + 1
+                return
+            errs = self.errors_per_source[src] = {}
         errs[error] = errs.get(error, 0) + 1
 
     def _deliver(self, payload: bytes, src: int | None, tid: int, stamp_ns: int) -> None:
@@ -297,6 +434,10 @@ class UDPLoopReceiver:
         self.local_ip = str(local_ip)
         self.local_node_id = local_node_id
         self.overflows = 0  # datagrams the kernel dropped (receive buffer full): SO_RXQ_OVFL
+        self.not_subscribed = 0  # datagrams read for no subscribed subject (the ports count the rest)
+        # When the kernel last dropped datagrams (monotonic ns; 0: never): a gap in a source's transfer ids across
+        # it is a loss, however far ahead (SubjectPort._take)
+        self.last_overflow_ns = 0
         self.failure: str | None = None  # why the socket stopped (the link supervisor reopens the transport)
         self._loop = asyncio.get_running_loop()
         self._ports: dict[bytes, SubjectPort] = {}
@@ -376,8 +517,10 @@ class UDPLoopReceiver:
                 elif kind == _SO_RXQ_OVFL and level == _SOL_SOCKET:
                     self._note_kernel_drops(int.from_bytes(cdata[:4], sys.byteorder))
             port = ports.get(group)
-            if port is not None:  # else: not a subscribed group (a unicast datagram to the port, a late one)
+            if port is not None:
                 port.feed(data, now)
+            else:  # not a subscribed group (a unicast datagram to the port, a late one): counted, not read further
+                self.not_subscribed += 1
 
     def _note_kernel_drops(self, total: int) -> None:
         # The counter is the socket's total so far (32 bits, wrapping): count what it grew by.
@@ -385,6 +528,7 @@ class UDPLoopReceiver:
         if grew:
             self._kernel_drops = total
             self.overflows += grew
+            self.last_overflow_ns = time.monotonic_ns()
 
     def _fail(self, ex: OSError) -> None:
         self.failure = f"Cyphal/UDP receive on {self.local_ip}: {type(ex).__name__}: {ex}"
@@ -397,6 +541,19 @@ class UDPLoopReceiver:
         subjects = sorted(p.subject_id for p in self._ports.values())
         return f"UDPLoopReceiver({self.local_ip!r}, local_node_id={self.local_node_id}, subjects={subjects})"
 
+
+
+@functools.cache
+def _statistics_class() -> type:
+    from pycyphal.transport.udp import PromiscuousUDPInputSessionStatistics
+
+    class Statistics(PromiscuousUDPInputSessionStatistics):
+        """pycyphal's statistics with ``reassembly_errors``: the errors no source can be blamed for (kind ->
+        count, e.g. a bad header CRC), which the bridge reports as it reports pycyphal's."""
+
+        reassembly_errors: dict[str, int]
+
+    return Statistics
 
 
 def loop_udp_transport(local_ip_address: str, local_node_id: int | None, **kwargs: Any) -> Any:

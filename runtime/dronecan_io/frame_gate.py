@@ -9,7 +9,10 @@ raise a toggle error. :class:`FrameGate` sits between the CAN driver and the nod
   passed on;
 - the frames of a multi-frame v0 transfer are held until its last frame arrives and then passed on together, so
   dronecan never holds a partial transfer; one that does not end within ``transfer_timeout`` (or is restarted by a
-  new first frame with the same CAN id and transfer id) is counted as ``incomplete_transfer``;
+  new first frame with the same CAN id and transfer id after :data:`RESTART_AFTER_S` without a frame) is counted as
+  ``incomplete_transfer``. A frame that cannot be the transfer's next one (its toggle bit, or a first frame while
+  the transfer is live) is counted and dropped alone: frames with a device's node id from another sender must not
+  spoil the device's transfer (issue 29);
 - completed transfers of the data types in :attr:`taps` (the bridge's wire path, :mod:`.wire`) go to their
   handlers as payload bytes instead of to the node;
 - :meth:`limit_batch` bounds how many frames one ``node.spin(0)`` takes, so an event loop stays responsive under a
@@ -37,6 +40,9 @@ __all__ = ["FrameGate"]
 # The largest v0 transfer dronecan can decode is a few hundred bytes (about 50 classic frames); far more than that
 # under one key is a broken sender, not a transfer.
 MAX_FRAMES_PER_TRANSFER = 512
+# A multi-frame transfer whose next frame has not come for this long is abandoned by its sender (its frames are sent
+# back to back), so that a new first frame under its key starts a new transfer; a younger one is kept.
+RESTART_AFTER_S = 0.1
 
 
 @dataclass
@@ -72,6 +78,9 @@ class FrameGate(AbstractDriver):
         self.drained = False
         # The wire path: completed transfers of the tapped data types go to their handlers, not to dronecan.
         self.taps: TransferTaps | None = None
+        # Frames read and not passed on: every one counted under a drop reason (a whole incomplete transfer is one
+        # drop of its reason but all its frames here).
+        self.frames_dropped = 0
 
     def __repr__(self) -> str:
         return f"FrameGate({self.inner!r})"
@@ -141,6 +150,7 @@ class FrameGate(AbstractDriver):
     def _admit(self, frame: CANFrame) -> CANFrame | None:
         """The frame to pass on now, or None (held as part of a transfer, or counted as a drop)."""
         if not frame.extended:
+            self.frames_dropped += 1
             self.drops.add(DropReason.NOT_EXTENDED_ID, detail=f"11-bit frame 0x{frame.id:03x}")
             return None
         data = frame.data
@@ -159,7 +169,13 @@ class FrameGate(AbstractDriver):
                 if not end:
                     self._v1[key] = now
                 return None
-            if key in self._partial:
+            held = self._partial.get(key)
+            if held is not None:
+                if now - held.last_seen <= RESTART_AFTER_S:
+                    # A transfer's frames come back to back: a first frame under the key of a live transfer is
+                    # not the device's (a hostile sender's, issue 29), and must not end the real one.
+                    self._drop(DropReason.FRAME_SEQUENCE_ERROR, frame, "first frame under the key of a live transfer")
+                    return None
                 self._drop_partial(key, "restarted by a new first frame")
             if end:
                 return None if self.taps is not None and self.taps.take([frame]) else frame
@@ -170,6 +186,11 @@ class FrameGate(AbstractDriver):
         now = self._clock()
         partial = self._partial.get(key)
         if partial is not None:
+            if bool(tail & TAIL_TOGGLE) != (len(partial.frames) & 1 == 1):
+                # Not the next frame of the transfer (its toggle bit alternates from 0): a repeat, or another
+                # sender's; dropped alone, so that the transfer's own frames still make it whole (issue 29).
+                self._drop(DropReason.TOGGLE_ERROR, frame, "frame with the wrong toggle bit for its transfer")
+                return None
             partial.frames.append(frame)
             partial.last_seen = now
             if end:
@@ -192,11 +213,13 @@ class FrameGate(AbstractDriver):
         return None
 
     def _drop(self, reason: DropReason, frame: CANFrame, detail: str) -> None:
+        self.frames_dropped += 1
         ident = V0Id.parse(frame.id)
         self.drops.add(reason, data_type_id=ident.data_type_id, source_node_id=ident.source_node_id,
                        detail=f"{detail}: id 0x{frame.id:08x} data {bytes(frame.data).hex()}")
 
     def _drop_partial(self, key: tuple[int, int], why: str) -> None:
         partial = self._partial.pop(key)
+        self.frames_dropped += len(partial.frames) - 1  # (_drop counts one)
         self._drop(DropReason.INCOMPLETE_TRANSFER, partial.frames[0],
                    f"multi-frame transfer {why} after {len(partial.frames)} frames")

@@ -18,6 +18,13 @@ Reads one command per line on stdin, answers one line ``DONE {json}`` per comman
                               [65504, -65504, 0] (float16 limits)
     burst N [RATE_HZ]         N valid transfers from node 11 as fast as possible (or at RATE_HZ), a 0.3 s pause,
                               then 10 more at 100 Hz (so that a loss at the end of the burst shows as a gap)
+    hostile KIND N            N valid RawIMU transfers from node 11 at 100 Hz (the real device), each followed by a
+                              hostile sender's datagrams of KIND (issue 29): bad_crc (3 single-frame transfers with
+                              node 11's id, the next transfer ids, their CRC broken), bad_crc_multi (a 2-frame
+                              transfer with node 11's id and its next transfer id, its CRC broken), header (node
+                              11's next transfer with its header CRC broken), jump (a valid transfer with node 11's
+                              id, its transfer id 2**40 ahead), partials (50 first frames of 2-frame transfers from
+                              distinct node ids, never finished), junk (5 datagrams of random bytes, 3 short ones)
     quit
 The JSON says what was sent: ``{"sent": {"11": n, ...}, "datagrams": n, "rate_hz": r, ...}``.
 """
@@ -197,6 +204,50 @@ class Injector:
         self.valid(10, IMU_NODE, 100.0, stamp_us=0)
         return {"sent": {str(IMU_NODE): n + 10}, "burst": n, "burst_s": round(dt, 4),
                 "burst_rate_hz": round(n / dt) if dt > 0 else None, "trailer": 10}
+    def hostile(self, kind: str, n: int) -> dict[str, Any]:
+        import random
+
+        rnd = random.Random(29)
+        sent, hostile, partial_src = n, 0, 200
+        t0 = time.monotonic()
+        for i in range(n):
+            self.tx.transfer(IMU_NODE, self.payload())
+            nxt = self.tx.next_tid[IMU_NODE]
+            bad: list[bytes] = []
+            if kind == "bad_crc":
+                for tid in (nxt, nxt + 1, nxt + 5):
+                    d = bytearray(self.tx.frames(IMU_NODE, self.payload(), tid)[0])
+                    d[-1] ^= 0x5A
+                    bad.append(bytes(d))
+            elif kind == "bad_crc_multi":
+                frames = self.tx.frames(IMU_NODE, self.payload(), nxt, max_frame_payload=40)
+                last = bytearray(frames[-1])
+                last[-1] ^= 0x5A
+                bad += [*frames[:-1], bytes(last)]
+            elif kind == "header":
+                d = bytearray(self.tx.frames(IMU_NODE, self.payload(), nxt)[0])
+                d[8] ^= 0x01
+                bad.append(bytes(d))
+            elif kind == "jump":
+                bad.append(self.tx.frames(IMU_NODE, self.payload(), nxt + 2**40)[0])
+                sent += 1  # a valid transfer of node 11: the bridge counts it (transfer_id_jump)
+            elif kind == "partials":
+                for _ in range(50):
+                    bad.append(self.tx.frames(partial_src, self.payload(), 0, max_frame_payload=40)[0])
+                    partial_src += 1
+            elif kind == "junk":
+                bad += [rnd.randbytes(rnd.randint(24, 80)) for _ in range(5)]
+                bad += [rnd.randbytes(rnd.randint(0, 21)) for _ in range(3)]
+            else:
+                raise ValueError(f"unknown hostile kind {kind!r}")
+            for d in bad:
+                self.tx.send(d)
+            hostile += len(bad)
+            delay = t0 + (i + 1) / 100.0 - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+        return {"sent": {str(IMU_NODE): sent}, "real": n, "hostile_datagrams": hostile,
+                "partial_sources": partial_src - 200}
 
 
 def main() -> int:
@@ -227,6 +278,8 @@ def main() -> int:
             res = inj.reorder()
         elif op == "stamps":
             res = inj.stamps()
+        elif op == "hostile":
+            res = inj.hostile(rest[0], int(rest[1]))
         elif op == "burst":
             res = inj.burst(int(rest[0]), float(rest[1]) if len(rest) > 1 else 0.0)
         else:

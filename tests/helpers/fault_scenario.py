@@ -255,6 +255,67 @@ async def main_udp(args: argparse.Namespace) -> dict[str, Any]:
     return result
 
 
+def _rss_kb() -> int:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1])
+    return 0
+
+
+def _imu_port(bridge: Any) -> Any:
+    rx = bridge.backend._loop_rx  # the bridge's Cyphal/UDP receiver (a test reads its counters)
+    return next(p for p in rx.ports if p.subject_id == 1100)
+
+
+def _port_counts(port: Any) -> dict[str, Any]:
+    # (getattr: the same scenario measures the receiver before issue 29, which had no refusals or slots to count)
+    return {"frames": port.frames, "own_frames": getattr(port, "own_frames", 0),
+            "refused": dict(getattr(port, "refused", {})), "errors": port.errors,
+            "partial_transfers": getattr(port, "partial_transfers", len(getattr(port, "_sources", ())))}
+
+
+async def main_udp_hostile(args: argparse.Namespace) -> dict[str, Any]:
+    """Issue 29: a hostile sender beside the real IMU (node 11, 100 Hz), one junk kind per phase."""
+    from sam_runtime.bridge import Bridge, TransportConfig
+    from sam_runtime.genpkg import GeneratedPackage
+
+    gen = GeneratedPackage()
+    gen.compile_dsdl()
+    bridge = Bridge(gen, transport=TransportConfig("udp", "127.0.0.1"), log_interval=args.log_interval)
+    await bridge.start()
+    probe = Probe(gen, ["/imu"], [], depth=20000)
+    inj = InjectorProc(gen.root)
+    result: dict[str, Any] = {}
+    try:
+        await wait_for(lambda: probe.node.count_publishers("/imu") > 0
+                       and (bridge.stats()["mappings"]["imu"]["ros_subscribers"] or 0) > 0, 20, "ROS discovery")
+        await asyncio.get_running_loop().run_in_executor(None, inj.expect, "READY")
+        await udp_phase(bridge, probe, inj, "valid 20 11 200")
+        st0 = bridge.stats()
+        phases: dict[str, Any] = {}
+        for kind in args.kinds.split(","):
+            port = _imu_port(bridge)
+            before, rss0 = _port_counts(port), _rss_kb()
+            errors0 = dict(bridge.stats()["bridge"]["errors"])
+            ph = await udp_phase(bridge, probe, inj, f"hostile {kind} {args.steps}")
+            ph["port_before"], ph["port_after"] = before, _port_counts(port)
+            ph["rss_kb"] = [rss0, _rss_kb()]
+            errors1 = bridge.stats()["bridge"]["errors"]
+            ph["bridge_errors"] = {k: v - errors0.get(k, 0) for k, v in errors1.items() if v != errors0.get(k, 0)}
+            phases[kind] = ph
+        result["phases"] = phases
+        st1 = bridge.stats()
+        result["commands_published"] = {
+            name: st1["mappings"][name]["published"] - st0["mappings"][name]["published"]
+            for name, m in st1["mappings"].items() if m["direction"] != "uavcan_to_ros"}
+        result["bridge"] = st1
+    finally:
+        inj.close()
+        probe.close()
+        await bridge.close()
+    return result
+
+
 # ============================================================================================ CAN
 class FaultPlan:
     """What the bridge's CAN interface does now: ``transient`` (send raises ENOBUFS, receive raises a python-can
@@ -798,6 +859,11 @@ def main() -> int:
     u = sub.add_parser("udp")
     u.add_argument("--out", type=Path, required=True)
     u.add_argument("--log-interval", type=float, default=2.0)
+    h = sub.add_parser("udp-hostile")
+    h.add_argument("--out", type=Path, required=True)
+    h.add_argument("--log-interval", type=float, default=2.0)
+    h.add_argument("--kinds", default="bad_crc,bad_crc_multi,header,jump,partials,junk")
+    h.add_argument("--steps", type=int, default=100)
     c = sub.add_parser("can")
     c.add_argument("--iface", required=True)
     c.add_argument("--mtu", type=int, default=64)
@@ -806,7 +872,8 @@ def main() -> int:
     c.add_argument("--log-interval", type=float, default=2.0)
     c.add_argument("--out", type=Path, required=True)
     args = p.parse_args()
-    res = asyncio.run(main_udp(args) if args.mode == "udp" else main_can(args))
+    res = asyncio.run(main_udp(args) if args.mode == "udp" else main_udp_hostile(args) if args.mode == "udp-hostile"
+                      else main_can(args))
     args.out.write_text(json.dumps(clean(res), default=str))
     print("DONE", flush=True)
     return 0

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import collections
 import logging
+import math
 import os
 import socket
 import threading
@@ -252,6 +253,7 @@ class CyphalBackend(Backend):
         self._hb_sub: Any = None  # a pycyphal Subscriber, or on Cyphal/UDP the heartbeat's port of the loop receiver
         self._loop_rx: Any = None  # on Cyphal/UDP: the transport's UDPLoopReceiver
         self._overflows_seen = 0
+        self._not_subscribed_seen = 0
         self._suspect: str | None = None
         self._modulo = 2**64
         self._poll_lock = threading.Lock()
@@ -283,6 +285,11 @@ class CyphalBackend(Backend):
     @property
     def transfer_id_modulo(self) -> int:
         return self._modulo
+
+    @property
+    def last_rx_overflow(self) -> float:
+        rx = self._loop_rx
+        return rx.last_overflow_ns * 1e-9 if rx is not None and rx.last_overflow_ns else -math.inf
 
     def suspect(self, reason: str) -> None:
         self._suspect = reason
@@ -378,7 +385,7 @@ class CyphalBackend(Backend):
             node.close()
             raise
         self._node = node
-        self._loop_rx, self._overflows_seen = loop_rx, 0
+        self._loop_rx, self._overflows_seen, self._not_subscribed_seen = loop_rx, 0, 0
         self._suspect = None
 
     async def close(self) -> None:
@@ -450,6 +457,11 @@ class CyphalBackend(Backend):
                 self._errors["cyphal.udp_rx_overflow"] += delta
                 self._rlog.note(("cyphal", "udp_rx_overflow"), logging.WARNING,
                                 "%d datagrams dropped by the kernel (receive buffer full)", delta, count=delta)
+            if loop_rx is not None and loop_rx.not_subscribed > self._not_subscribed_seen:
+                # Datagrams to the port for no subscribed subject (unicast, stray groups): counted (issue 29)
+                delta = loop_rx.not_subscribed - self._not_subscribed_seen
+                self._not_subscribed_seen = loop_rx.not_subscribed
+                self._errors["cyphal.udp_not_subscribed"] += delta
             for sub in self._subs:
                 subscriber = sub.subscriber
                 if subscriber is None:

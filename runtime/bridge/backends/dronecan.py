@@ -196,6 +196,7 @@ class DroneCanBackend(Backend):
         self.node_loop: Any = None
         self._suspect: str | None = None
         self._poll_lock = threading.Lock()
+        self._bus_seen: dict[str, int] = {}  # the drops of no subscribed data type already in errors (issue 29)
 
     def describe(self) -> str:
         return f"dronecan:{self.iface}"
@@ -262,6 +263,7 @@ class DroneCanBackend(Backend):
             # handlers wakes the NodeLoop (the service mappings' requests)
             loop = NodeLoop(node, logger=log, max_idle=IDLE_WAKEUP_S)
             taps = TransferTaps(loop.drops)
+            self._bus_seen = {}  # the new loop's counter starts at 0
             for sub, t in types:
                 sub.transfers, sub.seen, sub.drops = 0, {}, loop.drops
                 if sub.raw:
@@ -300,6 +302,18 @@ class DroneCanBackend(Backend):
         loop = self.node_loop
         detailed = loop.drops.detailed() if loop is not None else {}
         with self._poll_lock:
+            # The bus's drops no mapping's counters show (junk packets, 11-bit or Cyphal frames, others' data
+            # types): the bridge's errors, as dronecan.<reason> (issue 29: every frame read is counted somewhere).
+            subscribed = {sub.port_id for sub in self._subs}
+            bus: dict[str, int] = {}
+            for key, n in detailed.items():
+                if key.data_type_id is None or key.data_type_id not in subscribed:
+                    bus[key.reason.value] = bus.get(key.reason.value, 0) + n
+            for reason, n in bus.items():
+                delta = n - self._bus_seen.get(reason, 0)
+                if delta > 0:
+                    self._bus_seen[reason] = n
+                    self._errors[f"dronecan.{reason}"] += delta
             for sub in self._subs:
                 now: dict[str, int] = {"transfers": sub.transfers}
                 for key, n in detailed.items():

@@ -240,3 +240,24 @@ def test_receive_stamps_follow_the_ros_clock(scenario: dict[str, Any]) -> None:
     sim = stamps["sim"]
     assert sim["ros_time_active"] is True
     assert sim["stamp_ns"] == sim["clock_ns"], sim
+
+
+def test_garbage_cdr_on_a_command_topic_is_bad_cdr_not_convert_error() -> None:
+    """Issue 29 item 7: on the wire path a command whose bytes are not valid CDR is bad input from the ROS side,
+    counted as ``bad_cdr``; ``convert_error`` stays what it says (a converter bug), also on the wire path."""
+    import importlib
+
+    out, om = _outbound(queue_size=8)
+    codec = importlib.import_module("sam_bridge.codec")
+    om.raw = True
+    om.to_uavcan = codec.CODECS[om.info.name][1]  # the generated CDR -> payload codec of the mapping
+    for junk in (b"", b"\x00", b"\x00\x01\x00\x00", b"\xff" * 64, b"\x00\x01\x00\x00" + b"\xff" * 3):
+        out.on_ros([om], junk)
+    assert _drops(om) == {"bad_cdr": 5}
+
+    def broken(msg: Any, stats: Any) -> Any:
+        raise ZeroDivisionError("a bug")
+
+    om.to_uavcan = broken
+    out.on_ros([om], b"\x00\x01\x00\x00")
+    assert _drops(om) == {"bad_cdr": 5, "convert_error": 1}

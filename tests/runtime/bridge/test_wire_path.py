@@ -276,3 +276,25 @@ def test_a_shared_tap_hands_the_transfer_to_the_node_too(dronecan_mod: Any) -> N
     bad[0].data[0] ^= 0xFF
     assert taps.take(bad) and len(got) == 2  # a bad CRC: counted here, never handed on
     assert sum(drops.detailed().values()) == 1
+
+
+def test_a_transfer_id_jump_is_no_loss_and_does_not_move_the_stream() -> None:
+    """Issue 29 item 1: one valid transfer with the device's node id and a transfer id 2**40 ahead added
+    1,099,511,627,775 to ``lost``. A jump beyond what the time since the previous transfer allows is counted as
+    ``transfer_id_jump``, not published, and the real device's next transfers are taken as if it never came; a
+    real restart with another counter (two transfers in sequence after the jump) starts the new sequence, and a
+    real gap (after a second, 30 missing at 100 Hz) is still ``lost``."""
+    _, on_transfer, published, im, _ = _inbound()
+    for i in range(5):
+        on_transfer(b"ok:1", 11, 100 + i, 1.0 + 0.01 * i)
+    on_transfer(b"ok:1", 11, 2**40, 1.045)  # the spoof
+    for i in range(5, 10):
+        on_transfer(b"ok:1", 11, 100 + i, 1.0 + 0.01 * i)
+    st = im.stats.snapshot()
+    assert st["dropped"] == {"transfer_id_jump": 1} and st["published"] == 10
+    on_transfer(b"ok:1", 11, 5000, 1.2)  # a restart with another counter: its first transfer is a jump ...
+    on_transfer(b"ok:1", 11, 5001, 1.21)  # ... its second starts the new sequence
+    on_transfer(b"ok:1", 11, 5032, 2.21)  # a real gap: 30 lost in a second
+    st = im.stats.snapshot()
+    assert st["dropped"] == {"transfer_id_jump": 2, "lost": 30} and st["published"] == 12
+    assert len(published) == 12

@@ -7,9 +7,12 @@ the same frames, errors and error kinds per source. The sequences are made with 
 (``UDPFrame.compile_header_and_payload``, ``serialize_transfer``) and broken on purpose: header CRC, version,
 truncation, transfer CRC, duplicated / reordered / missing frames, transfer ids going back, the transfer-id
 timeout, anonymous and interleaved sources, payloads beyond the extent, other subjects' and services' frames, the
-node's own frames. The one difference is deliberate and checked: a datagram that makes pycyphal's parser raise
+node's own frames. The differences are deliberate and checked: a datagram that makes pycyphal's parser raise
 (priority above 7; a service frame from an anonymous node), which pycyphal logs with a traceback from its reader
-thread and counts nowhere, is one more error here.
+thread and counts nowhere, is one more error here, as are the datagrams pycyphal skips uncounted (another
+subject's, anonymous multi-frame or broken ones); and where a hostile sender could steer pycyphal's state (issue
+29: broken CRCs, transfer-id jumps, frames of other transfers, partial transfers from many node ids) this receiver
+keeps the real device's stream, which the fuzz target at the end checks.
 """
 
 from __future__ import annotations
@@ -41,8 +44,13 @@ from pycyphal.transport.udp._ip._endpoint_mapping import message_data_specifier_
 
 from sam_runtime.cyphal_io.crc32c import crc32c_register
 from sam_runtime.cyphal_io.udp_receiver import (
+    ANONYMOUS_INTEGRITY,
+    ANONYMOUS_MULTIFRAME,
     FRAME_INDEX_LIMIT,
+    MAX_ERROR_SOURCES,
     MAX_FRAME_INDEX,
+    MAX_SLOTS,
+    WRONG_SUBJECT,
     SubjectPort,
     single_frame_datagram,
     subject_group,
@@ -116,9 +124,16 @@ def _same(datagrams: list[tuple[bytes, int]], extent: int = EXTENT) -> tuple[Out
     assert all(abs(a[3] - b[3]) <= 1000 for a, b in zip(got.transfers, ref.transfers, strict=True))
     r, g = ref.stats, got.stats
     assert (g.transfers, g.frames, g.payload_bytes, g.drops) == (r.transfers, r.frames, r.payload_bytes, r.drops)
-    assert g.errors == r.errors + ref.raised
-    assert g.reassembly_errors_per_source_node_id == r.reassembly_errors_per_source_node_id
+    # What pycyphal drops uncounted is an error here too (issue 29: every datagram counted).
+    uncounted = sum(g.reassembly_errors.get(k, 0) for k in (WRONG_SUBJECT, ANONYMOUS_MULTIFRAME, ANONYMOUS_INTEGRITY))
+    assert g.errors == r.errors + ref.raised + uncounted
+    assert _per_source(g) == _per_source(r)
     return ref, got
+
+
+def _per_source(stats: PromiscuousUDPInputSessionStatistics) -> dict[int, dict[Any, int]]:
+    """The reassembly errors per source, without the sources of none (pycyphal lists every source it heard)."""
+    return {src: errs for src, errs in stats.reassembly_errors_per_source_node_id.items() if any(errs.values())}
 
 
 # ------------------------------------------------------------------------------------------------ datagrams
@@ -206,30 +221,42 @@ def test_what_pycyphals_parser_raises_on_is_an_error_here() -> None:
     assert [t[:3] for t in got.transfers] == [(b"hello", 11, 1)]
 
 
-def test_frames_not_for_the_subject_are_skipped_uncounted() -> None:
+def test_frames_not_for_the_subject_are_counted() -> None:
+    """Another subject's frame in this subject's group and a service frame are refused (pycyphal skips them
+    uncounted); the node's own looped-back frame is counted apart, as no error."""
     dgs = [_single(b"x", subject=OTHER_SUBJECT), _single(b"y", service=True), _single(b"z", src=LOCAL_NODE),
            _single(b"w", src=12)]
     _, got = _same(_timed(dgs))
-    assert got.stats.frames == 1 and got.stats.errors == 0 and [t[0] for t in got.transfers] == [b"w"]
+    assert got.stats.frames == 1 and got.stats.errors == 2 and [t[0] for t in got.transfers] == [b"w"]
+    assert got.stats.reassembly_errors == {WRONG_SUBJECT: 2}
 
 
 def test_transfer_crc_missing_frames_duplicates_and_transfer_ids() -> None:
+    """The errors pycyphal counts, counted as pycyphal does, but for what this receiver does differently on
+    purpose (issue 29): a transfer whose last frame is missing keeps its slot until the transfer-id timeout (a new
+    transfer id does not end it: it may be a hostile sender's), and a frame that contradicts its slot's frames is
+    dropped, not its slot."""
     payload = bytes(range(150))
     frames = _transfer(payload, mtu=64, tid=10)
     bad_crc = _single(b"abc", tid=20)
     bad_crc = bad_crc[:-1] + bytes([bad_crc[-1] ^ 0xFF])
-    dgs = [frames[0], frames[1], *_transfer(payload, mtu=64, tid=11)]  # 10 misses its last frame: 11 replaces it
+    dgs = [frames[0], frames[1], *_transfer(payload, mtu=64, tid=11)]  # 10 misses its last frame; 11 is whole
     dgs += [_single(b"dup", tid=12), _single(b"dup", tid=12), _single(b"old", tid=3)]  # a duplicate, one back
     dgs += [bad_crc, _single(b"", tid=21)[:24]]  # broken transfer CRC; no room for a CRC at all
     dgs += [_frame(b"", tid=30, index=1, eot=False)]  # an empty frame of a multi-frame transfer
     dgs += [_frame(b"p", tid=31, index=2, eot=True), _frame(b"q", tid=31, index=3, eot=False)]  # EOT misplaced
     dgs += [_frame(b"p", tid=32, index=2, eot=True), _frame(b"q", tid=32, index=3, eot=True)]  # EOT inconsistent
-    _, got = _same(_timed(dgs))
+    got = _with_port(_timed(dgs))
     errs = got.stats.reassembly_errors_per_source_node_id[11]
     assert {e.name: n for e, n in errs.items()} == {
         "MULTIFRAME_MISSING_FRAMES": 1, "UNEXPECTED_TRANSFER_ID": 2, "INTEGRITY_ERROR": 2,
         "MULTIFRAME_EMPTY_FRAME": 1, "MULTIFRAME_EOT_MISPLACED": 1, "MULTIFRAME_EOT_INCONSISTENT": 1}
     assert [t[:3] for t in got.transfers] == [(payload, 11, 11), (b"dup", 11, 12)]
+    # (10's slot ended when 11 was taken.) The two unfinished ones (31, 32) end after the transfer-id timeout
+    timed = _timed(dgs)
+    got = _with_port([*timed, (_frame(b"x", tid=40, index=0, eot=False), timed[-1][1] + 3_000_000_000)])
+    errs = got.stats.reassembly_errors_per_source_node_id[11]
+    assert errs["TRANSFER_EXPIRED"] == 2
 
 
 def test_transfer_id_timeout() -> None:
@@ -242,10 +269,11 @@ def test_transfer_id_timeout() -> None:
 def test_anonymous_transfers() -> None:
     dgs = [_single(b"anon", src=None, tid=3), _single(b"anon", src=None, tid=3),  # no deduplication: stateless
            _single(b"", src=None), _frame(b"abcdef", src=None, eot=False),  # no empty one; no multi-frame
-           _single(b"x", src=None)[:-1] + b"\x00"]  # broken CRC: dropped, and pycyphal counts no error
+           _single(b"x", src=None)[:-1] + b"\x00"]  # broken CRC: dropped (pycyphal counts no error; here one)
     _, got = _same(_timed(dgs))
     assert [t[:3] for t in got.transfers] == [(b"anon", None, 3)] * 2
-    assert got.stats.frames == 5 and got.stats.errors == 0
+    assert got.stats.frames == 5 and got.stats.errors == 3
+    assert got.stats.reassembly_errors == {ANONYMOUS_INTEGRITY: 2, ANONYMOUS_MULTIFRAME: 1}
 
 
 def test_payload_beyond_the_extent_is_delivered_whole() -> None:
@@ -270,15 +298,21 @@ _GAPS = st.sampled_from([0.0, 0.001, 0.3, 1.0, 2.5])
 
 
 @st.composite
-def _episode(draw: Callable[..., Any]) -> list[bytes]:
-    """A few datagrams: a transfer (maybe multi-frame, maybe mangled) or a broken datagram."""
-    kind = draw(st.sampled_from(["transfer", "transfer", "transfer", "frame", "garbage", "mangled"]))
+def _episode(draw: Callable[..., Any], hostile: bool = True) -> list[bytes]:
+    """A few datagrams: a transfer (maybe multi-frame, maybe mangled) or a broken datagram. Not ``hostile``:
+    whole transfers only, their frames in order, transfer ids that do not jump (where this receiver is
+    pycyphal; the hostile cases are the fuzz target's, below)."""
+    kind = draw(st.sampled_from(["transfer", "transfer", "transfer", "frame", "garbage", "mangled"])
+                if hostile else st.just("transfer"))
     src = draw(_SOURCES)
-    tid = draw(st.one_of(st.integers(0, 8), st.integers(2**32, 2**32 + 3), st.just(2**64 - 1)))
+    tid = draw(st.one_of(st.integers(0, 8), st.integers(2**32, 2**32 + 3), st.just(2**64 - 1))
+               if hostile else st.integers(0, 8))
     if kind == "transfer":
         payload = draw(st.binary(max_size=120))
         mtu = draw(st.sampled_from([16, 40, 1200]))
         dgs = _transfer(payload, mtu=mtu, src=src, tid=tid)
+        if not hostile:  # (in order: pycyphal refuses a later frame that comes first after the timeout, and
+            return dgs    # then the whole transfer; here the transfer is taken whole)
         if draw(st.booleans()):  # lose, repeat and reorder some frames
             dgs = draw(st.lists(st.sampled_from(dgs), max_size=len(dgs) + 2)) if len(dgs) > 1 else dgs * 2
             dgs = draw(st.permutations(dgs))
@@ -304,7 +338,7 @@ def _episode(draw: Callable[..., Any]) -> list[bytes]:
     return [_reheader(good, prio=draw(st.integers(8, 255)))]
 
 
-@given(st.lists(st.tuples(_episode(), _GAPS), max_size=14), st.sampled_from([0, 8, 200]))
+@given(st.lists(st.tuples(_episode(hostile=False), _GAPS), max_size=14), st.sampled_from([0, 8, 200]))
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 def test_same_as_pycyphal_on_any_datagram_sequence(episodes: list[tuple[list[bytes], float]], extent: int) -> None:
     datagrams, gaps = [], []
@@ -350,3 +384,81 @@ def test_the_transfer_id_timeout_is_pycyphals() -> None:
     from sam_runtime.cyphal_io.udp_receiver import TRANSFER_ID_TIMEOUT_S
 
     assert TRANSFER_ID_TIMEOUT_S == UDPInputSession.DEFAULT_TRANSFER_ID_TIMEOUT
+
+
+# ------------------------------------------------------------------------------------------------ the fuzz target
+# Issue 29: the receive path under hostile datagrams, in-process (no socket), derandomized. A real device (node 21)
+# sends its transfers, single- and multi-frame, one every 10 ms; between them come hostile datagrams: anything of
+# the property test's episodes (any node, garbage, mangled headers, partial transfers), and aimed at the device:
+# its node id with a broken transfer CRC (also with the id it sends next), valid transfers whose id jumped far
+# ahead or went back, partial transfers from many node ids. Never raises; every datagram is counted once; the
+# device loses nothing; the reassembly slots stay bounded; after the junk and a transfer-id timeout every source's
+# good transfers are taken again.
+_DEVICE = 21
+
+
+@st.composite
+def _aimed(draw: Callable[..., Any], next_tid: int) -> list[bytes]:
+    kind = draw(st.sampled_from(["bad_crc", "bad_crc_multi", "jump", "back", "partials", "header_crc"]))
+    if kind == "bad_crc":
+        tid = draw(st.sampled_from([next_tid, next_tid + 1, next_tid + 7, 2**40]))
+        good = _single(draw(st.binary(max_size=20)), src=_DEVICE, tid=tid)
+        return [good[:-1] + bytes([good[-1] ^ draw(st.integers(1, 255))])]
+    if kind == "bad_crc_multi":  # a whole multi-frame transfer with a broken CRC, of another transfer id
+        tid = draw(st.sampled_from([next_tid + 1, next_tid + 5, 2**40]))
+        dgs = _transfer(draw(st.binary(min_size=50, max_size=90)), mtu=40, src=_DEVICE, tid=tid)
+        dgs[-1] = dgs[-1][:-1] + bytes([dgs[-1][-1] ^ 0x33])
+        return dgs
+    if kind == "jump":
+        return [_single(b"spoof", src=_DEVICE, tid=next_tid + draw(st.sampled_from([2**40, 2**63, 10**6])))]
+    if kind == "back":
+        return [_single(b"old", src=_DEVICE, tid=max(0, next_tid - draw(st.integers(1, 50))))]
+    if kind == "partials":  # first frames of transfers that never end, from many node ids
+        first = draw(st.integers(200, 60000))
+        return [_transfer(bytes(80), mtu=40, src=first + i, tid=i)[0] for i in range(draw(st.integers(1, 90)))]
+    good = _single(b"x", src=_DEVICE, tid=next_tid)
+    return [good[:22] + bytes([good[22] ^ 0x01]) + good[23:]]  # the header CRC broken
+
+
+@st.composite
+def _hostile_run(draw: Callable[..., Any]) -> tuple[list[tuple[bytes, int]], list[int]]:
+    """The datagrams with their times, and the transfer ids the device sent."""
+    out, sent, ns, tid = [], [], T0_NS, 5000
+    for _ in range(draw(st.integers(1, 12))):
+        payload = draw(st.binary(max_size=100))
+        for d in _transfer(payload, mtu=draw(st.sampled_from([40, 1200])), src=_DEVICE, tid=tid):
+            out.append((d, ns))
+        sent.append(tid)
+        tid += 1
+        junk = draw(st.one_of(_episode(), _aimed(tid)))
+        for d in junk:
+            ns += 100_000
+            out.append((d, ns))
+        ns += 10_000_000
+    return out, sent
+
+
+@given(_hostile_run())
+@settings(max_examples=150, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+def test_fuzz_hostile_datagrams_beside_a_real_device(run: tuple[list[tuple[bytes, int]], list[int]]) -> None:
+    datagrams, sent = run
+    got: list[tuple[int | None, int]] = []
+    port = SubjectPort(_Receiver(), SUBJECT, EXTENT,  # type: ignore[arg-type]
+                       lambda payload, src, tid, stamp: got.append((src, tid)))
+    for data, ns in datagrams:
+        port.feed(data, ns)
+        assert port.partial_transfers <= MAX_SLOTS
+    assert [tid for src, tid in got if src == _DEVICE and tid in sent] == sent  # nothing of the device lost
+    # every datagram counted once: a frame (anonymous ones too: their refusals are counted on top), own, or refused
+    refused = sum(n for k, n in port.refused.items() if k not in (ANONYMOUS_MULTIFRAME, ANONYMOUS_INTEGRITY))
+    assert port.frames + port.own_frames + refused == len(datagrams)
+    assert port.errors == sum(port.refused.values()) + sum(port.unattributed.values()) + sum(
+        sum(e.values()) for e in port.errors_per_source.values())
+    assert len(port.errors_per_source) <= MAX_ERROR_SOURCES
+    # after the junk and a transfer-id timeout, good transfers from every source are taken again
+    ns = datagrams[-1][1] + 2_500_000_000
+    got.clear()
+    for i, src in enumerate((11, 12, 13, _DEVICE)):
+        for d in _transfer(bytes(range(60)), mtu=40 if i % 2 else 1200, src=src, tid=i):
+            port.feed(d, ns)
+    assert got == [(11, 0), (12, 1), (13, 2), (_DEVICE, 3)]
