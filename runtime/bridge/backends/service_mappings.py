@@ -18,9 +18,9 @@ by the response: the srv's default values, with its bool ``success`` False and i
 when the srv has those fields (std_srvs' convention; the ROS client never waits forever). Every call is counted per
 mapping: ``calls``, ``answered``, ``timeouts``, ``failed.<reason>``, ``saturated.<field>``, and the responses that
 reach no waiting call (``late_responses``, ``duplicate_responses``, ``malformed_responses``, counted by the
-subclass). The counters are published once a second, and at once after a failure, on /diagnostics as
-``<bridge>/service/<name>`` (WARN for 10 s after a failure or a bad response), and are in the bridge's
-``stats()["services"]``.
+subclass). The counters are published once a second (in the loop's housekeeping round), and at once after a
+failure, on /diagnostics as ``<bridge>/service/<name>`` (WARN for 10 s after a failure or a bad response), and are
+in the bridge's ``stats()["services"]``.
 """
 
 from __future__ import annotations
@@ -188,6 +188,10 @@ class ServiceMappingsRos:
 
     def attach(self) -> None:
         self.lifetime.add_hooks(f"{self.protocol} service mappings", start=self._start, close=self._close)
+        if self.diagnostics_period > 0:
+            # On the loop, in the bridge's housekeeping round (its period is the bridge's /diagnostics period): an
+            # rclpy timer woke the services' executor thread and one of its workers every period for it.
+            self.lifetime.every(self.diagnostics_period, "service diagnostics", self.publish_diagnostics)
 
     def count(self, m: Any, key: str, n: int = 1, problem: bool = True) -> None:
         """Add to a mapping's counter (any thread)."""
@@ -226,7 +230,6 @@ class ServiceMappingsRos:
             from diagnostic_msgs.msg import DiagnosticArray
 
             self._diag_pub = node.create_publisher(DiagnosticArray, "/diagnostics", 10)
-            node.create_timer(self.diagnostics_period, self.publish_diagnostics, callback_group=group)
         threads = max(_EXECUTOR_THREADS, 2 * len(self.mappings))  # two calls in flight per mapping at least
         executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
         self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-services",
@@ -337,7 +340,7 @@ class ServiceMappingsRos:
         return array
 
     def publish_diagnostics(self) -> None:
-        """Never raises (the timer and after a failure; rclpy's publish is thread-safe)."""
+        """Never raises (the housekeeping round, and a call thread after a failure; rclpy's publish is thread-safe)."""
         if self._diag_pub is None or self.lifetime.closed:
             return
         try:
