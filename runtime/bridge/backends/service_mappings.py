@@ -37,6 +37,7 @@ from typing import Any
 
 from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
+from sam_runtime.bridge.diagnostics import Status, statuses_cdr
 from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "to_uavcan"]
@@ -322,21 +323,30 @@ class ServiceMappingsRos:
                 }
         return out
 
-    def diagnostics_message(self) -> Any:
+    def diagnostics_statuses(self) -> list[Status]:
+        """One status per mapping: (level, name, message, hardware_id, values) as sam_runtime.bridge.diagnostics'."""
+        out: list[Status] = []
+        for name, entry in self.snapshot().items():
+            hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
+                           else f"the node of the request's {entry['destination_field']}")
+            message = (f"{entry['answered']}/{entry['calls']} answered, {entry['timeouts']} timed out"
+                       + (" (a recent failure or bad response)" if entry["warn"] else ""))
+            values = {k: str(v) for k, v in entry.items() if k != "warn"}
+            out.append((1 if entry["warn"] else 0, f"{self.status_prefix}/service/{name}", message, hardware_id,
+                        values))
+        return out
+
+    def diagnostics_message(self, stamp_ns: int | None = None) -> Any:
+        """The statuses as a diagnostic_msgs/DiagnosticArray (what :meth:`publish_diagnostics` publishes as CDR)."""
+        from builtin_interfaces.msg import Time
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
         array = DiagnosticArray()
-        array.header.stamp = self.ros.clock.now().to_msg()
-        for name, entry in self.snapshot().items():
-            status = DiagnosticStatus()
-            status.name = f"{self.status_prefix}/service/{name}"
-            status.hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
-                                  else f"the node of the request's {entry['destination_field']}")
-            status.level = DiagnosticStatus.WARN if entry["warn"] else DiagnosticStatus.OK
-            status.message = (f"{entry['answered']}/{entry['calls']} answered, {entry['timeouts']} timed out"
-                              + (" (a recent failure or bad response)" if entry["warn"] else ""))
-            status.values = [KeyValue(key=k, value=str(v)) for k, v in entry.items() if k != "warn"]
-            array.status.append(status)
+        ns = self.ros.clock.now().nanoseconds if stamp_ns is None else int(stamp_ns)
+        array.header.stamp = Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+        array.status = [DiagnosticStatus(level=bytes([level]), name=name, message=msg, hardware_id=hw,
+                                         values=[KeyValue(key=k, value=v) for k, v in values.items()])
+                        for level, name, msg, hw, values in self.diagnostics_statuses()]
         return array
 
     def publish_diagnostics(self) -> None:
@@ -344,7 +354,9 @@ class ServiceMappingsRos:
         if self._diag_pub is None or self.lifetime.closed:
             return
         try:
-            self._diag_pub.publish(self.diagnostics_message())
+            # Serialized here and published raw: building a KeyValue object per value (rclpy checks each field)
+            # cost as much as the bridge's whole /diagnostics, once a second (sam_runtime.bridge.diagnostics).
+            self._diag_pub.publish(statuses_cdr(self.diagnostics_statuses(), self.ros.clock.now().nanoseconds))
         except Exception as ex:
             self.lifetime.errors["service_diagnostics_error"] += 1
             self.lifetime.rlog.note(("service", "diagnostics"), logging.ERROR, "service diagnostics: %s: %s",
