@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 __all__ = ["RECENT_DROP_WINDOW_S", "Naming", "Status", "diagnostic_array", "diagnostic_array_cdr", "statuses",
-           "time_sync_fields", "time_sync_status", "traffic_values"]
+           "statuses_cdr", "time_sync_fields", "time_sync_status", "traffic_values"]
 
 RECENT_DROP_WINDOW_S = 10.0  # a mapping's diagnostics level is WARN while it dropped within this window
 _PROBLEMS = ("errors", "deserialization_failures", "overruns", "drops")
@@ -71,8 +71,13 @@ def diagnostic_array_cdr(snap: Mapping[str, Any], naming: Naming, stamp_ns: int)
     CPU. rclpy's serialize_message gives the same bytes but the alignment padding (zero here), which deserialize to
     the same message (tests/runtime/bridge/test_diagnostics_cdr.py). Most strings repeat from one message to the
     next (names, keys, small values): their encoding is kept (:data:`_ENCODED`)."""
+    return statuses_cdr(statuses(snap, naming), stamp_ns)
+
+
+def statuses_cdr(sts: list[Status], stamp_ns: int) -> bytes:
+    """A DiagnosticArray of these statuses (stamped ``stamp_ns``), serialized as :func:`diagnostic_array_cdr`
+    serializes the bridge's (the service mappings publish theirs so too)."""
     sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
-    sts = statuses(snap, naming)
     out = bytearray(_CDR_LE)
     out += _U32.pack(sec & 0xFFFFFFFF) + _U32.pack(nanosec) + _EMPTY_STRING + _U32.pack(len(sts))
     encoded = _ENCODED

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled, find_compiled
-from sam_runtime.cyphal_io.udp_receiver import loop_udp_transport
+from sam_runtime.cyphal_io.udp_sessions import loop_sessions_udp_transport
 
 if TYPE_CHECKING:  # pragma: no cover
     import pycyphal.application
@@ -107,7 +107,9 @@ def make_transport(
     :param mtu: UDP: payload bytes per datagram (pycyphal default 1200). CAN: 8 = Classic CAN,
         64 (default) = CAN FD; 12..48 are CAN FD too.
     :param loop_rx: UDP on one interface: a transport whose message subscriptions can be received on the event
-        loop instead of pycyphal's thread per session (sam_runtime.cyphal_io.udp_receiver.loop_udp_transport).
+        loop instead of pycyphal's thread per session (sam_runtime.cyphal_io.udp_receiver.loop_udp_transport), and
+        whose pycyphal input sessions (services, the heartbeat publisher's, the object path's subjects) are received
+        on the loop too (sam_runtime.cyphal_io.udp_sessions.loop_sessions_udp_transport).
     """
     kind = kind.lower().strip()
     if kind not in TRANSPORT_KINDS:
@@ -127,7 +129,7 @@ def make_transport(
         ips = (iface or _DEFAULT_UDP_IFACE).split()
         make_udp: Callable[..., pycyphal.transport.Transport] = UDPTransport
         if loop_rx and len(ips) == 1:
-            make_udp = loop_udp_transport
+            make_udp = loop_sessions_udp_transport
         for ip in ips:
             factories.append(functools.partial(make_udp, ip, node_id, **kw))
     else:
@@ -191,7 +193,8 @@ def transport_from_env(env: Mapping[str, str] | None = None, *, loop_rx: bool = 
     (8 or 64; default 64), UAVCAN__CAN__BITRATE ('1000000 1000000' for Classic CAN), UAVCAN__LOOPBACK=1,
     UAVCAN__SERIAL__IFACE. Several configured transports give a RedundantTransport.
     Needs the compiled ``uavcan`` namespace (it is compiled on demand).
-    ``loop_rx``: one UDP interface gives a loop_udp_transport (see :func:`make_transport`), configured as pycyphal's.
+    ``loop_rx``: one UDP interface gives a loop_sessions_udp_transport (see :func:`make_transport`), configured as
+    pycyphal's.
     """
     _ensure_uavcan()
     import pycyphal.application
@@ -210,7 +213,7 @@ def transport_from_env(env: Mapping[str, str] | None = None, *, loop_rx: bool = 
         multiplier = int(registry["uavcan.udp.duplicate_service_transfers"]) + 1
         ip, node_id, mtu = tr.local_ip_address, tr.local_node_id, tr.protocol_parameters.mtu
         tr.close()  # no session opened yet: nothing else to undo
-        tr = loop_udp_transport(str(ip), node_id, mtu=mtu, service_transfer_multiplier=multiplier)
+        tr = loop_sessions_udp_transport(str(ip), node_id, mtu=mtu, service_transfer_multiplier=multiplier)
     return tr
 
 

@@ -59,7 +59,8 @@ from sam_runtime.cyphal_io.crc32c import RESIDUE as CRC32C_RESIDUE
 from sam_runtime.cyphal_io.crc32c import crc32c_register
 
 __all__ = ["BATCH", "CYPHAL_PORT", "FRAME_INDEX_LIMIT", "MAX_FRAME_INDEX", "RCVBUF_BYTES", "TRANSFER_ID_TIMEOUT_S",
-           "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "single_frame_datagram", "subject_group"]
+           "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "loop_udp_transport_class",
+           "single_frame_datagram", "subject_group"]
 
 _log = logging.getLogger(__name__)
 
@@ -563,6 +564,12 @@ def loop_udp_transport(local_ip_address: str, local_node_id: int | None, **kwarg
     ``uavcan.node.port.List`` still names them) and it closes with the transport; publications, services and any
     pycyphal input session stay pycyphal's. ``kwargs``: UDPTransport's (mtu, service_transfer_multiplier)."""
     return _loop_udp_transport_class()(local_ip_address, local_node_id, **kwargs)
+
+
+def loop_udp_transport_class() -> type:
+    """The class :func:`loop_udp_transport` makes (pycyphal imported on the first call), for a subclass
+    (sam_runtime.cyphal_io.udp_sessions: pycyphal's input sessions on the loop too)."""
+    return _loop_udp_transport_class()
 
 
 @functools.cache

@@ -149,34 +149,40 @@ class LoopbackMulticastDriver(AbstractDriver):
     def receive(self, timeout: float | None = None) -> CANFrame | None:
         """The next frame from another driver on the bus; None when none came within ``timeout`` seconds
         (0: only what is already there; None: wait for ever)."""
-        self._check_open()
-        deadline = None if timeout is None else time.monotonic() + max(timeout, 0.0)
+        if self._closed:
+            self._check_open()
+        # (Per frame of the bus: a NodeLoop drains the socket with receive(0) at every wake-up, so the empty read
+        # that ends a wake-up takes no clock and no poll, and each frame is stamped once, not again by CANFrame.)
+        drain = timeout is not None and timeout <= 0
+        deadline = None if timeout is None or drain else time.monotonic() + timeout
+        rx = self._rx
         while True:
             try:
-                data, ancdata, _flags, source = self._rx.recvmsg(_RECV_SIZE, _ANC_SIZE)
+                data, ancdata, _flags, source = rx.recvmsg(_RECV_SIZE, _ANC_SIZE)
             except BlockingIOError:
                 if self._count_drops and time.monotonic() >= self._next_overflow_check:
                     self._count_overflow()
-                if not self._wait_readable(deadline):
+                if drain or not self._wait_readable(deadline):
                     return None
                 continue
             if source == self._own_address:
                 self.own_frames_skipped += 1
                 continue
+            ts_monotonic = ts_real = 0.0  # (0: CANFrame reads the clocks itself)
+            for level, kind, cdata in ancdata:
+                if kind == _SO_TIMESTAMPNS and level == _SOL_SOCKET and len(cdata) >= _TIMESPEC.size:
+                    sec, nsec = _TIMESPEC.unpack_from(cdata)
+                    arrived_ns = sec * 1_000_000_000 + nsec
+                    ts_real = arrived_ns * 1e-9
+                    ts_monotonic = time.monotonic() - (time.time_ns() - arrived_ns) * 1e-9
             try:
-                frame = decode_packet(data)
+                frame = decode_packet(data, ts_monotonic, ts_real)
             except PacketError as ex:
                 self.drops.add(DropReason.BAD_PACKET, detail=f"datagram from {source[0]}:{source[1]}: {ex}")
                 continue
             if self.accept is not None and not self.kernel_self_filter and not (
                     frame.extended and self.accept.accepts(frame.id)):
                 continue  # what the kernel filter would have dropped
-            for level, kind, cdata in ancdata:
-                if level == socket.SOL_SOCKET and kind == _SO_TIMESTAMPNS and len(cdata) >= _TIMESPEC.size:
-                    sec, nsec = _TIMESPEC.unpack_from(cdata)
-                    arrived_ns = sec * 1_000_000_000 + nsec
-                    frame.ts_real = arrived_ns * 1e-9
-                    frame.ts_monotonic = time.monotonic() - (time.time_ns() - arrived_ns) * 1e-9
             self._rx_hook(frame)
             return frame
 
@@ -245,6 +251,7 @@ class LoopbackMulticastDriver(AbstractDriver):
 
 _SO_ATTACH_FILTER = 26  # Linux; not exported by the socket module
 _SO_TIMESTAMPNS = 35  # Linux; also the cmsg type SCM_TIMESTAMPNS
+_SOL_SOCKET = socket.SOL_SOCKET
 _TIMESPEC = struct.Struct("qq")
 _ANC_SIZE = 64  # room for one struct timespec message
 _SO_MEMINFO = 55  # Linux >= 4.12: u32[SK_MEMINFO_VARS]

@@ -73,8 +73,9 @@ def encode_packet(frame: CANFrame) -> bytes:
     return struct.pack("<HH", MCAST_MAGIC, _crc16(body)) + body
 
 
-def decode_packet(data: bytes) -> CANFrame:
-    """The frame in a datagram; :class:`PacketError` if it is not one.
+def decode_packet(data: bytes, ts_monotonic: float = 0.0, ts_real: float = 0.0) -> CANFrame:
+    """The frame in a datagram; :class:`PacketError` if it is not one. ``ts_monotonic``, ``ts_real``: its reception
+    times (0: now, as dronecan's CANFrame stamps a frame).
 
     >>> f = decode_packet(encode_packet(CANFrame(0x123, bytearray(b"ab"), False)))
     >>> (hex(f.id), bytes(f.data), f.extended, f.canfd)
@@ -99,4 +100,4 @@ def decode_packet(data: bytes) -> CANFrame:
     can_id &= 0x1FFFFFFF
     if not extended and can_id > 0x7FF:
         raise PacketError(f"11-bit frame with id 0x{can_id:x}")
-    return CANFrame(can_id, bytearray(payload), extended, canfd=canfd)
+    return CANFrame(can_id, bytearray(payload), extended, ts_monotonic=ts_monotonic, ts_real=ts_real, canfd=canfd)

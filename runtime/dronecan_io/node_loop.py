@@ -255,6 +255,14 @@ class NodeLoop:
         # dronecan's Node is a Scheduler around a stdlib sched.scheduler (clock: time.monotonic) that it keeps in
         # the private `_scheduler`; it has no public "next deadline". Without it the timer falls back to max_idle.
         sched = getattr(self.node, "_scheduler", None)
+        # Its heap (the stdlib scheduler's `_queue`): the earliest event first. Read at every wake-up of the loop,
+        # where `queue` (a sorted copy of the heap, of named tuples) cost more than the rest of the timer's work.
+        heap = getattr(sched, "_queue", None)
+        if isinstance(heap, list):
+            try:
+                return float(heap[0].time) if heap else None
+            except (IndexError, AttributeError):  # emptied by another thread meanwhile; another layout
+                pass
         try:
             queue = sched.queue  # type: ignore[union-attr]
         except AttributeError:

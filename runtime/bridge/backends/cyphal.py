@@ -302,7 +302,11 @@ class CyphalBackend(Backend):
         if self._loop_rx is not None and self._loop_rx.failure:
             return str(self._loop_rx.failure)
         try:
-            if _transport_dead(self._node.presentation.transport):
+            transport = self._node.presentation.transport
+            sessions = getattr(transport, "session_socket", None)  # a LoopSessionsUDPTransport's (services' input)
+            if sessions is not None and sessions.failure:
+                return str(sessions.failure)
+            if _transport_dead(transport):
                 return "the transport's media closed itself"
         except Exception as ex:
             return f"{type(ex).__name__}: {ex}"

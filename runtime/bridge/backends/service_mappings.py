@@ -18,9 +18,9 @@ by the response: the srv's default values, with its bool ``success`` False and i
 when the srv has those fields (std_srvs' convention; the ROS client never waits forever). Every call is counted per
 mapping: ``calls``, ``answered``, ``timeouts``, ``failed.<reason>``, ``saturated.<field>``, and the responses that
 reach no waiting call (``late_responses``, ``duplicate_responses``, ``malformed_responses``, counted by the
-subclass). The counters are published once a second, and at once after a failure, on /diagnostics as
-``<bridge>/service/<name>`` (WARN for 10 s after a failure or a bad response), and are in the bridge's
-``stats()["services"]``.
+subclass). The counters are published once a second (in the loop's housekeeping round), and at once after a
+failure, on /diagnostics as ``<bridge>/service/<name>`` (WARN for 10 s after a failure or a bad response), and are
+in the bridge's ``stats()["services"]``.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from typing import Any
 from sam_codegen.model.text import cut_utf8, encode_text
 from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
+from sam_runtime.bridge.diagnostics import Status, statuses_cdr
 from sam_runtime.bridge.lifetime import Lifetime
 
 __all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "set_field", "to_uavcan"]
@@ -199,6 +200,10 @@ class ServiceMappingsRos:
 
     def attach(self) -> None:
         self.lifetime.add_hooks(f"{self.protocol} service mappings", start=self._start, close=self._close)
+        if self.diagnostics_period > 0:
+            # On the loop, in the bridge's housekeeping round (its period is the bridge's /diagnostics period): an
+            # rclpy timer woke the services' executor thread and one of its workers every period for it.
+            self.lifetime.every(self.diagnostics_period, "service diagnostics", self.publish_diagnostics)
 
     def count(self, m: Any, key: str, n: int = 1, problem: bool = True) -> None:
         """Add to a mapping's counter (any thread)."""
@@ -237,7 +242,6 @@ class ServiceMappingsRos:
             from diagnostic_msgs.msg import DiagnosticArray
 
             self._diag_pub = node.create_publisher(DiagnosticArray, "/diagnostics", 10)
-            node.create_timer(self.diagnostics_period, self.publish_diagnostics, callback_group=group)
         threads = max(_EXECUTOR_THREADS, 2 * len(self.mappings))  # two calls in flight per mapping at least
         executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
         self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-services",
@@ -330,29 +334,40 @@ class ServiceMappingsRos:
                 }
         return out
 
-    def diagnostics_message(self) -> Any:
+    def diagnostics_statuses(self) -> list[Status]:
+        """One status per mapping: (level, name, message, hardware_id, values) as sam_runtime.bridge.diagnostics'."""
+        out: list[Status] = []
+        for name, entry in self.snapshot().items():
+            hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
+                           else f"the node of the request's {entry['destination_field']}")
+            message = (f"{entry['answered']}/{entry['calls']} answered, {entry['timeouts']} timed out"
+                       + (" (a recent failure or bad response)" if entry["warn"] else ""))
+            values = {k: str(v) for k, v in entry.items() if k != "warn"}
+            out.append((1 if entry["warn"] else 0, f"{self.status_prefix}/service/{name}", message, hardware_id,
+                        values))
+        return out
+
+    def diagnostics_message(self, stamp_ns: int | None = None) -> Any:
+        """The statuses as a diagnostic_msgs/DiagnosticArray (what :meth:`publish_diagnostics` publishes as CDR)."""
+        from builtin_interfaces.msg import Time
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
         array = DiagnosticArray()
-        array.header.stamp = self.ros.clock.now().to_msg()
-        for name, entry in self.snapshot().items():
-            status = DiagnosticStatus()
-            status.name = f"{self.status_prefix}/service/{name}"
-            status.hardware_id = (f"node {entry['destination_node_id']} ({entry['device']})" if entry["device"]
-                                  else f"the node of the request's {entry['destination_field']}")
-            status.level = DiagnosticStatus.WARN if entry["warn"] else DiagnosticStatus.OK
-            status.message = (f"{entry['answered']}/{entry['calls']} answered, {entry['timeouts']} timed out"
-                              + (" (a recent failure or bad response)" if entry["warn"] else ""))
-            status.values = [KeyValue(key=k, value=str(v)) for k, v in entry.items() if k != "warn"]
-            array.status.append(status)
+        ns = self.ros.clock.now().nanoseconds if stamp_ns is None else int(stamp_ns)
+        array.header.stamp = Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+        array.status = [DiagnosticStatus(level=bytes([level]), name=name, message=msg, hardware_id=hw,
+                                         values=[KeyValue(key=k, value=v) for k, v in values.items()])
+                        for level, name, msg, hw, values in self.diagnostics_statuses()]
         return array
 
     def publish_diagnostics(self) -> None:
-        """Never raises (the timer and after a failure; rclpy's publish is thread-safe)."""
+        """Never raises (the housekeeping round, and a call thread after a failure; rclpy's publish is thread-safe)."""
         if self._diag_pub is None or self.lifetime.closed:
             return
         try:
-            self._diag_pub.publish(self.diagnostics_message())
+            # Serialized here and published raw: building a KeyValue object per value (rclpy checks each field)
+            # cost as much as the bridge's whole /diagnostics, once a second (sam_runtime.bridge.diagnostics).
+            self._diag_pub.publish(statuses_cdr(self.diagnostics_statuses(), self.ros.clock.now().nanoseconds))
         except Exception as ex:
             self.lifetime.errors["service_diagnostics_error"] += 1
             self.lifetime.rlog.note(("service", "diagnostics"), logging.ERROR, "service diagnostics: %s: %s",

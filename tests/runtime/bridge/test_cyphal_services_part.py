@@ -179,3 +179,27 @@ def test_restart_status_zero_is_success() -> None:
     mapping = NS(response=(_link("success", "status", "ok_if_zero"),))
     assert from_uavcan(mapping, NS(status=0), []) == {"success": True}
     assert from_uavcan(mapping, NS(status=3), []) == {"success": False}
+
+
+def test_the_published_diagnostics_cdr_is_the_message(part: cyphal_services.CyphalServices) -> None:
+    """The service mappings publish their /diagnostics as CDR (statuses_cdr): rclpy deserializes the very message
+    diagnostics_message() builds, after calls that answered, timed out and failed (WARN)."""
+    pytest.importorskip("diagnostic_msgs")
+    from diagnostic_msgs.msg import DiagnosticArray
+    from rclpy.serialization import deserialize_message
+
+    from sam_runtime.bridge.diagnostics import statuses_cdr
+
+    m = part.mappings[0]
+    part.count(m, "calls", 3, problem=False)
+    part.count(m, "answered", 1, problem=False)
+    part.count(m, "timeouts")
+    part.count(m, "failed.link_down")
+    stamp_ns = 1_700_000_000_123_456_789
+    got = deserialize_message(statuses_cdr(part.diagnostics_statuses(), stamp_ns), DiagnosticArray)
+    want = part.diagnostics_message(stamp_ns)
+    assert got == want
+    (status,) = got.status
+    assert status.level == b"\x01" and status.name == "bridge/service/limits"
+    values = {kv.key: kv.value for kv in status.values}
+    assert values["calls"] == "3" and values["timeouts"] == "1" and values["failed.link_down"] == "1"

@@ -2,7 +2,7 @@
 
 - the assembled bridge's periodic jobs, per protocol: all at 1 s, in one task (one wake-up a second): the link and
   silence checks, the bounded log's pending counts, /diagnostics (which polls the stack's counters itself; without
-  /diagnostics a job of its own polls them), the Cyphal services' counters;
+  /diagnostics a job of its own polls them), the service mappings' /diagnostics, the Cyphal services' counters;
 - the bounds that rate keeps: the offline timeout and every silence grace are 3 s or more, so a check a second
   finds a silence within a second of its grace;
 - the rounds run at fixed deadlines (:func:`~sam_runtime.bridge.lifetime.next_round`): a job's own time does not
@@ -34,7 +34,8 @@ def test_one_housekeeping_round_a_second(layout: str, services: list[str], diagn
     bridge = Bridge(gen, layout=layout, diagnostics_period=diagnostics_period)
     convert = gen.convert_v0() if bridge.selection.protocol == "dronecan" else gen.convert()
     bridge._assemble(convert, bridge._codec())  # the parts attached as start() attaches them, nothing started
-    jobs = ["silence", "log", *services, "link check"]
+    # the service mappings' /diagnostics (every layout has its node duties' services) in the round, no rclpy timer
+    jobs = ["silence", "log", *(["service diagnostics"] if diagnostics_period else []), *services, "link check"]
     if diagnostics_period:
         jobs.append("diagnostics")  # last in the round: after the checks whose findings it reports
     else:

@@ -600,6 +600,23 @@ def test_node_loop_runs_the_scheduler_at_its_deadlines() -> None:
     asyncio.run(scenario())
 
 
+def test_node_loop_reads_the_earliest_deadline_from_the_schedulers_heap() -> None:
+    """The timer's deadline is read from the scheduler's heap (not its sorted copy): the earliest event's, whatever
+    the order the events were added in."""
+
+    async def scenario() -> None:
+        node = make_node(private_iface(), 10)
+        nl = NodeLoop(node, max_idle=60.0)
+        for delay in (30.0, 0.7, 5.0, 0.3, 12.0):
+            node.defer(delay, lambda: None)
+        earliest = node._scheduler.queue[0].time  # the stdlib's sorted view
+        assert nl._next_scheduler_deadline() == earliest
+        assert earliest <= time.monotonic() + 0.3
+        node.close()
+
+    asyncio.run(scenario())
+
+
 def test_bus_load_meter_counts_frames_on_the_wire() -> None:
     a, b = _driver_pair()
     meter = BusLoadMeter()
