@@ -17,6 +17,8 @@ Traffic control (issue 19): a mapping the spec starts disabled drops and counts 
 its slot comes out of the first :meth:`OfflineBridge.feed` at or after that slot (before that transfer's own
 publications, as live), and the ones still held at the end out of :meth:`OfflineBridge.finish`. Its ``cdr_later`` is
 the conversion of the transfer it came from.
+Namespaced runs (issue 30): given the run's :class:`~sam_runtime.common.ros_namespace.RosNamespace`, the topics are
+named as that run resolved them and every frame id carries its prefix, as the live bridge in that namespace wrote.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from sam_runtime.bridge.loss import TransferLoss
 from sam_runtime.bridge.switches import switches_of
 from sam_runtime.bridge.wiring import codec_gaps, in_groups, missing_codecs, nominal_rates
 from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.genpkg import GeneratedPackage
 
 __all__ = ["RECEIVE_TIME_PROBE_NS", "OfflineBridge", "Published"]
@@ -172,14 +175,17 @@ class _Ros:
 
 class OfflineBridge:
     """:param gen: the generated package (its tables and wire codecs; its ROS classes must be importable).
-    :param layout: the spec's layout; :param protocol: the half of a mixed layout (as :class:`~.composition.Bridge`).
+    :param layout: the spec's layout; :param protocol: the half of a mixed layout (as :class:`~.composition.Bridge`);
+    :param namespace: the recorded run's namespace and frame prefix (default: the root, no prefix).
     """
 
-    def __init__(self, gen: GeneratedPackage, *, layout: str | None = None, protocol: str | None = None) -> None:
+    def __init__(self, gen: GeneratedPackage, *, layout: str | None = None, protocol: str | None = None,
+                 namespace: RosNamespace | None = None) -> None:
         tables = gen.tables()
+        self.names = names = namespace or RosNamespace()
         self.selection = sel = select(tables, layout, protocol)
         self.protocol = sel.protocol
-        codec = gen.codec(sel.protocol)
+        codec = gen.codec(sel.protocol, names.frame_prefix)
         missing = missing_codecs(codec, sel.mappings)
         if missing:
             raise BridgeConfigError(f"the generated package {gen.root} has no wire codecs for "
@@ -201,6 +207,7 @@ class OfflineBridge:
 
         groups = in_groups(gen, None, self.counters, loss, sel.mappings, codec)
         self.inbound = Inbound(self.lifetime, groups, self._ros, backend)
+        self.inbound.frame_prefix = names.frame_prefix  # (the object path's; the codecs took it above)
         self._clock = _RecordedClock()
         self._convert: dict[str, Callable[..., Any]] = {}  # each mapping's own conversion
         self._inputs: dict[str, tuple[bytes, int]] = {}  # each mapping's last converted (payload, receive_ns)
@@ -221,7 +228,8 @@ class OfflineBridge:
     @property
     def topics(self) -> dict[str, str]:
         """topic -> ROS type of every UAVCAN -> ROS mapping."""
-        return {im.info.topic.name: im.info.topic.ros_type for g in self.inbound.groups.values() for im in g.mappings}
+        return {self.names.resolve(im.info.topic.name): im.info.topic.ros_type
+                for g in self.inbound.groups.values() for im in g.mappings}
 
     @property
     def ports(self) -> set[int]:
@@ -264,7 +272,7 @@ class OfflineBridge:
                 later = self._convert[im.info.name](payload, receive_ns + RECEIVE_TIME_PROBE_NS, _Scratch())
             except Exception:  # it converted once: the probe cannot fail differently, but never raise
                 later = None
-            out.append(Published(im.info.topic.name, im.info.topic.ros_type, im.info.name, cdr,
+            out.append(Published(self.names.resolve(im.info.topic.name), im.info.topic.ros_type, im.info.name, cdr,
                                  bytes(later[0]) if later else cdr))
         return out
 

@@ -41,6 +41,7 @@ from sam_runtime.cli_support import (
     write_json_atomic,
 )
 from sam_runtime.common.ros_namespace import ros_namespace
+from sam_runtime.common.run_names import run_names
 from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
 from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError
 from sam_runtime.recording.reading import read_recording
@@ -67,8 +68,11 @@ def _record_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
     p.add_argument("--log-level", default="INFO")
     p.add_argument("--namespace", default=None, metavar="NS",
-                   help="the vehicle's ROS namespace: the spec's relative topics are recorded under it (channels keep "
-                        "the names as the spec writes them; default /)")
+                   help="the vehicle's ROS namespace: the spec's relative topics are recorded under it (channels are "
+                        "named as the run resolves them; default /)")
+    p.add_argument("--frame-prefix", default=None, metavar="PREFIX",
+                   help="the run's frame prefix, kept in the recording for plot and replay (default: from the "
+                        "namespace, sam1/ for /sam1)")
     return p
 
 
@@ -77,7 +81,7 @@ def record_main(argv: Sequence[str] | None = None) -> int:
     require_runtime("run")
     try:
         check_target(args.file)  # before anything starts
-        namespace = ros_namespace(args.namespace).node_namespace
+        names = ros_namespace(args.namespace, frame_prefix=args.frame_prefix)
     except (RecordingTargetError, ValueError) as ex:
         print(f"sam-record: {ex}", file=sys.stderr)
         return EXIT_ERROR
@@ -87,7 +91,8 @@ def record_main(argv: Sequence[str] | None = None) -> int:
     async def run(stop: asyncio.Event) -> int:
         rec = Recorder(generated_package(args), RecorderConfig(args.file, layout=args.layout, iface=args.iface,
                                                                dronecan_iface=args.dronecan_iface, bus=args.bus,
-                                                               namespace=namespace))
+                                                               namespace=names.node_namespace,
+                                                               frame_prefix=names.frame_prefix))
         summary: dict[str, Any] = {}
         try:
             await rec.start()
@@ -153,10 +158,12 @@ def replay_main(argv: Sequence[str] | None = None) -> int:
             meta = rec.metadata.get(METADATA_NAME, {})
             layout = args.layout or meta.get("layout") or None
             recorded = [p for p in meta.get("protocols", "cyphal").split(",") if p]
+            names = run_names(meta)  # a namespaced run's topics and frame ids, as it wrote them
             converters = []
             for proto in recorded:
                 try:
-                    converters.append(OfflineBridge(gen, layout=layout, protocol=proto if len(recorded) > 1 else None))
+                    converters.append(OfflineBridge(gen, layout=layout, protocol=proto if len(recorded) > 1 else None,
+                                                    namespace=names))
                 except BridgeConfigError as ex:
                     print(f"sam-replay: {proto}: {ex}", file=sys.stderr)
             if not converters:

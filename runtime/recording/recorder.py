@@ -39,6 +39,8 @@ from typing import Any
 
 from sam_codegen.catalogs.ros import ros_share_dirs
 from sam_codegen.project.cyphal_path import dsdl_lookup_roots
+from sam_runtime.common.ros_namespace import RosNamespace
+from sam_runtime.common.run_names import RECORDING_METADATA, recorded_metadata
 from sam_runtime.cyphal_io.transport import aclose, make_transport
 from sam_runtime.dronecan_io.can_id import TAIL_TOGGLE
 from sam_runtime.dronecan_io.drops import DropCounter
@@ -73,7 +75,7 @@ __all__ = ["DIAGNOSTICS_TOPIC", "METADATA_NAME", "DroneCanTaps", "Recorder", "Re
 log = logging.getLogger("sam_runtime.recording")
 
 DIAGNOSTICS_TOPIC = ("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray")
-METADATA_NAME = "sam_codegen.recording"
+METADATA_NAME = RECORDING_METADATA
 FORMAT = "sam-recording/1"
 _SUBSCRIPTION_DEPTH = 1000
 _RECEIVE_TIMEOUT_S = 0.5
@@ -87,8 +89,10 @@ class RecorderConfig:
     dronecan_iface: str = "mcast-lo:"
     ros: bool = True
     bus: bool = True
-    # the vehicle's ROS namespace (None: /): relative topics are subscribed under it; channels keep the spec's names
+    # the vehicle's ROS namespace (None: /) and frame prefix: relative topics are subscribed under it, and each
+    # channel is named as the run resolved it (/sam1/core/imu); both are kept in the metadata (common.run_names)
     namespace: str | None = None
+    frame_prefix: str = ""
 
 
 def layout_protocols(tables: Any, layout: str | None) -> tuple[str, list[str]]:
@@ -181,6 +185,7 @@ class Recorder:
     def __init__(self, gen: GeneratedPackage, config: RecorderConfig) -> None:
         self.gen, self.config = gen, config
         self.tables = gen.tables()
+        self.names = RosNamespace(config.namespace or "/", config.frame_prefix)
         self.layout, self.protocols = layout_protocols(self.tables, config.layout)
         self.writer = RecordingWriter(config.path)  # RecordingTargetError before anything starts
         self.counts = _Counts()
@@ -203,7 +208,8 @@ class Recorder:
         meta = {"format": FORMAT, "vehicle": str(tables.VEHICLE), "layout": self.layout,
                 "protocols": ",".join(self.protocols), "generated": str(self.gen.root),
                 "log_time": "ROS: rclpy receive time; transfers: the listener's receive time (system clock, ns)",
-                "publish_time": "ROS: the publisher's source timestamp; transfers: the listener's receive time"}
+                "publish_time": "ROS: the publisher's source timestamp; transfers: the listener's receive time",
+                **recorded_metadata(self.names)}
         if "cyphal" in self.protocols:
             self.subjects = {p.subject_id: p.dsdl_type for d in tables.DEVICES for p in (*d.publishes, *d.subscribes)}
             self.subjects[HEARTBEAT_SUBJECT] = HEARTBEAT_TYPE
@@ -238,7 +244,8 @@ class Recorder:
         """topic -> (ROS type, QoS profile) of the topics whose definitions were found (the others are reported)."""
         share = [*ros_share_dirs(), self.gen.root / "ros"]
         out = {}
-        for topic, (ros_type, rel, dur, depth) in topic_qos(self.tables).items():
+        for name, (ros_type, rel, dur, depth) in topic_qos(self.tables).items():
+            topic = self.names.resolve(name)  # as the run's nodes resolve it (rosbag2 records resolved names too)
             try:
                 definition = ros2msg_definition(ros_type, share)
             except LookupError as ex:

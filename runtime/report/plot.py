@@ -24,11 +24,12 @@ from typing import Any
 
 import yaml
 
+from sam_runtime.common.run_names import spec_frame, spec_status_name
 from sam_runtime.physics.geo import depth_from_pressure
 from sam_runtime.report.recording import Recording, RecordingError, read_recording
 from sam_runtime.tf_buffer import Transform
 
-__all__ = ["LIMITS", "TOPICS", "RecordingError", "limits_from_params", "plot_run", "track"]
+__all__ = ["LIMITS", "TOPICS", "RecordingError", "limits_from_params", "node_states", "plot_run", "track"]
 
 LIMITS = ("safe_depth", "critical_depth", "safe_altitude", "critical_altitude")
 # What the picture shows: only these are decoded (a run's /imu and raw bus are most of its messages).
@@ -63,8 +64,9 @@ def track(rec: Recording) -> tuple[str, list[tuple[float, float, float, float]]]
     for t, msg in rec.get("/tf"):
         for ts in msg.transforms:
             tr, rot = ts.transform.translation, ts.transform.rotation
-            edge = Transform(ts.header.frame_id, ts.child_frame_id, _stamp_ns(ts.header.stamp), (tr.x, tr.y, tr.z),
-                             (rot.x, rot.y, rot.z, rot.w))
+            # a namespaced run's frames carry its prefix (sam1/odom): the spec's names again
+            edge = Transform(spec_frame(rec.names, ts.header.frame_id), spec_frame(rec.names, ts.child_frame_id),
+                             _stamp_ns(ts.header.stamp), (tr.x, tr.y, tr.z), (rot.x, rot.y, rot.z, rot.w))
             if (edge.parent, edge.child) == ("odom", "base_link"):
                 odom_base.append((t, edge))
             elif (edge.parent, edge.child) == ("world", "odom"):
@@ -299,17 +301,25 @@ def _draw_battery(ax_bat: Any, run: _Run) -> None:
         _not_recorded(ax_bat, "/battery_state")
 
 
+def node_states(rec: Recording) -> dict[str, list[tuple[float, int]]]:
+    """Each node's (and the bridge's) levels over time from /diagnostics, by the spec's name: a namespaced run's
+    statuses (sam1/controller) without the namespace, another vehicle's and the per-mapping statuses left out."""
+    rows: dict[str, list[tuple[float, int]]] = {}
+    for t, msg in rec.get("/diagnostics"):
+        for status in msg.status:
+            name = spec_status_name(rec.names, status.name)  # None: another vehicle's (shared /diagnostics)
+            if name is not None and "/" not in name:  # the nodes and the bridge itself, not per-mapping statuses
+                level = status.level[0] if isinstance(status.level, bytes | bytearray) else int(status.level)
+                rows.setdefault(name, []).append((t, level))
+    return rows
+
+
 def _draw_states(ax_state: Any, run: _Run) -> None:
     from matplotlib.patches import Patch
 
     rec, spans, end = run.rec, run.spans, run.end
     ax_state.set_title("Abort (/abort) and node states (/diagnostics)")
-    rows: dict[str, list[tuple[float, int]]] = {}
-    for t, msg in rec.get("/diagnostics"):
-        for status in msg.status:
-            if "/" not in status.name:  # the nodes and the bridge itself, not its per-mapping statuses
-                level = status.level[0] if isinstance(status.level, bytes | bytearray) else int(status.level)
-                rows.setdefault(status.name, []).append((t, level))
+    rows = node_states(rec)
     names = sorted(rows)
     if rows or rec.get("/abort"):
         rows_shown = [*names, "abort"]
