@@ -6,7 +6,11 @@ slowed or killed by the recording; the recording holds what was on the bus, also
 - Cyphal/UDP: an anonymous pycyphal UDP transport on the same interface with a promiscuous input session per subject
   of the spec (every device's publications and subscriptions) and uavcan.node.Heartbeat. Cyphal/UDP subjects are
   multicast groups, so this sees every transfer the bridge sees, reassembled by the same transport code; pycyphal's
-  capture API (``begin_capture``) would see the services too, but needs libpcap and CAP_NET_RAW (root).
+  capture API (``begin_capture``) would see the services too, but needs libpcap and CAP_NET_RAW (root). Service
+  transfers go to their destination node's multicast group: one more listener per node id that takes part (the
+  bridge and every Cyphal device of the spec), a transport with that node id (it sends nothing) with promiscuous
+  request and response sessions of the standard services the bridge and tools use (GetInfo, ExecuteCommand,
+  GetTransportStatistics, register Access and List) and of the spec's Cyphal service mappings.
 - DroneCAN on ``mcast-lo:``: a :class:`~sam_runtime.dronecan_io.LoopbackMulticastDriver` joined to the same loopback
   group behind a :class:`~sam_runtime.dronecan_io.FrameGate` whose taps take every completed transfer (messages and
   services, checked as dronecan checks them: toggle bits, and the CRC where the data type's signature is known).
@@ -78,6 +82,11 @@ DIAGNOSTICS_TOPIC = ("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray")
 METADATA_NAME = RECORDING_METADATA
 FORMAT = "sam-recording/1"
 _SUBSCRIPTION_DEPTH = 1000
+# service id -> type of the standard Cyphal services recorded (the spec's service mappings are added)
+CYPHAL_SERVICES = {430: "uavcan.node.GetInfo.1.0", 434: "uavcan.node.GetTransportStatistics.0.1",
+                   435: "uavcan.node.ExecuteCommand.1.3", 384: "uavcan.register.Access.1.0",
+                   385: "uavcan.register.List.1.0"}
+_SERVICE_EXTENT = 1 << 16  # bytes: a service payload is kept whole (register values, GetInfo's names)
 _RECEIVE_TIMEOUT_S = 0.5
 
 
@@ -200,6 +209,8 @@ class Recorder:
         self._taps: DroneCanTaps | None = None
         self._dronecan_drops: DropCounter | None = None
         self.subjects: dict[int, str] = {}
+        self.services: dict[int, str] = {}
+        self._service_transports: list[Any] = []
         self.ros_errors: list[str] = []
 
     # ------------------------------------------------------------------ setup
@@ -213,9 +224,16 @@ class Recorder:
         if "cyphal" in self.protocols:
             self.subjects = {p.subject_id: p.dsdl_type for d in tables.DEVICES for p in (*d.publishes, *d.subscribes)}
             self.subjects[HEARTBEAT_SUBJECT] = HEARTBEAT_TYPE
+            self.services = dict(CYPHAL_SERVICES)
+            services = self.gen.services()
+            for m in getattr(services, "SERVICE_MAPPINGS", ()) if services is not None else ():
+                if m.protocol == "cyphal":
+                    self.services[int(m.data_type_id)] = str(m.data_type)
             meta["cyphal.iface"] = f"udp:{self.config.iface}"
             meta["cyphal.subjects"] = json.dumps({str(k): v for k, v in sorted(self.subjects.items())})
-            standard = {t for t in self.subjects.values() if not t.startswith(f"{tables.DSDL_ROOT_NAMESPACE}.")}
+            meta["cyphal.services"] = json.dumps({str(k): v for k, v in sorted(self.services.items())})
+            standard = {t for t in (*self.subjects.values(), *self.services.values())
+                        if not t.startswith(f"{tables.DSDL_ROOT_NAMESPACE}.")}
             try:
                 for name, data in cyphal_definition_files(self.gen.dsdl_dirs, dsdl_lookup_roots(),
                                                           sorted(standard)).items():
@@ -324,29 +342,45 @@ class Recorder:
     # ------------------------------------------------------------------ Cyphal/UDP
     async def _start_cyphal(self) -> None:
         from pycyphal.transport import InputSessionSpecifier, MessageDataSpecifier, PayloadMetadata
+        from pycyphal.transport import ServiceDataSpecifier as Service
 
         self.gen.compile_dsdl()  # cached; the extents come from the compiled classes
         self._transport = make_transport("udp", node_id=None, iface=self.config.iface)
+        loop = asyncio.get_running_loop()
         for sid, dsdl_type in sorted(self.subjects.items()):
             session = self._transport.get_input_session(
                 InputSessionSpecifier(MessageDataSpecifier(sid), None), PayloadMetadata(_extent(dsdl_type)))
-            self._tasks.append(asyncio.get_running_loop().create_task(self._receive(session, sid, dsdl_type),
-                                                                      name=f"recorder-rx-{sid}"))
+            self._tasks.append(loop.create_task(self._receive(session, sid, dsdl_type), name=f"recorder-rx-{sid}"))
+        # services: as each node that takes part (module docstring)
+        nids = {d.node_id for d in self.tables.DEVICES}
+        if self.tables.BRIDGE_NODE_ID is not None:
+            nids.add(int(self.tables.BRIDGE_NODE_ID))
+        for nid in sorted(nids):
+            transport = make_transport("udp", node_id=nid, iface=self.config.iface)
+            self._service_transports.append(transport)
+            for sid, dsdl_type in sorted(self.services.items()):
+                for role, kind in ((Service.Role.REQUEST, KIND_REQUEST), (Service.Role.RESPONSE, KIND_RESPONSE)):
+                    session = transport.get_input_session(InputSessionSpecifier(Service(sid, role), None),
+                                                          PayloadMetadata(_SERVICE_EXTENT))
+                    self._tasks.append(loop.create_task(self._receive(session, sid, dsdl_type, kind, nid),
+                                                        name=f"recorder-rx-{nid}-{sid}-{kind}"))
 
-    async def _receive(self, session: Any, sid: int, dsdl_type: str) -> None:
+    async def _receive(self, session: Any, sid: int, dsdl_type: str, kind: int = KIND_MESSAGE,
+                       destination: int | None = None) -> None:
         from pycyphal.transport import ResourceClosedError
 
         loop = asyncio.get_running_loop()
         try:
             while True:
-                tr = await session.receive(loop.time() + _RECEIVE_TIMEOUT_S)
+                # services are rare: a long wait (cancelled at close) instead of 220 wake-ups a second
+                tr = await session.receive(loop.time() + (_RECEIVE_TIMEOUT_S if kind == KIND_MESSAGE else 60.0))
                 if tr is None:
                     continue
                 try:
                     payload = b"".join(bytes(f) for f in tr.fragmented_payload)
                     now = int(tr.timestamp.system_ns) or time.time_ns()  # when the transport read the datagram
                     t = Transfer("cyphal", sid, dsdl_type, tr.source_node_id, int(tr.transfer_id),
-                                 int(tr.priority), now, payload)
+                                 int(tr.priority), now, payload, kind=kind, destination_node_id=destination)
                     if self.writer.write(CYPHAL_TOPIC, encode_transfer(t), now, now):
                         self.counts.transfers["cyphal"] += 1
                 except Exception as ex:
@@ -405,8 +439,9 @@ class Recorder:
         self._dronecan_stop.set()
         for t in self._tasks:
             t.cancel()
-        if self._transport is not None:
-            await aclose(self._transport)
+        closables = [t for t in (self._transport, *self._service_transports) if t is not None]
+        if closables:
+            await aclose(*closables)  # at once: one deadline for all of them
         await asyncio.gather(*self._tasks, return_exceptions=True)
         if self._dronecan_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._dronecan_thread.join, 2.0)
