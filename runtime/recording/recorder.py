@@ -9,8 +9,9 @@ slowed or killed by the recording; the recording holds what was on the bus, also
   capture API (``begin_capture``) would see the services too, but needs libpcap and CAP_NET_RAW (root). Service
   transfers go to their destination node's multicast group: one more listener per node id that takes part (the
   bridge and every Cyphal device of the spec), a transport with that node id (it sends nothing) with promiscuous
-  request and response sessions of the standard services the bridge and tools use (GetInfo, ExecuteCommand,
-  GetTransportStatistics, register Access and List) and of the spec's Cyphal service mappings.
+  sessions (requests to a device; requests to and responses to the bridge) of the standard services the bridge
+  and tools use (GetInfo, ExecuteCommand, GetTransportStatistics, register Access and List) and of the spec's Cyphal
+  service mappings.
 - DroneCAN on ``mcast-lo:``: a :class:`~sam_runtime.dronecan_io.LoopbackMulticastDriver` joined to the same loopback
   group behind a :class:`~sam_runtime.dronecan_io.FrameGate` whose taps take every completed transfer (messages and
   services, checked as dronecan checks them: toggle bits, and the CRC where the data type's signature is known).
@@ -86,6 +87,7 @@ _SUBSCRIPTION_DEPTH = 1000
 CYPHAL_SERVICES = {430: "uavcan.node.GetInfo.1.0", 434: "uavcan.node.GetTransportStatistics.0.1",
                    435: "uavcan.node.ExecuteCommand.1.3", 384: "uavcan.register.Access.1.0",
                    385: "uavcan.register.List.1.0"}
+_SERVICE_RECEIVE_TIMEOUT_S = 2.0
 _SERVICE_EXTENT = 1 << 16  # bytes: a service payload is kept whole (register values, GetInfo's names)
 _RECEIVE_TIMEOUT_S = 0.5
 
@@ -352,14 +354,17 @@ class Recorder:
                 InputSessionSpecifier(MessageDataSpecifier(sid), None), PayloadMetadata(_extent(dsdl_type)))
             self._tasks.append(loop.create_task(self._receive(session, sid, dsdl_type), name=f"recorder-rx-{sid}"))
         # services: as each node that takes part (module docstring)
-        nids = {d.node_id for d in self.tables.DEVICES}
-        if self.tables.BRIDGE_NODE_ID is not None:
-            nids.add(int(self.tables.BRIDGE_NODE_ID))
-        for nid in sorted(nids):
+        # a device is asked (requests to it), the bridge asks and is asked (responses and requests to it)
+        bridge = None if self.tables.BRIDGE_NODE_ID is None else int(self.tables.BRIDGE_NODE_ID)
+        roles: dict[int, tuple[tuple[Any, int], ...]] = {
+            d.node_id: ((Service.Role.REQUEST, KIND_REQUEST),) for d in self.tables.DEVICES}
+        if bridge is not None:
+            roles[bridge] = ((Service.Role.REQUEST, KIND_REQUEST), (Service.Role.RESPONSE, KIND_RESPONSE))
+        for nid in sorted(roles):
             transport = make_transport("udp", node_id=nid, iface=self.config.iface)
             self._service_transports.append(transport)
             for sid, dsdl_type in sorted(self.services.items()):
-                for role, kind in ((Service.Role.REQUEST, KIND_REQUEST), (Service.Role.RESPONSE, KIND_RESPONSE)):
+                for role, kind in roles[nid]:
                     session = transport.get_input_session(InputSessionSpecifier(Service(sid, role), None),
                                                           PayloadMetadata(_SERVICE_EXTENT))
                     self._tasks.append(loop.create_task(self._receive(session, sid, dsdl_type, kind, nid),
@@ -372,8 +377,11 @@ class Recorder:
         loop = asyncio.get_running_loop()
         try:
             while True:
-                # services are rare: a long wait (cancelled at close) instead of 220 wake-ups a second
-                tr = await session.receive(loop.time() + (_RECEIVE_TIMEOUT_S if kind == KIND_MESSAGE else 60.0))
+                # services are rare: a longer wait than the subjects' (~100 sessions), short enough that a
+                # cancellation Python 3.11 loses inside pycyphal's wait_for still ends the task within the stop
+                # budget of `run` (a 60 s wait got the recorder killed and its file cut)
+                tr = await session.receive(loop.time() + (_RECEIVE_TIMEOUT_S if kind == KIND_MESSAGE
+                                                          else _SERVICE_RECEIVE_TIMEOUT_S))
                 if tr is None:
                     continue
                 try:
@@ -439,9 +447,12 @@ class Recorder:
         self._dronecan_stop.set()
         for t in self._tasks:
             t.cancel()
+        # pycyphal's UDP close waits for each session's socket reader (~60 ms each): the service listeners' ~70
+        # sessions closed one after the other took 8 s, past the stop budget of `run`; in threads, at once, ~1 s
+        await asyncio.gather(*(asyncio.to_thread(t.close) for t in self._service_transports))
         closables = [t for t in (self._transport, *self._service_transports) if t is not None]
         if closables:
-            await aclose(*closables)  # at once: one deadline for all of them
+            await aclose(*closables)  # the tasks of what closed (close() again does nothing)
         await asyncio.gather(*self._tasks, return_exceptions=True)
         if self._dronecan_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._dronecan_thread.join, 2.0)
