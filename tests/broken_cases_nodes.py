@@ -77,7 +77,7 @@ CASES: tuple[Case, ...] = (
         "unknown_qos_profile",
         (("  /level: {type: buoy_msgs/Level}", "  /level: {type: buoy_msgs/Level, qos: fast}"),),
         (
-            "minimal.yaml:25:40: error: unknown QoS profile 'fast' in the QoS of topic '/level' (expected one of sensor_data, reliable, latched, tf, or a mapping {reliability, durability, depth})",
+            "minimal.yaml:25:40: error: unknown QoS profile 'fast' in the QoS of topic '/level' (expected one of sensor_data, reliable, latched, tf, a mapping {reliability, durability, depth}, or a mapping {publishers, subscribers} of those)",
         ),
     ),
     Case(
@@ -91,7 +91,8 @@ CASES: tuple[Case, ...] = (
     ),
     Case(
         "reliable_subscription_of_a_best_effort_sensor",
-        (("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [{topic: /level, qos: reliable}]\n    parameters: [/warn_level]"),),
+        (("  /level: {type: buoy_msgs/Level}", "  /level: {type: buoy_msgs/Level, qos: {publishers: sensor_data}}"),
+         ("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [{topic: /level, qos: reliable}]\n    parameters: [/warn_level]"),),
         (
             "minimal.yaml:63:18: error: node logger subscribes to /level with reliable (reliable, volatile, keep last 10), but the bridge (mapping level) publishes it with sensor_data (best_effort, volatile, keep last 5): a best_effort publisher cannot serve a reliable subscription (expected a QoS the publishers can serve)",
         ),
@@ -100,7 +101,44 @@ CASES: tuple[Case, ...] = (
         "transient_local_subscription_of_a_volatile_topic",
         (("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [{topic: /level, qos: {reliability: best_effort, durability: transient_local, depth: 1}}]\n    parameters: [/warn_level]"),),
         (
-            "minimal.yaml:63:18: error: node logger subscribes to /level with best_effort, transient_local, keep last 1, but the bridge (mapping level) publishes it with sensor_data (best_effort, volatile, keep last 5): a volatile publisher cannot serve a transient_local subscription (expected a QoS the publishers can serve)",
+            "minimal.yaml:63:18: error: node logger subscribes to /level with best_effort, transient_local, keep last 1, but the bridge (mapping level) publishes it with reliable, volatile, keep last 5: a volatile publisher cannot serve a transient_local subscription (expected a QoS the publishers can serve)",
+        ),
+    ),
+    Case(
+        "qos_mixes_sides_and_both",
+        (("  /level: {type: buoy_msgs/Level}", "  /level: {type: buoy_msgs/Level, qos: {publishers: reliable, depth: 5}}"),),
+        (
+            "minimal.yaml:25:63: error: the QoS of topic '/level' gives depth beside per-side publishers: which side is it for? (expected either {reliability, durability, depth} for both sides, or each side in {publishers, subscribers})",
+        ),
+    ),
+    Case(
+        "qos_sides_a_publisher_cannot_serve",
+        (("  /level: {type: buoy_msgs/Level}", "  /level: {type: buoy_msgs/Level, qos: {publishers: sensor_data, subscribers: reliable}}"),),
+        (
+            "minimal.yaml:25:40: error: the QoS of topic '/level' has subscribers reliable (reliable, volatile, keep last 10), which its publishers sensor_data (best_effort, volatile, keep last 5) cannot serve: a best_effort publisher cannot serve a reliable subscription (expected a subscribers' side the publishers' side serves (best_effort subscribers take reliable publishers, volatile ones transient_local publishers))",
+        ),
+    ),
+    Case(
+        "qos_one_side_against_the_default_other",
+        (("  /valve: {type: std_msgs/UInt8}", "  /valve: {type: std_msgs/UInt8, qos: {subscribers: latched}}"),),
+        (
+            "minimal.yaml:26:39: error: the QoS of topic '/valve' has subscribers latched (reliable, transient_local, keep last 1), which its publishers reliable (reliable, volatile, keep last 10) cannot serve: a volatile publisher cannot serve a transient_local subscription (expected a subscribers' side the publishers' side serves (best_effort subscribers take reliable publishers, volatile ones transient_local publishers))",
+        ),
+    ),
+    Case(
+        "qos_bad_side",
+        (("  /level: {type: buoy_msgs/Level}", "  /level: {type: buoy_msgs/Level, qos: {publishers: fast, subscribers: {reliability: sure, durability: volatile, depth: 5}, readers: reliable}}"),),
+        (
+            "minimal.yaml:25:53: error: unknown QoS profile 'fast' in the publishers' side of the QoS of topic '/level' (expected one of sensor_data, reliable, latched, tf, or a mapping {reliability, durability, depth})",
+            "minimal.yaml:25:73: error: reliability 'sure' in the subscribers' side of the QoS of topic '/level' is unknown (expected reliable or best_effort)",
+            "minimal.yaml:25:125: error: unknown field 'readers' in the QoS of topic '/level' (expected one of publishers, subscribers)",
+        ),
+    ),
+    Case(
+        "per_side_qos_on_a_subscription",
+        (("    subscribes: [/level]\n    parameters: [/warn_level]", "    subscribes: [{topic: /level, qos: {subscribers: reliable}}]\n    parameters: [/warn_level]"),),
+        (
+            "minimal.yaml:63:40: error: the QoS of /level in subscribes of node 'logger' is one side, it cannot give subscribers (expected a profile name or a mapping {reliability, durability, depth}; per-side QoS is a topic's `qos:`)",
         ),
     ),
     Case(

@@ -16,7 +16,14 @@ from pathlib import Path
 from sam_codegen.frontend.bridge import parse_device, parse_layout, parse_mapping
 from sam_codegen.frontend.bus import parse_bus
 from sam_codegen.frontend.node_services import parse_node_services, with_duty_srvs
-from sam_codegen.frontend.nodes import QOS_DEPTH_MAX, parse_frame, parse_node, parse_parameter, parse_qos
+from sam_codegen.frontend.nodes import (
+    QOS_DEPTH_MAX,
+    parse_frame,
+    parse_node,
+    parse_parameter,
+    parse_qos,
+    parse_topic_qos,
+)
 from sam_codegen.frontend.reading import Reader, map_items, scalar, seq_items, str_list, text_of
 from sam_codegen.frontend.services import parse_service_mapping
 from sam_codegen.frontend.time_sync import parse_time_sync
@@ -187,12 +194,14 @@ def _declared_topics(top: Reader, diag: Diagnostics) -> list[Topic]:
         r = Reader(node, f"topic {key!r}", diag, ("type", "description", "section", "qos", "published_by"))
         type_ = r.get("type", str)
         qos_node = r.node("qos")
-        qos = parse_qos(qos_node, f"the QoS of topic {key!r}", diag) if qos_node is not None else None
+        pub_qos, sub_qos = (parse_topic_qos(qos_node, f"the QoS of topic {key!r}", diag) if qos_node is not None
+                            else (None, None))
         external, external_pos = parse_published_by(r.node("published_by"), key, diag)
         if type_ is not None:
             declared_topics.append(Topic(key, type_.replace("/msg/", "/"), text_of(r, "description"),
-                                         str(r.get("section", (str, float, int), "")), pos, qos,
+                                         str(r.get("section", (str, float, int), "")), pos, pub_qos,
                                          qos_node.pos if qos_node is not None else pos,
+                                         declared_subscriber_qos=sub_qos,
                                          external_publisher=external, external_pos=external_pos))
     return declared_topics
 
@@ -261,11 +270,15 @@ def _ros_services(top: Reader, package: str, diag: Diagnostics) -> dict[str, Ros
 
 
 def _with_effective_qos(topic: Topic, bridged: set[str]) -> Topic:
-    """The topic with the QoS its endpoints use: the declared one, else the ROS-convention default."""
-    if topic.declared_qos is not None:
-        return replace(topic, qos=topic.declared_qos, qos_origin="declared")
-    qos, origin = default_qos(topic, bridged)
-    return replace(topic, qos=qos, qos_origin=origin)
+    """The topic with the QoS its endpoints use, per side: the declared one, else the ROS-convention default
+    (validate.nodes checks that the subscribers' side is one the publishers' side serves)."""
+    publishers, subscribers, origin = default_qos(topic, bridged)
+    pub, sub = topic.declared_qos, topic.declared_subscriber_qos
+    if pub is not None and sub is not None:
+        origin = "declared"
+    elif pub is not None or sub is not None:
+        origin = f"{'publishers' if pub is not None else 'subscribers'} declared, the other side: {origin}"
+    return replace(topic, qos=pub or publishers, subscriber_qos=sub or subscribers, qos_origin=origin)
 
 
 # The largest spec file read: SAM's is 43 KB, a generated spec of 1000 types under 1 MB. A bound keeps `--spec

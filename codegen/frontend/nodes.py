@@ -10,6 +10,7 @@ from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.spec import (
     DURABILITIES,
     QOS_PROFILES,
+    QOS_SIDES,
     RELIABILITIES,
     Frame,
     Node,
@@ -19,9 +20,10 @@ from sam_codegen.model.spec import (
     Parameter,
     Qos,
     Scalar,
+    topic_profile,
 )
 
-__all__ = ["QOS_DEPTH_MAX", "parse_frame", "parse_node", "parse_parameter", "parse_qos"]
+__all__ = ["QOS_DEPTH_MAX", "parse_frame", "parse_node", "parse_parameter", "parse_qos", "parse_topic_qos"]
 
 
 def parse_parameter(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Parameter | None:
@@ -92,6 +94,11 @@ def parse_qos(node: YNode, what: str, diag: Diagnostics) -> Qos | None:
         diag.error(node.pos, f"{what} must be a profile name or a mapping, found {kind_of(node)}",
                    "one of " + ", ".join(QOS_PROFILES) + ", or a mapping {reliability, durability, depth}")
         return None
+    sides = [k for k in node.entries if k in QOS_SIDES]
+    if sides:  # a subscription's own QoS, or one side of a topic's: it is one side already
+        diag.error(node.key_pos[sides[0]], f"{what} is one side, it cannot give {' and '.join(sides)}",
+                   "a profile name or a mapping {reliability, durability, depth}; per-side QoS is a topic's `qos:`")
+        return None
     r = Reader(node, what, diag, _QOS_KEYS)
     reliability, durability, depth = r.get("reliability", str), r.get("durability", str), r.get("depth", int)
     ok = r.ok
@@ -109,6 +116,43 @@ def parse_qos(node: YNode, what: str, diag: Diagnostics) -> Qos | None:
     if not ok or reliability is None or durability is None or depth is None:
         return None
     return Qos(reliability, durability, depth)
+
+
+_TOPIC_QOS_EXPECTED = ("one of " + ", ".join(QOS_PROFILES) + ", a mapping {reliability, durability, depth}, or "
+                       "a mapping {publishers, subscribers} of those")
+
+
+def parse_topic_qos(node: YNode, what: str, diag: Diagnostics) -> tuple[Qos | None, Qos | None]:
+    """A topic's `qos:` as (publishers, subscribers); None for a side it does not give (or gives wrongly, reported).
+
+    A profile name or a {reliability, durability, depth} mapping gives both sides (`sensor_data`: REP 2003's pair,
+    model.spec.topic_profile); {publishers: ..., subscribers: ...} gives either side or both, each a profile (the
+    rclpy profile of that name: `publishers: sensor_data` publishes best effort) or a mapping.
+    """
+    if isinstance(node, YScalar) and isinstance(node.value, str):
+        sides = topic_profile(node.value)
+        if sides is None:
+            diag.error(node.pos, f"unknown QoS profile {node.value!r} in {what}", _TOPIC_QOS_EXPECTED)
+            return None, None
+        return sides
+    if not isinstance(node, YMap) or not any(k in node.entries for k in QOS_SIDES):
+        if not isinstance(node, YMap):
+            diag.error(node.pos, f"{what} must be a profile name or a mapping, found {kind_of(node)}",
+                       _TOPIC_QOS_EXPECTED)
+            return None, None
+        both = parse_qos(node, what, diag)
+        return both, both
+    mixed = [k for k in node.entries if k in _QOS_KEYS]
+    if mixed:
+        diag.error(node.key_pos[mixed[0]], f"{what} gives {', '.join(mixed)} beside per-side "
+                   f"{' and '.join(k for k in QOS_SIDES if k in node.entries)}: which side is it for?",
+                   "either {reliability, durability, depth} for both sides, or each side in {publishers, subscribers}")
+        return None, None
+    r = Reader(node, what, diag, QOS_SIDES)
+    pub_node, sub_node = r.node("publishers"), r.node("subscribers")
+    publishers = parse_qos(pub_node, f"the publishers' side of {what}", diag) if pub_node is not None else None
+    subscribers = parse_qos(sub_node, f"the subscribers' side of {what}", diag) if sub_node is not None else None
+    return publishers, subscribers
 
 
 def parse_frame(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Frame:

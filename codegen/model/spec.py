@@ -168,6 +168,38 @@ QOS_PROFILES: dict[str, Qos] = {
     "latched": Qos("reliable", "transient_local", 1, "latched"),
     "tf": Qos("reliable", "volatile", 100, "tf"),
 }
+# A topic's `qos:` names both sides of it. `sensor_data` there follows REP 2003: sensor drivers (the bridge)
+# publish reliably, consumers subscribe best effort (rclpy's qos_profile_sensor_data), so a subscriber with default
+# (reliable) settings, a best-effort one and a reliable one all match. Every other profile is the same on both sides.
+SENSOR_PUBLISHERS = Qos("reliable", "volatile", 5)
+QOS_SIDES = ("publishers", "subscribers")
+
+
+def topic_profile(name: str) -> tuple[Qos, Qos] | None:
+    """(publishers, subscribers) of a topic's `qos: <name>`; None for an unknown name.
+
+    >>> [q.reliability for q in topic_profile("sensor_data")]
+    ['reliable', 'best_effort']
+    >>> topic_profile("latched")[0] == topic_profile("latched")[1] == QOS_PROFILES["latched"]
+    True
+    """
+    profile = QOS_PROFILES.get(name)
+    if profile is None:
+        return None
+    return (SENSOR_PUBLISHERS, profile) if name == "sensor_data" else (profile, profile)
+
+
+def describe_sides(publishers: Qos, subscribers: Qos) -> str:
+    """The QoS of a topic's two sides, once when they are the same.
+
+    >>> describe_sides(*topic_profile("reliable"))
+    'publishers and subscribers reliable (reliable, volatile, keep last 10)'
+    >>> describe_sides(*topic_profile("sensor_data"))
+    'publishers reliable, volatile, keep last 5; subscribers sensor_data (best_effort, volatile, keep last 5)'
+    """
+    if publishers == subscribers:
+        return f"publishers and subscribers {publishers.describe()}"
+    return f"publishers {publishers.describe()}; subscribers {subscribers.describe()}"
 RELIABILITIES: tuple[Reliability, ...] = ("reliable", "best_effort")
 DURABILITIES: tuple[Durability, ...] = ("volatile", "transient_local")
 TF_TOPIC = "/tf"
@@ -182,12 +214,18 @@ class Topic:
     description: str = ""
     section: str = ""
     pos: Pos = NOWHERE
-    declared_qos: Qos | None = None  # the spec's `qos:`, if any
+    # The spec's `qos:` per side (publishers, subscribers), if it gives that side
+    declared_qos: Qos | None = None
     qos_pos: Pos = NOWHERE
-    # The QoS its endpoints use: the declared one or the default for the topic (default_qos), chosen by the
-    # frontend, which knows the bridge's mappings when it builds the topic. None only for a hand-built Topic.
+    # The QoS its publishers use (the bridge's and external ones too): the declared one or the default for the
+    # topic (default_qos), chosen by the frontend, which knows the bridge's mappings when it builds the topic.
+    # None only for a hand-built Topic.
     qos: Qos | None = None
-    qos_origin: str = ""  # why: "declared", or the default rule that chose it
+    qos_origin: str = ""  # why: "declared", or the default rule that chose it (either side)
+    # The QoS its subscriptions use (the bridge's command subscriptions too) unless a node's subscription gives its
+    # own; chosen as `qos` is. REP 2003: best effort for sensor data, which a reliable publisher serves.
+    declared_subscriber_qos: Qos | None = None
+    subscriber_qos: Qos | None = None
     # `published_by: external`: published (also) from outside the spec (an operator GUI, a mission executive);
     # the text says who ("" when the spec does not say). None: only the spec's nodes and bridge publish it.
     external_publisher: str | None = None
@@ -195,24 +233,29 @@ class Topic:
     implied: bool = False  # not declared: /tf or /tf_static, which the nodes' transforms imply (frontend.tf_topics)
 
 
-def default_qos(topic: Topic, bridged: set[str]) -> tuple[Qos, str]:
-    """The QoS of a topic without `qos:`, by ROS convention, and why; `bridged`: the topics the bridge publishes
-    from UAVCAN (its uavcan_to_ros mappings).
+def default_qos(topic: Topic, bridged: set[str]) -> tuple[Qos, Qos, str]:
+    """The QoS of a topic without `qos:` (publishers, subscribers), by ROS convention, and why; `bridged`: the
+    topics the bridge publishes from UAVCAN (its uavcan_to_ros mappings).
 
     >>> default_qos(Topic("/tf_static", "tf2_msgs/TFMessage"), set())[0].profile
     'latched'
-    >>> default_qos(Topic("/imu", "sensor_msgs/Imu"), {"/imu"})
-    (Qos(reliability='best_effort', durability='volatile', depth=5, profile='sensor_data'), 'a UAVCAN sensor stream')
-    >>> default_qos(Topic("/goal", "geometry_msgs/PoseStamped"), set())[1]
+    >>> pub, sub, why = default_qos(Topic("/imu", "sensor_msgs/Imu"), {"/imu"})
+    >>> pub.reliability, sub.reliability, why
+    ('reliable', 'best_effort', 'a UAVCAN sensor stream (REP 2003)')
+    >>> default_qos(Topic("/goal", "geometry_msgs/PoseStamped"), set())[2]
     'a command, goal or plan'
     """
     if topic.name == TF_STATIC_TOPIC:
-        return QOS_PROFILES["latched"], "static transforms (tf2's convention)"
-    if topic.type == TF_MESSAGE:
-        return QOS_PROFILES["tf"], "transforms (tf2's convention)"
-    if topic.name in bridged:
-        return QOS_PROFILES["sensor_data"], "a UAVCAN sensor stream"
-    return QOS_PROFILES["reliable"], "a command, goal or plan"
+        profile, why = "latched", "static transforms (tf2's convention)"
+    elif topic.type == TF_MESSAGE:
+        profile, why = "tf", "transforms (tf2's convention)"
+    elif topic.name in bridged:
+        profile, why = "sensor_data", "a UAVCAN sensor stream (REP 2003)"
+    else:
+        profile, why = "reliable", "a command, goal or plan"
+    sides = topic_profile(profile)
+    assert sides is not None, "a known profile"
+    return sides[0], sides[1], why
 
 
 @dataclass(frozen=True)

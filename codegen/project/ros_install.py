@@ -19,6 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from sam_codegen.project.lock import ProjectLock, lock_path
+from sam_codegen.project.progress import TerminalProgress
 
 __all__ = [
     "HASH_STAMP",
@@ -156,7 +157,9 @@ def build_ros_package(
     def step(what: str, cmd: Sequence[str], env: Mapping[str, str]) -> None:
         if progress is not None:
             progress(what)
-        _run_step(what, cmd, env)
+        # a build step runs 5-40 s without a word: a line with the elapsed time on a terminal (issue 30)
+        with TerminalProgress(f"ROS package {Path(package_dir).name}: CMake {what}"):
+            _run_step(what, cmd, env)
 
     cmake = shutil.which("cmake")
     if cmake is None:

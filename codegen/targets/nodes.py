@@ -165,7 +165,7 @@ def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
     subscriptions, publications = [], []
     for item in node.subscribe_items:
         topic = spec.topics[item.topic]
-        qos = node_topic_qos(spec, item)
+        qos = node_topic_qos(spec, item, subscription=True)
         subscriptions.append({
             "topic": item.topic, "ident": topic_identifier(item.topic), "cls": imports.use(topic.type),
             "type": topic.type, "qos": qos_args(qos), "qos_text": qos.describe(),
@@ -173,7 +173,7 @@ def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
         })
     for item in node.publish_items:
         topic = spec.topics[item.topic]
-        qos = node_topic_qos(spec, item)
+        qos = node_topic_qos(spec, item, subscription=False)
         publications.append({
             "topic": item.topic, "ident": topic_identifier(item.topic), "cls": imports.use(topic.type),
             "type": topic.type, "qos": qos_args(qos), "qos_text": qos.describe(),
@@ -181,6 +181,9 @@ def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
         })
     tf_qos = spec.topics[TF_TOPIC].qos if TF_TOPIC in spec.topics else None
     static_qos = spec.topics[TF_STATIC_TOPIC].qos if TF_STATIC_TOPIC in spec.topics else None
+    # the TF feed subscribes: the subscribers' side
+    tf_sub_qos = spec.topics[TF_TOPIC].subscriber_qos if TF_TOPIC in spec.topics else None
+    static_sub_qos = spec.topics[TF_STATIC_TOPIC].subscriber_qos if TF_STATIC_TOPIC in spec.topics else None
     descriptions = {(t.parent, t.child): t.description for t in spec.transforms}
     publishes_tf = [{"parent": p, "child": c, "ident": transform_identifier(p, c),
                      "description": one_line(descriptions.get((p, c), ""))} for p, c in node.transforms]
@@ -202,8 +205,9 @@ def _node_context(resolved: Resolved, name: str) -> dict[str, Any]:
         "parameters": [_parameter_spec(spec, p) for p in own], "partners": [_parameter_spec(spec, p) for p in partners],
         "rules": rule_items, "publishes_tf": publishes_tf, "reads_tf": reads_tf,
         "tf_topic": TF_TOPIC, "tf_qos": qos_args(tf_qos) if tf_qos else "",
+        "tf_sub_qos": qos_args(tf_sub_qos) if tf_sub_qos else "",
         "static_topic": TF_STATIC_TOPIC if static_qos else None,
-        "static_qos": qos_args(static_qos) if static_qos else "",
+        "static_sub_qos": qos_args(static_sub_qos) if static_sub_qos else "",
     }
 
 

@@ -226,6 +226,7 @@ class _NodeChecks:
                            TF_MESSAGE)
 
     def check(self) -> None:
+        self.check_topic_sides()
         self.check_tf_topics()
         self.check_transform_list()
         for node in self.spec.nodes.values():
@@ -307,6 +308,20 @@ class _NodeChecks:
             else:
                 member(f"on_{ident}", f"subscribing {item.topic}", item.pos)
                 self.check_subscription(node, item, topic)
+
+    def check_topic_sides(self) -> None:
+        """A topic's subscribers' QoS (declared, or the default beside a declared publishers' side) must be one its
+        publishers' QoS serves: otherwise no subscription that takes the topic's QoS would get anything."""
+        for topic in self.spec.topics.values():
+            pub, sub = topic.qos, topic.subscriber_qos
+            if pub is None or sub is None or (topic.declared_qos is None and topic.declared_subscriber_qos is None):
+                continue
+            why = incompatibility(pub, sub)
+            if why is not None:
+                self.error(topic.qos_pos, f"the QoS of topic {topic.name!r} has subscribers {sub.describe()}, which "
+                           f"its publishers {pub.describe()} cannot serve: {why}",
+                           "a subscribers' side the publishers' side serves (best_effort subscribers take reliable "
+                           "publishers, volatile ones transient_local publishers)")
 
     def check_subscription(self, node: Node, item: NodeTopic, topic: Topic) -> None:
         ends = self.publishers.get(item.topic, [])
@@ -414,11 +429,13 @@ def check_nodes(spec: Spec, ros: RosCatalog, diag: Diagnostics) -> None:
     _NodeChecks(spec, ros, diag).check()
 
 
-def node_topic_qos(spec: Spec, item: NodeTopic) -> Qos:
-    """The QoS a node's endpoint uses: its own (subscriptions may override) or its topic's."""
+def node_topic_qos(spec: Spec, item: NodeTopic, *, subscription: bool) -> Qos:
+    """The QoS a node's endpoint uses: its own (subscriptions may override) or its topic's side (publishers' or
+    subscribers')."""
     if item.qos is not None:
         return item.qos
-    qos = spec.topics[item.topic].qos
+    topic = spec.topics[item.topic]
+    qos = topic.subscriber_qos if subscription else topic.qos
     assert qos is not None, "a topic the frontend built"
     return qos
 

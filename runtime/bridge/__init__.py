@@ -135,7 +135,8 @@ message is still published), rejected ones under ``rejected.<...>``.
   back-off (0.5 s doubling to 2 s) until it works again; meanwhile commands are dropped as ``link_down`` and
   /diagnostics shows the bridge at ERROR. Transient bus errors (a send raising) are counted and the next message
   goes through.
-- ROS QoS: each topic's from the spec (``qos``: sensor data best effort, commands and states reliable, ...).
+- ROS QoS: each topic's two sides from the spec (``qos`` for the publishers, ``subscriber_qos`` for the command
+  subscriptions; REP 2003: sensor data published reliable for best-effort subscribers, commands reliable, ...).
   A slow or stuck ROS subscriber never blocks UAVCAN -> ROS: the ROS publishers are keep-last, so DDS drops that
   subscriber's oldest samples (reliable topics) or never waits for it (best effort) instead of blocking the bridge.
 - Security: a mapping accepts transfers only from its spec's source node ids (``unknown_source`` otherwise), or

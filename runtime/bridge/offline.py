@@ -17,6 +17,12 @@ Traffic control (issue 19): a mapping the spec starts disabled drops and counts 
 its slot comes out of the first :meth:`OfflineBridge.feed` at or after that slot (before that transfer's own
 publications, as live), and the ones still held at the end out of :meth:`OfflineBridge.finish`. Its ``cdr_later`` is
 the conversion of the transfer it came from.
+Commands (issue 30): :meth:`OfflineBridge.command` converts a recorded ROS command (its CDR, as the bridge's raw
+subscription received it) by each of its topic's ROS -> UAVCAN mappings with the same generated codecs into the
+payloads the live bridge sends (before its queue, rate limit and deadline, which depend on the live loop), so the
+replay can compare them with the transfers the recording holds from the bridge's node id.
+Namespaced runs (issue 30): given the run's :class:`~sam_runtime.common.ros_namespace.RosNamespace`, the topics are
+named as that run resolved them and every frame id carries its prefix, as the live bridge in that namespace wrote.
 """
 
 from __future__ import annotations
@@ -35,15 +41,16 @@ from typing import Any
 from sam_runtime.bridge.backend import Backend, BelowBridge, BridgeConfigError, DeviceStatus, Inlet, Outlet
 from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.inbound import Inbound, InMapping
-from sam_runtime.bridge.layout import select
+from sam_runtime.bridge.layout import port_id_of, select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.loss import TransferLoss
 from sam_runtime.bridge.switches import switches_of
-from sam_runtime.bridge.wiring import codec_gaps, in_groups, missing_codecs, nominal_rates
+from sam_runtime.bridge.wiring import codec_gaps, in_groups, missing_codecs, nominal_rates, out_mappings
 from sam_runtime.common.rate_log import RateLimitedLog
+from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.genpkg import GeneratedPackage
 
-__all__ = ["RECEIVE_TIME_PROBE_NS", "OfflineBridge", "Published"]
+__all__ = ["RECEIVE_TIME_PROBE_NS", "Command", "OfflineBridge", "Published"]
 
 log = logging.getLogger("sam_runtime.bridge.offline")
 RECEIVE_TIME_PROBE_NS = 1_000_000_007  # the second conversion's receive time is this much later
@@ -58,6 +65,15 @@ class Published:
     mapping: str
     cdr: bytes
     cdr_later: bytes  # the same conversion at receive_ns + RECEIVE_TIME_PROBE_NS
+
+
+@dataclass(frozen=True)
+class Command:
+    """One transfer the bridge would send for a ROS command."""
+
+    port_id: int  # Cyphal subject id or DroneCAN data type id
+    mapping: str
+    payload: bytes
 
 
 class _Inlet(Inlet):
@@ -175,14 +191,17 @@ class _Ros:
 
 class OfflineBridge:
     """:param gen: the generated package (its tables and wire codecs; its ROS classes must be importable).
-    :param layout: the spec's layout; :param protocol: the half of a mixed layout (as :class:`~.composition.Bridge`).
+    :param layout: the spec's layout; :param protocol: the half of a mixed layout (as :class:`~.composition.Bridge`);
+    :param namespace: the recorded run's namespace and frame prefix (default: the root, no prefix).
     """
 
-    def __init__(self, gen: GeneratedPackage, *, layout: str | None = None, protocol: str | None = None) -> None:
+    def __init__(self, gen: GeneratedPackage, *, layout: str | None = None, protocol: str | None = None,
+                 namespace: RosNamespace | None = None) -> None:
         tables = gen.tables()
+        self.names = names = namespace or RosNamespace()
         self.selection = sel = select(tables, layout, protocol)
         self.protocol = sel.protocol
-        codec = gen.codec(sel.protocol)
+        codec = gen.codec(sel.protocol, names.frame_prefix)
         missing = missing_codecs(codec, sel.mappings)
         if missing:
             raise BridgeConfigError(f"the generated package {gen.root} has no wire codecs for "
@@ -204,6 +223,7 @@ class OfflineBridge:
 
         groups = in_groups(gen, None, self.counters, loss, sel.mappings, codec)
         self.inbound = Inbound(self.lifetime, groups, self._ros, backend)
+        self.inbound.frame_prefix = names.frame_prefix  # (the object path's; the codecs took it above)
         self._clock = _RecordedClock()
         self._convert: dict[str, Callable[..., Any]] = {}  # each mapping's own conversion
         self._inputs: dict[str, tuple[bytes, int]] = {}  # each mapping's last converted (payload, receive_ns)
@@ -220,11 +240,53 @@ class OfflineBridge:
                 self._convert[im.info.name] = convert = im.to_ros
                 im.to_ros = functools.partial(self._remembering, im.info.name, convert)
         self._out: list[tuple[InMapping, bytes, tuple[bytes, int]]] = []
+        # the ROS -> UAVCAN side: each command topic's mappings, on the same codecs (stats of their own)
+        self.node_id = tables.BRIDGE_NODE_ID  # the recorded transfers the commands are compared with come from it
+        self._commands: dict[str, list[Any]] = {}
+        for om in out_mappings(gen, None, self.counters, sel.mappings, codec):
+            om.switch = switches_of([om.info])[om.info.name]  # a mapping the spec starts disabled sends nothing
+            self._commands.setdefault(names.resolve(om.info.topic.name), []).append(om)
 
     @property
     def topics(self) -> dict[str, str]:
         """topic -> ROS type of every UAVCAN -> ROS mapping."""
-        return {im.info.topic.name: im.info.topic.ros_type for g in self.inbound.groups.values() for im in g.mappings}
+        return {self.names.resolve(im.info.topic.name): im.info.topic.ros_type
+                for g in self.inbound.groups.values() for im in g.mappings}
+
+    @property
+    def command_topics(self) -> dict[str, str]:
+        """topic (as the run resolved it) -> ROS type of every ROS -> UAVCAN mapping."""
+        return {t: oms[0].info.topic.ros_type for t, oms in self._commands.items()}
+
+    @property
+    def command_ports(self) -> dict[int, str]:
+        """port id -> a label (the mappings that send on it) of the ROS -> UAVCAN mappings."""
+        out: dict[int, list[str]] = {}
+        for oms in self._commands.values():
+            for om in oms:
+                out.setdefault(port_id_of(om.info), []).append(om.info.name)
+        return {p: "+".join(sorted(set(names))) for p, names in out.items()}
+
+    def command(self, topic: str, cdr: bytes) -> list[Command]:
+        """The payloads the bridge sends for one ROS command on ``topic`` (nothing for another topic, a disabled
+        mapping, or a message a mapping rejects: those are counted as live). Never raises."""
+        out = []
+        for om in self._commands.get(topic, ()):
+            om.stats.receive()
+            if not om.switch.enabled:
+                om.stats.drop("disabled")
+                continue
+            try:
+                payload = om.to_uavcan(cdr, om.stats)
+            except Exception:  # counted as the live bridge counts it
+                om.stats.drop("convert_error")
+                continue
+            if payload is None:
+                om.stats.drop("rejected")
+                continue
+            om.stats.publish()
+            out.append(Command(port_id_of(om.info), om.info.name, bytes(payload)))
+        return out
 
     @property
     def ports(self) -> set[int]:
@@ -267,7 +329,7 @@ class OfflineBridge:
                 later = self._convert[im.info.name](payload, receive_ns + RECEIVE_TIME_PROBE_NS, _Scratch())
             except Exception:  # it converted once: the probe cannot fail differently, but never raise
                 later = None
-            out.append(Published(im.info.topic.name, im.info.topic.ros_type, im.info.name, cdr,
+            out.append(Published(self.names.resolve(im.info.topic.name), im.info.topic.ros_type, im.info.name, cdr,
                                  bytes(later[0]) if later else cdr))
         return out
 

@@ -2,7 +2,9 @@
 through sam_runtime.node_support), each topic's QoS from the spec, the receive clock, and the executor spinning in
 its own thread.
 
-- QoS: each topic's ``qos`` of the generated tables (sensor data best effort, commands and states reliable, ...);
+- QoS: each topic's side of the generated tables: publishers its ``qos``, command subscriptions its
+  ``subscriber_qos`` (sensor data published reliable as REP 2003 says, so any subscriber matches; commands and
+  states reliable, ...);
   ``qos_depth`` and ``command_reliability`` override the depth of every endpoint and the reliability of the
   command subscriptions when given. Publishers are keep-last: a slow or stuck ROS subscriber never blocks the
   bridge (DDS drops that subscriber's oldest samples, or never waits for it on a best-effort topic).
@@ -174,8 +176,9 @@ class RosSide:
 
     # -------------------------------------------------------------------------------------------- endpoints
     def qos(self, topic: Any, *, command: bool = False) -> Any:
-        """The topic's QoS from the spec, with the overrides."""
-        q = topic.qos
+        """The topic's QoS from the spec, with the overrides: its publishers' side, or for a command subscription
+        its subscribers' side."""
+        q = topic.subscriber_qos if command else topic.qos
         reliability = (self.command_reliability if command else None) or q.reliability
         return qos_profile(reliability, q.durability, q.depth if self.qos_depth is None else self.qos_depth)
 

@@ -28,6 +28,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from sam_codegen.project.cyphal_path import CyphalPathError, dsdl_lookup_roots
+from sam_codegen.project.progress import TerminalProgress
 from sam_codegen.project.workspace import user_cache_dir
 from sam_runtime.cyphal_io.nunavut_fix import FIX_VERSION, fix_support
 
@@ -263,7 +264,9 @@ def ensure_compiled(namespace_dirs: Sequence[Path], cache_dir: Path | None = Non
         tmp = Path(tempfile.mkdtemp(prefix=f".tmp-{out.name}-", dir=base))
         try:
             started = time.monotonic()
-            done = _compile_into(tmp, targets, lookups)
+            # the first compile takes tens of seconds: a progress line on a terminal (issue 30)
+            with TerminalProgress(f"compiling DSDL ({', '.join(t.name for t in targets) or 'uavcan'})"):
+                done = _compile_into(tmp, targets, lookups)
             (tmp / _COMPLETE_MARKER).write_text(
                 f"namespaces={','.join(done)}\nseconds={time.monotonic() - started:.2f}\n{_versions()}\n"
             )

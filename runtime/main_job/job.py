@@ -303,7 +303,7 @@ def _start_children(children: list[_Child], opts: RunOptions, gen_dir: Path, tab
     if opts.record is not None:
         children.append(_Child("recorder", [*py, "record", str(opts.record), "--generated", str(gen_dir),
                                             "--iface", opts.iface, "--dronecan-iface", opts.dronecan_iface,
-                                            *ns_args[:2],
+                                            *ns_args,  # the frame prefix too: the recording keeps both
                                             *(["--layout", opts.layout] if opts.layout else []),
                                             *(["--package", opts.package] if opts.package else [])],
                                env, log_dir / "recorder.log"))

@@ -41,13 +41,14 @@ from sam_runtime.cli_support import (
     write_json_atomic,
 )
 from sam_runtime.common.ros_namespace import ros_namespace
+from sam_runtime.common.run_names import run_names
 from sam_runtime.cyphal_io.dsdl_cache import DsdlCompileError
 from sam_runtime.genpkg import GeneratedPackage, GeneratedPackageError
-from sam_runtime.recording.reading import Recording, read_recording, recording_file_problem
+from sam_runtime.recording.reading import Recording, read_recording, recording_file_problem, rosbag2_folder
 from sam_runtime.recording.recorder import METADATA_NAME, Recorder, RecorderConfig
 from sam_runtime.recording.replay import SPEEDS, replay
 from sam_runtime.recording.schemas import TRANSFER_TYPE
-from sam_runtime.recording.target import RecordingTargetError, check_target
+from sam_runtime.recording.target import RecordingTargetError, bag_target, check_target
 
 __all__ = ["EXIT_DIFFERENT", "record_main", "replay_main"]
 
@@ -58,7 +59,10 @@ _TICK_S = 0.2
 def _record_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="sam-record", description="Record every ROS topic of the spec and the raw "
                                 "UAVCAN bus of a running vehicle into one MCAP file (Ctrl-C stops).")
-    p.add_argument("file", type=Path, help="the MCAP file to write")
+    p.add_argument("file", type=Path, help="the MCAP file to write (with --rosbag2: the bag folder)")
+    p.add_argument("--rosbag2", action="store_true",
+                   help="write a rosbag2 folder: FILE is a new folder, holding FILE_0.mcap and, once the recording "
+                        "ends, its metadata.yaml (what ros2 bag info/play and other rosbag2 readers open)")
     add_generated_args(p)
     p.add_argument("--layout", default=None, metavar="NAME", help="the spec's layout (default: its default layout)")
     p.add_argument("--iface", default="127.0.0.1", help="Cyphal/UDP interface to listen on (default 127.0.0.1)")
@@ -68,8 +72,11 @@ def _record_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, default=None, help="stop after S seconds (default: until signal)")
     p.add_argument("--log-level", default="INFO")
     p.add_argument("--namespace", default=None, metavar="NS",
-                   help="the vehicle's ROS namespace: the spec's relative topics are recorded under it (channels keep "
-                        "the names as the spec writes them; default /)")
+                   help="the vehicle's ROS namespace: the spec's relative topics are recorded under it (channels are "
+                        "named as the run resolves them; default /)")
+    p.add_argument("--frame-prefix", default=None, metavar="PREFIX",
+                   help="the run's frame prefix, kept in the recording for plot and replay (default: from the "
+                        "namespace, sam1/ for /sam1)")
     return p
 
 
@@ -77,8 +84,9 @@ def record_main(argv: Sequence[str] | None = None) -> int:
     args = _record_parser().parse_args(argv)
     require_runtime("run")
     try:
-        check_target(args.file)  # before anything starts
-        namespace = ros_namespace(args.namespace).node_namespace
+        # before anything starts
+        target = bag_target(args.file) if args.rosbag2 else check_target(args.file)
+        names = ros_namespace(args.namespace, frame_prefix=args.frame_prefix)
     except (RecordingTargetError, ValueError) as ex:
         print(f"sam-record: {ex}", file=sys.stderr)
         return EXIT_ERROR
@@ -86,13 +94,14 @@ def record_main(argv: Sequence[str] | None = None) -> int:
     setup_logging(args.log_level)
 
     async def run(stop: asyncio.Event) -> int:
-        rec = Recorder(generated_package(args), RecorderConfig(args.file, layout=args.layout, iface=args.iface,
+        rec = Recorder(generated_package(args), RecorderConfig(target, layout=args.layout, iface=args.iface,
                                                                dronecan_iface=args.dronecan_iface, bus=args.bus,
-                                                               namespace=namespace))
+                                                               namespace=names.node_namespace,
+                                                               frame_prefix=names.frame_prefix))
         summary: dict[str, Any] = {}
         try:
             await rec.start()
-            print(f"READY recorder {args.file} topics={len(rec.writer.channels)} protocols="
+            print(f"READY recorder {target} topics={len(rec.writer.channels)} protocols="
                   f"{','.join(rec.protocols) if args.bus else 'none'}", flush=True)
             deadline = None if args.duration is None else time.monotonic() + args.duration
             while not stop.is_set():
@@ -103,6 +112,12 @@ def record_main(argv: Sequence[str] | None = None) -> int:
                 rec.tick()
         finally:
             summary = await rec.close()
+            if args.rosbag2:  # the bag's metadata.yaml beside the finished file (a cut one recovered in place)
+                try:
+                    summary["rosbag2"] = str(await asyncio.to_thread(rosbag2_folder, target, target.parent))
+                except Exception as ex:  # the MCAP stays; only the folder's metadata is missing: said, not raised
+                    summary["rosbag2_error"] = f"{type(ex).__name__}: {ex}"
+                    print(f"sam-record: no metadata.yaml for {target.parent}: {ex}", file=sys.stderr)
         print("DONE recorder " + json.dumps(summary, sort_keys=True), flush=True)
         return EXIT_OK
 
@@ -171,10 +186,12 @@ def replay_main(argv: Sequence[str] | None = None) -> int:
             meta = rec.metadata.get(METADATA_NAME, {})
             layout = args.layout or meta.get("layout") or None
             recorded = [p for p in meta.get("protocols", "cyphal").split(",") if p]
+            names = run_names(meta)  # a namespaced run's topics and frame ids, as it wrote them
             converters = []
             for proto in recorded:
                 try:
-                    converters.append(OfflineBridge(gen, layout=layout, protocol=proto if len(recorded) > 1 else None))
+                    converters.append(OfflineBridge(gen, layout=layout, protocol=proto if len(recorded) > 1 else None,
+                                                    namespace=names))
                 except BridgeConfigError as ex:
                     print(f"sam-replay: {proto}: {ex}", file=sys.stderr)
             if not converters:

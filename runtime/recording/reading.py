@@ -8,10 +8,11 @@ Invariants:
   one starts), and the reading stops only where a record runs past the end of the file. A cut file yields every
   message of every complete chunk, in file order, and ``Recording.complete`` says whether the file ended with its
   footer.
-- :func:`rosbag2_folder` makes a folder that rosbags' rosbag2 ``Reader`` opens (it reads only rosbag2 folders with
-  a ``metadata.yaml``, and only MCAP files with a footer): the recording itself (a symbolic link) when complete,
-  else a complete copy of everything readable (as ``mcap recover`` does); the metadata lists the ROS topics (CDR)
-  with their message counts, as rosbag2 writes it (version 9).
+- :func:`rosbag2_folder` makes a rosbag2 folder (what ``ros2 bag info/play`` and other rosbag2 readers open; rosbags
+  0.11 also reads a bare MCAP that has its footer): the recording itself (a symbolic link, or the file as it is when
+  it was written inside the folder, as ``sam-codegen record --rosbag2`` does) when complete, else a complete copy of
+  everything readable (as ``mcap recover`` does; in place when written inside); the ``metadata.yaml`` lists the ROS
+  topics (CDR) with their message counts and the file, as rosbag2 writes it (version 9).
 """
 
 from __future__ import annotations
@@ -182,12 +183,15 @@ def rosbag2_folder(mcap_path: Path, folder: Path) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     rec = read_recording(mcap_path)
     target = folder / mcap_path.name
-    if target.exists() or target.is_symlink():
+    in_place = target.absolute() == mcap_path  # recorded inside the folder: the file is the bag's own
+    if not in_place and (target.exists() or target.is_symlink()):
         target.unlink()
     if rec.complete:
-        os.symlink(mcap_path, target)
+        if not in_place:
+            os.symlink(mcap_path, target)
     else:
-        with open(target, "wb") as fh:
+        recovered = target.with_name(target.name + ".recovering") if in_place else target
+        with open(recovered, "wb") as fh:
             w = Writer(fh, compression=CompressionType.ZSTD)
             w.start(profile="ros2", library="sam-codegen recover")
             sids = {sid: w.register_schema(s.name, s.encoding, s.data) for sid, s in rec.schemas.items()}
@@ -200,6 +204,8 @@ def rosbag2_folder(mcap_path: Path, folder: Path) -> Path:
             for name, meta in rec.metadata.items():
                 w.add_metadata(name, meta)
             w.finish()
+        if in_place:
+            os.replace(recovered, target)
     counts = Counter(m.topic for m in rec.messages)
     times = [m.log_time for m in rec.messages] or [0]
     topics: list[dict[str, Any]] = []
@@ -215,7 +221,11 @@ def rosbag2_folder(mcap_path: Path, folder: Path) -> Path:
         "version": 9, "storage_identifier": "mcap", "relative_file_paths": [target.name],
         "duration": {"nanoseconds": max(times) - min(times)}, "starting_time": {"nanoseconds_since_epoch": min(times)},
         "message_count": sum(t["message_count"] for t in topics), "topics_with_message_count": topics,
-        "compression_format": "", "compression_mode": "", "files": [], "custom_data": {}, "ros_distro": "jazzy"}}
+        "compression_format": "", "compression_mode": "",
+        "files": [{"path": target.name, "starting_time": {"nanoseconds_since_epoch": min(times)},
+                   "duration": {"nanoseconds": max(times) - min(times)},
+                   "message_count": sum(t["message_count"] for t in topics)}],
+        "custom_data": {}, "ros_distro": "jazzy"}}
     # JSON is YAML: no YAML writer needed, and every string is quoted safely.
     (folder / "metadata.yaml").write_text(json.dumps(info, indent=1) + "\n")
     return folder

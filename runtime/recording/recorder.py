@@ -6,7 +6,12 @@ slowed or killed by the recording; the recording holds what was on the bus, also
 - Cyphal/UDP: an anonymous pycyphal UDP transport on the same interface with a promiscuous input session per subject
   of the spec (every device's publications and subscriptions) and uavcan.node.Heartbeat. Cyphal/UDP subjects are
   multicast groups, so this sees every transfer the bridge sees, reassembled by the same transport code; pycyphal's
-  capture API (``begin_capture``) would see the services too, but needs libpcap and CAP_NET_RAW (root).
+  capture API (``begin_capture``) would see the services too, but needs libpcap and CAP_NET_RAW (root). Service
+  transfers go to their destination node's multicast group: one more listener per node id that takes part (the
+  bridge and every Cyphal device of the spec), a transport with that node id (it sends nothing) with promiscuous
+  sessions (requests to a device; requests to and responses to the bridge) of the standard services the bridge
+  and tools use (GetInfo, ExecuteCommand, GetTransportStatistics, register Access and List) and of the spec's Cyphal
+  service mappings.
 - DroneCAN on ``mcast-lo:``: a :class:`~sam_runtime.dronecan_io.LoopbackMulticastDriver` joined to the same loopback
   group behind a :class:`~sam_runtime.dronecan_io.FrameGate` whose taps take every completed transfer (messages and
   services, checked as dronecan checks them: toggle bits, and the CRC where the data type's signature is known).
@@ -39,6 +44,8 @@ from typing import Any
 
 from sam_codegen.catalogs.ros import ros_share_dirs
 from sam_codegen.project.cyphal_path import dsdl_lookup_roots
+from sam_runtime.common.ros_namespace import RosNamespace
+from sam_runtime.common.run_names import RECORDING_METADATA, recorded_metadata
 from sam_runtime.cyphal_io.transport import aclose, make_transport
 from sam_runtime.dronecan_io.can_id import TAIL_TOGGLE
 from sam_runtime.dronecan_io.drops import DropCounter
@@ -73,9 +80,15 @@ __all__ = ["DIAGNOSTICS_TOPIC", "METADATA_NAME", "DroneCanTaps", "Recorder", "Re
 log = logging.getLogger("sam_runtime.recording")
 
 DIAGNOSTICS_TOPIC = ("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray")
-METADATA_NAME = "sam_codegen.recording"
+METADATA_NAME = RECORDING_METADATA
 FORMAT = "sam-recording/1"
 _SUBSCRIPTION_DEPTH = 1000
+# service id -> type of the standard Cyphal services recorded (the spec's service mappings are added)
+CYPHAL_SERVICES = {430: "uavcan.node.GetInfo.1.0", 434: "uavcan.node.GetTransportStatistics.0.1",
+                   435: "uavcan.node.ExecuteCommand.1.3", 384: "uavcan.register.Access.1.0",
+                   385: "uavcan.register.List.1.0"}
+_SERVICE_RECEIVE_TIMEOUT_S = 2.0
+_SERVICE_EXTENT = 1 << 16  # bytes: a service payload is kept whole (register values, GetInfo's names)
 _RECEIVE_TIMEOUT_S = 0.5
 
 
@@ -87,8 +100,10 @@ class RecorderConfig:
     dronecan_iface: str = "mcast-lo:"
     ros: bool = True
     bus: bool = True
-    # the vehicle's ROS namespace (None: /): relative topics are subscribed under it; channels keep the spec's names
+    # the vehicle's ROS namespace (None: /) and frame prefix: relative topics are subscribed under it, and each
+    # channel is named as the run resolved it (/sam1/core/imu); both are kept in the metadata (common.run_names)
     namespace: str | None = None
+    frame_prefix: str = ""
 
 
 def layout_protocols(tables: Any, layout: str | None) -> tuple[str, list[str]]:
@@ -181,6 +196,7 @@ class Recorder:
     def __init__(self, gen: GeneratedPackage, config: RecorderConfig) -> None:
         self.gen, self.config = gen, config
         self.tables = gen.tables()
+        self.names = RosNamespace(config.namespace or "/", config.frame_prefix)
         self.layout, self.protocols = layout_protocols(self.tables, config.layout)
         self.writer = RecordingWriter(config.path)  # RecordingTargetError before anything starts
         self.counts = _Counts()
@@ -195,6 +211,8 @@ class Recorder:
         self._taps: DroneCanTaps | None = None
         self._dronecan_drops: DropCounter | None = None
         self.subjects: dict[int, str] = {}
+        self.services: dict[int, str] = {}
+        self._service_transports: list[Any] = []
         self.ros_errors: list[str] = []
 
     # ------------------------------------------------------------------ setup
@@ -203,13 +221,21 @@ class Recorder:
         meta = {"format": FORMAT, "vehicle": str(tables.VEHICLE), "layout": self.layout,
                 "protocols": ",".join(self.protocols), "generated": str(self.gen.root),
                 "log_time": "ROS: rclpy receive time; transfers: the listener's receive time (system clock, ns)",
-                "publish_time": "ROS: the publisher's source timestamp; transfers: the listener's receive time"}
+                "publish_time": "ROS: the publisher's source timestamp; transfers: the listener's receive time",
+                **recorded_metadata(self.names)}
         if "cyphal" in self.protocols:
             self.subjects = {p.subject_id: p.dsdl_type for d in tables.DEVICES for p in (*d.publishes, *d.subscribes)}
             self.subjects[HEARTBEAT_SUBJECT] = HEARTBEAT_TYPE
+            self.services = dict(CYPHAL_SERVICES)
+            services = self.gen.services()
+            for m in getattr(services, "SERVICE_MAPPINGS", ()) if services is not None else ():
+                if m.protocol == "cyphal":
+                    self.services[int(m.data_type_id)] = str(m.data_type)
             meta["cyphal.iface"] = f"udp:{self.config.iface}"
             meta["cyphal.subjects"] = json.dumps({str(k): v for k, v in sorted(self.subjects.items())})
-            standard = {t for t in self.subjects.values() if not t.startswith(f"{tables.DSDL_ROOT_NAMESPACE}.")}
+            meta["cyphal.services"] = json.dumps({str(k): v for k, v in sorted(self.services.items())})
+            standard = {t for t in (*self.subjects.values(), *self.services.values())
+                        if not t.startswith(f"{tables.DSDL_ROOT_NAMESPACE}.")}
             try:
                 for name, data in cyphal_definition_files(self.gen.dsdl_dirs, dsdl_lookup_roots(),
                                                           sorted(standard)).items():
@@ -238,7 +264,8 @@ class Recorder:
         """topic -> (ROS type, QoS profile) of the topics whose definitions were found (the others are reported)."""
         share = [*ros_share_dirs(), self.gen.root / "ros"]
         out = {}
-        for topic, (ros_type, rel, dur, depth) in topic_qos(self.tables).items():
+        for name, (ros_type, rel, dur, depth) in topic_qos(self.tables).items():
+            topic = self.names.resolve(name)  # as the run's nodes resolve it (rosbag2 records resolved names too)
             try:
                 definition = ros2msg_definition(ros_type, share)
             except LookupError as ex:
@@ -317,29 +344,51 @@ class Recorder:
     # ------------------------------------------------------------------ Cyphal/UDP
     async def _start_cyphal(self) -> None:
         from pycyphal.transport import InputSessionSpecifier, MessageDataSpecifier, PayloadMetadata
+        from pycyphal.transport import ServiceDataSpecifier as Service
 
         self.gen.compile_dsdl()  # cached; the extents come from the compiled classes
         self._transport = make_transport("udp", node_id=None, iface=self.config.iface)
+        loop = asyncio.get_running_loop()
         for sid, dsdl_type in sorted(self.subjects.items()):
             session = self._transport.get_input_session(
                 InputSessionSpecifier(MessageDataSpecifier(sid), None), PayloadMetadata(_extent(dsdl_type)))
-            self._tasks.append(asyncio.get_running_loop().create_task(self._receive(session, sid, dsdl_type),
-                                                                      name=f"recorder-rx-{sid}"))
+            self._tasks.append(loop.create_task(self._receive(session, sid, dsdl_type), name=f"recorder-rx-{sid}"))
+        # services: as each node that takes part (module docstring)
+        # a device is asked (requests to it), the bridge asks and is asked (responses and requests to it)
+        bridge = None if self.tables.BRIDGE_NODE_ID is None else int(self.tables.BRIDGE_NODE_ID)
+        roles: dict[int, tuple[tuple[Any, int], ...]] = {
+            d.node_id: ((Service.Role.REQUEST, KIND_REQUEST),) for d in self.tables.DEVICES}
+        if bridge is not None:
+            roles[bridge] = ((Service.Role.REQUEST, KIND_REQUEST), (Service.Role.RESPONSE, KIND_RESPONSE))
+        for nid in sorted(roles):
+            transport = make_transport("udp", node_id=nid, iface=self.config.iface)
+            self._service_transports.append(transport)
+            for sid, dsdl_type in sorted(self.services.items()):
+                for role, kind in roles[nid]:
+                    session = transport.get_input_session(InputSessionSpecifier(Service(sid, role), None),
+                                                          PayloadMetadata(_SERVICE_EXTENT))
+                    self._tasks.append(loop.create_task(self._receive(session, sid, dsdl_type, kind, nid),
+                                                        name=f"recorder-rx-{nid}-{sid}-{kind}"))
 
-    async def _receive(self, session: Any, sid: int, dsdl_type: str) -> None:
+    async def _receive(self, session: Any, sid: int, dsdl_type: str, kind: int = KIND_MESSAGE,
+                       destination: int | None = None) -> None:
         from pycyphal.transport import ResourceClosedError
 
         loop = asyncio.get_running_loop()
         try:
             while True:
-                tr = await session.receive(loop.time() + _RECEIVE_TIMEOUT_S)
+                # services are rare: a longer wait than the subjects' (~100 sessions), short enough that a
+                # cancellation Python 3.11 loses inside pycyphal's wait_for still ends the task within the stop
+                # budget of `run` (a 60 s wait got the recorder killed and its file cut)
+                tr = await session.receive(loop.time() + (_RECEIVE_TIMEOUT_S if kind == KIND_MESSAGE
+                                                          else _SERVICE_RECEIVE_TIMEOUT_S))
                 if tr is None:
                     continue
                 try:
                     payload = b"".join(bytes(f) for f in tr.fragmented_payload)
                     now = int(tr.timestamp.system_ns) or time.time_ns()  # when the transport read the datagram
                     t = Transfer("cyphal", sid, dsdl_type, tr.source_node_id, int(tr.transfer_id),
-                                 int(tr.priority), now, payload)
+                                 int(tr.priority), now, payload, kind=kind, destination_node_id=destination)
                     if self.writer.write(CYPHAL_TOPIC, encode_transfer(t), now, now):
                         self.counts.transfers["cyphal"] += 1
                 except Exception as ex:
@@ -398,8 +447,12 @@ class Recorder:
         self._dronecan_stop.set()
         for t in self._tasks:
             t.cancel()
-        if self._transport is not None:
-            await aclose(self._transport)
+        # pycyphal's UDP close waits for each session's socket reader (~60 ms each): the service listeners' ~70
+        # sessions closed one after the other took 8 s, past the stop budget of `run`; in threads, at once, ~1 s
+        await asyncio.gather(*(asyncio.to_thread(t.close) for t in self._service_transports))
+        closables = [t for t in (self._transport, *self._service_transports) if t is not None]
+        if closables:
+            await aclose(*closables)  # the tasks of what closed (close() again does nothing)
         await asyncio.gather(*self._tasks, return_exceptions=True)
         if self._dronecan_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._dronecan_thread.join, 2.0)

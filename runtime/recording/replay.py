@@ -19,7 +19,21 @@ Invariants:
   ``identical``: the same CDR bytes; ``receive_time``: they differ only in fields that depend on the receive time
   (those that change when the same transfer is converted at a later receive time: the bridge stamps a message
   whose device stamp is 0 with its own receive time, which the listener's cannot equal); ``differing``: other
-  fields differ (named); ``missing``: recorded, not replayed; ``extra``: replayed, not recorded.
+  fields differ (named, each with its count and the first differing recorded and replayed values);
+  ``missing``: recorded, not replayed; ``extra``: replayed, not recorded.
+- Commands, the other direction (issue 30): a converter that offers ``command`` (the offline bridge) turns each
+  recorded ROS command into the payloads the bridge sends, compared per port with the transfers the recording holds
+  from the bridge's node id, matched in order as the topics are (the offset where most payloads agree, the one
+  nearest the first transfer after the first recorded command on a tie: a controller repeats one command), gaps
+  skipped and counted the same way. ``recorded`` counts the bridge's transfers, ``replayed`` the converted
+  commands, ``missing`` a transfer no recorded command gives, ``extra`` a command whose payload the bus did not
+  carry, ``outside`` the transfers before the first recorded command, the commands before the first one the
+  bridge sent (its subscription may match a publisher after the recorder's does) and those after its last
+  transfer (the bus side of a recording starts before its ROS side; the bridge may stop before the recorder); the
+  values shown are the recorded transfer's payload and the replayed one (hex). Only a differing payload makes the
+  commands differ: a gap is what a live run has (a transfer the listener lost under load, or a command coalesced
+  or expired by ``max_rate_hz`` / ``deadline``, which are not applied offline, shows as ``extra``; a transfer
+  whose command the recorder lacks as ``missing``), counted and shown.
 """
 
 from __future__ import annotations
@@ -70,19 +84,26 @@ class TopicDiff:
     before: int = 0  # replayed from transfers before the ROS side of the recording began (not compared)
     after: int = 0  # ... after it ended
     fields: Counter[str] = field(default_factory=Counter)  # field path -> messages where it differs
+    # field path -> (index, recorded value, replayed value) of the first message where it differs (short reprs)
+    first_values: dict[str, tuple[int, str, str]] = field(default_factory=dict)
     receive_time_fields: Counter[str] = field(default_factory=Counter)
     examples: list[dict[str, Any]] = field(default_factory=list)
+    # commands: a gap is what a live run has (a transfer the listener lost under load, a command rate-limited),
+    # counted and shown, but only a differing payload makes the replay differ
+    gaps_allowed: bool = False
 
     @property
     def same(self) -> bool:
-        """Nothing but receive-time fields differs, and nothing is missing or extra."""
-        return not (self.differing or self.missing or self.extra)
+        """Nothing but receive-time fields differs, and nothing is missing or extra (unless gaps are allowed)."""
+        return not (self.differing or (not self.gaps_allowed and (self.missing or self.extra)))
 
     def as_dict(self) -> dict[str, Any]:
         return {"recorded": self.recorded, "replayed": self.replayed, "identical": self.identical,
                 "receive_time_only": self.receive_time, "differing": self.differing, "missing": self.missing,
                 "extra": self.extra, "outside_ros_recording": self.before + self.after,
                 "differing_fields": dict(self.fields),
+                "first_differing_values": {k: {"index": i, "recorded": old, "replayed": new}
+                                           for k, (i, old, new) in sorted(self.first_values.items())},
                 "receive_time_fields": dict(self.receive_time_fields), "examples": self.examples}
 
 
@@ -95,26 +116,36 @@ class ReplayReport:
     replay_s: float
     topics: dict[str, TopicDiff]
     bridge: dict[str, Any]
+    # "<protocol> <port id> (<mappings>)" -> the bridge's recorded transfers against the replayed commands
+    commands: dict[str, TopicDiff] = field(default_factory=dict)
 
     @property
     def same(self) -> bool:
-        return all(d.same for d in self.topics.values())
+        return all(d.same for d in (*self.topics.values(), *self.commands.values()))
 
     def as_dict(self) -> dict[str, Any]:
         return {"input": self.input, "output": self.output, "transfers": self.transfers,
                 "recorded_span_s": round(self.recorded_span_s, 3), "replay_s": round(self.replay_s, 3),
                 "same": self.same, "topics": {t: d.as_dict() for t, d in sorted(self.topics.items())},
-                "bridge": self.bridge}
+                "commands": {p: d.as_dict() for p, d in sorted(self.commands.items())}, "bridge": self.bridge}
 
     def lines(self) -> list[str]:
         out = [f"replayed {self.transfers} transfers ({self.recorded_span_s:.1f} s recorded) in {self.replay_s:.2f} s"
                + (f" -> {self.output}" if self.output else ""),
                f"{'TOPIC':32} {'RECORDED':>8} {'REPLAYED':>8} {'SAME':>6} {'RX-TIME':>7} {'DIFFER':>6} "
                f"{'MISSING':>7} {'EXTRA':>5} {'OUTSIDE':>7}  FIELDS"]
-        for t, d in sorted(self.topics.items()):
+        rows = sorted(self.topics.items())
+        if self.commands:
+            rows += [(f"-> {p}", d) for p, d in sorted(self.commands.items())]
+        for t, d in rows:
             fields = ", ".join(f"{k} ({n})" for k, n in d.fields.most_common(6))
             out.append(f"{t:32} {d.recorded:8d} {d.replayed:8d} {d.identical:6d} {d.receive_time:7d} "
                        f"{d.differing:6d} {d.missing:7d} {d.extra:5d} {d.before + d.after:7d}  {fields}")
+        for t, d in rows:  # what differs, by example: the first differing values of each field
+            for k, n in d.fields.most_common(6):
+                if k in d.first_values:
+                    i, old, new = d.first_values[k]
+                    out.append(f"  {t} {k}: {n} differ; first at message {i}: recorded {old}, replayed {new}")
         rt = sorted({k for d in self.topics.values() for k in d.receive_time_fields})
         if rt:
             out.append(f"receive-time fields (differ only because the recorder's receive time is not the bridge's): "
@@ -223,8 +254,15 @@ class _Matcher:
                 return {}
         return out
 
+    def values(self, old: bytes, out: _Out) -> dict[str, tuple[Any, Any]]:
+        """field path -> (recorded value, replayed value) of the pair (``<missing>`` for a field one side lacks)."""
+        fa, fb = self.fields(self.dec_rec, old), self.fields(self.dec_new, out.cdr)
+        return {k: (fa.get(k, "<missing>"), fb.get(k, "<missing>")) for k in fa.keys() | fb.keys()}
+
     def classify(self, old: bytes, out: _Out) -> tuple[str, list[str], set[str]]:
-        if old == out.cdr:
+        # the trailing alignment padding is no content: a recorder may receive a payload padded or not (seen both
+        # ways; a namespaced run's frame prefix changes the lengths)
+        if old == out.cdr or _as_delivered(old) == out.cdr:
             return "identical", [], set()
         if self.dec_rec is None:
             return "differing", ["<no schema>"], set()
@@ -236,7 +274,14 @@ class _Matcher:
         return "differing", [f for f in diff if f not in rt], rt
 
 
-def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher) -> tuple[int, int]:
+def _short(value: Any) -> str:
+    """A value for the report, at most 60 characters."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher, follows: bool = False
+           ) -> tuple[int, int]:
     """(i, j): the recorded message i and the replayed message j that correspond, where the comparison begins.
 
     The ROS side of a recording starts when the recorder's subscriptions have matched the bridge's publishers, its
@@ -250,7 +295,10 @@ def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher)
     if not recorded or not replayed:
         return 0, 0
     first = recorded[0].log_time
-    guess = max(0, sum(1 for o in replayed if o.log_time <= first) - 1)
+    # ``follows``: the replayed side comes after the recorded one (a command's transfer after the command): the first
+    # replayed at or after the first recorded; else the last one before it
+    guess = sum(1 for o in replayed if o.log_time < first) if follows else \
+        max(0, sum(1 for o in replayed if o.log_time <= first) - 1)
     best, best_score = guess, 0
     for off in sorted(range(guess - _ALIGN_WINDOW, guess + _ALIGN_WINDOW + 1), key=lambda o: abs(o - guess)):
         i0, j0 = max(0, -off), max(0, off)
@@ -283,12 +331,14 @@ def _align_by_fields(recorded: Sequence[Any], replayed: Sequence[_Out], matcher:
     return best
 
 
-def _diff_topic(topic: str, recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher) -> TopicDiff:
+def _diff_topic(topic: str, recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher,
+                follows: bool = False, start: tuple[int, int] | None = None) -> TopicDiff:
     d = TopicDiff(topic, len(recorded), len(replayed))
-    i0, k = _align(recorded, replayed, matcher)
+    i0, k = start if start is not None else _align(recorded, replayed, matcher, follows)
     d.before = k
     d.missing = i0  # recorded before the bus side began: no transfer to replay
-    last = recorded[-1].log_time if recorded else 0
+    # after the ROS side stopped recording (a command's transfer follows it: by up to _COMMAND_LATE_NS)
+    last = (recorded[-1].log_time if recorded else 0) + (_COMMAND_LATE_NS if follows else 0)
     window = list(replayed[k:])
     while len(window) > len(recorded) and window[-1].log_time > last:  # after the ROS side stopped recording
         window.pop()
@@ -326,6 +376,12 @@ def _diff_topic(topic: str, recorded: Sequence[Any], replayed: Sequence[_Out], m
         else:
             d.differing += 1
             d.fields.update(fields)
+            if any(f not in d.first_values for f in fields):
+                values = matcher.values(recorded[i].data, window[j])
+                for f in fields:
+                    if f not in d.first_values and f in values:
+                        old, new = values[f]
+                        d.first_values[f] = (i, _short(old), _short(new))
             if len(d.examples) < _MAX_EXAMPLES:
                 d.examples.append({"index": i, "fields": fields})
         i, j = i + 1, j + 1
@@ -411,6 +467,105 @@ def replay(path: Path, converters: Iterable[Converter], *, out: Path | None = No
     diffs = {t: _diff_topic(t, recorded.get(t, []), replayed.get(t, []),
                             _Matcher(rec.schema_of(t), schema_new.get(t) or rec.schema_of(t), decoders))
              for t in topics}
+    commands = _compare_commands(by_protocol.values(), recorded, transfers)
     span = (transfers[-1][0].log_time - first_log) * 1e-9 if transfers else 0.0
     return ReplayReport(str(path), None if out is None else str(out), len(transfers), span, elapsed, diffs,
-                        {c.protocol: c.stats() for c in by_protocol.values()})
+                        {c.protocol: c.stats() for c in by_protocol.values()}, commands)
+
+
+class _PayloadMatcher(_Matcher):
+    """The command direction: payloads compared as bytes (the field ``payload``; the values in hex). Called with the
+    commands as the recorded side and the transfers as the replayed one (see :func:`_diff_commands`)."""
+
+    def __init__(self) -> None:
+        self.dec_rec = self.dec_new = None
+
+    def classify(self, old: bytes, out: _Out) -> tuple[str, list[str], set[str]]:
+        return ("identical", [], set()) if old == out.cdr else ("differing", ["payload"], set())
+
+    def values(self, old: bytes, out: _Out) -> dict[str, tuple[Any, Any]]:
+        return {"payload": (out.cdr.hex(), old.hex())}  # (the recorded transfer, the replayed payload)
+
+
+def _align_commands(sent: Sequence[_Sent], bus: Sequence[_Out]) -> tuple[int, int]:
+    """(i, j): the first command and the transfer that carried it. A controller repeats one command, so many offsets
+    give equal payloads: of those within :data:`_ALIGN_WINDOW` of the first transfer after the first command, the
+    one with the most equal payloads wins, on a tie the one with the most transfers after their commands, then the
+    one whose transfers are nearest their commands (the median delay; a transfer never before its command by more
+    than :data:`_COMMAND_EARLY_NS`)."""
+    if not sent or not bus:
+        return 0, 0
+    guess = sum(1 for o in bus if o.log_time < sent[0].log_time)
+    best, best_key = (0, guess), (-1, -1, 0.0)
+    for off in range(guess - _ALIGN_WINDOW, guess + _ALIGN_WINDOW + 1):
+        i0, j0 = max(0, -off), max(0, off)
+        pairs = list(zip(sent[i0:i0 + _ALIGN_PROBE], bus[j0:j0 + _ALIGN_PROBE], strict=False))
+        if not pairs:
+            continue
+        delays = sorted(b.log_time - c.log_time for c, b in pairs)
+        if delays[0] < -_COMMAND_EARLY_NS:
+            continue  # a transfer before its command: not this offset
+        key = (sum(1 for c, b in pairs if c.data == b.cdr), sum(1 for x in delays if x >= 0),
+               -abs(float(delays[len(delays) // 2])))
+        if key > best_key:
+            best, best_key = (i0, j0), key
+    return best
+
+
+_COMMAND_EARLY_NS = 50_000_000  # the listener's stamp may precede the recorder's of the same command this much
+_COMMAND_LATE_NS = 1_000_000_000  # and follow it by at most this much (the bridge's queue on a loaded machine)
+
+
+def _diff_commands(key: str, bus: Sequence[_Out], sent: Sequence[_Sent]) -> TopicDiff:
+    """The bridge's recorded transfers on one port against the replayed commands (the module docstring): matched
+    as the topics are, the commands standing where the transfers stand for them (a command's transfer follows it);
+    the commands the recorder got after the bus's last transfer from the bridge (it had stopped) are outside."""
+    last = bus[-1].log_time if bus else 0
+    inside = [c for c in sent if c.log_time <= last]
+    matcher = _PayloadMatcher()
+    # the commands before the first one the bridge sent: its subscription matched the publisher after the
+    # recorder's did (discovery), so it never had them
+    first, k = _align_commands(inside, bus)
+    d = _diff_topic(key, inside[first:], bus, matcher, follows=True, start=(0, k))
+    # the roles back: recorded = the bridge's transfers, replayed = the commands
+    d.recorded, d.replayed = len(bus), len(sent)
+    d.missing, d.extra = d.extra, d.missing
+    d.after += len(sent) - len(inside) + first
+    d.gaps_allowed = True
+    return d
+
+
+@dataclass(frozen=True)
+class _Sent:
+    """A replayed command payload, where a recorded message stands in _diff_topic (``data``, ``log_time``)."""
+
+    data: bytes
+    log_time: int  # the recorded ROS command's receive time
+
+
+def _compare_commands(converters: Iterable[Any], recorded: dict[str, list[Any]], transfers: Sequence[Any]
+                      ) -> dict[str, TopicDiff]:
+    """Per command port of each converter that converts commands: the recorded ROS commands, converted, against
+    the transfers the recording holds from the bridge's node id on that port (the module docstring)."""
+    out: dict[str, TopicDiff] = {}
+    for conv in converters:
+        command = getattr(conv, "command", None)
+        if command is None:
+            continue
+        ports: dict[int, str] = conv.command_ports
+        sent: dict[int, list[_Sent]] = {p: [] for p in ports}
+        ros = sorted((m for t in conv.command_topics for m in recorded.get(t, [])), key=lambda m: m.log_time)
+        for m in ros:
+            for c in command(m.topic, m.data):
+                sent.setdefault(c.port_id, []).append(_Sent(c.payload, m.log_time))
+        bus: dict[int, list[_Out]] = {p: [] for p in ports}
+        for msg, tr in transfers:
+            if (tr.protocol == conv.protocol and tr.kind == KIND_MESSAGE and tr.port_id in bus
+                    and tr.source_node_id == conv.node_id):
+                bus[tr.port_id].append(_Out(tr.payload, tr.payload, msg.log_time))
+        for port, label in sorted(ports.items()):
+            if not sent[port] and not bus[port]:
+                continue  # a command nobody gave in this recording
+            key = f"{conv.protocol} {port} ({label})"
+            out[key] = _diff_commands(key, bus[port], sent[port])
+    return out

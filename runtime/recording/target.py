@@ -12,7 +12,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["MIN_FREE_BYTES", "RecordingTargetError", "check_target"]
+__all__ = ["MIN_FREE_BYTES", "RecordingTargetError", "bag_target", "check_target"]
 
 MIN_FREE_BYTES = 16 * 1024 * 1024  # about a minute of the demo mission's recording
 
@@ -53,3 +53,27 @@ def check_target(path: Path) -> Path:
         raise RecordingTargetError(f"cannot record to {path}: only {free // 1024} KiB free on its file system "
                                    f"(at least {MIN_FREE_BYTES // (1024 * 1024)} MiB needed)")
     return path
+
+
+def bag_target(folder: Path) -> Path:
+    """The MCAP file of a rosbag2 folder to record into (``<folder>/<name>_0.mcap``, rosbag2's naming), the folder
+    created; RecordingTargetError as :func:`check_target`, and for a folder that exists and is not empty (rosbag2
+    refuses an existing bag folder: a recording never mixes with an older one).
+
+    >>> try:
+    ...     bag_target(Path("/no/such/bag"))
+    ... except RecordingTargetError as ex:
+    ...     print(ex)
+    cannot record to /no/such/bag: the folder /no/such does not exist
+    """
+    folder = Path(folder).expanduser().absolute()
+    if not folder.parent.is_dir():
+        raise RecordingTargetError(f"cannot record to {folder}: the folder {folder.parent} does not exist")
+    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+        raise RecordingTargetError(f"cannot record to {folder}: it exists and is not an empty folder (a rosbag2 "
+                                   "folder is new)")
+    try:
+        folder.mkdir(exist_ok=True)
+    except OSError as ex:
+        raise RecordingTargetError(f"cannot record to {folder}: {ex.strerror}") from None
+    return check_target(folder / f"{folder.name}_0.mcap")

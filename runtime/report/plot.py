@@ -24,18 +24,24 @@ from typing import Any
 
 import yaml
 
+from sam_runtime.common.run_names import spec_frame, spec_status_name
 from sam_runtime.physics.geo import depth_from_pressure
 from sam_runtime.report.recording import Recording, RecordingError, read_recording
 from sam_runtime.tf_buffer import Transform
 
-__all__ = ["LIMITS", "TOPICS", "RecordingError", "limits_from_params", "plot_run", "track"]
+__all__ = ["LIMITS", "TOPICS", "RecordingError", "limits_from_params", "node_states", "plot_run", "track"]
 
 LIMITS = ("safe_depth", "critical_depth", "safe_altitude", "critical_altitude")
 # What the picture shows: only these are decoded (a run's /imu and raw bus are most of its messages).
 TOPICS = ("/tf", "/nav_goal", "/pressure", "/altitude", "/thruster_rpms", "/thruster_angles", "/ballast_angles",
-          "/buoyancy_piston_position", "/longitudinal_weight_position", "/battery_state", "/abort", "/diagnostics")
+          "/buoyancy_piston_position", "/longitudinal_weight_position", "/battery_state", "/abort", "/diagnostics",
+          "/thruster_1/feedback", "/thruster_2/feedback", "/thrust_vector/feedback", "/buoyancy_piston/feedback",
+          "/longitudinal_weight/feedback")
 LEVELS = {0: ("OK", "#2e8b57"), 1: ("WARN", "#f39c12"), 2: ("ERROR", "#c0392b"), 3: ("STALE", "#95a5a6")}
-ABORT_COLOUR = "#c0392b"
+ABORT_COLOUR = "#6c3483"  # not ERROR's red: an abort and a node in ERROR are different facts
+# Series of one panel may be equal (both thrusters commanded alike): each its own dash pattern and width, the
+# later ones thinner and drawn over the earlier, so that none hides another.
+_STYLES = (("-", 2.4), ((0, (6, 3)), 1.6), ((0, (2, 2)), 1.2), ((0, (6, 2, 1, 2)), 1.0))
 
 
 def limits_from_params(path: Path) -> dict[str, float]:
@@ -63,8 +69,9 @@ def track(rec: Recording) -> tuple[str, list[tuple[float, float, float, float]]]
     for t, msg in rec.get("/tf"):
         for ts in msg.transforms:
             tr, rot = ts.transform.translation, ts.transform.rotation
-            edge = Transform(ts.header.frame_id, ts.child_frame_id, _stamp_ns(ts.header.stamp), (tr.x, tr.y, tr.z),
-                             (rot.x, rot.y, rot.z, rot.w))
+            # a namespaced run's frames carry its prefix (sam1/odom): the spec's names again
+            edge = Transform(spec_frame(rec.names, ts.header.frame_id), spec_frame(rec.names, ts.child_frame_id),
+                             _stamp_ns(ts.header.stamp), (tr.x, tr.y, tr.z), (rot.x, rot.y, rot.z, rot.w))
             if (edge.parent, edge.child) == ("odom", "base_link"):
                 odom_base.append((t, edge))
             elif (edge.parent, edge.child) == ("world", "odom"):
@@ -109,13 +116,20 @@ def _shade_aborts(ax: Any, spans: list[tuple[float, float, str]]) -> None:
         ax.axvspan(a, b, color=ABORT_COLOUR, alpha=0.08, lw=0)
 
 
-def _lines(ax: Any, rec: Recording, topic: str, fields: list[tuple[str, str]], *, scale: float = 1.0) -> bool:
+def _lines(ax: Any, rec: Recording, topic: str, fields: list[tuple[str, str]], *, scale: float = 1.0,
+           feedback: bool = False) -> bool:
+    """One line per field of ``topic``; ``feedback``: a device's report, drawn with markers beside the commands."""
     items = rec.get(topic)
     if not items:
         return False
     t = [s for s, _ in items]
     for attr, label in fields:
-        ax.plot(t, [float(getattr(m, attr)) * scale for _, m in items], label=label, lw=1.2)
+        values = [float(getattr(m, attr)) * scale for _, m in items]
+        if feedback:
+            ax.plot(t, values, label=label, lw=0.8, marker=".", ms=3, alpha=0.85)
+        else:
+            style, width = _STYLES[len(ax.get_lines()) % len(_STYLES)]
+            ax.plot(t, values, label=label, ls=style, lw=width)
     return True
 
 
@@ -243,8 +257,10 @@ def _draw_altitude(ax_alt: Any, run: _Run) -> None:
 
 def _draw_commands(ax_rpm: Any, ax_ang: Any, ax_pct: Any, run: _Run) -> None:
     rec, spans = run.rec, run.spans
-    ax_rpm.set_title("Thruster commands (/thruster_rpms)")
+    ax_rpm.set_title("Thrusters: command (/thruster_rpms) and feedback")
     if _lines(ax_rpm, rec, "/thruster_rpms", [("thruster_1_rpm", "thruster 1"), ("thruster_2_rpm", "thruster 2")]):
+        for k in (1, 2):
+            _lines(ax_rpm, rec, f"/thruster_{k}/feedback", [("rpm", f"thruster {k} feedback")], feedback=True)
         ax_rpm.set_ylabel("speed [rpm]")
         ax_rpm.grid(alpha=0.3)
         ax_rpm.legend(loc="best", fontsize=8)
@@ -259,6 +275,10 @@ def _draw_commands(ax_rpm: Any, ax_ang: Any, ax_pct: Any, run: _Run) -> None:
                                                      ("weight_2_offset_radians", "ballast weight 2")],
                    scale=180 / math.pi) or drawn
     if drawn:
+        _lines(ax_ang, rec, "/thrust_vector/feedback", [("vertical_mrad", "thrust vector vertical feedback"),
+                                                         ("horizontal_mrad", "thrust vector horizontal feedback")],
+               scale=0.001 * 180 / math.pi, feedback=True)
+    if drawn:
         ax_ang.set_ylabel("angle [deg]")
         ax_ang.grid(alpha=0.3)
         ax_ang.legend(loc="best", fontsize=8, ncol=2)
@@ -269,6 +289,8 @@ def _draw_commands(ax_rpm: Any, ax_ang: Any, ax_pct: Any, run: _Run) -> None:
     drawn = _lines(ax_pct, rec, "/buoyancy_piston_position", [("percent", "buoyancy piston (VBS)")])
     drawn = _lines(ax_pct, rec, "/longitudinal_weight_position", [("percent", "longitudinal weight (LCG)")]) or drawn
     if drawn:
+        _lines(ax_pct, rec, "/buoyancy_piston/feedback", [("percent", "VBS feedback")], feedback=True)
+        _lines(ax_pct, rec, "/longitudinal_weight/feedback", [("percent", "LCG feedback")], feedback=True)
         ax_pct.set_ylabel("position [%]")
         ax_pct.set_ylim(-5, 105)
         ax_pct.grid(alpha=0.3)
@@ -291,12 +313,32 @@ def _draw_battery(ax_bat: Any, run: _Run) -> None:
         volts = ax_bat.twinx()
         volts.plot(times, [float(m.voltage) for _, m in battery], color="#7d3c98", lw=1.0, ls="--", label="voltage")
         volts.set_ylabel("voltage [V]")
-        handles = ax_bat.get_legend_handles_labels()
-        more = volts.get_legend_handles_labels()
-        ax_bat.legend(handles[0] + more[0], handles[1] + more[1], loc="best", fontsize=8)
+        amps = ax_bat.twinx()  # a third axis, its spine moved out: the current has its own unit
+        amps.spines["right"].set_position(("axes", 1.17))
+        amps.plot(times, [float(m.current) for _, m in battery], color="#1f618d", lw=1.0, ls=":", label="current")
+        amps.set_ylabel("current [A]")
+        handles, labels = [], []
+        for ax in (ax_bat, volts, amps):
+            h, lab = ax.get_legend_handles_labels()
+            handles += h
+            labels += lab
+        ax_bat.legend(handles, labels, loc="best", fontsize=8)
         _shade_aborts(ax_bat, spans)
     else:
         _not_recorded(ax_bat, "/battery_state")
+
+
+def node_states(rec: Recording) -> dict[str, list[tuple[float, int]]]:
+    """Each node's (and the bridge's) levels over time from /diagnostics, by the spec's name: a namespaced run's
+    statuses (sam1/controller) without the namespace, another vehicle's and the per-mapping statuses left out."""
+    rows: dict[str, list[tuple[float, int]]] = {}
+    for t, msg in rec.get("/diagnostics"):
+        for status in msg.status:
+            name = spec_status_name(rec.names, status.name)  # None: another vehicle's (shared /diagnostics)
+            if name is not None and "/" not in name:  # the nodes and the bridge itself, not per-mapping statuses
+                level = status.level[0] if isinstance(status.level, bytes | bytearray) else int(status.level)
+                rows.setdefault(name, []).append((t, level))
+    return rows
 
 
 def _draw_states(ax_state: Any, run: _Run) -> None:
@@ -304,12 +346,7 @@ def _draw_states(ax_state: Any, run: _Run) -> None:
 
     rec, spans, end = run.rec, run.spans, run.end
     ax_state.set_title("Abort (/abort) and node states (/diagnostics)")
-    rows: dict[str, list[tuple[float, int]]] = {}
-    for t, msg in rec.get("/diagnostics"):
-        for status in msg.status:
-            if "/" not in status.name:  # the nodes and the bridge itself, not its per-mapping statuses
-                level = status.level[0] if isinstance(status.level, bytes | bytearray) else int(status.level)
-                rows.setdefault(status.name, []).append((t, level))
+    rows = node_states(rec)
     names = sorted(rows)
     if rows or rec.get("/abort"):
         rows_shown = [*names, "abort"]
@@ -359,7 +396,7 @@ def plot_run(mcap: Path, out: Path, *, limits: Mapping[str, float] | None = None
 
     fig = plt.figure(figsize=(15, 19), dpi=100)
     grid = fig.add_gridspec(5, 2, height_ratios=[1.15, 1.15, 1, 1, 1.05], hspace=0.42, wspace=0.2,
-                            left=0.12, right=0.93, top=0.94, bottom=0.05)
+                            left=0.12, right=0.88, top=0.94, bottom=0.05)
     ax_track = fig.add_subplot(grid[0:2, 0])
     ax_depth = fig.add_subplot(grid[0, 1])
     ax_alt = fig.add_subplot(grid[1, 1], sharex=ax_depth)

@@ -7,6 +7,10 @@ Invariants:
   file; one that was cut short (a killed run, a full disk) or has a corrupt tail gives every message read before the
   damage, and says so in `problems`.
 - A message that does not decode is counted per topic (`problems` names the topic and the count), never raised.
+- A namespaced run's recording (issue 30) is read with the names it used (its recorder metadata,
+  sam_runtime.common.run_names): `Recording.get` takes SAM's topic name and finds the channel the run recorded it
+  on (under its namespace when the spec names it relative); `names` gives the frame prefix and namespace to take
+  off frame ids and status names.
 - Needs `mcap` and `mcap-ros2-support` (the `runtime` extra), imported when a file is read.
 """
 
@@ -17,6 +21,9 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
+
+from sam_runtime.common.ros_namespace import RosNamespace
+from sam_runtime.common.run_names import RECORDING_METADATA, run_names
 
 __all__ = ["MCAP_MAGIC", "Recording", "RecordingError", "read_recording"]
 
@@ -35,9 +42,32 @@ class Recording:
     start_ns: int = 0
     end_s: float = 0.0
     problems: list[str] = field(default_factory=list)
+    names: RosNamespace = field(default_factory=RosNamespace)  # the run's namespace and frame prefix
 
     def get(self, topic: str) -> list[tuple[float, Any]]:
-        return self.series.get(topic, [])
+        """A topic's messages, by the name SAM's spec gives it: the run's own first (a spec with relative names
+        recorded under the run's namespace: /sam1/pressure for /pressure), else as written."""
+        return self.series.get(self.names.resolve(topic.lstrip("/"))) or self.series.get(topic, [])
+
+
+_METADATA_SCAN = 256  # records: the recorder writes its metadata before the first chunk closes
+
+
+def _recorded_names(stream: IO[bytes]) -> RosNamespace:
+    """The run's names from the recorder's metadata record near the file's start (chunks are not opened); the root
+    namespace when there is none or the start is unreadable."""
+    from mcap.records import Metadata
+    from mcap.stream_reader import StreamReader
+
+    try:
+        for k, r in enumerate(StreamReader(stream, skip_magic=False, emit_chunks=True).records):
+            if isinstance(r, Metadata) and r.name == RECORDING_METADATA:
+                return run_names(dict(r.metadata))
+            if k >= _METADATA_SCAN:
+                break
+    except Exception:  # a damaged start: the messages' reader reports it
+        pass
+    return RosNamespace()
 
 
 def _messages(stream: IO[bytes], topics: list[str] | None, problems: list[str]
@@ -70,7 +100,6 @@ def read_recording(path: Path, topics: Iterable[str] | None = None) -> Recording
     from mcap_ros2.decoder import DecoderFactory
 
     path = Path(path)
-    wanted = sorted(set(topics)) if topics is not None else None
     try:
         stream = open(path, "rb")  # closed below, once the generator is drained
     except OSError as exc:
@@ -84,6 +113,11 @@ def read_recording(path: Path, topics: Iterable[str] | None = None) -> Recording
         if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
             raise RecordingError(f"{path} is not an MCAP file (no MCAP magic at its start)")
         stream.seek(0)
+        rec.names = _recorded_names(stream)
+        stream.seek(0)
+        # the spec's names and the run's resolved ones (a recording of an older version kept the spec's)
+        wanted = sorted({n for t in topics for n in (t, rec.names.resolve(t.lstrip("/")))}) \
+            if topics is not None else None
         for schema, channel, message in _messages(stream, wanted, rec.problems):
             if schema is None:
                 failed[channel.topic] += 1

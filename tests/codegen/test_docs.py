@@ -208,7 +208,10 @@ def test_topic_publishers_include_the_bridge(resolved: Resolved, output: dict[st
     assert bridge in rows["`/thruster_rpms`"][6] and "`controller`" in rows["`/thruster_rpms`"][5]
     assert rows["`/nav_goal`"][5] == "`mission`" and rows["`/nav_goal`"][6] == "`motion_planner`"
     assert rows["`/tf`"][5] == "`dead_reckoning`, `slam`"
-    assert rows["`/imu`"][4].startswith("sensor\\_data (best\\_effort, volatile, keep last 5)")
+    # both sides (REP 2003): a reliable publisher, best-effort subscribers
+    assert rows["`/imu`"][4].startswith("publishers reliable, volatile, keep last 5; subscribers sensor\\_data "
+                                        "(best\\_effort, volatile, keep last 5)")
+    assert rows["`/nav_goal`"][4].startswith("publishers and subscribers reliable (reliable, volatile, keep last 10)")
 
 
 def test_mapping_field_tables(resolved: Resolved, output: dict[str, str]) -> None:

@@ -166,7 +166,9 @@ def test_sam_nodes_as_the_contract_lists() -> None:
     topics = resolved.spec.topics
     assert (topics["/altitude"].type, topics["/abort"].type) == ("sensor_msgs/Range", "sam_msgs/Abort")
     assert topics["/abort"].qos.profile == "latched" and topics["/tf_static"].qos.durability == "transient_local"
-    assert topics["/imu"].qos.reliability == "best_effort" and topics["/global_plan"].qos.reliability == "reliable"
+    # REP 2003: sensor data published reliably, subscribed best effort
+    assert (topics["/imu"].qos.reliability, topics["/imu"].subscriber_qos.reliability) == ("reliable", "best_effort")
+    assert topics["/global_plan"].qos.reliability == topics["/global_plan"].subscriber_qos.reliability == "reliable"
     altimeter = resolved.spec.devices["altimeter"]
     assert (altimeter.node_id, altimeter.publishes[0].subject_id, altimeter.publishes[0].rate_hz) == (16, 1106, 10)
     assert altimeter.publishes[0].type == "sam.sensor.Altitude.0.1"
@@ -245,9 +247,9 @@ def test_tables_carry_qos_frames_and_nodes(resolved: Resolved, tmp_path: Path) -
     tables = _load(path, f"_nodes_tables_{resolved.spec.vehicle}")
     spec = resolved.spec
     for t in tables.TOPICS:
-        q = spec.topics[t.name].qos
-        assert (t.qos.reliability, t.qos.durability, t.qos.depth, t.qos.profile) == (
-            q.reliability, q.durability, q.depth, q.profile)
+        for q, info in ((spec.topics[t.name].qos, t.qos), (spec.topics[t.name].subscriber_qos, t.subscriber_qos)):
+            assert (info.reliability, info.durability, info.depth, info.profile) == (
+                q.reliability, q.durability, q.depth, q.profile)
     static = [f for f in spec.frames.values() if f.parent]
     assert [(s.parent, s.child, s.translation) for s in tables.STATIC_TRANSFORMS] == [
         (f.parent, f.name, f.xyz) for f in static]
@@ -262,7 +264,7 @@ def test_tables_carry_qos_frames_and_nodes(resolved: Resolved, tmp_path: Path) -
         assert [e.topic for e in n.subscribes] == node.subscribes and n.parameters == tuple(node.parameters)
         own = {i.topic: i.qos for i in node.subscribe_items if i.qos is not None}
         for e in n.subscribes:
-            q = own.get(e.topic) or spec.topics[e.topic].qos
+            q = own.get(e.topic) or spec.topics[e.topic].subscriber_qos
             assert (e.qos.reliability, e.qos.durability, e.qos.depth) == (q.reliability, q.durability, q.depth)
 
 

@@ -150,6 +150,7 @@ def test_sam_tables(sam: Resolved, sam_files: dict[str, str], tmp_path: Path) ->
     assert [t.name for t in tables.TOPICS] == list(sam.spec.topics)
     imu = next(m for m in tables.MAPPINGS if m.name == "imu")
     assert imu.topic == tables.TopicInfo("/imu", "sensor_msgs/msg/Imu", "sensor_msgs.msg", "Imu", "IMU samples.",
+                                         tables.QosInfo("reliable", "volatile", 5, ""),
                                          tables.QosInfo("best_effort", "volatile", 5, "sensor_data"))
     assert imu.port == tables.PortInfo(1100, "sam.sensor.RawIMU.0.1", "sam.sensor", "RawIMU_0_1", 100.0)
     assert (imu.direction, imu.source_node_ids, imu.destination_node_id) == ("uavcan_to_ros", frozenset({11}), None)

@@ -85,13 +85,33 @@ def _tf(t: float, parent: str, child: str, xyz: tuple[float, float, float], yaw:
                                                        "w": math.cos(yaw / 2)}}}]}
 
 
+def _namespaced(msg: Any, prefix: str) -> Any:
+    """A message as a run with frame prefix ``prefix`` writes it: every non-empty frame id (header, child) and
+    status name prefixed."""
+    if isinstance(msg, list):
+        return [_namespaced(m, prefix) for m in msg]
+    if not isinstance(msg, dict):
+        return msg
+    out = {k: _namespaced(v, prefix) for k, v in msg.items()}
+    for key in ("frame_id", "child_frame_id"):
+        if out.get(key):
+            out[key] = prefix + out[key]
+    if "level" in out and out.get("name"):
+        out["name"] = prefix + out["name"]
+    return out
+
+
 def dive_depth(t: float) -> float:
     return 3.0 * min(1.0, t / 15.0) if t < 40 else max(0.0, 3.0 * (1 - (t - 40) / 15.0))
 
 
-def write_dive(path: Path, *, seconds: float = 60.0, skip: tuple[str, ...] = (), chunk_size: int = 1 << 20) -> Path:
+def write_dive(path: Path, *, seconds: float = 60.0, skip: tuple[str, ...] = (), chunk_size: int = 1 << 20,
+               namespace: str = "") -> Path:
     """Write the synthetic dive to ``path``; ``skip`` leaves topics out (for the "not recorded" panels); small chunks
-    make a file that a cut leaves partly readable."""
+    make a file that a cut leaves partly readable. ``namespace`` (``/sam1``): the dive as a namespaced run of a spec
+    with relative topic names records it: channels under the namespace (but the global /tf and /diagnostics), frame
+    ids with its prefix, status names with the namespace, and the recorder's metadata saying so."""
+    prefix = namespace[1:] + "/" if namespace else ""
     from mcap_ros2.writer import Writer
 
     events: list[tuple[float, str, dict[str, Any]]] = []
@@ -146,11 +166,18 @@ def write_dive(path: Path, *, seconds: float = 60.0, skip: tuple[str, ...] = (),
     add(0.0, "/abort", {"header": _header(0.0), "active": False, "reason": ""})
     add(45.0, "/abort", {"header": _header(45.0), "active": True, "reason": "battery below min_battery_percent"})
     events.sort(key=lambda e: e[0])
+    if namespace:
+        events = [(t, topic if topic in ("/tf", "/diagnostics") else namespace + topic, _namespaced(msg, prefix))
+                  for t, topic, msg in events]
     with open(path, "wb") as f:
         writer = Writer(f, chunk_size=chunk_size)
+        if namespace:
+            writer.add_metadata("sam_codegen.recording", {"format": "sam-recording/1", "ros.namespace": namespace,
+                                                          "ros.frame_prefix": prefix})
         schemas = {topic: writer.register_msgdef(TYPES[topic], msgdef(TYPES[topic])) for topic in TYPES}
         for seq, (t, topic, msg) in enumerate(events):
             ns = T0_NS + int(t * 1e9)
-            writer.write_message(topic, schemas[topic], msg, log_time=ns, publish_time=ns, sequence=seq)
+            schema = schemas[topic[len(namespace):] if namespace and topic.startswith(namespace + "/") else topic]
+            writer.write_message(topic, schema, msg, log_time=ns, publish_time=ns, sequence=seq)
         writer.finish()
     return path

@@ -1,6 +1,6 @@
 """A slow ROS subscriber in its own process, for tests/test_faults.py: subscribes to a bridged topic with the
-spec's QoS (reliability and durability of the generated tables, as any ROS node of the vehicle would; keep-last
-DEPTH) and sleeps SLEEP seconds in every callback.
+spec's subscribers' QoS (reliability and durability of the generated tables' subscriber side, as any ROS node of
+the vehicle would; keep-last DEPTH) and sleeps SLEEP seconds in every callback.
 
 python slow_subscriber.py --topic /imu --sleep 0.1 --depth 10 --out OUT.json   (SAM_GENERATED_DIR or --generated)
 Prints READY once the topic has a publisher, then ``COUNT n`` (messages received so far) every 0.2 s; writes
@@ -52,7 +52,8 @@ def main() -> int:
         state["slept_s"] += args.sleep
 
     node.create_subscription(gen.ros_class(topic), args.topic, cb,
-                             qos_profile(topic.qos.reliability, topic.qos.durability, args.depth))
+                             qos_profile(topic.subscriber_qos.reliability, topic.subscriber_qos.durability,
+                                         args.depth))
     stop: list[int] = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     signal.signal(signal.SIGINT, lambda *_: stop.append(1))

@@ -20,7 +20,7 @@ from collections.abc import Hashable, Iterable
 from pathlib import Path
 
 from sam_codegen.catalogs.ros_known import external_messages_to_generate
-from sam_codegen.model.spec import QOS_PROFILES, Mapping, Node, Port, Qos, Spec
+from sam_codegen.model.spec import QOS_PROFILES, Mapping, Node, Port, Qos, Spec, describe_sides, topic_profile
 from sam_codegen.targets.docs.graph import ROS_TO_UAVCAN, SVG_NAME, UAVCAN_TO_ROS, Graph, PortIndex, mermaid_context
 from sam_codegen.targets.docs.traffic import traffic_words
 from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
@@ -60,8 +60,7 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         "nodes": _node_rows(spec),
         "nodes_package": nodes_package(spec),
         "params_file": params_file(spec),
-        "qos_profiles": [{"name": name, "text": Qos(q.reliability, q.durability, q.depth).describe()}
-                         for name, q in QOS_PROFILES.items()],
+        "qos_profiles": [{"name": name, "text": describe_sides(*_unnamed(name))} for name in QOS_PROFILES],
         "external_packages": sorted({m.package for m in external_messages_to_generate(spec).values()}),
         **_message_rows(resolved),
         "parameters": _parameter_rows(spec),
@@ -144,13 +143,21 @@ def _topic_users(spec: Spec) -> TopicUsers:
     return users
 
 
+def _unnamed(profile: str) -> tuple[Qos, Qos]:
+    """A topic profile's two sides, spelled out (the list explains the names)."""
+    sides = topic_profile(profile)
+    assert sides is not None, "a profile of QOS_PROFILES"
+    return tuple(Qos(q.reliability, q.durability, q.depth) for q in sides)  # type: ignore[return-value]
+
+
 def _topic_rows(spec: Spec, users: TopicUsers) -> list[Row]:
     """Each topic with its type, QoS (and where the QoS comes from) and who publishes and subscribes it."""
     topics: list[Row] = []
     for name, t in spec.topics.items():
         publishers, subscribers = users[name]
-        qos = t.qos.describe() + (f"; default: {t.qos_origin}" if t.qos_origin != "declared" else "") \
-            if t.qos is not None else ""
+        qos = describe_sides(t.qos, t.subscriber_qos) \
+            + (f"; default: {t.qos_origin}" if t.qos_origin != "declared" else "") \
+            if t.qos is not None and t.subscriber_qos is not None else ""
         topics.append({"name": name, "type": t.type, "section": t.section, "description": t.description, "qos": qos,
                        "publishers": publishers, "subscribers": subscribers})
     return topics

@@ -48,8 +48,9 @@ class QosInfo:
 
 @dataclass(frozen=True)
 class TopicInfo:
-    """A ROS topic; its publishers (the bridge's too) use its QoS, and so do its subscriptions unless a node's
-    own differs (NodeInfo)."""
+    """A ROS topic; its publishers (the bridge's too) use its ``qos``, its subscriptions (the bridge's command
+    subscriptions too) its ``subscriber_qos`` unless a node's own differs (NodeInfo). Sensor data: publishers
+    reliable, subscribers best effort (REP 2003), so any subscriber matches."""
 
     name: str
     ros_type: str  # e.g. "sensor_msgs/msg/Imu"
@@ -57,6 +58,7 @@ class TopicInfo:
     ros_class: str  # e.g. "Imu"
     description: str
     qos: QosInfo
+    subscriber_qos: QosInfo
 
 
 @dataclass(frozen=True)

@@ -206,21 +206,24 @@ def nodes_context(resolved: Resolved) -> dict[str, Any]:
     def qos_info(qos: Qos) -> str:
         return f"QosInfo({py_str(qos.reliability)}, {py_str(qos.durability)}, {qos.depth}, {py_str(qos.profile)})"
 
-    def endpoints(node_items: list) -> list[str]:
-        return [f"EndpointInfo({py_str(i.topic)}, {qos_info(node_topic_qos(spec, i))})" for i in node_items]
+    def endpoints(node_items: list, subscription: bool) -> list[str]:
+        return [f"EndpointInfo({py_str(i.topic)}, {qos_info(node_topic_qos(spec, i, subscription=subscription))})"
+                for i in node_items]
 
     nodes = []
     for n in spec.nodes.values():
         nodes.append({
             "name": py_str(n.name), "description": n.description,
             "module": py_str(f"{package}.{n.name}"), "base_class": py_str(class_name(n.name)),
-            "publishes": endpoints(n.publish_items), "subscribes": endpoints(n.subscribe_items),
+            "publishes": endpoints(n.publish_items, False), "subscribes": endpoints(n.subscribe_items, True),
             "parameters": [py_str(p) for p in n.parameters],
             "transforms": [f"({py_str(p)}, {py_str(c)})" for p, c in n.transforms],
             "reads_transforms": [f"({py_str(p)}, {py_str(c)})" for p, c in n.reads_transforms],
         })
     return {
         "topic_qos": {py_str(t.name): qos_info(t.qos) for t in spec.topics.values() if t.qos is not None},
+        "topic_subscriber_qos": {py_str(t.name): qos_info(t.subscriber_qos) for t in spec.topics.values()
+                                 if t.subscriber_qos is not None},
         "static_transforms": [{"parent": py_str(p), "child": py_str(c), "xyz": ", ".join(map(float_literal, xyz)),
                                "rotation": ", ".join(map(float_literal, q))}
                               for p, c, xyz, q in static_transforms(spec)],

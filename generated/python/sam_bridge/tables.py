@@ -44,8 +44,9 @@ class QosInfo:
 
 @dataclass(frozen=True)
 class TopicInfo:
-    """A ROS topic; its publishers (the bridge's too) use its QoS, and so do its subscriptions unless a node's
-    own differs (NodeInfo)."""
+    """A ROS topic; its publishers (the bridge's too) use its ``qos``, its subscriptions (the bridge's command
+    subscriptions too) its ``subscriber_qos`` unless a node's own differs (NodeInfo). Sensor data: publishers
+    reliable, subscribers best effort (REP 2003), so any subscriber matches."""
 
     name: str
     ros_type: str  # e.g. "sensor_msgs/msg/Imu"
@@ -53,6 +54,7 @@ class TopicInfo:
     ros_class: str  # e.g. "Imu"
     description: str
     qos: QosInfo
+    subscriber_qos: QosInfo
 
 
 @dataclass(frozen=True)
@@ -376,7 +378,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='Imu',
         description='IMU samples.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/magnetic_field',
@@ -384,7 +387,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='MagneticField',
         description='Magnetometer samples.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/gps_fix',
@@ -392,7 +396,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='NavSatFix',
         description='GPS fixes, at the surface.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/pressure',
@@ -400,7 +405,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='FluidPressure',
         description='Water pressure.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thruster_rpms',
@@ -409,6 +415,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='ThrusterRPMs',
         description='Thruster speed commands.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/thruster_angles',
@@ -417,6 +424,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='ThrusterAngles',
         description='Thrust vector commands.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/ballast_angles',
@@ -425,6 +433,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='BallastAngles',
         description='Ballast weight commands.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/longitudinal_weight_position',
@@ -433,6 +442,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='PercentStamped',
         description='Longitudinal weight position command.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/buoyancy_piston_position',
@@ -441,6 +451,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='PercentStamped',
         description='Buoyancy piston position command.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/tf',
@@ -449,6 +460,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='TFMessage',
         description='Transforms odom->base_link (DR) and world->odom (SLAM).',
         qos=QosInfo('reliable', 'volatile', 100, 'tf'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 100, 'tf'),
     ),
     TopicInfo(
         name='/tf_static',
@@ -457,6 +469,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='TFMessage',
         description='The static child frames (sensor mountings), published once.',
         qos=QosInfo('reliable', 'transient_local', 1, 'latched'),
+        subscriber_qos=QosInfo('reliable', 'transient_local', 1, 'latched'),
     ),
     TopicInfo(
         name='/nav_heading',
@@ -465,6 +478,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='HeadingStamped',
         description='Heading goal; z < 0 depth, z > 0 altitude.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/nav_goal',
@@ -473,6 +487,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='PoseStamped',
         description='Pose goal in /world; position.z < 0 depth, > 0 altitude.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/global_plan',
@@ -481,6 +496,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='Path',
         description='The planned path the controller follows.',
         qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
+        subscriber_qos=QosInfo('reliable', 'volatile', 10, 'reliable'),
     ),
     TopicInfo(
         name='/battery_state',
@@ -488,7 +504,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='BatteryState',
         description='Battery health and charge.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/altitude',
@@ -496,7 +513,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sensor_msgs.msg',
         ros_class='Range',
         description='Altitude above the sea floor from the altimeter; NaN range = no bottom lock.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/abort',
@@ -505,6 +523,7 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_class='Abort',
         description='Emergency ascent ordered (active) or cleared by the performance monitor.',
         qos=QosInfo('reliable', 'transient_local', 1, 'latched'),
+        subscriber_qos=QosInfo('reliable', 'transient_local', 1, 'latched'),
     ),
     TopicInfo(
         name='/battery_info',
@@ -512,7 +531,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='BatteryInfo',
         description="The battery's full UAVCAN report.",
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thruster_1/feedback',
@@ -520,7 +540,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrusterFeedback',
         description='Thruster 1 feedback.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thruster_2/feedback',
@@ -528,7 +549,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrusterFeedback',
         description='Thruster 2 feedback.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/thrust_vector/feedback',
@@ -536,7 +558,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='ThrustVectorFeedback',
         description='Thrust vector feedback.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/longitudinal_weight/feedback',
@@ -544,7 +567,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='PositionFeedback',
         description='Longitudinal weight position.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
     TopicInfo(
         name='/buoyancy_piston/feedback',
@@ -552,7 +576,8 @@ TOPICS: tuple[TopicInfo, ...] = (
         ros_module='sam_msgs.msg',
         ros_class='PositionFeedback',
         description='Buoyancy piston position.',
-        qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
+        qos=QosInfo('reliable', 'volatile', 5, ''),
+        subscriber_qos=QosInfo('best_effort', 'volatile', 5, 'sensor_data'),
     ),
 )
 

@@ -204,7 +204,7 @@ if WORKER:
                     subs = session.spin_until(
                         lambda n=info.name, t=topic: [e for e in node.get_subscriptions_info_by_topic(t)
                                                       if e.node_name == n], f"{info.name} subscribing {topic}")
-                    q = TOPICS[topic].qos
+                    q = TOPICS[topic].subscriber_qos  # the subscribers' side of the topic's QoS
                     assert qos_names(subs[0].qos_profile) == (q.reliability, q.durability)
 
     def test_parameters_are_declared_with_ranges(session: Session) -> None:

@@ -13,7 +13,7 @@ pytest.importorskip("matplotlib")
 from helpers.mcap_fixture import write_dive
 
 from sam_codegen.cli import main as codegen_main
-from sam_runtime.report.plot import limits_from_params, plot_run, track
+from sam_runtime.report.plot import TOPICS, limits_from_params, node_states, plot_run, track
 from sam_runtime.report.recording import RecordingError, read_recording
 
 REPO = Path(__file__).resolve().parents[3]
@@ -40,6 +40,22 @@ def test_the_track_composes_world_odom_and_odom_base_link(dive: Path) -> None:
     # The fixture's odom -> base_link is (x - 0.5, y, -depth) and world -> odom (0.5, 0, 0): world (20, 5) at the end.
     assert (t, x, y, depth) == pytest.approx((60.0, 20.0, 5.0, 0.0))
     assert max(p[3] for p in points) == pytest.approx(3.0)
+
+
+def test_a_namespaced_run_reads_as_the_plain_one(dive: Path, tmp_path: Path) -> None:
+    """Issue 30: a run as /sam1 of a spec with relative names recorded /sam1/pressure, sam1/odom, sam1/controller;
+    the reader finds the spec's topics through the recorded namespace and the picture is the plain run's."""
+    namespaced = write_dive(tmp_path / "sam1.mcap", chunk_size=4096, namespace="/sam1")
+    plain, rec = read_recording(dive, TOPICS), read_recording(namespaced, TOPICS)
+    assert (rec.names.namespace, rec.names.frame_prefix) == ("/sam1", "sam1/")
+    assert "/sam1/pressure" in rec.series and "/pressure" not in rec.series
+    assert len([t for t in TOPICS if plain.get(t)]) >= 12  # the dive's topics (it has no actuator feedback)
+    for topic in TOPICS:
+        assert len(rec.get(topic)) == len(plain.get(topic)), topic
+    assert track(rec) == track(plain)
+    assert node_states(rec) == node_states(plain) and "controller" in node_states(rec)
+    svg = plot_run(namespaced, tmp_path / "sam1.svg").read_text()
+    assert "not recorded" not in svg and "performance_monitor" in svg
 
 
 def test_limits_come_from_the_generated_parameters() -> None:
