@@ -192,25 +192,33 @@ def build_ros_package(
     _forget_build_of_other_source(build_dir, package_dir)
     build_dir.mkdir(parents=True, exist_ok=True)
     cmake_prefix_path = ";".join(env["CMAKE_PREFIX_PATH"].split(os.pathsep))
-    step(
-        "configure",
-        [
-            cmake,
-            "-S",
-            str(package_dir),
-            "-B",
-            str(build_dir),
-            f"-DCMAKE_PREFIX_PATH={cmake_prefix_path}",
-            f"-DCMAKE_INSTALL_PREFIX={install_prefix}",
-            f"-DPython3_EXECUTABLE={interpreter}",
-            "-DCMAKE_BUILD_TYPE=Release",
-            # The generated package has no tests; skipping ament's lint/test hooks saves configure time.
-            "-DBUILD_TESTING=OFF",
-        ],
-        env,
-    )
-    step("build", [cmake, "--build", str(build_dir), "-j", str(max(1, jobs))], env)
+    base = [
+        cmake,
+        "-S",
+        str(package_dir),
+        "-B",
+        str(build_dir),
+        f"-DCMAKE_PREFIX_PATH={cmake_prefix_path}",
+        f"-DCMAKE_INSTALL_PREFIX={install_prefix}",
+        f"-DPython3_EXECUTABLE={interpreter}",
+        "-DCMAKE_BUILD_TYPE=Release",
+        # The generated package has no tests; skipping ament's lint/test hooks saves configure time.
+        "-DBUILD_TESTING=OFF",
+    ]
+    step("configure", [*base, f"-D{UNITY_OPTION}=ON"], env)
+    build = [cmake, "--build", str(build_dir), "-j", str(max(1, jobs))]
+    try:
+        step("build", build, env)
+    except RosBuildError:
+        # The generated CMakeLists.txt compiles the type supports as unity files (see there); one that a future
+        # rosidl cannot compile must not cost the user the package: file by file.
+        step("configure without unity files", [*base, f"-D{UNITY_OPTION}=OFF"], env)
+        step("build", build, env)
     step("install", [cmake, "--install", str(build_dir)], env)
+
+
+# The generated CMakeLists.txt's option (templates/ros/CMakeLists.txt.j2) that compiles in unity batches.
+UNITY_OPTION = "SAM_CODEGEN_UNITY_BUILD"
 
 
 def _forget_build_of_other_source(build_dir: Path, package_dir: Path) -> None:
