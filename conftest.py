@@ -112,6 +112,7 @@ def isolation_lock_name() -> str:
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     tiers.mark_system(items)
+    tiers.group_by_module(items)
     tiers.system_first(items)
     if config.getoption("--unit-tier"):
         keep = [item for item in items if item.get_closest_marker("system") is None]

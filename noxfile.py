@@ -47,8 +47,9 @@ def _ros_install(session: nox.Session) -> None:
 
 
 # pytest-xdist: one worker per core, each in a private network (tests/helpers/isolation.py). A module's tests stay on
-# one worker (--dist loadfile): their module fixtures (a built spec, a running stack) are set up once.
-PARALLEL = ["-n", "auto", "--dist", "loadfile"]
+# one worker (--dist loadgroup, a group per module: tests/helpers/tiers.py): their module fixtures (a built spec, a
+# running stack) are set up once; a module marked `spread` goes test by test.
+PARALLEL = ["-n", "auto", "--dist", "loadgroup"]
 
 
 @nox.session(python="3.11")

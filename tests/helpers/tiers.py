@@ -44,6 +44,16 @@ def warm_up() -> None:
     platform.processor()
 
 
+def group_by_module(items: list[pytest.Item]) -> None:
+    """The unit of distribution over xdist's workers (``--dist loadgroup``): a module's tests stay together on one
+    worker (its module fixtures, a built spec or a running stack, are set up once), unless the module is marked
+    ``spread``: its tests are independent and long (property tests per spec, each building and running its own
+    children), so they go one by one to whichever worker is free and a long module does not leave one core alone."""
+    for item in items:
+        if item.get_closest_marker("spread") is None and item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::", 1)[0]))
+
+
 def system_first(items: list[pytest.Item]) -> None:
     """System tests (the long ones: processes, CMake) first, each group in its own order: with xdist's
     distribution by file, a long module started last would leave one core alone at the end. Test order must not

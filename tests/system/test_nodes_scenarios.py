@@ -24,7 +24,8 @@ from helpers.stack import Stack, stack, wait_for
 
 from sam_runtime.nav.controller import ControllerConfig
 
-pytestmark = [pytest.mark.ros, pytest.mark.slow]
+# Each scenario flies a stack of its own: spread over the workers (tests/helpers/tiers.py).
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.spread]
 
 S = 1e9  # ns per second
 # The nodes' rates (sam_runtime.nodes.controller.CONTROL_HZ, .performance_monitor.EVALUATE_HZ; those modules import
