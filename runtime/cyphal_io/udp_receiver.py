@@ -57,6 +57,17 @@ from typing import Any
 from sam_runtime.common.transfer_ids import JUMP_SLACK, MAX_PLAUSIBLE_RATE_HZ
 from sam_runtime.cyphal_io.crc32c import RESIDUE as CRC32C_RESIDUE
 from sam_runtime.cyphal_io.crc32c import crc32c_register
+from sam_runtime.cyphal_io.multicast import (
+    ANC_OVERFLOW_SIZE,
+    ANC_PKTINFO_SIZE,
+    CYPHAL_PORT,
+    IP_PKTINFO,
+    SO_RXQ_OVFL,
+    join_group,
+    leave_group,
+    open_socket,
+    stop_reading,
+)
 
 __all__ = ["BATCH", "CYPHAL_PORT", "FRAME_INDEX_LIMIT", "MAX_FRAME_INDEX", "RCVBUF_BYTES", "TRANSFER_ID_TIMEOUT_S",
            "Handler", "SubjectPort", "UDPLoopReceiver", "loop_udp_transport", "loop_udp_transport_class",
@@ -66,7 +77,6 @@ _log = logging.getLogger(__name__)
 
 Handler = Callable[[bytes, "int | None", int, float], None]  # (payload, source node id, transfer id, monotonic s)
 
-CYPHAL_PORT = 9382  # pycyphal.transport.udp's CYPHAL_PORT
 BATCH = 256  # datagrams per wake-up at most: a flood cannot hold the loop
 # The receive buffer asked for (the kernel doubles it, capped at 2 * net.core.rmem_max): one socket queues every
 # subject, so it holds more than one of pycyphal's sockets (rmem_default, 208 KiB) yet not so much that a flood on
@@ -75,10 +85,7 @@ RCVBUF_BYTES = 1 << 20
 MAX_FRAME_INDEX = 4095  # 4096 frames: 4.9 MB at pycyphal's default MTU, far beyond any extent the bridge has
 _READ_SIZE = 0xFFFF  # as pycyphal's reader: any UDP/IPv4 datagram fits
 # Linux values; Python 3.11's socket module names none of them.
-_IP_PKTINFO = 8
-_IP_MULTICAST_ALL = 49
-_SO_RXQ_OVFL = 40
-_ANC_SIZE = socket.CMSG_SPACE(12) + socket.CMSG_SPACE(4)  # struct in_pktinfo; the drop counter (uint32)
+_ANC_SIZE = ANC_PKTINFO_SIZE + ANC_OVERFLOW_SIZE
 _SOL_IP, _SOL_SOCKET = socket.IPPROTO_IP, socket.SOL_SOCKET
 
 _HEADER = struct.Struct("<BBHHHQIH")  # pycyphal's UDPFrame header without its CRC (22 bytes)
@@ -444,21 +451,7 @@ class UDPLoopReceiver:
         self._ports: dict[bytes, SubjectPort] = {}
         self._iface = socket.inet_aton(self.local_ip)
         self._kernel_drops = 0
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
-        try:
-            sock.setblocking(False)
-            # Shared with pycyphal's sockets and other nodes on this host (set before bind, as pycyphal does).
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
-            # Only the groups this socket joined (the default, 1, delivers every group any socket joined).
-            sock.setsockopt(socket.IPPROTO_IP, _IP_MULTICAST_ALL, 0)
-            sock.setsockopt(socket.IPPROTO_IP, _IP_PKTINFO, 1)
-            sock.setsockopt(socket.SOL_SOCKET, _SO_RXQ_OVFL, 1)
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, int(rcvbuf_bytes))
-            sock.bind(("", CYPHAL_PORT))  # every destination: the group (IP_PKTINFO) says whose a datagram is
-        except BaseException:
-            sock.close()
-            raise
+        sock = open_socket(rcvbuf_bytes=rcvbuf_bytes, overflow_counter=True)
         self._sock: socket.socket | None = sock
         self._loop.add_reader(sock.fileno(), self._on_readable)
 
@@ -474,7 +467,7 @@ class UDPLoopReceiver:
         group = subject_group(subject_id)
         if group in self._ports:
             raise ValueError(f"subject {subject_id} is subscribed already")
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, group + self._iface)
+        join_group(sock, group, self._iface)
         port = self._ports[group] = SubjectPort(self, subject_id, extent_bytes, handler)
         return port
 
@@ -484,18 +477,12 @@ class UDPLoopReceiver:
             return
         del self._ports[group]
         if self._sock is not None:
-            try:
-                self._sock.setsockopt(socket.IPPROTO_IP, socket.IP_DROP_MEMBERSHIP, group + self._iface)
-            except OSError as ex:  # the interface went away: the membership went with it
-                _log.debug("leaving %s: %s", socket.inet_ntoa(group), ex)
+            leave_group(self._sock, group, self._iface)
 
     def close(self) -> None:
         sock, self._sock = self._sock, None
         self._ports.clear()
-        if sock is not None:
-            if not self._loop.is_closed():
-                self._loop.remove_reader(sock.fileno())
-            sock.close()
+        stop_reading(self._loop, sock, close=True)
 
     def _on_readable(self) -> None:
         sock = self._sock
@@ -513,9 +500,9 @@ class UDPLoopReceiver:
             now = clock()
             group = b""
             for level, kind, cdata in ancdata:
-                if kind == _IP_PKTINFO and level == _SOL_IP:
+                if kind == IP_PKTINFO and level == _SOL_IP:
                     group = cdata[8:12]  # in_pktinfo.ipi_addr: the datagram's destination
-                elif kind == _SO_RXQ_OVFL and level == _SOL_SOCKET:
+                elif kind == SO_RXQ_OVFL and level == _SOL_SOCKET:
                     self._note_kernel_drops(int.from_bytes(cdata[:4], sys.byteorder))
             port = ports.get(group)
             if port is not None:
@@ -534,9 +521,7 @@ class UDPLoopReceiver:
     def _fail(self, ex: OSError) -> None:
         self.failure = f"Cyphal/UDP receive on {self.local_ip}: {type(ex).__name__}: {ex}"
         _log.warning("%s", self.failure)
-        sock = self._sock
-        if sock is not None and not self._loop.is_closed():
-            self._loop.remove_reader(sock.fileno())  # no busy loop on a broken socket; the reopen replaces it
+        stop_reading(self._loop, self._sock)  # the reopen replaces it
 
     def __repr__(self) -> str:
         subjects = sorted(p.subject_id for p in self._ports.values())

@@ -46,7 +46,15 @@ import socket
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from sam_runtime.cyphal_io.udp_receiver import BATCH, CYPHAL_PORT, loop_udp_transport_class, subject_group
+from sam_runtime.cyphal_io.multicast import (
+    ANC_PKTINFO_SIZE,
+    IP_PKTINFO,
+    join_group,
+    leave_group,
+    open_socket,
+    stop_reading,
+)
+from sam_runtime.cyphal_io.udp_receiver import BATCH, loop_udp_transport_class, subject_group
 
 if TYPE_CHECKING:  # pycyphal is imported where it is used (a DroneCAN-only vehicle imports this module too)
     from pycyphal.transport import InputSessionSpecifier, PayloadMetadata, Timestamp, TransferFrom
@@ -59,9 +67,6 @@ _log = logging.getLogger(__name__)
 
 DEFAULT_TRANSFER_ID_TIMEOUT_S = 2.0  # pycyphal's UDPInputSession.DEFAULT_TRANSFER_ID_TIMEOUT
 _READ_SIZE = 0xFFFF  # as pycyphal's reader: any UDP/IPv4 datagram fits
-_IP_PKTINFO = 8  # Linux values; Python 3.11's socket module names neither
-_IP_MULTICAST_ALL = 49
-_ANC_SIZE = socket.CMSG_SPACE(12)  # struct in_pktinfo
 
 
 def service_group(node_id: int) -> bytes:
@@ -251,17 +256,7 @@ class SessionSocket:
         self._loop = asyncio.get_running_loop()
         self._iface = socket.inet_aton(self.local_ip)
         self._groups: dict[bytes, list[LoopInputSession]] = {}
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
-        try:
-            sock.setblocking(False)
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # shared with other nodes' sockets
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
-            sock.setsockopt(socket.IPPROTO_IP, _IP_MULTICAST_ALL, 0)
-            sock.setsockopt(socket.IPPROTO_IP, _IP_PKTINFO, 1)
-            sock.bind(("", CYPHAL_PORT))
-        except BaseException:
-            sock.close()
-            raise
+        sock = open_socket()
         self._sock: socket.socket | None = sock
         self._loop.add_reader(sock.fileno(), self._on_readable)
 
@@ -278,7 +273,7 @@ class SessionSocket:
         sessions = self._groups.get(group)
         if sessions is None:
             try:
-                sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, group + self._iface)
+                join_group(sock, group, self._iface)
             except OSError as ex:  # as pycyphal's make_input_socket
                 raise pycyphal.transport.InvalidMediaConfigurationError(
                     f"could not join {socket.inet_ntoa(group)} via {self.local_ip}: {ex}") from None
@@ -293,18 +288,12 @@ class SessionSocket:
         if not sessions:
             del self._groups[group]
             if self._sock is not None:
-                try:
-                    self._sock.setsockopt(socket.IPPROTO_IP, socket.IP_DROP_MEMBERSHIP, group + self._iface)
-                except OSError as ex:  # the interface went away: the membership went with it
-                    _log.debug("leaving %s: %s", socket.inet_ntoa(group), ex)
+                leave_group(self._sock, group, self._iface)
 
     def close(self) -> None:
         sock, self._sock = self._sock, None
         self._groups.clear()
-        if sock is not None:
-            if not self._loop.is_closed():
-                self._loop.remove_reader(sock.fileno())
-            sock.close()
+        stop_reading(self._loop, sock, close=True)
 
     def _on_readable(self) -> None:
         sock = self._sock
@@ -315,7 +304,7 @@ class SessionSocket:
         groups, now = self._groups, Timestamp.now
         for _ in range(BATCH):
             try:
-                data, ancdata, _flags, _addr = sock.recvmsg(_READ_SIZE, _ANC_SIZE)
+                data, ancdata, _flags, _addr = sock.recvmsg(_READ_SIZE, ANC_PKTINFO_SIZE)
             except (BlockingIOError, InterruptedError):
                 return
             except OSError as ex:
@@ -325,7 +314,7 @@ class SessionSocket:
             self.datagrams += 1
             group = b""
             for level, kind, cdata in ancdata:
-                if kind == _IP_PKTINFO and level == socket.IPPROTO_IP:
+                if kind == IP_PKTINFO and level == socket.IPPROTO_IP:
                     group = cdata[8:12]  # in_pktinfo.ipi_addr: the datagram's destination
             sessions = groups.get(group)
             if sessions:
@@ -336,8 +325,7 @@ class SessionSocket:
     def _fail(self, ex: OSError) -> None:
         self.failure = f"Cyphal/UDP session receive on {self.local_ip}: {type(ex).__name__}: {ex}"
         _log.warning("%s", self.failure)
-        if self._sock is not None and not self._loop.is_closed():
-            self._loop.remove_reader(self._sock.fileno())
+        stop_reading(self._loop, self._sock)
 
     def __repr__(self) -> str:
         return f"SessionSocket({self.local_ip!r}, groups={self.groups})"
