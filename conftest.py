@@ -110,9 +110,12 @@ def isolation_lock_name() -> str:
     return str(UDP_LOCK)
 
 
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
+    return tiers.spread_scheduler(config, log)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     tiers.mark_system(items)
-    tiers.group_by_module(items)
     tiers.system_first(items)
     if config.getoption("--unit-tier"):
         keep = [item for item in items if item.get_closest_marker("system") is None]

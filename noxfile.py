@@ -47,9 +47,9 @@ def _ros_install(session: nox.Session) -> None:
 
 
 # pytest-xdist: one worker per core, each in a private network (tests/helpers/isolation.py). A module's tests stay on
-# one worker (--dist loadgroup, a group per module: tests/helpers/tiers.py): their module fixtures (a built spec, a
-# running stack) are set up once; a module marked `spread` goes test by test.
-PARALLEL = ["-n", "auto", "--dist", "loadgroup"]
+# one worker (by file): their module fixtures (a built spec, a running stack) are set up once; the long modules of
+# independent tests go test by test (tests/helpers/tiers.py, SPREAD_MODULES).
+PARALLEL = ["-n", "auto", "--dist", "loadfile"]
 
 
 @nox.session(python="3.11")

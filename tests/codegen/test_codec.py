@@ -42,9 +42,6 @@ from sam_codegen.targets.python import convert as emit_python
 from sam_codegen.targets.wire import codec as emit_codec
 from sam_codegen.validate.resolve import validate
 
-# Per-spec property tests, each with its own built package and children: spread over the workers (tiers.py).
-pytestmark = pytest.mark.spread
-
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {**tc.SPECS, "barge": Path(__file__).resolve().parents[1] / "specs" / "barge.yaml",
          "relay": Path(__file__).resolve().parents[1] / "specs" / "relay.yaml",

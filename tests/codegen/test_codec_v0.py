@@ -40,9 +40,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-# Per-spec property tests, each with its own built package and children: spread over the workers (tiers.py).
-pytestmark = pytest.mark.spread
-
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml",
          "minimal_v0": ROOT / "tests" / "specs" / "minimal_v0.yaml", "buoy": ROOT / "tests" / "specs" / "buoy_v0.yaml",

@@ -39,9 +39,6 @@ from sam_codegen.targets import ros as emit_ros
 from sam_codegen.targets.python import convert as emit_python
 from sam_codegen.validate.resolve import Resolved, validate
 
-# Per-spec property tests, each with its own built package and children: spread over the workers (tiers.py).
-pytestmark = pytest.mark.spread
-
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml",
          "rover": Path(__file__).resolve().parents[1] / "specs" / "rover.yaml",

@@ -24,9 +24,6 @@ from typing import Any
 
 import pytest
 
-# Per-spec property tests, each with its own built package and children: spread over the workers (tiers.py).
-pytestmark = pytest.mark.spread
-
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = {"sam": ROOT / "spec" / "interfaces.yaml", "ferry": ROOT / "tests" / "specs" / "ferry.yaml"}
 WORKER_ENV = "SAM_V0_CONVERTERS_WORKER"

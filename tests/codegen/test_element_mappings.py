@@ -30,9 +30,6 @@ from typing import Any
 
 import pytest
 
-# Per-spec property tests, each with its own built package and children: spread over the workers (tiers.py).
-pytestmark = pytest.mark.spread
-
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = ROOT / "tests" / "specs" / "power_v0.yaml"
 WORKER_ENV = "SAM_ELEMENT_MAPPINGS_WORKER"

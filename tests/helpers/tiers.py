@@ -44,14 +44,40 @@ def warm_up() -> None:
     platform.processor()
 
 
-def group_by_module(items: list[pytest.Item]) -> None:
-    """The unit of distribution over xdist's workers (``--dist loadgroup``): a module's tests stay together on one
-    worker (its module fixtures, a built spec or a running stack, are set up once), unless the module is marked
-    ``spread``: its tests are independent and long (property tests per spec, each building and running its own
-    children), so they go one by one to whichever worker is free and a long module does not leave one core alone."""
-    for item in items:
-        if item.get_closest_marker("spread") is None and item.get_closest_marker("xdist_group") is None:
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::", 1)[0]))
+# The modules whose tests are independent and long (property tests per spec, each building and running its own
+# children; scenarios that each fly a stack): xdist gives them out test by test (SpreadLongModules).
+SPREAD_MODULES = frozenset({
+    "tests/codegen/test_codec.py",
+    "tests/codegen/test_codec_v0.py",
+    "tests/codegen/test_converters.py",
+    "tests/codegen/test_converters_v0.py",
+    "tests/codegen/test_element_mappings.py",
+    "tests/system/test_nodes_scenarios.py",
+})
+
+
+def scope_of(nodeid: str) -> str:
+    """The unit of distribution a test belongs to: its module, or itself in a :data:`SPREAD_MODULES` module.
+
+    >>> scope_of("tests/codegen/test_codec.py::test_x[sam]"), scope_of("tests/test_layers.py::test_y")
+    ('tests/codegen/test_codec.py::test_x[sam]', 'tests/test_layers.py')
+    """
+    module = nodeid.split("::", 1)[0]
+    return nodeid if module in SPREAD_MODULES else module
+
+
+def spread_scheduler(config: pytest.Config, log: Any) -> Any:
+    """xdist's distribution by file (a module's tests on one worker: its module fixtures, a built spec or a running
+    stack, are set up once), except for :data:`SPREAD_MODULES`: their tests go one by one to whichever worker is
+    free, so a long module does not leave one core alone at the end. (Not ``--dist loadgroup`` with marks: with
+    pytest 9 xdist 3.8 can no longer add the group to the test ids it schedules by.)"""
+    from xdist.scheduler import LoadFileScheduling
+
+    class SpreadLongModules(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return scope_of(nodeid)
+
+    return SpreadLongModules(config, log)
 
 
 def system_first(items: list[pytest.Item]) -> None:

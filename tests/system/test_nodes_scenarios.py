@@ -24,8 +24,7 @@ from helpers.stack import Stack, stack, wait_for
 
 from sam_runtime.nav.controller import ControllerConfig
 
-# Each scenario flies a stack of its own: spread over the workers (tests/helpers/tiers.py).
-pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.spread]
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 S = 1e9  # ns per second
 # The nodes' rates (sam_runtime.nodes.controller.CONTROL_HZ, .performance_monitor.EVALUATE_HZ; those modules import
