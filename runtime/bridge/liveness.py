@@ -9,8 +9,10 @@ nominal periods) counted from the latest of: the last message, the moment the de
 the moment the bridge started listening. A device that is not alive is not flagged here: its own status is
 ERROR already. Nor is one that went quiet altogether (powered off): its heartbeat and its data stop together, and
 the bridge learns that the heartbeat is gone only at the offline timeout (3 s), which may come after the grace
-counted from the last message; so the silence counts only when a heartbeat came later than one nominal period
-after the last message (a live device's heartbeat comes at least once a second, well within the grace).
+counted from the last message; so the silence counts only when a heartbeat came later than one heartbeat period
+(1 s), or one nominal period where that is longer, after the last message: a live device's heartbeats go on once
+a second, so one comes that late well within the grace, while a powered-off device's last heartbeat follows its
+last message by less (by more than one data period when its last data ticks came late on a loaded machine).
 ROS -> UAVCAN mappings are not watched: commands come when ROS nodes send them.
 
 Pure logic on monotonic times passed in (no clock, no I/O), so the rules are tested without waiting.
@@ -25,6 +27,7 @@ from dataclasses import dataclass
 __all__ = ["GRACE_PERIODS", "MIN_GRACE_S", "LivenessCheck", "Silence", "grace_s", "silence_of"]
 
 MIN_GRACE_S = 3.0  # uavcan.node.Heartbeat.OFFLINE_TIMEOUT: no quicker than a lost heartbeat is noticed
+HEARTBEAT_PERIOD_S = 1.0  # uavcan.node.Heartbeat.MAX_PUBLICATION_PERIOD (DroneCAN's NodeStatus: the same)
 GRACE_PERIODS = 5.0
 
 
@@ -84,7 +87,7 @@ def silence_of(now: float, *, rate_hz: float, alive_since: float | None, last_me
     True
     >>> silence_of(10.0, rate_hz=10.0, alive_since=2.0, last_message=6.9, listening_since=0.0, last_heartbeat=9.5)
     (3.0999999999999996, 3.0)
-    >>> silence_of(10.0, rate_hz=10.0, alive_since=2.0, last_message=6.9, listening_since=0.0, last_heartbeat=6.95)
+    >>> silence_of(10.0, rate_hz=10.0, alive_since=2.0, last_message=6.9, listening_since=0.0, last_heartbeat=7.6)
     """
     if alive_since is None:
         return None
@@ -93,7 +96,8 @@ def silence_of(now: float, *, rate_hz: float, alive_since: float | None, last_me
     silent = now - since
     if silent <= grace:
         return None
-    if last_heartbeat is not None and last_message is not None and last_heartbeat <= last_message + 1.0 / rate_hz:
+    if last_heartbeat is not None and last_message is not None and \
+            last_heartbeat <= last_message + max(HEARTBEAT_PERIOD_S, 1.0 / rate_hz):
         return None  # no heartbeat since its data stopped: it went quiet altogether (see the module docstring)
     return silent, grace
 

@@ -634,7 +634,9 @@ async def can_commands(bridge: Any, sim: Any, probe: Probe) -> dict[str, Any]:
     sent = [
         ("/thruster_rpms", {"thruster_1_rpm": 200_000, "thruster_2_rpm": -200_000}),
         ("/thruster_angles", {"thruster_vertical_radians": math.inf, "thruster_horizontal_radians": -math.inf}),
-        ("/ballast_angles", {"weight_1_offset_radians": math.nan, "weight_2_offset_radians": 1e6}),
+        # NaN is no setpoint: this one is dropped (not_a_number, issue 29); the next one's 1e6 saturates
+        ("/ballast_angles", {"weight_1_offset_radians": math.nan, "weight_2_offset_radians": 0.0}),
+        ("/ballast_angles", {"weight_1_offset_radians": 0.5, "weight_2_offset_radians": 1e6}),
         ("/longitudinal_weight_position", {"percent": math.nan}),
         ("/buoyancy_piston_position", {"percent": 150.0}),
     ]
@@ -794,8 +796,13 @@ async def can_down(bridge: Any, sim: Any, probe: Probe, plan: FaultPlan) -> dict
         info["open_attempts_after_up"] = len(after_up)
         info["first_attempt_after_up_s"] = round(after_up[0] - t_up, 3) if after_up else None
         pub0 = bridge.stats()["mappings"]["imu"]["published"]
+        every0 = {m: x["published"] for m, x in bridge.stats()["mappings"].items() if m in IN_SUBJECTS}
         await wait_for(lambda: bridge.stats()["mappings"]["imu"]["published"] > pub0 + 10, 10, "IMU data again")
         info["data_again_after_up_s"] = round(time.monotonic() - t_up, 3)
+        # Every stream once more, the 1 Hz ones too: what the bridge missed while down is counted (from the transfer
+        # ids) only when a source's next transfer arrives, which on a loaded machine may be after a short window.
+        await wait_for(lambda: all(bridge.stats()["mappings"][m]["published"] > n for m, n in every0.items()), 15,
+                       "every sensor's data again")
         await try_wait_for(lambda: probe.level(BRIDGE) == 0, 30, "the bridge OK on /diagnostics")
         info["diag_bridge_level_after"] = probe.level(BRIDGE)
         for i in range(5):  # commands after it

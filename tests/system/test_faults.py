@@ -290,15 +290,16 @@ def test_out_of_range_commands_through_the_running_bridge(can_run: dict[str, Any
                                                "thrust_vector.horizontal_radians": 1}
     assert last["buoyancy_piston"] == {"percent": 100.0} and b["buoyancy_piston"]["saturated"] == {
         "buoyancy_piston.percent": 1}
-    # NaN percent: rejected (a limited field), counted; the actuator never saw it, the next valid value goes.
+    # A NaN command is no setpoint: dropped and counted as not_a_number (a limited field or not); the actuator
+    # never saw it, the next valid value goes.
     assert last["longitudinal_weight"] is None and ph["last_longitudinal_weight"] == {"percent": 42.0}
-    assert b["longitudinal_weight"]["dropped"] == {"rejected": 1}
+    assert b["longitudinal_weight"]["dropped"] == {"not_a_number": 1}
     assert b["longitudinal_weight"]["rejected_fields"] == {"longitudinal_weight.percent": 1}
-    # float16 without limits: NaN passes as NaN (float16 holds it), 1e6 saturates to 65504.
-    assert math.isnan(float(last["ballast"]["weight_1_offset_radians"]))
-    assert last["ballast"]["weight_2_offset_radians"] == F16_MAX
+    assert b["ballast"]["dropped"] == {"not_a_number": 1}
+    # float16 without limits: 1e6 saturates to 65504.
+    assert last["ballast"] == {"weight_1_offset_radians": 0.5, "weight_2_offset_radians": F16_MAX}
     lw = ph["diagnostics"]["longitudinal_weight"]["values"]
-    assert lw["dropped.rejected"] == "1" and lw["rejected.longitudinal_weight.percent"] == "1"
+    assert lw["dropped.not_a_number"] == "1" and lw["rejected.longitudinal_weight.percent"] == "1"
     t1 = ph["diagnostics"]["thruster_1_rpm"]["values"]
     assert t1["saturated"] == "1" and t1["saturated.thruster_1_rpm.rpm"] == "1"
 

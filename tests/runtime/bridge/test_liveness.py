@@ -70,23 +70,29 @@ def test_a_device_that_went_quiet_altogether_is_never_flagged_silent() -> None:
     the grace after the last message and the offline timeout after the last heartbeat the device still reads alive,
     but it sent no heartbeat after its data stopped, so its mapping is not silent. A device whose data stops while
     its heartbeats go on is flagged once the grace has passed."""
-    from sam_runtime.bridge.health import OFFLINE_TIMEOUT_S
-
-    def alive(last_hb: float, now: float) -> float | None:
-        return 0.0 if now - last_hb < OFFLINE_TIMEOUT_S else None
-
-    last_msg, last_hb = 15.303, 15.452  # (a powered-off pump in the glider system test)
-    for k in range(400):
-        now = last_msg + k * 0.01
-        mon = LivenessCheck([("pump_status", 5.0, [21])], {21: "pump"})
-        changes = mon.update(now, alive_since=lambda n, now=now: alive(last_hb, now),
-                             last_message=lambda m, n: last_msg, listening_since=0.0,
-                             last_heartbeat=lambda n: last_hb)
-        assert changes == [], now
+    # (a powered-off pump in the glider system test; and one whose last data ticks came late on a loaded machine)
+    for last_msg, last_hb in ((15.303, 15.452), (15.303, 16.1)):
+        _never_flagged(last_msg, last_hb)
     # the data stopped at 15.303, the heartbeats go on once a second: flagged as soon as the grace has passed
+    last_msg = 15.303
     for now, flagged in ((18.2, False), (18.31, True)):
         hb = 15.452 + int(now - 15.452)  # the last of the 1 Hz heartbeats by now
         mon = LivenessCheck([("pump_status", 5.0, [21])], {21: "pump"})
         changes = mon.update(now, alive_since=lambda n: 0.0, last_message=lambda m, n: last_msg,
                              listening_since=0.0, last_heartbeat=lambda n, hb=hb: hb)
         assert bool(changes) is flagged, now
+
+
+def _never_flagged(last_msg: float, last_hb: float) -> None:
+    from sam_runtime.bridge.health import OFFLINE_TIMEOUT_S
+
+    def alive(last_hb: float, now: float) -> float | None:
+        return 0.0 if now - last_hb < OFFLINE_TIMEOUT_S else None
+
+    for k in range(400):
+        now = last_msg + k * 0.01
+        mon = LivenessCheck([("pump_status", 5.0, [21])], {21: "pump"})
+        changes = mon.update(now, alive_since=lambda n, now=now: alive(last_hb, now),
+                             last_message=lambda m, n: last_msg, listening_since=0.0,
+                             last_heartbeat=lambda n: last_hb)
+        assert changes == [], (last_msg, last_hb, now)
