@@ -60,7 +60,9 @@ def tests(session: nox.Session) -> None:
     _static_checks(session)
     session.run("sam-codegen", "build", "--check")
     _ros_install(session)
-    session.run("pytest", *(session.posargs or ["-q", *PARALLEL]), env=LOOPBACK)
+    # The per-test times land in .nox/tests/junit.xml: `python tests/helpers/durations.py` tables them per folder.
+    report = f"--junitxml={session.virtualenv.location}/junit.xml"
+    session.run("pytest", *(session.posargs or ["-q", *PARALLEL, report]), env=LOOPBACK)
 
 
 @nox.session(python="3.11")

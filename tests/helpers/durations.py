@@ -1,6 +1,7 @@
 """Wall time per test folder from pytest's ``--durations=0`` output, as a markdown table (not part of CI).
 
     python tests/helpers/durations.py before.log [after.log] [--top N]
+    python tests/helpers/durations.py before.log .nox/tests/junit.xml
 
 With two logs the table has a column for each. The times are pytest's per-phase durations (setup + call +
 teardown) summed: in a parallel run that is the work done, not the wall time (which pytest prints at the end).
@@ -23,6 +24,28 @@ from collections.abc import Iterable
 from pathlib import Path
 
 LINE = re.compile(r"^\s*(\d+(?:\.\d+)?)s\s+(setup|call|teardown)\s+(\S.*?)\s*$")
+
+
+def parse_junit(path: Path) -> dict[str, float]:
+    """Seconds per test id from a JUnit XML report (pytest's ``--junitxml``, what ``nox -s tests`` writes to
+    .nox/tests/junit.xml); the id's file part comes from the test case's dotted class name.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = Path(d) / "j.xml"
+    ...     _ = p.write_text('<testsuites><testsuite><testcase classname="tests.system.test_a" name="test_x[1]" '
+    ...                      'time="13.0"/></testsuite></testsuites>')
+    ...     parse_junit(p)
+    {'tests/system/test_a.py::test_x[1]': 13.0}
+    """
+    import xml.etree.ElementTree as ET
+
+    out: dict[str, float] = {}
+    for case in ET.parse(path).getroot().iter("testcase"):
+        module = (case.get("classname") or "").replace(".", "/")
+        test_id = f"{module}.py::{case.get('name')}"
+        out[test_id] = out.get(test_id, 0.0) + float(case.get("time") or 0.0)
+    return out
 
 
 def parse(lines: Iterable[str]) -> dict[str, float]:
@@ -70,10 +93,12 @@ def slowest(rows: dict[str, float], n: int) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("logs", nargs="+", type=Path, help="pytest outputs with --durations=0 (before, after)")
+    parser.add_argument("logs", nargs="+", type=Path,
+                        help="pytest outputs with --durations=0, or JUnit XML reports (before, after)")
     parser.add_argument("--top", type=int, default=0, help="also list the N slowest tests of the last log")
     args = parser.parse_args(argv)
-    logs = [(p.stem, parse(p.read_text(errors="replace").splitlines())) for p in args.logs]
+    logs = [(p.stem, parse_junit(p) if p.suffix == ".xml" else parse(p.read_text(errors="replace").splitlines()))
+            for p in args.logs]
     print(table(logs))
     if args.top:
         print()
