@@ -48,8 +48,10 @@ def _ros_install(session: nox.Session) -> None:
 
 # pytest-xdist: one worker per core, each in a private network (tests/helpers/isolation.py). A module's tests stay on
 # one worker (by file): their module fixtures (a built spec, a running stack) are set up once; the long modules of
-# independent tests go test by test (tests/helpers/tiers.py, SPREAD_MODULES).
-PARALLEL = ["-n", "auto", "--dist", "loadfile"]
+# independent tests go test by test (tests/helpers/tiers.py, SPREAD_MODULES). In the order of the collection (system
+# tests first: tiers.system_first), not xdist's default of the scopes with most tests first, which left the long
+# single-test scopes (a colcon build, each spread property test) for the end.
+PARALLEL = ["-n", "auto", "--dist", "loadfile", "--no-loadscope-reorder"]
 
 
 @nox.session(python="3.11")

@@ -37,6 +37,15 @@ def _f(v: float | None, fmt: str = "6.2f", unit: str = "") -> str:
     return "-" if v is None or not math.isfinite(v) else f"{v:{fmt}}{unit}"
 
 
+def _number(text: str | None) -> float | None:
+    """A /diagnostics value as a number (None: absent or not one), so it is shown in the view's own format: the
+    dead-reckoning node writes its speed with repr() (3.165e-78 m/s at rest)."""
+    try:
+        return None if text is None else float(text)
+    except ValueError:
+        return None
+
+
 class VehicleView:
     """Subscribes on ``node`` (an rclpy Node of the main job); ``lines()`` renders the view."""
 
@@ -157,7 +166,7 @@ class VehicleView:
             f"{_f(num(true, 'altitude'))} m")
         row("heading", f"{_f(num(est, 'yaw', scale=180 / math.pi), '7.1f')} deg (ENU yaw, from east)",
             f"{_f(num(true, 'yaw', scale=180 / math.pi), '7.1f')} deg")
-        row("speed", f"{dr_speed or '-'} m/s  (dead reckoning)", f"{_f(num(true, 'speed'))} m/s")
+        row("speed", f"{_f(_number(dr_speed))} m/s  (dead reckoning)", f"{_f(num(true, 'speed'))} m/s")
         if tf_note:
             out.append(f"  {'':14} {tf_note}")
         out.append("")
