@@ -20,7 +20,7 @@ from types import ModuleType
 from typing import ClassVar
 
 import pytest
-from helpers import isolation, tiers
+from helpers import durations, isolation, tiers
 
 collect_ignore = [f"runtime/nodes/{name}.py" for name in
                   ("controller", "dead_reckoning", "mission", "motion_planner", "performance_monitor", "slam")]
@@ -49,6 +49,7 @@ sys.meta_path.insert(0, _SourceFolderAlias())
 # enter a private network. pyproject's `pythonpath = ["tests"]` is applied before this file is imported.
 
 _GUARD = pytest.StashKey["tiers.ChildProcessGuard"]()
+_CPU = pytest.StashKey[float]()
 _WORKER_ISOLATION: list[dict[str, object]] = []  # what each xdist worker reported (the controller's summary)
 _SERIAL_FALLBACK: list[str] = []  # why the run was made serial, if it was
 
@@ -127,6 +128,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> object:
+    item.stash[_CPU] = durations.cpu_seconds()
     if not item.config.getoption("--unit-tier"):
         yield
         return
@@ -137,6 +139,10 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> object:
+    if call.when == "teardown" and _CPU in item.stash:
+        # Before the report is made: junit writes the teardown report's properties (.nox/tests/junit.xml), so the
+        # work a test cost (this process and the children it reaped) can be tabled beside its wall time.
+        item.user_properties.append((durations.CPU_PROPERTY, round(durations.cpu_seconds() - item.stash[_CPU], 3)))
     outcome = yield
     guard = item.stash.get(_GUARD, None)
     if guard is not None:

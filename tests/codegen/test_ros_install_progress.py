@@ -46,3 +46,21 @@ def test_a_failure_names_its_package(monkeypatch: pytest.MonkeyPatch, tmp_path: 
     with pytest.raises(ros_install.RosBuildError) as info:
         ros_install.build_ros_packages([tmp_path / "sam_msgs"], tmp_path / "b", tmp_path / "i", log=lines.append)
     assert info.value.package == "sam_msgs" and lines == ["[1/1] sam_msgs: configure (0.0 s)"]
+
+
+def test_a_new_build_folder_uses_ninja_where_it_is_found(tmp_path: Path) -> None:
+    """Ninja for a new build folder when it is on the build's PATH; nothing for a folder CMake configured (it keeps
+    its generator and refuses another) or when the user chose one; Makefiles (no -G) without Ninja."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    ninja = bin_dir / "ninja"
+    ninja.write_text("#!/bin/sh\n")
+    ninja.chmod(0o755)
+    env = {"PATH": str(bin_dir)}
+    assert ros_install.cmake_generator(tmp_path / "new", env) == ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"]
+    assert ros_install.cmake_generator(tmp_path / "new", {**env, "CMAKE_GENERATOR": "Unix Makefiles"}) == []
+    assert ros_install.cmake_generator(tmp_path / "new", {"PATH": str(tmp_path / "empty")}) == []
+    configured = tmp_path / "old"
+    configured.mkdir()
+    (configured / "CMakeCache.txt").write_text("CMAKE_GENERATOR:INTERNAL=Unix Makefiles\n")
+    assert ros_install.cmake_generator(configured, env) == []

@@ -2,6 +2,7 @@
 
     python tests/helpers/durations.py before.log [after.log] [--top N]
     python tests/helpers/durations.py before.log .nox/tests/junit.xml
+    python tests/helpers/durations.py --cpu .nox/tests/junit.xml --top 30   # CPU seconds instead of wall
 
 With two logs the table has a column for each. The times are pytest's per-phase durations (setup + call +
 teardown) summed: in a parallel run that is the work done, not the wall time (which pytest prints at the end).
@@ -19,24 +20,36 @@ from __future__ import annotations
 
 import argparse
 import re
+import resource
 import sys
 from collections.abc import Iterable
 from pathlib import Path
 
+# The junit property the root conftest.py gives every test: CPU seconds of the worker and of the children it reaped
+# during the test (setup to teardown).
+CPU_PROPERTY = "cpu_s"
 LINE = re.compile(r"^\s*(\d+(?:\.\d+)?)s\s+(setup|call|teardown)\s+(\S.*?)\s*$")
 
 
-def parse_junit(path: Path) -> dict[str, float]:
+def cpu_seconds() -> float:
+    """User + system CPU seconds of this process and of its reaped children so far."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def parse_junit(path: Path, what: str = "time") -> dict[str, float]:
     """Seconds per test id from a JUnit XML report (pytest's ``--junitxml``, what ``nox -s tests`` writes to
-    .nox/tests/junit.xml); the id's file part comes from the test case's dotted class name.
+    .nox/tests/junit.xml); the id's file part comes from the test case's dotted class name. `what` is "time"
+    (wall) or :data:`CPU_PROPERTY` (CPU, the property the root conftest.py records).
 
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as d:
     ...     p = Path(d) / "j.xml"
     ...     _ = p.write_text('<testsuites><testsuite><testcase classname="tests.system.test_a" name="test_x[1]" '
-    ...                      'time="13.0"/></testsuite></testsuites>')
-    ...     parse_junit(p)
-    {'tests/system/test_a.py::test_x[1]': 13.0}
+    ...                      'time="13.0"><properties><property name="cpu_s" value="4.5"/></properties>'
+    ...                      '</testcase></testsuite></testsuites>')
+    ...     parse_junit(p), parse_junit(p, CPU_PROPERTY)
+    ({'tests/system/test_a.py::test_x[1]': 13.0}, {'tests/system/test_a.py::test_x[1]': 4.5})
     """
     import xml.etree.ElementTree as ET
 
@@ -44,7 +57,11 @@ def parse_junit(path: Path) -> dict[str, float]:
     for case in ET.parse(path).getroot().iter("testcase"):
         module = (case.get("classname") or "").replace(".", "/")
         test_id = f"{module}.py::{case.get('name')}"
-        out[test_id] = out.get(test_id, 0.0) + float(case.get("time") or 0.0)
+        if what == "time":
+            seconds = float(case.get("time") or 0.0)
+        else:
+            seconds = sum(float(p.get("value") or 0.0) for p in case.iter("property") if p.get("name") == what)
+        out[test_id] = out.get(test_id, 0.0) + seconds
     return out
 
 
@@ -96,8 +113,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("logs", nargs="+", type=Path,
                         help="pytest outputs with --durations=0, or JUnit XML reports (before, after)")
     parser.add_argument("--top", type=int, default=0, help="also list the N slowest tests of the last log")
+    parser.add_argument("--cpu", action="store_true",
+                        help="CPU seconds (JUnit reports of this suite) instead of wall seconds")
     args = parser.parse_args(argv)
-    logs = [(p.stem, parse_junit(p) if p.suffix == ".xml" else parse(p.read_text(errors="replace").splitlines()))
+    what = CPU_PROPERTY if args.cpu else "time"
+    logs = [(p.stem, parse_junit(p, what) if p.suffix == ".xml" else parse(p.read_text(errors="replace").splitlines()))
             for p in args.logs]
     print(table(logs))
     if args.top:

@@ -140,7 +140,7 @@ def cmake_build(package_dir: Path, build_dir: Path, prefix: Path, chain: Sequenc
     """Configure, build and install one package on the venv's ROS and the prefixes of `chain` (its built
     dependencies), as ``sam_codegen.project.ros_install.build_ros_package`` does but with the tests' build type;
     raises its RosBuildError with CMake's output."""
-    from sam_codegen.project.ros_install import RosBuildError
+    from sam_codegen.project.ros_install import RosBuildError, cmake_generator
 
     cmake = shutil.which("cmake")
     if cmake is None:
@@ -153,7 +153,8 @@ def cmake_build(package_dir: Path, build_dir: Path, prefix: Path, chain: Sequenc
     env.pop("COLCON_PREFIX_PATH", None)
     build_dir.mkdir(parents=True, exist_ok=True)
     steps = {
-        "configure": [cmake, "-S", str(package_dir.absolute()), "-B", str(build_dir),
+        "configure": [cmake, *cmake_generator(build_dir, env), "-S", str(package_dir.absolute()),
+                      "-B", str(build_dir),
                       f"-DCMAKE_PREFIX_PATH={';'.join(search)}", f"-DCMAKE_INSTALL_PREFIX={prefix}",
                       f"-DPython3_EXECUTABLE={sys.executable}", f"-DCMAKE_BUILD_TYPE={BUILD_TYPE}",
                       "-DBUILD_TESTING=OFF"],
