@@ -11,6 +11,8 @@ from sam_codegen.frontend.traffic import TRAFFIC_KEYS, parse_traffic
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
 from sam_codegen.model.expr import ExprSource, PNum, UavcanExpr
+from sam_codegen.model.protocols.registry import DEFAULT_PROTOCOL
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.spec import (
     DIRECTIONS,
     PROTOCOLS,
@@ -139,8 +141,9 @@ _DRONECAN_MAPPING_KEYS = (
 
 
 def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol: str = "cyphal") -> Mapping | None:
-    dronecan = protocol == "dronecan"
-    what = f"DroneCAN mapping {name!r}" if dronecan else f"mapping {name!r}"
+    entry = protocol_of(protocol)
+    dronecan = entry.v0
+    what = f"{entry.mapping_noun} {name!r}"
     r = Reader(node, what, diag, _DRONECAN_MAPPING_KEYS if dronecan else _MAPPING_KEYS)
     if not r.ok:
         return None
@@ -271,7 +274,7 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     what = f"device {key!r}"
     r = Reader(node, what, diag, _DEVICE_KEYS)
     node_id = r.get("node_id", int)
-    protocol = r.get("protocol", str, "cyphal")
+    protocol = r.get("protocol", str, DEFAULT_PROTOCOL.name)
     protocol_pos = {protocol: pos}
 
     def device(ports: dict[str, list[Port]], v0_ports: dict[str, list[V0Port]], protocols: tuple[str, ...]) -> Device:
@@ -296,7 +299,7 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     v0: dict[str, list[V0Port]] = {}
     for side, ports in sides:
         for key_ in ("publishes", "subscribes"):
-            if side == "cyphal":
+            if not protocol_of(side).v0:
                 cyphal[key_] = _ports(ports.entries.get(key_), what, diag)
             else:
                 v0[key_] = _v0_ports(ports.entries.get(key_), what, diag)

@@ -13,6 +13,7 @@ from typing import Final, Literal
 
 from sam_codegen.model.diagnostics import NOWHERE, Pos
 from sam_codegen.model.expr import ExprSource, UavcanExpr
+from sam_codegen.model.protocols.registry import PROTOCOL_NAMES
 from sam_codegen.model.types import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
@@ -319,7 +320,7 @@ class V0Port:
     pos: Pos = NOWHERE
 
 
-PROTOCOLS = ("cyphal", "dronecan")
+PROTOCOLS = PROTOCOL_NAMES  # (sam_codegen.model.protocols.registry: one entry per protocol)
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,8 @@ from sam_codegen.catalogs.dronecan import (
     V0Catalog,
 )
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.protocols.description import ProtocolDescription
+from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import (
     PROTOCOLS,
     UAVCAN_TO_ROS,
@@ -54,6 +56,11 @@ class ResolvedLayout:
     def devices(self, protocol: str) -> list[str]:
         return [d for d, p in self.protocols.items() if p == protocol]
 
+    def mappings_of(self, protocol: ProtocolDescription) -> list[str]:
+        """The layout's mappings on `protocol`."""
+        mappings: list[str] = getattr(self, protocol.layout_mappings_field)
+        return mappings
+
 
 def _v0_ports(device: Device) -> list[tuple[V0Port, bool]]:
     return [(p, True) for p in device.dronecan_publishes] + [(p, False) for p in device.dronecan_subscribes]
@@ -72,7 +79,7 @@ class DronecanValidator:
 
     def uses_dronecan(self) -> bool:
         s = self.spec
-        return bool(s.dronecan_types or any("dronecan" in d.protocols for d in s.devices.values())
+        return bool(s.dronecan_types or any(DRONECAN.name in d.protocols for d in s.devices.values())
                     or (s.bridge is not None and (s.bridge.dronecan_mappings or s.bridge.service_mappings)))
 
     def message_type(self, name: str, pos: Pos, what: str) -> V0Struct | None:
@@ -211,7 +218,7 @@ class DronecanValidator:
             self.error(s.bridge.pos, f"bridge node id {s.bridge.node_id} is out of range for DroneCAN",
                        f"{V0_NODE_IDS.start}..{V0_NODE_IDS.stop - 1}")
         for device in s.devices.values():
-            if "dronecan" not in device.protocols:
+            if DRONECAN.name not in device.protocols:
                 continue
             what = f"device {device.name}"
             if device.node_id >= 0 and device.node_id not in V0_NODE_IDS:
@@ -248,7 +255,7 @@ class DronecanValidator:
         role = "source" if publishing else "destination"
         users: dict[int, V0Port] = {}
         for device in s.devices.values():
-            if "dronecan" in device.protocols:
+            if DRONECAN.name in device.protocols:
                 for port, pub in _v0_ports(device):
                     if pub == publishing and port.type == mapping.data_type:
                         users.setdefault(device.node_id, port)
