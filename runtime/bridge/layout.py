@@ -17,13 +17,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
+from sam_runtime.protocols import DEFAULT_PROTOCOL, PROTOCOL_NAMES, REGISTERED, runtime_protocol
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 __all__ = ["PROTOCOLS", "Selection", "destinations_of", "port_id_of", "select"]
 
-PROTOCOLS = ("cyphal", "dronecan")
+PROTOCOLS = PROTOCOL_NAMES  # the registered protocols (sam_runtime.protocols), in the spec's order
 
 
 @dataclass(frozen=True)
@@ -58,13 +59,8 @@ def protocols_in_use(tables: TablesModule, layout: str) -> list[str]:
     """The protocols whose mappings the layout runs, in PROTOCOLS order."""
     lay = _layouts(tables).get(layout)
     if lay is None:
-        return ["cyphal"] if layout == "default" else []
-    used = []
-    if lay.cyphal_mappings:
-        used.append("cyphal")
-    if lay.dronecan_mappings:
-        used.append("dronecan")
-    return used
+        return [DEFAULT_PROTOCOL.name] if layout == "default" else []
+    return [p.name for p in REGISTERED if p.layout_mappings(lay)]
 
 
 def select(tables: TablesModule, layout: str | None = None, protocol: str | None = None) -> Selection:
@@ -83,17 +79,16 @@ def select(tables: TablesModule, layout: str | None = None, protocol: str | None
             raise BridgeConfigError(
                 f"layout {name!r} has devices on {' and '.join(used)}: run one bridge per protocol "
                 f"(--protocol {' / --protocol '.join(used)})")
-        protocol = used[0] if used else "cyphal"
+        protocol = used[0] if used else DEFAULT_PROTOCOL.name
     elif used and protocol not in used:
         raise BridgeConfigError(f"layout {name!r} has no mapping on {protocol} (it uses {', '.join(used)})")
-    if lay is None:  # generated tables without layouts: every mapping on Cyphal
-        infos: Sequence[Any] = tables.DEVICES
-        mappings: tuple[Any, ...] = tuple(tables.MAPPINGS)
+    entry = runtime_protocol(protocol)
+    if lay is None:  # generated tables without layouts: every mapping on the default protocol (Cyphal)
+        infos: Sequence[Any] = entry.devices(tables)
+        mappings: tuple[Any, ...] = entry.mappings(tables)
     else:
         names = set(lay.devices(protocol))
-        infos = [d for d in (tables.DEVICES if protocol == "cyphal" else tables.DRONECAN_DEVICES)
-                 if d.name in names]
-        wanted = set(lay.cyphal_mappings if protocol == "cyphal" else lay.dronecan_mappings)
-        mappings = tuple(m for m in (tables.MAPPINGS if protocol == "cyphal" else tables.DRONECAN_MAPPINGS)
-                         if m.name in wanted)
+        infos = [d for d in entry.devices(tables) if d.name in names]
+        wanted = set(entry.layout_mappings(lay))
+        mappings = tuple(m for m in entry.mappings(tables) if m.name in wanted)
     return Selection(name, protocol, mappings, {d.node_id: d.name for d in infos}, tuple(infos), len(used) > 1)

@@ -13,6 +13,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sam_codegen.contracts import table_types
 from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import UAVCAN_TO_ROS, Mapping, Port, Qos, V0Struct
@@ -20,7 +21,6 @@ from sam_codegen.render.filters import py_number, py_str
 from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
 from sam_codegen.targets import dsdl_v0
 from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
-from sam_codegen.targets.python import table_types
 from sam_codegen.targets.python.convert_v0 import used_types
 from sam_codegen.targets.python.names import py_class_name, py_module
 from sam_codegen.targets.ros import build_order
