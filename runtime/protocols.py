@@ -22,7 +22,7 @@ from sam_codegen.model.protocols.description import ProtocolDescription
 from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.protocols.registry import UnknownProtocolError
 
-__all__ = ["DEFAULT_PROTOCOL", "PROTOCOL_NAMES", "REGISTERED", "RuntimeProtocol", "runtime_protocol"]
+__all__ = ["REGISTERED", "RuntimeProtocol", "default_protocol", "protocol_names", "registered", "runtime_protocol"]
 
 
 @dataclass(frozen=True)
@@ -84,8 +84,20 @@ REGISTERED: tuple[RuntimeProtocol, ...] = (
     RuntimeProtocol(DRONECAN, "sam_runtime.bridge.backends.dronecan_part:PART",
                     "sam_runtime.sim.dronecan:DroneCanDevices", needs="the dronecan package (pip extra 'runtime')"),
 )
-PROTOCOL_NAMES: tuple[str, ...] = tuple(p.name for p in REGISTERED)
-DEFAULT_PROTOCOL = REGISTERED[0]  # a spec's devices without `protocol`; tables without layouts
+
+
+# Read at every call, never copied at import: what asks the registry sees a protocol registered later (a test's).
+def registered() -> tuple[RuntimeProtocol, ...]:
+    return REGISTERED
+
+
+def protocol_names() -> tuple[str, ...]:
+    return tuple(p.name for p in REGISTERED)
+
+
+def default_protocol() -> RuntimeProtocol:
+    """The spec's default (a device without `protocol`; tables without layouts run every device on it)."""
+    return REGISTERED[0]
 
 
 def runtime_protocol(name: str) -> RuntimeProtocol:
@@ -93,4 +105,4 @@ def runtime_protocol(name: str) -> RuntimeProtocol:
     for p in REGISTERED:
         if p.name == name:
             return p
-    raise UnknownProtocolError(f"unknown protocol {name!r}: expected one of {', '.join(PROTOCOL_NAMES)}")
+    raise UnknownProtocolError(f"unknown protocol {name!r}: expected one of {', '.join(protocol_names())}")

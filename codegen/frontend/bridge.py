@@ -11,11 +11,10 @@ from sam_codegen.frontend.traffic import TRAFFIC_KEYS, parse_traffic
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
 from sam_codegen.model.expr import ExprSource, PNum, UavcanExpr
-from sam_codegen.model.protocols.registry import DEFAULT_PROTOCOL
+from sam_codegen.model.protocols.registry import default_protocol, protocol_names
 from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.spec import (
     DIRECTIONS,
-    PROTOCOLS,
     ROS_TO_UAVCAN,
     UAVCAN_TO_ROS,
     Device,
@@ -265,16 +264,17 @@ def _v0_ports(node: YNode | None, what: str, diag: Diagnostics) -> list[V0Port]:
     return ports
 
 
-_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes", *PROTOCOLS)
+_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes")  # and each protocol's name
 
 
 def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     """A device: its ports in its `protocol` (cyphal by default), and under the other protocol's name the ports of
     its firmware for that protocol."""
     what = f"device {key!r}"
-    r = Reader(node, what, diag, _DEVICE_KEYS)
+    known = protocol_names()
+    r = Reader(node, what, diag, (*_DEVICE_KEYS, *known))
     node_id = r.get("node_id", int)
-    protocol = r.get("protocol", str, DEFAULT_PROTOCOL.name)
+    protocol = r.get("protocol", str, default_protocol().name)
     protocol_pos = {protocol: pos}
 
     def device(ports: dict[str, list[Port]], v0_ports: dict[str, list[V0Port]], protocols: tuple[str, ...]) -> Device:
@@ -282,14 +282,14 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
                       ports.get("publishes", []), ports.get("subscribes", []), pos, protocol, protocols,
                       v0_ports.get("publishes", []), v0_ports.get("subscribes", []), protocol_pos)
 
-    if protocol not in PROTOCOLS:
-        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+    if protocol not in known:
+        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(known))
         return device({}, {}, ())  # its ports would be read in the wrong protocol
     sides = [(protocol, r.map)]
     if r.node(protocol) is not None:
         diag.error(r.key_pos(protocol), f"{what} speaks {protocol}: its {protocol} ports are its `publishes` and "
-                   "`subscribes`", f"a section for the other protocol ({', '.join(set(PROTOCOLS) - {protocol})})")
-    for other in PROTOCOLS:
+                   "`subscribes`", f"a section for the other protocol ({', '.join(set(known) - {protocol})})")
+    for other in known:
         section = r.node(other)
         if other != protocol and section is not None:
             sub = Reader(section, f"the {other} ports of {what}", diag, ("publishes", "subscribes"))
@@ -310,16 +310,17 @@ def parse_layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
     what = f"layout {key!r}"
     r = Reader(node, what, diag, ("description", "protocol", "devices", "bus"))
     layout_protocol = r.get("protocol", str, None)
-    if layout_protocol is not None and layout_protocol not in PROTOCOLS:
-        diag.error(r.key_pos("protocol"), f"protocol {layout_protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+    known = protocol_names()
+    if layout_protocol is not None and layout_protocol not in known:
+        diag.error(r.key_pos("protocol"), f"protocol {layout_protocol!r} of {what} is unknown", " or ".join(known))
         layout_protocol = None
     devices: dict[str, str] = {}
     device_pos: dict[str, Pos] = {}
     for device, key_pos, value in map_items(r.node("devices"), f"the devices of {what}", diag):
         protocol = scalar(value, str, f"the protocol of device {device!r} in {what}", diag)
-        if protocol is not None and protocol not in PROTOCOLS:
+        if protocol is not None and protocol not in known:
             diag.error(value.pos, f"protocol {protocol!r} of device {device!r} in {what} is unknown",
-                       " or ".join(PROTOCOLS))
+                       " or ".join(protocol_names()))
         elif protocol is not None:
             devices[device] = protocol
             device_pos[device] = key_pos

@@ -40,7 +40,7 @@ from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
 from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.protocols.dronecan import DRONECAN
-from sam_codegen.model.protocols.registry import REGISTERED
+from sam_codegen.model.protocols.registry import registered
 from sam_codegen.model.spec import (
     UAVCAN_TO_ROS,
     Bridge,
@@ -225,11 +225,11 @@ def _bridge(bridge_node: YNode | None, package: str, diag: Diagnostics) -> Bridg
     """The `bridge` section (None without one): its Cyphal and DroneCAN mappings, service mappings, time sync."""
     if bridge_node is None:
         return None
-    r = Reader(bridge_node, "bridge", diag, ("name", "node_id", *(p.mappings_key for p in REGISTERED),
+    r = Reader(bridge_node, "bridge", diag, ("name", "node_id", *(p.mappings_key for p in registered()),
                                              "panic_duty", "service_mappings", "time_sync", "node_services"))
     name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
-    mappings: dict[str, list[Mapping]] = {p.name: [] for p in REGISTERED}
-    for p in REGISTERED:
+    mappings: dict[str, list[Mapping]] = {p.name: [] for p in registered()}
+    for p in registered():
         for key, pos, node in map_items(r.node(p.mappings_key), f"bridge {p.mappings_key}", diag):
             mapping = parse_mapping(key, pos, node, diag, p.name)
             if mapping is not None:

@@ -13,7 +13,6 @@ from typing import Final, Literal
 
 from sam_codegen.model.diagnostics import NOWHERE, Pos
 from sam_codegen.model.expr import ExprSource, UavcanExpr
-from sam_codegen.model.protocols.registry import PROTOCOL_NAMES
 from sam_codegen.model.types import DsdlType, RosType, split_composite_name
 
 Direction = Literal["uavcan_to_ros", "ros_to_uavcan"]
@@ -318,9 +317,6 @@ class V0Port:
     type: str  # full name, e.g. uavcan.equipment.ahrs.RawIMU
     rate_hz: float
     pos: Pos = NOWHERE
-
-
-PROTOCOLS = PROTOCOL_NAMES  # (sam_codegen.model.protocols.registry: one entry per protocol)
 
 
 @dataclass(frozen=True)

@@ -33,8 +33,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from sam_codegen.model.diagnostics import Diagnostic, Pos, SpecError
-from sam_codegen.model.protocols.registry import REGISTERED
 from sam_codegen.model.protocols.registry import protocol as protocol_of
+from sam_codegen.model.protocols.registry import registered
 from sam_codegen.model.spec import CanBus, DsdlStruct, Spec, V0Struct
 from sam_codegen.model.types import DsdlType
 from sam_codegen.validate.dronecan import ResolvedLayout
@@ -458,7 +458,7 @@ def layout_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str
                                  "dronecan") for p in device.dronecan_publishes]
             nodes.append(NodeBudget(device.name, device.node_id, protocol, (*sent, _liveness(protocol))))
         if spec.bridge is not None:
-            for protocol, active in ((p.name, layout.mappings_of(p)) for p in REGISTERED):
+            for protocol, active in ((p.name, layout.mappings_of(p)) for p in registered()):
                 commands = []
                 for rm in mappings.get(protocol, []):
                     m = rm.mapping

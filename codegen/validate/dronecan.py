@@ -16,7 +16,6 @@ from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.protocols.description import ProtocolDescription
 from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import (
-    PROTOCOLS,
     UAVCAN_TO_ROS,
     Constant,
     Device,
@@ -35,7 +34,7 @@ from sam_codegen.validate.routing import check_shared_broadcasts, routed_node_id
 from sam_codegen.validate.type_graph import dsdl_children, type_graph
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
-V0_NODE_IDS = range(1, 126)  # 0 is anonymous, 126 and 127 are kept for maintenance tools
+V0_NODE_IDS = DRONECAN.node_ids  # 0 is anonymous, 126 and 127 are kept for maintenance tools
 V0_FIELD_NAME = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
 DEFAULT_LAYOUT = "default"
 # Types inside types: the cycle check, the signatures and the codecs walk them recursively, a few frames a level,
@@ -349,4 +348,4 @@ class DronecanValidator:
                               active_mappings["dronecan"])
 
 
-__all__ = ["DEFAULT_LAYOUT", "PROTOCOLS", "V0_NODE_IDS", "DronecanValidator", "ResolvedLayout"]
+__all__ = ["DEFAULT_LAYOUT", "V0_NODE_IDS", "DronecanValidator", "ResolvedLayout"]

@@ -17,14 +17,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
-from sam_runtime.protocols import DEFAULT_PROTOCOL, PROTOCOL_NAMES, REGISTERED, runtime_protocol
+from sam_runtime.protocols import default_protocol, protocol_names, registered, runtime_protocol
 
 if TYPE_CHECKING:
     from sam_codegen.contracts.tables_api import TablesModule
 
-__all__ = ["PROTOCOLS", "Selection", "destinations_of", "port_id_of", "select"]
-
-PROTOCOLS = PROTOCOL_NAMES  # the registered protocols (sam_runtime.protocols), in the spec's order
+__all__ = ["Selection", "destinations_of", "port_id_of", "protocols_in_use", "select"]
 
 
 @dataclass(frozen=True)
@@ -56,11 +54,11 @@ def _layouts(tables: TablesModule) -> dict[str, Any]:
 
 
 def protocols_in_use(tables: TablesModule, layout: str) -> list[str]:
-    """The protocols whose mappings the layout runs, in PROTOCOLS order."""
+    """The protocols whose mappings the layout runs, in the registry's order (sam_runtime.protocols)."""
     lay = _layouts(tables).get(layout)
     if lay is None:
-        return [DEFAULT_PROTOCOL.name] if layout == "default" else []
-    return [p.name for p in REGISTERED if p.layout_mappings(lay)]
+        return [default_protocol().name] if layout == "default" else []
+    return [p.name for p in registered() if p.layout_mappings(lay)]
 
 
 def select(tables: TablesModule, layout: str | None = None, protocol: str | None = None) -> Selection:
@@ -72,14 +70,14 @@ def select(tables: TablesModule, layout: str | None = None, protocol: str | None
     if lay is None and not (name == "default" and not layouts):
         raise BridgeConfigError(f"the spec has no layout {name!r}; its layouts: {', '.join(sorted(layouts))}")
     used = protocols_in_use(tables, name)
-    if protocol is not None and protocol not in PROTOCOLS:
-        raise BridgeConfigError(f"unknown protocol {protocol!r}: expected one of {', '.join(PROTOCOLS)}")
+    if protocol is not None and protocol not in protocol_names():
+        raise BridgeConfigError(f"unknown protocol {protocol!r}: expected one of {', '.join(protocol_names())}")
     if protocol is None:
         if len(used) > 1:
             raise BridgeConfigError(
                 f"layout {name!r} has devices on {' and '.join(used)}: run one bridge per protocol "
                 f"(--protocol {' / --protocol '.join(used)})")
-        protocol = used[0] if used else DEFAULT_PROTOCOL.name
+        protocol = used[0] if used else default_protocol().name
     elif used and protocol not in used:
         raise BridgeConfigError(f"layout {name!r} has no mapping on {protocol} (it uses {', '.join(used)})")
     entry = runtime_protocol(protocol)

@@ -57,7 +57,7 @@ from sam_runtime.dronecan_io.types import ensure_types
 from sam_runtime.dronecan_io.wire import TransferTaps, crc16
 from sam_runtime.genpkg import GeneratedPackage
 from sam_runtime.node_support import qos_profile
-from sam_runtime.protocols import DEFAULT_PROTOCOL, REGISTERED
+from sam_runtime.protocols import default_protocol, registered
 from sam_runtime.recording.schemas import (
     CYPHAL_TOPIC,
     DRONECAN_TOPIC,
@@ -117,14 +117,14 @@ def layout_protocols(tables: Any, layout: str | None) -> tuple[str, list[str]]:
     if lay is None:
         if layouts and name != "default":
             raise ValueError(f"the spec has no layout {name!r}; its layouts: {', '.join(sorted(layouts))}")
-        return name, [DEFAULT_PROTOCOL.name]
-    return name, [p.name for p in REGISTERED if p.layout_mappings(lay)]
+        return name, [default_protocol().name]
+    return name, [p.name for p in registered() if p.layout_mappings(lay)]
 
 
 def topic_qos(tables: Any) -> dict[str, tuple[str, str, str, int]]:
     """topic -> (ROS type, reliability, durability, depth) of the recorder's subscription (module docstring)."""
     offered: dict[str, list[Any]] = {}
-    for m in (m for p in REGISTERED for m in p.mappings(tables)):
+    for m in (m for p in registered() for m in p.mappings(tables)):
         if m.direction == "uavcan_to_ros":
             offered.setdefault(m.topic.name, []).append(m.topic.qos)
     for n in tables.NODES:

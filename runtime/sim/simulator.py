@@ -51,7 +51,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.tasks import cancel_and_wait
 from sam_runtime.genpkg import GeneratedPackage
-from sam_runtime.protocols import DEFAULT_PROTOCOL, REGISTERED, runtime_protocol
+from sam_runtime.protocols import default_protocol, registered, runtime_protocol
 from sam_runtime.sim.config import SimConfig
 from sam_runtime.sim.devices import (
     PHYSICS,
@@ -84,7 +84,7 @@ def layout_protocols(tables: TablesModule, layout: str = "default") -> dict[str,
     if lay is not None:
         return dict(lay.protocols)
     if layout == "default" and not layouts:
-        return {d.name: DEFAULT_PROTOCOL.name for d in DEFAULT_PROTOCOL.devices(tables)}
+        return {d.name: default_protocol().name for d in default_protocol().devices(tables)}
     raise ValueError(f"the spec has no layout {layout!r}; its layouts: {', '.join(sorted(layouts) or ['default'])}")
 
 
@@ -110,7 +110,8 @@ class Simulator:
         wanted = None if self.config.devices is None else set(self.config.devices)
         if wanted is not None and wanted - set(protocols):
             raise ValueError(f"unknown device(s) {sorted(wanted - set(protocols))}; the spec has {sorted(protocols)}")
-        firmware: dict[str, dict[str, Any]] = {p.name: {d.name: d for d in p.devices(self.tables)} for p in REGISTERED}
+        firmware: dict[str, dict[str, Any]] = {p.name: {d.name: d for d in p.devices(self.tables)}
+                                               for p in registered()}
         self.devices = []
         for name, protocol in protocols.items():
             info = firmware.get(protocol, {}).get(name)

@@ -8,12 +8,22 @@ from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.protocols.description import ProtocolDescription
 from sam_codegen.model.protocols.dronecan import DRONECAN
 
-__all__ = ["DEFAULT_PROTOCOL", "PROTOCOL_NAMES", "REGISTERED", "UnknownProtocolError", "protocol"]
+__all__ = ["REGISTERED", "UnknownProtocolError", "default_protocol", "protocol", "protocol_names", "registered"]
 
 REGISTERED: tuple[ProtocolDescription, ...] = (CYPHAL, DRONECAN)
 
-DEFAULT_PROTOCOL = REGISTERED[0]
-PROTOCOL_NAMES: tuple[str, ...] = tuple(p.name for p in REGISTERED)
+
+# Read at every call, never copied at import: what asks the registry sees a protocol registered later (a test's).
+def registered() -> tuple[ProtocolDescription, ...]:
+    return REGISTERED
+
+
+def protocol_names() -> tuple[str, ...]:
+    return tuple(p.name for p in REGISTERED)
+
+
+def default_protocol() -> ProtocolDescription:
+    return REGISTERED[0]
 
 
 class UnknownProtocolError(ValueError):
@@ -25,4 +35,4 @@ def protocol(name: str) -> ProtocolDescription:
     for p in REGISTERED:
         if p.name == name:
             return p
-    raise UnknownProtocolError(f"unknown protocol {name!r}: expected one of {', '.join(PROTOCOL_NAMES)}")
+    raise UnknownProtocolError(f"unknown protocol {name!r}: expected one of {', '.join(protocol_names())}")
