@@ -30,6 +30,3 @@ class ProtocolDescription:
     device_stamped_table: str  # the mappings whose stamps come from the device's clock,
     layout_mappings_field: str  # and the LayoutInfo field of the layout's mappings on this protocol
     can_fd: bool  # its frames use CAN FD's data phase when the bus has one
-
-    def __str__(self) -> str:
-        return self.name
