@@ -198,55 +198,21 @@ def _sim_parser() -> argparse.ArgumentParser:
 
 def _add_vehicle_args(p: argparse.ArgumentParser, *, main_job: bool = False) -> None:
     """The simulated vehicle's options (``sim``; ``run`` forwards them to its sim, except --time-scale: the nodes
-    run on the wall clock)."""
+    run on the wall clock): the flags of SimConfig's fields (sam_runtime.physics.vehicle.VehicleOptions)."""
+    from sam_runtime.common.cli_fields import add_flags
+    from sam_runtime.sim.config import SimConfig
+
     v = p.add_argument_group("simulated vehicle (frames: ENU metres around --gps-origin, yaw counter-clockwise "
                              "from east, depth positive down)")
-    v.add_argument("--seed", type=int, default=0, help="sensor noise seed (default 0)")
-    v.add_argument("--sea-floor", default="25", metavar="DEPTH|S:D,...",
-                   help="sea floor depth [m], or a profile of distance:depth points along --sea-floor-axis "
-                        "(e.g. 0:25,40:25,60:6 rises to 6 m between 40 and 60 m east; default 25)")
-    v.add_argument("--sea-floor-axis", type=float, default=0.0, metavar="RAD",
-                   help="direction of the profile's axis, counter-clockwise from east (default 0: east)")
-    v.add_argument("--start", default="0,0,0,0", metavar="X,Y,DEPTH,YAW",
-                   help="start position [m], depth [m] and yaw [rad] (default 0,0,0,0: at the surface, facing east)")
-    v.add_argument("--battery-start", type=float, default=95.0, metavar="PERCENT", help="state of charge (default 95)")
-    v.add_argument("--battery-drain-factor", type=float, default=1.0,
-                   help="multiplies the power drawn from the battery (default 1; e.g. 300 to drain it in minutes)")
-    v.add_argument("--battery-health", type=int, default=98, metavar="PERCENT",
-                   help="state of health; below 60 the BMS flags NEED_SERVICE, below 30 BAD_BATTERY (default 98)")
-    v.add_argument("--gps-origin", default="59.35,18.07", metavar="LAT,LON",
-                   help="latitude and longitude of the sim's origin (default 59.35,18.07: KTH, Stockholm)")
-    if not main_job:
-        v.add_argument("--time-scale", type=float, default=1.0,
-                       help="vehicle seconds per wall second; rates and stamps follow (default 1)")
-    v.add_argument("--truth-file", type=Path, default=None,
-                   help="the vehicle's true state: JSON lines if it ends in .jsonl, else one JSON object replaced "
-                        "atomically")
-    v.add_argument("--truth-rate", type=float, default=5.0, help="truth samples per vehicle second (default 5)")
-
-
-def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
-    try:
-        values = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != n:
-        raise ValueError(f"{what}: expected {n} comma-separated numbers, got {text!r}")
-    return values
+    add_flags(v, SimConfig, main_job=main_job)
 
 
 def _vehicle_options(args: argparse.Namespace) -> dict[str, Any]:
     """SimConfig's vehicle options from the sim's command line (ValueError: one clear line)."""
-    from sam_runtime.physics.vehicle import SeaFloor
+    from sam_runtime.common.cli_fields import options_from
+    from sam_runtime.sim.config import SimConfig
 
-    lat, lon = _floats(args.gps_origin, 2, "--gps-origin")
-    return {
-        "seed": args.seed, "sea_floor": SeaFloor.parse(args.sea_floor, axis_yaw=args.sea_floor_axis),
-        "start": _floats(args.start, 4, "--start"), "battery_percent": args.battery_start,
-        "battery_drain_factor": args.battery_drain_factor, "battery_health_pct": args.battery_health,
-        "gps_origin": (lat, lon), "time_scale": getattr(args, "time_scale", 1.0), "truth_file": args.truth_file,
-        "truth_rate_hz": args.truth_rate,
-    }
+    return options_from(SimConfig, args)
 
 
 def sim_main(argv: Sequence[str] | None = None) -> int:
@@ -438,12 +404,11 @@ def _run_parser() -> argparse.ArgumentParser:
 
 def _sim_vehicle_argv(args: argparse.Namespace) -> list[str]:
     """The vehicle options the main job forwards to its sim (checked here first: ValueError, one clear line)."""
+    from sam_runtime.common.cli_fields import forwarded_argv
+    from sam_runtime.sim.config import SimConfig
+
     _vehicle_options(args)
-    out = ["--seed", str(args.seed), "--sea-floor", args.sea_floor, "--sea-floor-axis", repr(args.sea_floor_axis),
-           "--start", args.start, "--battery-start", repr(args.battery_start), "--battery-drain-factor",
-           repr(args.battery_drain_factor), "--battery-health", str(args.battery_health), "--gps-origin",
-           args.gps_origin, "--truth-rate", repr(args.truth_rate)]
-    return out
+    return forwarded_argv(SimConfig, args)
 
 
 def run_main(argv: Sequence[str] | None = None) -> int:

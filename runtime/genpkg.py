@@ -25,8 +25,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
+from sam_codegen.contracts.tables_api import TablesModule
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.project.ros_install import (
     RosBuildError,
     build_ros_package,
@@ -39,9 +41,6 @@ from sam_codegen.project.ros_install import (
 )
 from sam_codegen.project.workspace import GENERATED_ENV_VAR, WorkspaceError, find_generated, user_cache_dir
 from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
-
-if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
 
 __all__ = [
     "GENERATED_ENV_VAR",
@@ -135,7 +134,14 @@ class GeneratedPackage:
     def tables(self) -> TablesModule:
         """``<pkg>.tables`` (standard library only: safe to import anywhere, anytime)."""
         if self._tables is None:
-            self._tables = cast("TablesModule", self._import("tables"))
+            module = self._import("tables")
+            # The runtime reads every member the contract names, without fallbacks: tables of an older build are
+            # rebuilt, not half-read.
+            missing = [name for name in TablesModule.__annotations__ if not hasattr(module, name)]
+            if missing:
+                raise GeneratedPackageError(f"{module.__file__} lacks {', '.join(missing)}: it was built by an older "
+                                            f"sam-codegen; run `sam-codegen build`")
+            self._tables = cast("TablesModule", module)
         return self._tables
 
     def compile_dsdl(self) -> Path:
@@ -201,7 +207,7 @@ class GeneratedPackage:
         """The generated wire codecs of ``protocol``: ``<pkg>.codec`` (Cyphal) or ``<pkg>.codec_v0`` (DroneCAN),
         standard library only, writing ``frame_prefix`` before every frame id (see :func:`bound_codec`); None
         when the package has none, or none that takes a frame prefix (built by an older sam-codegen)."""
-        sub = "codec_v0" if protocol == "dronecan" else "codec"
+        sub = protocol_of(protocol).codec_package
         if (sub, "") not in self._codecs:
             try:
                 self._codecs[sub, ""] = self._import(sub)

@@ -5,8 +5,9 @@ The layers (top -> bottom; a module may import its own layer's modules unless th
 layer below):
 
 sam_codegen: cli > build > targets > conversion_plan | render > validate > catalogs | frontend > model | project
+             > contracts
 sam_runtime: cli | cli_support | main_job > bridge | sim | nodes | recording | report
-             > genpkg | node_support | tf_buffer | nav > cyphal_io | dronecan_io | physics > common
+             > genpkg | protocols | node_support | tf_buffer | nav > cyphal_io | dronecan_io | physics > common
 
 Inside targets/ the sibling edges run one way: wire -> python -> {nodes, ros, dsdl_v0}, dsdl_v0 -> dsdl, docs -> nodes,
 and registry (the list of emitters) above them all. sam_runtime may import sam_codegen (the spec, the project, the
@@ -32,9 +33,10 @@ PACKAGES = {"sam_codegen": REPO / "codegen", "sam_runtime": REPO / "runtime"}
 # layer is marked so.
 LAYERS: dict[str, list[tuple[str, ...]]] = {
     "sam_codegen": [("cli",), ("build",), ("targets",), ("conversion_plan", "render"), ("validate",),
-                    ("catalogs", "frontend"), ("model", "project")],
+                    ("catalogs", "frontend"), ("model", "project"), ("contracts",)],
     "sam_runtime": [("cli", "cli_support", "main_job"), ("bridge", "sim", "nodes", "recording", "report"),
-                    ("genpkg", "node_support", "tf_buffer", "nav"), ("cyphal_io", "dronecan_io", "physics"),
+                    ("genpkg", "protocols", "node_support", "tf_buffer", "nav"),
+                    ("cyphal_io", "dronecan_io", "physics"),
                     ("common",)],
 }
 INDEPENDENT: dict[str, set[frozenset[str]]] = {
@@ -52,8 +54,9 @@ LAZY_FIRST_PARTY = {
     # The DroneCAN side imports dronecan, which parses its whole DSDL set at import (~0.4 s): a vehicle without
     # DroneCAN devices never loads it.
     ("sam_runtime.genpkg", "sam_runtime.dronecan_io"),
-    ("sam_runtime.sim.simulator", "sam_runtime.sim.dronecan"),
-    ("sam_runtime.bridge.composition", "sam_runtime.bridge.backends.dronecan"),
+    # (sam_runtime.protocols names each protocol's simulated devices and bridge part by module path, imported when
+    # a device or a bridge runs that protocol)
+    ("sam_runtime.bridge.backends.dronecan_part", "sam_runtime.bridge.backends.dronecan"),
 }
 # The entry points import a command's implementation when that command runs: `sam-codegen validate` must not load
 # rclpy or pycyphal, nor `sam-bridge --help` the simulator.

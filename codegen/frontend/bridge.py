@@ -11,9 +11,10 @@ from sam_codegen.frontend.traffic import TRAFFIC_KEYS, parse_traffic
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar
 from sam_codegen.model.diagnostics import NOWHERE, Diagnostics, Pos
 from sam_codegen.model.expr import ExprSource, PNum, UavcanExpr
+from sam_codegen.model.protocols.registry import default_protocol, protocol_names
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.spec import (
     DIRECTIONS,
-    PROTOCOLS,
     ROS_TO_UAVCAN,
     UAVCAN_TO_ROS,
     Device,
@@ -139,8 +140,9 @@ _DRONECAN_MAPPING_KEYS = (
 
 
 def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol: str = "cyphal") -> Mapping | None:
-    dronecan = protocol == "dronecan"
-    what = f"DroneCAN mapping {name!r}" if dronecan else f"mapping {name!r}"
+    entry = protocol_of(protocol)
+    dronecan = entry.v0
+    what = f"{entry.mapping_noun} {name!r}"
     r = Reader(node, what, diag, _DRONECAN_MAPPING_KEYS if dronecan else _MAPPING_KEYS)
     if not r.ok:
         return None
@@ -262,16 +264,17 @@ def _v0_ports(node: YNode | None, what: str, diag: Diagnostics) -> list[V0Port]:
     return ports
 
 
-_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes", *PROTOCOLS)
+_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes")  # and each protocol's name
 
 
 def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     """A device: its ports in its `protocol` (cyphal by default), and under the other protocol's name the ports of
     its firmware for that protocol."""
     what = f"device {key!r}"
-    r = Reader(node, what, diag, _DEVICE_KEYS)
+    known = protocol_names()
+    r = Reader(node, what, diag, (*_DEVICE_KEYS, *known))
     node_id = r.get("node_id", int)
-    protocol = r.get("protocol", str, "cyphal")
+    protocol = r.get("protocol", str, default_protocol().name)
     protocol_pos = {protocol: pos}
 
     def device(ports: dict[str, list[Port]], v0_ports: dict[str, list[V0Port]], protocols: tuple[str, ...]) -> Device:
@@ -279,14 +282,14 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
                       ports.get("publishes", []), ports.get("subscribes", []), pos, protocol, protocols,
                       v0_ports.get("publishes", []), v0_ports.get("subscribes", []), protocol_pos)
 
-    if protocol not in PROTOCOLS:
-        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+    if protocol not in known:
+        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(known))
         return device({}, {}, ())  # its ports would be read in the wrong protocol
     sides = [(protocol, r.map)]
     if r.node(protocol) is not None:
         diag.error(r.key_pos(protocol), f"{what} speaks {protocol}: its {protocol} ports are its `publishes` and "
-                   "`subscribes`", f"a section for the other protocol ({', '.join(set(PROTOCOLS) - {protocol})})")
-    for other in PROTOCOLS:
+                   "`subscribes`", f"a section for the other protocol ({', '.join(set(known) - {protocol})})")
+    for other in known:
         section = r.node(other)
         if other != protocol and section is not None:
             sub = Reader(section, f"the {other} ports of {what}", diag, ("publishes", "subscribes"))
@@ -296,7 +299,7 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     v0: dict[str, list[V0Port]] = {}
     for side, ports in sides:
         for key_ in ("publishes", "subscribes"):
-            if side == "cyphal":
+            if not protocol_of(side).v0:
                 cyphal[key_] = _ports(ports.entries.get(key_), what, diag)
             else:
                 v0[key_] = _v0_ports(ports.entries.get(key_), what, diag)
@@ -307,16 +310,17 @@ def parse_layout(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Layout:
     what = f"layout {key!r}"
     r = Reader(node, what, diag, ("description", "protocol", "devices", "bus"))
     layout_protocol = r.get("protocol", str, None)
-    if layout_protocol is not None and layout_protocol not in PROTOCOLS:
-        diag.error(r.key_pos("protocol"), f"protocol {layout_protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+    known = protocol_names()
+    if layout_protocol is not None and layout_protocol not in known:
+        diag.error(r.key_pos("protocol"), f"protocol {layout_protocol!r} of {what} is unknown", " or ".join(known))
         layout_protocol = None
     devices: dict[str, str] = {}
     device_pos: dict[str, Pos] = {}
     for device, key_pos, value in map_items(r.node("devices"), f"the devices of {what}", diag):
         protocol = scalar(value, str, f"the protocol of device {device!r} in {what}", diag)
-        if protocol is not None and protocol not in PROTOCOLS:
+        if protocol is not None and protocol not in known:
             diag.error(value.pos, f"protocol {protocol!r} of device {device!r} in {what} is unknown",
-                       " or ".join(PROTOCOLS))
+                       " or ".join(protocol_names()))
         elif protocol is not None:
             devices[device] = protocol
             device_pos[device] = key_pos

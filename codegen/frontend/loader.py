@@ -38,6 +38,9 @@ from sam_codegen.frontend.types import (
 )
 from sam_codegen.frontend.yaml_source import YMap, YNode, YScalar, load_yaml
 from sam_codegen.model.diagnostics import Diagnostic, Diagnostics, Pos, SpecError
+from sam_codegen.model.protocols.cyphal import CYPHAL
+from sam_codegen.model.protocols.dronecan import DRONECAN
+from sam_codegen.model.protocols.registry import registered
 from sam_codegen.model.spec import (
     UAVCAN_TO_ROS,
     Bridge,
@@ -222,22 +225,21 @@ def _bridge(bridge_node: YNode | None, package: str, diag: Diagnostics) -> Bridg
     """The `bridge` section (None without one): its Cyphal and DroneCAN mappings, service mappings, time sync."""
     if bridge_node is None:
         return None
-    r = Reader(bridge_node, "bridge", diag, ("name", "node_id", "mappings", "dronecan_mappings", "panic_duty",
-                                             "service_mappings", "time_sync", "node_services"))
+    r = Reader(bridge_node, "bridge", diag, ("name", "node_id", *(p.mappings_key for p in registered()),
+                                             "panic_duty", "service_mappings", "time_sync", "node_services"))
     name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
-    mappings: dict[str, list[Mapping]] = {"cyphal": [], "dronecan": []}
-    for protocol, key_ in (("cyphal", "mappings"), ("dronecan", "dronecan_mappings")):
-        what = "bridge mappings" if protocol == "cyphal" else "bridge dronecan_mappings"
-        for key, pos, node in map_items(r.node(key_), what, diag):
-            mapping = parse_mapping(key, pos, node, diag, protocol)
+    mappings: dict[str, list[Mapping]] = {p.name: [] for p in registered()}
+    for p in registered():
+        for key, pos, node in map_items(r.node(p.mappings_key), f"bridge {p.mappings_key}", diag):
+            mapping = parse_mapping(key, pos, node, diag, p.name)
             if mapping is not None:
-                mappings[protocol].append(mapping)
+                mappings[p.name].append(mapping)
     for protocol, protocol_mappings in mappings.items():
         check_enable_services(protocol_mappings, protocol, diag)
     service_mappings = [m for key, pos, node in map_items(r.node("service_mappings"), "bridge service_mappings",
                                                           diag)
                         for m in [parse_service_mapping(key, pos, node, diag)] if m is not None]
-    return Bridge(name, node_id, mappings["cyphal"], bridge_node.pos, mappings["dronecan"],
+    return Bridge(name, node_id, mappings[CYPHAL.name], bridge_node.pos, mappings[DRONECAN.name],
                   service_mappings=service_mappings,
                   time_sync=parse_time_sync(r.node("time_sync"), "bridge time_sync", diag),
                   panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"),

@@ -10,7 +10,8 @@ from sam_codegen.frontend.bridge import parse_link
 from sam_codegen.frontend.reading import Reader, map_items, number, scalar, str_list
 from sam_codegen.frontend.yaml_source import YNode
 from sam_codegen.model.diagnostics import Diagnostics, Pos
-from sam_codegen.model.spec import PROTOCOLS, FieldLink, Scalar, ServiceMapping
+from sam_codegen.model.protocols.registry import protocol_names
+from sam_codegen.model.spec import FieldLink, Scalar, ServiceMapping
 
 __all__ = ["DEFAULT_TIMEOUT_S", "parse_service_mapping"]
 
@@ -25,8 +26,8 @@ def parse_service_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics) -
     if not r.ok:
         return None
     protocol = r.get("protocol", str, "dronecan")
-    if protocol not in PROTOCOLS:
-        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(PROTOCOLS))
+    if protocol not in protocol_names():
+        diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(protocol_names()))
     service_id = r.get("service_id", int, None)
     timeout = DEFAULT_TIMEOUT_S
     if r.node("timeout") is not None:

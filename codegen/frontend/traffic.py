@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 from sam_codegen.frontend.reading import Reader, number
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.spec import UAVCAN_TO_ROS, Mapping
 
 __all__ = ["TRAFFIC_KEYS", "Traffic", "check_enable_services", "parse_traffic"]
@@ -83,7 +84,7 @@ def check_enable_services(mappings: Sequence[Mapping], protocol: str, diag: Diag
         name = m.enable_service_name
         if name in seen:
             first, pos = seen[name]
-            what = "DroneCAN mapping" if protocol == "dronecan" else "mapping"
+            what = protocol_of(protocol).mapping_noun
             diag.error(m.pos, f"enable_service {name!r} of {what} {m.name!r} is also that of {first!r} (line "
                        f"{pos.line})", "one service per mapping")
         else:

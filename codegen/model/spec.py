@@ -319,9 +319,6 @@ class V0Port:
     pos: Pos = NOWHERE
 
 
-PROTOCOLS = ("cyphal", "dronecan")
-
-
 @dataclass(frozen=True)
 class Device:
     name: str

@@ -33,6 +33,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from sam_codegen.model.diagnostics import Diagnostic, Pos, SpecError
+from sam_codegen.model.protocols.registry import protocol as protocol_of
+from sam_codegen.model.protocols.registry import registered
 from sam_codegen.model.spec import CanBus, DsdlStruct, Spec, V0Struct
 from sam_codegen.model.types import DsdlType
 from sam_codegen.validate.dronecan import ResolvedLayout
@@ -66,8 +68,6 @@ FD_MTU = 64
 FD_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)
 LIVENESS_BYTES = 7  # uavcan.node.Heartbeat.1.0 and uavcan.protocol.NodeStatus are both 56 bits
 LIVENESS_HZ = 1.0
-HEARTBEAT = "uavcan.node.Heartbeat.1.0"
-NODE_STATUS = "uavcan.protocol.NodeStatus"
 
 Lookup = Callable[[str], DsdlStruct | None]
 V0Lookup = Callable[[str], V0Struct | None]
@@ -320,7 +320,7 @@ class Transfer:
         return [n for n, count in self.frame_split(bus) for _ in range(count)]
 
     def frame_split(self, bus: Bus) -> tuple[tuple[int, int], ...]:
-        if self.protocol == "dronecan":
+        if protocol_of(self.protocol).v0:
             return dronecan_frame_split(self.payload_bytes)
         return cyphal_frame_split(self.payload_bytes, FD_MTU if bus.fd else CLASSIC_MTU)
 
@@ -334,7 +334,7 @@ class Transfer:
         """The share of the bus's time this message takes (1.0 = the whole bus)."""
         total = 0.0
         for n, count in self.frame_split(bus):
-            if bus.data_bitrate is not None and self.protocol == "cyphal":
+            if bus.data_bitrate is not None and protocol_of(self.protocol).can_fd:
                 nominal, data = fd_frame_bits(n, worst_case=worst_case)
                 total += count * (nominal / bus.bitrate + data / bus.data_bitrate)
             else:  # a classic frame (DroneCAN is classic on an FD bus too)
@@ -418,7 +418,7 @@ def bus_for(spec: Spec, layout: str) -> Bus | None:
 
 
 def _liveness(protocol: str) -> Transfer:
-    kind = HEARTBEAT if protocol == "cyphal" else NODE_STATUS
+    kind = protocol_of(protocol).liveness_type
     return Transfer(kind, LIVENESS_HZ, LIVENESS_BYTES, protocol, "liveness")
 
 
@@ -450,7 +450,7 @@ def layout_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str
         nodes: list[NodeBudget] = []
         for device in spec.devices.values():
             protocol = layout.protocols[device.name]
-            if protocol == "cyphal":
+            if not protocol_of(protocol).v0:
                 sent = [Transfer(p.type, p.rate_hz, cyphal_max_bytes(_cyphal_struct(cyphal, p.type), cyphal),
                                  "cyphal", f"subject {p.subject_id}") for p in device.publishes]
             else:
@@ -458,13 +458,13 @@ def layout_budgets(spec: Spec, layouts: list[ResolvedLayout], mappings: dict[str
                                  "dronecan") for p in device.dronecan_publishes]
             nodes.append(NodeBudget(device.name, device.node_id, protocol, (*sent, _liveness(protocol))))
         if spec.bridge is not None:
-            for protocol, active in (("cyphal", layout.cyphal_mappings), ("dronecan", layout.dronecan_mappings)):
+            for protocol, active in ((p.name, layout.mappings_of(p)) for p in registered()):
                 commands = []
                 for rm in mappings.get(protocol, []):
                     m = rm.mapping
                     if m.name not in active or m.direction != "ros_to_uavcan":
                         continue
-                    if protocol == "cyphal":
+                    if not protocol_of(protocol).v0:
                         commands.append(Transfer(rm.dsdl_struct.name, rm.rate_hz,
                                                  cyphal_max_bytes(rm.dsdl_struct, cyphal), protocol,
                                                  f"mapping {m.name}, subject {m.subject_id}"))

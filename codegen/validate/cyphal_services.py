@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.spec import ServiceMapping
 from sam_codegen.model.types import RosType
 
@@ -54,7 +55,7 @@ def resolve_cyphal_mapping(v: Any, m: ServiceMapping, what: str) -> tuple[Any, l
             return None
     else:
         device = s.devices_by_node_id().get(m.destination_node_id)
-        if device is None or "cyphal" not in device.protocols:
+        if device is None or CYPHAL.name not in device.protocols:
             v.error(m.pos, f"destination node id {m.destination_node_id} of {what} is not a Cyphal device",
                     "the node id of a device with Cyphal ports")
     if srv is None or found is None or service_id is None or srv.full_name in v.bad:

@@ -13,8 +13,9 @@ from sam_codegen.catalogs.dronecan import (
     V0Catalog,
 )
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.protocols.description import ProtocolDescription
+from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import (
-    PROTOCOLS,
     UAVCAN_TO_ROS,
     Constant,
     Device,
@@ -33,7 +34,7 @@ from sam_codegen.validate.routing import check_shared_broadcasts, routed_node_id
 from sam_codegen.validate.type_graph import dsdl_children, type_graph
 from sam_codegen.validate.values import check_dsdl_value, python_safe
 
-V0_NODE_IDS = range(1, 126)  # 0 is anonymous, 126 and 127 are kept for maintenance tools
+V0_NODE_IDS = DRONECAN.node_ids  # 0 is anonymous, 126 and 127 are kept for maintenance tools
 V0_FIELD_NAME = re.compile(r"^[a-zA-Z][a-zA-Z0-9_]*$")
 DEFAULT_LAYOUT = "default"
 # Types inside types: the cycle check, the signatures and the codecs walk them recursively, a few frames a level,
@@ -54,6 +55,11 @@ class ResolvedLayout:
     def devices(self, protocol: str) -> list[str]:
         return [d for d, p in self.protocols.items() if p == protocol]
 
+    def mappings_of(self, protocol: ProtocolDescription) -> list[str]:
+        """The layout's mappings on `protocol`."""
+        mappings: list[str] = getattr(self, protocol.layout_mappings_field)
+        return mappings
+
 
 def _v0_ports(device: Device) -> list[tuple[V0Port, bool]]:
     return [(p, True) for p in device.dronecan_publishes] + [(p, False) for p in device.dronecan_subscribes]
@@ -72,7 +78,7 @@ class DronecanValidator:
 
     def uses_dronecan(self) -> bool:
         s = self.spec
-        return bool(s.dronecan_types or any("dronecan" in d.protocols for d in s.devices.values())
+        return bool(s.dronecan_types or any(DRONECAN.name in d.protocols for d in s.devices.values())
                     or (s.bridge is not None and (s.bridge.dronecan_mappings or s.bridge.service_mappings)))
 
     def message_type(self, name: str, pos: Pos, what: str) -> V0Struct | None:
@@ -211,7 +217,7 @@ class DronecanValidator:
             self.error(s.bridge.pos, f"bridge node id {s.bridge.node_id} is out of range for DroneCAN",
                        f"{V0_NODE_IDS.start}..{V0_NODE_IDS.stop - 1}")
         for device in s.devices.values():
-            if "dronecan" not in device.protocols:
+            if DRONECAN.name not in device.protocols:
                 continue
             what = f"device {device.name}"
             if device.node_id >= 0 and device.node_id not in V0_NODE_IDS:
@@ -248,7 +254,7 @@ class DronecanValidator:
         role = "source" if publishing else "destination"
         users: dict[int, V0Port] = {}
         for device in s.devices.values():
-            if "dronecan" in device.protocols:
+            if DRONECAN.name in device.protocols:
                 for port, pub in _v0_ports(device):
                     if pub == publishing and port.type == mapping.data_type:
                         users.setdefault(device.node_id, port)
@@ -342,4 +348,4 @@ class DronecanValidator:
                               active_mappings["dronecan"])
 
 
-__all__ = ["DEFAULT_LAYOUT", "PROTOCOLS", "V0_NODE_IDS", "DronecanValidator", "ResolvedLayout"]
+__all__ = ["DEFAULT_LAYOUT", "V0_NODE_IDS", "DronecanValidator", "ResolvedLayout"]

@@ -17,6 +17,7 @@ from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
 from sam_codegen.model.expr import names_of
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.spec import (
     ROS_TO_UAVCAN,
     UAVCAN_TO_ROS,
@@ -322,7 +323,7 @@ class MappingValidator(MappingExpressions, MappingCoverage):
                 raise RuleError("limits bound the values a ROS -> UAVCAN mapping commands; a UAVCAN -> ROS mapping "
                                 "passes on what the device measured")
             if uav_type.kind == "utf8" or ros_type.base == "string":
-                exact = check_string(ros_type, uav_type, link, mapping.protocol == "dronecan")
+                exact = check_string(ros_type, uav_type, link, protocol_of(mapping.protocol).v0)
                 kind = "string"
             elif uav_type.array or ros_type.array:
                 exact = check_arrays(ros_type, uav_type, link)

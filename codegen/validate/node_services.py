@@ -24,6 +24,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from sam_codegen.model.diagnostics import Diagnostics
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.ros_names import ros_name_problem
 from sam_codegen.model.spec import NodeService, RosService, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import ROS_INT_RANGES, RosType
@@ -169,7 +170,8 @@ def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
              signed: Callable[[str], V0Struct | None], lookup: Lookup) -> ResolvedServiceMapping | None:
     data_type, service_id = DUTY_TYPES[(ns.duty, protocol)]
     struct = None
-    if protocol == "dronecan":
+    v0 = protocol_of(protocol).v0
+    if v0:
         struct = signed(data_type)
         if struct is None:  # the standard definitions could not be read: reported by the catalog
             return None
@@ -179,7 +181,7 @@ def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
     for name in fields:  # a path: `status.uptime_sec` is uptime_sec
         key = "success" if name == "ok" else name.rsplit(".", 1)[-1]
         kind, dronecan_source, cyphal_source = known[key]
-        source = dronecan_source if protocol == "dronecan" else cyphal_source
+        source = dronecan_source if v0 else cyphal_source
         if source == "status":  # Cyphal ExecuteCommand: status 0 is success
             kind = "ok_if_zero"
         if source is None:
@@ -192,7 +194,7 @@ def _mapping(ns: NodeService, srv: RosService, protocol: str, fields: list[str],
                 lo, hi = ROS_INT_RANGES[f.type.base]
             response.append(ServiceLink(name, source, kind, None, None, None, lo, hi))
     request: list[ServiceLink] = []
-    if ns.duty == "restart_node" and protocol == "dronecan":
+    if ns.duty == "restart_node" and v0:
         request.append(ServiceLink("magic_number", None, "int", DRONECAN_RESTART_MAGIC, lo=0, hi=2 ** 40 - 1))
     elif ns.duty == "restart_node":
         request += [ServiceLink("command", None, "int", CYPHAL_COMMAND_RESTART, lo=0, hi=65535),

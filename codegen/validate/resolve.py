@@ -16,6 +16,7 @@ from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.ros_names import NAME_RULES, ros_name_problem
 from sam_codegen.model.spec import Constant, DsdlService, DsdlStruct, Field, RosMessage, RosService, Spec, V0Struct
 from sam_codegen.model.types import (
@@ -307,7 +308,7 @@ class _Validator:
         for device in s.devices.values():
             if not re.fullmatch(r"[a-z][a-z0-9_]*", device.name):
                 self.error(device.pos, f"device name {device.name!r} is not valid", "lower_case")
-            if device.node_id not in CAN_NODE_IDS and "cyphal" in device.protocols:
+            if device.node_id not in CAN_NODE_IDS and CYPHAL.name in device.protocols:
                 self.error(device.pos, f"node id {device.node_id} of device {device.name} is out of range for "
                            "Cyphal/CAN", "0..127")
             elif device.node_id in owners:

@@ -15,6 +15,7 @@ Invariants:
 from __future__ import annotations
 
 from sam_codegen.model.diagnostics import Diagnostics
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS, Mapping, Spec
 from sam_codegen.validate.mapping_rules import Key, ResolvedMapping, format_path
 
@@ -29,7 +30,7 @@ def port_users(spec: Spec, mapping: Mapping) -> list[int]:
     for device in spec.devices.values():
         if mapping.protocol not in device.protocols:
             continue
-        if mapping.protocol == "dronecan":
+        if protocol_of(mapping.protocol).v0:
             ports = device.dronecan_publishes if publishing else device.dronecan_subscribes
             if any(p.type == mapping.data_type for p in ports):
                 users.add(device.node_id)
@@ -46,7 +47,7 @@ def routed_node_ids(spec: Spec, mapping: Mapping) -> list[int]:
         return port_users(spec, mapping)
     if mapping.direction == UAVCAN_TO_ROS:
         return list(mapping.source_node_ids)
-    if mapping.protocol == "dronecan":
+    if protocol_of(mapping.protocol).v0:  # a broadcast: a set of destinations
         return list(mapping.destination_node_ids)
     return [] if mapping.destination_node_id is None else [mapping.destination_node_id]
 
@@ -57,8 +58,9 @@ def check_routing(spec: Spec, diag: Diagnostics) -> None:
     if spec.bridge is None:
         return
     for m in spec.bridge.all_mappings:
-        dronecan = m.protocol == "dronecan"
-        what = f"DroneCAN mapping {m.name!r}" if dronecan else f"mapping {m.name!r}"
+        entry = protocol_of(m.protocol)
+        dronecan = entry.v0
+        what = f"{entry.mapping_noun} {m.name!r}"
         if m.any_node and not port_users(spec, m):
             key = "source_node_ids" if m.direction == UAVCAN_TO_ROS else "destination_node_ids"
             verb, ports = ("publishes", "publishes") if m.direction == UAVCAN_TO_ROS else ("subscribes to",

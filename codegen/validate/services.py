@@ -20,6 +20,8 @@ from sam_codegen.catalogs.cyphal import DsdlCatalog
 from sam_codegen.catalogs.dronecan import SERVICE_ID_MAX, VENDOR_SERVICE_IDS, V0Catalog
 from sam_codegen.catalogs.ros import RosCatalog
 from sam_codegen.model.diagnostics import Diagnostics, Pos
+from sam_codegen.model.protocols.dronecan import DRONECAN
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.model.ros_names import NAME_RULES, ros_name_problem
 from sam_codegen.model.spec import DsdlStruct, Field, FieldLink, RosService, Scalar, ServiceMapping, Spec, V0Struct
 from sam_codegen.model.types import (
@@ -235,7 +237,7 @@ class ServiceValidator:
 
     def resolve_mapping(self, m: ServiceMapping, what: str) -> ResolvedServiceMapping | None:
         s = self.spec
-        if m.protocol == "cyphal":
+        if not protocol_of(m.protocol).v0:
             self.nested = self.dsdl.get
             try:
                 found = resolve_cyphal_mapping(self, m, what)
@@ -266,7 +268,7 @@ class ServiceValidator:
                 self.error(m.pos, f"destination_node_id {m.destination_field!r} of {what} is not an integer field of "
                            f"the srv request", "a node id, or the name of an integer field of the request")
                 return None
-        elif device is None or "dronecan" not in device.protocols:
+        elif device is None or DRONECAN.name not in device.protocols:
             self.error(m.pos, f"destination node id {m.destination_node_id} of {what} is not a DroneCAN device",
                        "the node id of a device with DroneCAN ports")
         if srv is None or struct is None or srv.full_name in self.bad or struct.name in self.bad:
@@ -311,7 +313,7 @@ class ServiceValidator:
                 ok = False
                 continue
             check_dsdl_value(self.diag, f.type, value, m.pos, f"uavcan value {name!r} of {what}",
-                             v0=m.protocol != "cyphal")
+                             v0=protocol_of(m.protocol).v0)
             if name in request:
                 self.error(m.pos, f"{what} writes UAVCAN request field {name!r} twice")
                 ok = False

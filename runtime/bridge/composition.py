@@ -4,19 +4,15 @@ the rclpy executor thread); they close in reverse order."""
 
 from __future__ import annotations
 
-import asyncio
 import threading
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 from sam_codegen.model.spec import UAVCAN_TO_ROS
 from sam_runtime.bridge.backend import Backend, BridgeConfigError
-from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, CyphalBackend, TransportConfig
-from sam_runtime.bridge.backends.cyphal_services import CyphalServices
-from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
-from sam_runtime.bridge.backends.dronecan_services import DroneCanServices
+from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportConfig
+from sam_runtime.bridge.backends.part import BackendSettings, BridgePart
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
-from sam_runtime.bridge.backends.time_sync_messages import sync_message
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
@@ -40,8 +36,8 @@ from sam_runtime.bridge.wiring import (
 )
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.ros_namespace import RosNamespace
-from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.protocols import RuntimeProtocol, runtime_protocol
 
 __all__ = ["Bridge"]
 
@@ -132,21 +128,17 @@ class Bridge:
         self.mappings = sel.mappings
         self.counters = {m.name: MappingStats(lock, m.name, self.log) for m in sel.mappings}
         self.switches = switches_of(sel.mappings)  # enable/disable per mapping (sam_runtime.bridge.switches)
-        self.backend: Backend
-        if sel.protocol == "dronecan":
-            from sam_runtime.bridge.backends.dronecan import DroneCanBackend  # needs dronecan (the runtime extra)
-
-            self.backend = DroneCanBackend(dronecan_iface, self.node_id, rlog=self.log, errors=self.lifetime.errors,
-                                           name=f"org.{tables.VEHICLE}.{self.name}")
-        else:
-            self.backend = CyphalBackend(f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.transport_config,
-                                         rlog=self.log, errors=self.lifetime.errors, rx_queue_size=rx_queue_size)
+        self.protocol: RuntimeProtocol = runtime_protocol(sel.protocol)
+        self.part: BridgePart = self.protocol.bridge()  # its backend, converters, duties (sam_runtime.protocols)
+        self.backend: Backend = self.part.backend(BackendSettings(
+            f"org.{tables.VEHICLE}.{self.name}", self.node_id, self.log, self.lifetime.errors,
+            transport=self.transport_config, rx_queue_size=rx_queue_size, dronecan_iface=dronecan_iface))
         self._dronecan_options = dict(dronecan_options or {})
         # The bus's time-sync master: the spec's bridge.time_sync unless the caller says (dronecan_options'
-        # "time_sync", the older spelling, too); generated packages from before the key: on, at its default period.
+        # "time_sync", the older spelling, too).
         override = self._dronecan_options.pop("time_sync", None) if time_sync is None else time_sync
         self._dronecan_options.pop("time_sync", None)
-        period = getattr(tables, "TIME_SYNC_PERIOD_S", DEFAULT_TIME_SYNC_PERIOD_S)
+        period = tables.TIME_SYNC_PERIOD_S
         if override is not None:
             period = (period or DEFAULT_TIME_SYNC_PERIOD_S) if override else None
         self.time_sync_period: float | None = period
@@ -163,7 +155,7 @@ class Bridge:
         self.inbound: Inbound | None = None
         self.outbound: Outbound | None = None
         self.reporter: Reporter | None = None
-        self.duties: Any = None  # DroneCAN: sam_runtime.bridge.backends.dronecan_duties
+        self.duties: Any = None  # the protocol's built-in duties (DroneCAN: backends.dronecan_duties), if any
         self.services: ServiceMappingsRos | None = None  # the spec's service mappings of this protocol
 
     @property
@@ -177,11 +169,7 @@ class Bridge:
         """Import the converters, assemble the parts, start them in order."""
         if self.lifetime.loop is not None or self.inbound is not None:
             raise RuntimeError("Bridge.start() called twice")
-        if self.selection.protocol == "dronecan":
-            convert = self.gen.convert_v0()  # loads the spec's v0 types into dronecan first
-        else:
-            quiet_late_media_completions(asyncio.get_running_loop())
-            convert = self.gen.convert()  # compiles the DSDL first (before uavcan/pycyphal.application)
+        convert = self.part.converters(self.gen)  # loads the protocol's types first
         codec = self._codec()
         try:
             self._assemble(convert, codec)
@@ -251,32 +239,17 @@ class Bridge:
             lifetime.every(HOUSEKEEPING_PERIOD_S, "stack counters", backend.poll_statistics)
         silence.attach(lifetime)
         lifetime.every(HOUSEKEEPING_PERIOD_S, "log", self.log.flush)
-        if sel.protocol == "dronecan":
-            # the spec's `panic_duty: mappings` turns the built-in Panic duty off (tables of older builds: on)
-            options = {"panic": getattr(tables, "DRONECAN_PANIC_DUTY", "builtin") != "mappings",
-                       **self._dronecan_options}
-            self.duties = DroneCanDuties(lifetime, backend, self.ros, sel.devices, **options)
-            self.duties.attach()
-            services = self.gen.services()
-            served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
-                      if getattr(m, "protocol", "dronecan") == "dronecan"
-                      and (m.destination_node_id in sel.devices or m.destination_field is not None)]
-            if served:
-                self.services = DroneCanServices(lifetime, backend, self.ros, served,
-                                                 diagnostics_period=self._diagnostics_period)
-                self._duty_options(self.services)
-                self.services.attach()
-        else:
-            services = self.gen.services()
-            served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
-                      if getattr(m, "protocol", "dronecan") == "cyphal"
-                      and (m.destination_node_id in sel.devices or m.destination_field is not None)]
-            if served:
-                self.services = CyphalServices(lifetime, backend, self.ros, served,
+        self.duties = self.part.duties(lifetime, backend, self.ros, sel.devices, tables, self._dronecan_options)
+        services = self.gen.services()
+        served = [m for m in (services.SERVICE_MAPPINGS if services is not None else ())
+                  if m.protocol == sel.protocol
+                  and (m.destination_node_id in sel.devices or m.destination_field is not None)]
+        if served:
+            self.services = self.part.services(lifetime, backend, self.ros, served,
                                                diagnostics_period=self._diagnostics_period)
-                self._duty_options(self.services)
-                self.services.attach()
-        self.time_sync = self._time_sync(sel.protocol)
+            self._duty_options(self.services)
+            self.services.attach()
+        self.time_sync = self._time_sync()
         inbound.on_stamp = self.time_sync.on_stamp
         reporter.time_sync = self.time_sync
         link.attach()
@@ -291,11 +264,11 @@ class Bridge:
         services.health = self.health
         services.duty_suffix = f"_{self.selection.protocol}" if self.selection.shared else ""
 
-    def _time_sync(self, protocol: str) -> StampWatch:
+    def _time_sync(self) -> StampWatch:
         """The time-sync master (advertised before the link opens; its task starts after it) and the stamp watch."""
         master = None
         if self.time_sync_period is not None:
-            msg = sync_message(protocol)
+            msg = self.part.sync_message()
             # (a port name with a dot: no mapping's, as mapping names are identifiers; the type's fixed port id, no
             # register)
             outlet = self.backend.advertise("time.synchronization", msg.port_id, msg.dtype)
@@ -303,9 +276,7 @@ class Bridge:
             master = TimeSyncMaster(self.lifetime, outlet, msg.make, self.ros.receive_ns, self.time_sync_period,
                                     msg.max_interval_s, msg.label)
             master.attach()
-        key = "DRONECAN_DEVICE_STAMPED_MAPPINGS" if protocol == "dronecan" else "DEVICE_STAMPED_MAPPINGS"
-        return StampWatch(self.lifetime, frozenset(getattr(self.tables, key, frozenset())), self.selection.devices,
-                          master)
+        return StampWatch(self.lifetime, self.protocol.device_stamped(self.tables), self.selection.devices, master)
 
     def _on_health(self, nid: int, event: str, device: bool) -> None:
         if event == "restarted":

@@ -17,13 +17,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
+from sam_runtime.protocols import default_protocol, protocol_names, registered, runtime_protocol
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
-__all__ = ["PROTOCOLS", "Selection", "destinations_of", "port_id_of", "select"]
-
-PROTOCOLS = ("cyphal", "dronecan")
+__all__ = ["Selection", "destinations_of", "port_id_of", "protocols_in_use", "select"]
 
 
 @dataclass(frozen=True)
@@ -55,16 +54,11 @@ def _layouts(tables: TablesModule) -> dict[str, Any]:
 
 
 def protocols_in_use(tables: TablesModule, layout: str) -> list[str]:
-    """The protocols whose mappings the layout runs, in PROTOCOLS order."""
+    """The protocols whose mappings the layout runs, in the registry's order (sam_runtime.protocols)."""
     lay = _layouts(tables).get(layout)
     if lay is None:
-        return ["cyphal"] if layout == "default" else []
-    used = []
-    if lay.cyphal_mappings:
-        used.append("cyphal")
-    if lay.dronecan_mappings:
-        used.append("dronecan")
-    return used
+        return [default_protocol().name] if layout == "default" else []
+    return [p.name for p in registered() if p.layout_mappings(lay)]
 
 
 def select(tables: TablesModule, layout: str | None = None, protocol: str | None = None) -> Selection:
@@ -76,24 +70,23 @@ def select(tables: TablesModule, layout: str | None = None, protocol: str | None
     if lay is None and not (name == "default" and not layouts):
         raise BridgeConfigError(f"the spec has no layout {name!r}; its layouts: {', '.join(sorted(layouts))}")
     used = protocols_in_use(tables, name)
-    if protocol is not None and protocol not in PROTOCOLS:
-        raise BridgeConfigError(f"unknown protocol {protocol!r}: expected one of {', '.join(PROTOCOLS)}")
+    if protocol is not None and protocol not in protocol_names():
+        raise BridgeConfigError(f"unknown protocol {protocol!r}: expected one of {', '.join(protocol_names())}")
     if protocol is None:
         if len(used) > 1:
             raise BridgeConfigError(
                 f"layout {name!r} has devices on {' and '.join(used)}: run one bridge per protocol "
                 f"(--protocol {' / --protocol '.join(used)})")
-        protocol = used[0] if used else "cyphal"
+        protocol = used[0] if used else default_protocol().name
     elif used and protocol not in used:
         raise BridgeConfigError(f"layout {name!r} has no mapping on {protocol} (it uses {', '.join(used)})")
-    if lay is None:  # generated tables without layouts: every mapping on Cyphal
-        infos: Sequence[Any] = tables.DEVICES
-        mappings: tuple[Any, ...] = tuple(tables.MAPPINGS)
+    entry = runtime_protocol(protocol)
+    if lay is None:  # generated tables without layouts: every mapping on the default protocol (Cyphal)
+        infos: Sequence[Any] = entry.devices(tables)
+        mappings: tuple[Any, ...] = entry.mappings(tables)
     else:
         names = set(lay.devices(protocol))
-        infos = [d for d in (tables.DEVICES if protocol == "cyphal" else tables.DRONECAN_DEVICES)
-                 if d.name in names]
-        wanted = set(lay.cyphal_mappings if protocol == "cyphal" else lay.dronecan_mappings)
-        mappings = tuple(m for m in (tables.MAPPINGS if protocol == "cyphal" else tables.DRONECAN_MAPPINGS)
-                         if m.name in wanted)
+        infos = [d for d in entry.devices(tables) if d.name in names]
+        wanted = set(entry.layout_mappings(lay))
+        mappings = tuple(m for m in entry.mappings(tables) if m.name in wanted)
     return Selection(name, protocol, mappings, {d.node_id: d.name for d in infos}, tuple(infos), len(used) > 1)

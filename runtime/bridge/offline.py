@@ -38,6 +38,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_runtime.bridge.backend import Backend, BelowBridge, BridgeConfigError, DeviceStatus, Inlet, Outlet
 from sam_runtime.bridge.counters import MappingStats
 from sam_runtime.bridge.inbound import Inbound, InMapping
@@ -49,6 +50,7 @@ from sam_runtime.bridge.wiring import codec_gaps, in_groups, missing_codecs, nom
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.protocols import runtime_protocol
 
 __all__ = ["RECEIVE_TIME_PROBE_NS", "Command", "OfflineBridge", "Published"]
 
@@ -116,7 +118,7 @@ class _Backend(Backend):
 
     @property
     def transfer_id_modulo(self) -> int:
-        return 32 if self.protocol == "dronecan" else 2**64
+        return protocol_of(self.protocol).transfer_id_modulo
 
 
 class _Timer:
@@ -206,8 +208,7 @@ class OfflineBridge:
         if missing:
             raise BridgeConfigError(f"the generated package {gen.root} has no wire codecs for "
                                     f"{codec_gaps(codec, missing)}")
-        if sel.protocol == "cyphal":
-            gen.compile_dsdl()  # the groups name the ports' compiled classes
+        runtime_protocol(sel.protocol).bridge().prepare_replay(gen)  # (Cyphal: the DSDL, compiled)
         self.rlog = RateLimitedLog(log)
         lock = threading.Lock()
         self.counters = {m.name: MappingStats(lock, m.name, self.rlog) for m in sel.mappings}

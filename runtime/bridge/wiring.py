@@ -18,7 +18,7 @@ from sam_runtime.bridge.outbound import OutMapping
 from sam_runtime.cyphal_io.ports import subscription_names
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 __all__ = ["check_destinations", "codec_gaps", "find_converter", "in_groups", "missing_codecs", "nominal_rates",
            "out_mappings", "writes_header"]

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 
 __all__ = ["DRONECAN_ROOTS", "add_types", "ensure_types", "select_types", "type_problems"]
@@ -56,7 +56,7 @@ def ensure_types(gen: Any) -> None:
     tables = gen.tables()
     if type_problems(tables) and tables.DRONECAN_DSDL_DIRS:
         add_types([gen.root / folder for folder in tables.DRONECAN_DSDL_DIRS])
-    select_types(getattr(tables, "DRONECAN_NAMESPACES", None), {t.name for t in tables.DRONECAN_TYPES if t.custom})
+    select_types(tables.DRONECAN_NAMESPACES, {t.name for t in tables.DRONECAN_TYPES if t.custom})
     problems = type_problems(tables)
     if problems:
         raise ValueError("the DroneCAN types of " + str(gen.root) + ": " + "; ".join(problems))

@@ -19,7 +19,7 @@ from sam_runtime.main_job.diag_view import bridge_lines, status_key
 from sam_runtime.main_job.vehicle_view import VehicleView
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 __all__ = ["LiveView", "summarize_message"]
 

@@ -25,7 +25,7 @@ from sam_runtime.physics.geo import depth_from_pressure, euler_from_quaternion, 
 from sam_runtime.tf_buffer import TfBuffer, TfError
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 __all__ = ["VehicleView"]
 

@@ -17,7 +17,7 @@ import importlib
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 
 __all__ = ["IMPLEMENTATIONS", "ImplementationError", "implemented", "load_implementation", "unimplemented"]

@@ -30,7 +30,7 @@ from sam_runtime.nav.mission import MissionGoal
 from sam_runtime.nodes import ImplementationError, implemented, load_implementation, unimplemented
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 __all__ = ["HostConfigError", "HostPlan", "NodeHost", "plan_host"]
 

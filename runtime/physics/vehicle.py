@@ -28,9 +28,10 @@ from __future__ import annotations
 import itertools
 import math
 import random
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any, cast
 
+from sam_runtime.common.cli_fields import Flag, cli_field, float_list
 from sam_runtime.physics.geo import (
     P_ATM,
     RHO_SEAWATER,
@@ -54,6 +55,7 @@ __all__ = [
     "SimulatedVehicle",
     "TrueState",
     "Vehicle",
+    "VehicleOptions",
     "VehicleParams",
     "steady_surge_speed",
     "surge_acceleration",
@@ -528,23 +530,55 @@ class Sensors:
                               health_pct=health, status_flags=flags)
 
 
-@dataclass
-class SimulatedVehicle:
-    """A vehicle and its sensors, built from plain options (what the simulator and the in-process tests use)."""
+def _numbers(values: tuple[float, ...]) -> str:
+    return ",".join(f"{v:g}" for v in values)
 
-    seed: int = 0
-    sea_floor: SeaFloor = field(default_factory=SeaFloor)
-    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw
-    battery_percent: float = 95.0
-    battery_drain_factor: float = 1.0
-    battery_health_pct: int = 98
-    gps_origin: tuple[float, float] = (59.35, 18.07)
+
+@dataclass(frozen=True, kw_only=True)
+class VehicleOptions:
+    """The simulated vehicle's options, defined once: SimulatedVehicle takes them, the simulator's SimConfig and the
+    closed loop's LoopOptions extend them, and the command line's options (sam_runtime.cli: `sam-sim`, and `run`,
+    which passes them on to its sim) are their fields' flags (sam_runtime.common.cli_fields). Frames: the sim's
+    world, ENU metres around gps_origin, yaw counter-clockwise from east, depth positive down."""
+
+    seed: int = field(default=0, metadata=cli_field(
+        Flag("--seed", "sensor noise seed (default 0)", type=int), value=lambda a: a.seed))
+    sea_floor: SeaFloor = field(default_factory=SeaFloor, metadata=cli_field(
+        Flag("--sea-floor", "sea floor depth [m], or a profile of distance:depth points along --sea-floor-axis "
+             "(e.g. 0:25,40:25,60:6 rises to 6 m between 40 and 60 m east; default 25)", metavar="DEPTH|S:D,...",
+             default=lambda floor: f"{floor.depth:g}"),
+        Flag("--sea-floor-axis", "direction of the profile's axis, counter-clockwise from east (default 0: east)",
+             metavar="RAD", type=float, default=lambda floor: floor.axis_yaw),
+        value=lambda a: SeaFloor.parse(a.sea_floor, axis_yaw=a.sea_floor_axis)))
+    start: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0), metadata=cli_field(
+        Flag("--start", "start position [m], depth [m] and yaw [rad] (default 0,0,0,0: at the surface, facing east)",
+             metavar="X,Y,DEPTH,YAW", default=_numbers),
+        value=lambda a: float_list(a.start, 4, "--start")))  # x, y, depth, yaw
+    battery_percent: float = field(default=95.0, metadata=cli_field(
+        Flag("--battery-start", "state of charge (default 95)", metavar="PERCENT", type=float),
+        value=lambda a: a.battery_start))
+    battery_drain_factor: float = field(default=1.0, metadata=cli_field(
+        Flag("--battery-drain-factor", "multiplies the power drawn from the battery (default 1; e.g. 300 to drain it "
+             "in minutes)", type=float), value=lambda a: a.battery_drain_factor))
+    battery_health_pct: int = field(default=98, metadata=cli_field(
+        Flag("--battery-health", "state of health; below 60 the BMS flags NEED_SERVICE, below 30 BAD_BATTERY "
+             "(default 98)", metavar="PERCENT", type=int), value=lambda a: a.battery_health))
+    gps_origin: tuple[float, float] = field(default=(59.35, 18.07), metadata=cli_field(  # KTH, Stockholm
+        Flag("--gps-origin", "latitude and longitude of the sim's origin (default 59.35,18.07: KTH, Stockholm)",
+             metavar="LAT,LON", default=_numbers),
+        value=lambda a: float_list(a.gps_origin, 2, "--gps-origin")))
     params: VehicleParams = field(default_factory=VehicleParams)
     noise: SensorNoise = field(default_factory=SensorNoise)
 
-    def __post_init__(self) -> None:
-        x, y, depth, yaw = self.start
-        self.vehicle = Vehicle(self.params, sea_floor=self.sea_floor, x=x, y=y, depth=depth, yaw=yaw,
-                               battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
-                               battery_health_pct=self.battery_health_pct)
-        self.sensors = Sensors(self.vehicle, seed=self.seed, noise=self.noise, gps_origin=self.gps_origin)
+
+class SimulatedVehicle:
+    """A vehicle and its sensors, built from its options (what the simulator and the in-process tests use):
+    ``SimulatedVehicle(options)``, or the options' fields by keyword (``SimulatedVehicle(seed=3)``)."""
+
+    def __init__(self, options: VehicleOptions | None = None, /, **fields: Any) -> None:
+        self.options = o = replace(options, **fields) if options is not None else VehicleOptions(**fields)
+        x, y, depth, yaw = o.start
+        self.vehicle = Vehicle(o.params, sea_floor=o.sea_floor, x=x, y=y, depth=depth, yaw=yaw,
+                               battery_percent=o.battery_percent, battery_drain_factor=o.battery_drain_factor,
+                               battery_health_pct=o.battery_health_pct)
+        self.sensors = Sensors(self.vehicle, seed=o.seed, noise=o.noise, gps_origin=o.gps_origin)

@@ -43,6 +43,8 @@ from pathlib import Path
 from typing import Any
 
 from sam_codegen.catalogs.ros import ros_share_dirs
+from sam_codegen.model.protocols.cyphal import CYPHAL
+from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.project.cyphal_path import dsdl_lookup_roots
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.common.run_names import RECORDING_METADATA, recorded_metadata
@@ -55,6 +57,7 @@ from sam_runtime.dronecan_io.types import ensure_types
 from sam_runtime.dronecan_io.wire import TransferTaps, crc16
 from sam_runtime.genpkg import GeneratedPackage
 from sam_runtime.node_support import qos_profile
+from sam_runtime.protocols import default_protocol, registered
 from sam_runtime.recording.schemas import (
     CYPHAL_TOPIC,
     DRONECAN_TOPIC,
@@ -108,24 +111,23 @@ class RecorderConfig:
 
 def layout_protocols(tables: Any, layout: str | None) -> tuple[str, list[str]]:
     """(layout name, the protocols its devices run), as the main job starts its bridges."""
-    layouts = {lay.name: lay for lay in getattr(tables, "LAYOUTS", ())}
-    name = str(layout or getattr(tables, "DEFAULT_LAYOUT", "default"))
+    layouts = {lay.name: lay for lay in tables.LAYOUTS}
+    name = str(layout or tables.DEFAULT_LAYOUT)
     lay = layouts.get(name)
     if lay is None:
         if layouts and name != "default":
             raise ValueError(f"the spec has no layout {name!r}; its layouts: {', '.join(sorted(layouts))}")
-        return name, ["cyphal"]
-    used = [p for p, ms in (("cyphal", lay.cyphal_mappings), ("dronecan", lay.dronecan_mappings)) if ms]
-    return name, used
+        return name, [default_protocol().name]
+    return name, [p.name for p in registered() if p.layout_mappings(lay)]
 
 
 def topic_qos(tables: Any) -> dict[str, tuple[str, str, str, int]]:
     """topic -> (ROS type, reliability, durability, depth) of the recorder's subscription (module docstring)."""
     offered: dict[str, list[Any]] = {}
-    for m in list(getattr(tables, "MAPPINGS", ())) + list(getattr(tables, "DRONECAN_MAPPINGS", ())):
+    for m in (m for p in registered() for m in p.mappings(tables)):
         if m.direction == "uavcan_to_ros":
             offered.setdefault(m.topic.name, []).append(m.topic.qos)
-    for n in getattr(tables, "NODES", ()):
+    for n in tables.NODES:
         for ep in n.publishes:
             offered.setdefault(ep.topic, []).append(ep.qos)
     out = {}
@@ -223,13 +225,13 @@ class Recorder:
                 "log_time": "ROS: rclpy receive time; transfers: the listener's receive time (system clock, ns)",
                 "publish_time": "ROS: the publisher's source timestamp; transfers: the listener's receive time",
                 **recorded_metadata(self.names)}
-        if "cyphal" in self.protocols:
+        if CYPHAL.name in self.protocols:
             self.subjects = {p.subject_id: p.dsdl_type for d in tables.DEVICES for p in (*d.publishes, *d.subscribes)}
             self.subjects[HEARTBEAT_SUBJECT] = HEARTBEAT_TYPE
             self.services = dict(CYPHAL_SERVICES)
             services = self.gen.services()
             for m in getattr(services, "SERVICE_MAPPINGS", ()) if services is not None else ():
-                if m.protocol == "cyphal":
+                if m.protocol == CYPHAL.name:
                     self.services[int(m.data_type_id)] = str(m.data_type)
             meta["cyphal.iface"] = f"udp:{self.config.iface}"
             meta["cyphal.subjects"] = json.dumps({str(k): v for k, v in sorted(self.subjects.items())})
@@ -244,11 +246,11 @@ class Recorder:
                 log.warning("the DSDL definitions could not be stored: %s: %s", type(ex).__name__, ex)
             w.add_channel(CYPHAL_TOPIC, TRANSFER_TYPE, "ros2msg", TRANSFER_MSG,
                           metadata={"offered_qos_profiles": qos_yaml("reliable", "volatile", 1)})
-        if "dronecan" in self.protocols:
+        if DRONECAN.name in self.protocols:
             import dronecan
 
             ensure_types(self.gen)
-            names = [t.name for t in getattr(tables, "DRONECAN_TYPES", ())]
+            names = [t.name for t in tables.DRONECAN_TYPES]
             names += ["uavcan.protocol.NodeStatus", "uavcan.protocol.GetNodeInfo", "uavcan.protocol.RestartNode",
                       "uavcan.protocol.Panic", "uavcan.protocol.GlobalTimeSync"]
             dtypes = [dronecan.TYPENAMES[n] for n in names if n in dronecan.TYPENAMES]
@@ -280,9 +282,9 @@ class Recorder:
     async def start(self) -> None:
         self._describe()
         channels = self._ros_channels()
-        if self.config.bus and "cyphal" in self.protocols:  # the bus first: its side spans the ROS side
+        if self.config.bus and CYPHAL.name in self.protocols:  # the bus first: its side spans the ROS side
             await self._start_cyphal()
-        if self.config.bus and "dronecan" in self.protocols:
+        if self.config.bus and DRONECAN.name in self.protocols:
             self._start_dronecan()
         if self.config.ros:
             self._start_ros(channels)

@@ -23,7 +23,7 @@ from sam_runtime.nav.motion_planner import GoalDecision, Plan, Planner, PlannerC
 from sam_runtime.nav.performance_monitor import MonitorLimits, MonitorOutput, PerformanceMonitor
 from sam_runtime.nav.slam import SlamConfig, SlamCorrector
 from sam_runtime.physics.geo import Vec3, local_from_latlon
-from sam_runtime.physics.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, VehicleParams
+from sam_runtime.physics.vehicle import SimulatedVehicle, VehicleOptions
 
 __all__ = ["ClosedLoop", "LoopOptions"]
 
@@ -39,17 +39,10 @@ def _f16_3(v: Sequence[float]) -> Vec3:
     return _f16(v[0]), _f16(v[1]), _f16(v[2])
 
 
-@dataclass
-class LoopOptions:
-    seed: int = 0
-    sea_floor: SeaFloor = field(default_factory=SeaFloor)
-    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw (truth frame)
-    battery_percent: float = 95.0
-    battery_drain_factor: float = 1.0
-    battery_health_pct: int = 98
-    gps_origin: tuple[float, float] = (59.35, 18.07)
-    params: VehicleParams = field(default_factory=VehicleParams)
-    noise: SensorNoise = field(default_factory=SensorNoise)
+@dataclass(frozen=True, kw_only=True)
+class LoopOptions(VehicleOptions):
+    """The simulated vehicle's options (its start in the truth frame) and the navigation stack's."""
+
     safe_depth: float = 50.0
     safe_altitude: float = 5.0
     limits: MonitorLimits = field(default_factory=MonitorLimits)
@@ -69,10 +62,7 @@ _PERIODS = {"imu": 1, "mag": 2, "pressure": 5, "altitude": 10, "feedback": 10, "
 class ClosedLoop:
     def __init__(self, options: LoopOptions | None = None) -> None:
         o = self.options = options or LoopOptions()
-        self.sim = SimulatedVehicle(seed=o.seed, sea_floor=o.sea_floor, start=o.start,
-                                    battery_percent=o.battery_percent, battery_drain_factor=o.battery_drain_factor,
-                                    battery_health_pct=o.battery_health_pct, gps_origin=o.gps_origin,
-                                    params=o.params, noise=o.noise)
+        self.sim = SimulatedVehicle(o)
         self.vehicle, self.sensors = self.sim.vehicle, self.sim.sensors
         self.dr = DeadReckoning(o.dead_reckoning)
         self.slam = SlamCorrector(o.slam)

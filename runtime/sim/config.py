@@ -6,16 +6,18 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from sam_runtime.physics.vehicle import SeaFloor, SensorNoise, SimulatedVehicle, VehicleParams
+from sam_runtime.common.cli_fields import Flag, cli_field
+from sam_runtime.physics.vehicle import SimulatedVehicle, VehicleOptions
 
 __all__ = ["SimConfig"]
 
 
-@dataclass
-class SimConfig:
+@dataclass(frozen=True)
+class SimConfig(VehicleOptions):
     """``kind``/``iface``/``mtu`` as in :func:`~sam_runtime.cyphal_io.transport.make_transport`
     (``env``: UAVCAN__UDP__IFACE
-    / UAVCAN__CAN__IFACE / UAVCAN__CAN__MTU from ``environ``; node ids always come from the spec)."""
+    / UAVCAN__CAN__IFACE / UAVCAN__CAN__MTU from ``environ``; node ids always come from the spec). The simulated
+    vehicle's options are VehicleOptions' (keyword only); the fields with a flag are `sam-sim`'s options."""
 
     kind: str = "udp"
     iface: str | None = None
@@ -27,27 +29,15 @@ class SimConfig:
     devices: Iterable[str] | None = None  # subset of device names; default all
     rate_scale: float = 1.0
     record: Path | None = None  # JSON lines of every transmitted/received message
-    # The simulated vehicle (physics.vehicle): noise seed, sea floor, start pose in the sim's world frame
-    # (ENU metres around gps_origin; yaw counter-clockwise from east), battery, time.
-    seed: int = 0
-    sea_floor: SeaFloor = field(default_factory=SeaFloor)
-    start: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, depth, yaw
-    battery_percent: float = 95.0
-    battery_drain_factor: float = 1.0  # multiplies the power drawn (a scenario can drain the battery quickly)
-    battery_health_pct: int = 98
-    gps_origin: tuple[float, float] = (59.35, 18.07)  # lat, lon of the sim's world origin (KTH, Stockholm)
-    vehicle_params: VehicleParams = field(default_factory=VehicleParams)
-    noise: SensorNoise = field(default_factory=SensorNoise)
-    time_scale: float = 1.0  # vehicle seconds per wall second (rates and stamps follow)
-    truth_file: Path | None = None  # the true state: JSON lines if it ends in .jsonl, else an atomic JSON file
-    truth_rate_hz: float = 5.0  # of vehicle time
-
-    def make_vehicle(self) -> SimulatedVehicle:
-        """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""
-        return SimulatedVehicle(seed=self.seed, sea_floor=self.sea_floor, start=self.start,
-                                battery_percent=self.battery_percent, battery_drain_factor=self.battery_drain_factor,
-                                battery_health_pct=self.battery_health_pct, gps_origin=self.gps_origin,
-                                params=self.vehicle_params, noise=self.noise)
+    # The vehicle's time (the main job runs its nodes on the wall clock: no --time-scale there) and its true state.
+    time_scale: float = field(default=1.0, metadata=cli_field(
+        Flag("--time-scale", "vehicle seconds per wall second; rates and stamps follow (default 1)", type=float,
+             main_job=False), value=lambda a: a.time_scale))
+    truth_file: Path | None = field(default=None, metadata=cli_field(  # the main job names its own
+        Flag("--truth-file", "the vehicle's true state: JSON lines if it ends in .jsonl, else one JSON object "
+             "replaced atomically", type=Path, forwarded=False), value=lambda a: a.truth_file))
+    truth_rate_hz: float = field(default=5.0, metadata=cli_field(  # of vehicle time
+        Flag("--truth-rate", "truth samples per vehicle second (default 5)", type=float), value=lambda a: a.truth_rate))
     log_interval: float = 10.0  # failed publications: the first logged at once, then a count per interval
     # Each device its own clock (an offset of 5..120 s from the computers', sam_runtime.sim.time_sync), following the
     # bus's time-sync master and stamping 0 ("unknown") until it synchronised; off: the shared stamp clock, as
@@ -56,3 +46,7 @@ class SimConfig:
     # A reboot (ExecuteCommand RESTART, RestartNode): the device is silent this long (its reset, bootloader and
     # firmware start) before its new node (uptime and transfer ids from 0) comes up
     reboot_s: float = 1.0
+
+    def make_vehicle(self) -> SimulatedVehicle:
+        """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""
+        return SimulatedVehicle(self)

@@ -131,6 +131,9 @@ class CyphalDevices:
         except Exception as ex:
             _log.warning("closing the simulated Cyphal nodes: %s: %s", type(ex).__name__, ex)
 
+    def command_report(self, sp: SubPort) -> dict[str, Any]:
+        return {}
+
     def blank(self, pp: PubPort, t: float, now_us: int) -> Any:
         return generic_fill(pp.dtype(), t, now_us, seed=pp.ident)
 

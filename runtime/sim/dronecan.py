@@ -299,6 +299,9 @@ class DroneCanDevices:
             close_node(loop, node, _log, f"{dev.info.name}: closing its DroneCAN node")
 
     # ------------------------------------------------------------------------------------------ messages
+    def command_report(self, sp: SubPort) -> dict[str, Any]:
+        return {"not_addressed": sp.not_addressed}  # broadcasts whose node-id field names another device
+
     def blank(self, pp: PubPort, t: float, now_us: int) -> Any:
         import dronecan
 

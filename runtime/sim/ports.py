@@ -16,7 +16,7 @@ from sam_runtime.sim.devices import DeviceState, PhysicsFn
 from sam_runtime.sim.time_sync import DeviceClock, SyncSlave
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 __all__ = ["DeviceAdapter", "DeviceHost", "PubPort", "SimDevice", "SubPort"]
 
@@ -138,6 +138,9 @@ class DeviceAdapter(Protocol):
 
     def record(self, port: Any, obj: Any, transmitted: bool) -> dict[str, Any]:
         """A JSON-able record of a message (as transmitted)."""
+
+    def command_report(self, sp: SubPort) -> dict[str, Any]:
+        """The protocol's own counts of a command port in the run report (beside accepted and rejected)."""
 
     def sync_params(self, dev: SimDevice) -> tuple[float, int]:
         """The protocol's time sync: the longest interval between two messages of a master (s), the transfer id

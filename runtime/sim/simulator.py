@@ -51,8 +51,8 @@ from typing import TYPE_CHECKING, Any, TextIO
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.common.tasks import cancel_and_wait
 from sam_runtime.genpkg import GeneratedPackage
+from sam_runtime.protocols import default_protocol, registered, runtime_protocol
 from sam_runtime.sim.config import SimConfig
-from sam_runtime.sim.cyphal import CyphalDevices
 from sam_runtime.sim.devices import (
     PHYSICS,
     SAM_ACTUATORS,
@@ -65,7 +65,7 @@ from sam_runtime.sim.ports import DeviceAdapter, PubPort, SimDevice, SubPort
 from sam_runtime.sim.time_sync import DeviceClock, SyncSlave, device_offset_us
 
 if TYPE_CHECKING:
-    from sam_codegen.targets.python.tables_api import TablesModule
+    from sam_codegen.contracts.tables_api import TablesModule
 
 # The device models live in sam_runtime.sim.devices; re-exported here, where the tests and benchmarks import them.
 __all__ = ["PHYSICS", "SAM_ACTUATORS", "DeviceState", "SimConfig", "Simulator", "VehicleState", "generic_fill",
@@ -84,7 +84,7 @@ def layout_protocols(tables: TablesModule, layout: str = "default") -> dict[str,
     if lay is not None:
         return dict(lay.protocols)
     if layout == "default" and not layouts:
-        return {d.name: "cyphal" for d in tables.DEVICES}
+        return {d.name: default_protocol().name for d in default_protocol().devices(tables)}
     raise ValueError(f"the spec has no layout {layout!r}; its layouts: {', '.join(sorted(layouts) or ['default'])}")
 
 
@@ -110,8 +110,8 @@ class Simulator:
         wanted = None if self.config.devices is None else set(self.config.devices)
         if wanted is not None and wanted - set(protocols):
             raise ValueError(f"unknown device(s) {sorted(wanted - set(protocols))}; the spec has {sorted(protocols)}")
-        firmware: dict[str, dict[str, Any]] = {"cyphal": {d.name: d for d in self.tables.DEVICES},
-                    "dronecan": {d.name: d for d in self.tables.DRONECAN_DEVICES}}
+        firmware: dict[str, dict[str, Any]] = {p.name: {d.name: d for d in p.devices(self.tables)}
+                                               for p in registered()}
         self.devices = []
         for name, protocol in protocols.items():
             info = firmware.get(protocol, {}).get(name)
@@ -125,15 +125,12 @@ class Simulator:
                 dev.clock = DeviceClock(self.vehicle.epoch_us, self.vehicle.mono0_ns, device_offset_us(dev.info.name))
         self._adapters: dict[str, DeviceAdapter] = {}
         for protocol in {d.protocol for d in self.devices}:
-            if protocol == "dronecan":
-                try:
-                    from sam_runtime.sim.dronecan import DroneCanDevices  # imports dronecan (the runtime extra)
-                except ImportError as ex:
-                    raise ValueError(f"layout {self.config.layout!r} has DroneCAN devices, which need the dronecan "
-                                     f"package (pip extra 'runtime'): {ex}") from None
-                self._adapters[protocol] = DroneCanDevices(self)
-            else:
-                self._adapters[protocol] = CyphalDevices(self)
+            entry = runtime_protocol(protocol)
+            try:  # (DroneCAN's imports dronecan, the runtime extra: only when a device runs it)
+                adapter = entry.sim()
+            except ImportError as ex:
+                raise ValueError(f"layout {self.config.layout!r} has {entry.label} devices: {ex}") from None
+            self._adapters[protocol] = adapter(self)
         self._go: asyncio.Event | None = None  # created in start() (inside the loop)
         self._running: asyncio.Event | None = None  # cleared by pause()
         self._record: TextIO | None = None
@@ -458,7 +455,7 @@ class Simulator:
                         "accepted": s.accepted, "rejected": s.rejected,
                         "rejected_sources": {str(k): v for k, v in s.rejected_sources.items()},
                         "last": s.last,
-                        **({"not_addressed": s.not_addressed} if d.protocol == "dronecan" else {}),
+                        **self._adapter(d).command_report(s),
                     } for s in d.subs
                 },
                 "position": dict(d.state.position),

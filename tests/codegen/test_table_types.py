@@ -9,11 +9,11 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+from sam_codegen.contracts import table_types
+from sam_codegen.contracts.tables_api import TablesModule
 from sam_codegen.frontend.loader import load_spec_file
-from sam_codegen.targets.python import table_types
 from sam_codegen.targets.python.convert import emit
 from sam_codegen.targets.python.tables import table_types_source, tables_context
-from sam_codegen.targets.python.tables_api import TablesModule
 from sam_codegen.validate.resolve import validate
 
 ROOT = Path(__file__).resolve().parents[2]

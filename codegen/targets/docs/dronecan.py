@@ -8,6 +8,7 @@ worded by wording.field_rows, as for Cyphal mappings. Imported only by the packa
 
 from __future__ import annotations
 
+from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.targets.docs.graph import UAVCAN_TO_ROS
 from sam_codegen.targets.docs.traffic import traffic_words
 from sam_codegen.targets.docs.wording import field_rows, fmt_number, fmt_rate
@@ -29,7 +30,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, object]:
         "name": d.name, "node_id": d.node_id, "default": d.protocol,
         "publishes": [f"{p.type} at {fmt_rate(p.rate_hz)}" for p in d.dronecan_publishes],
         "subscribes": [f"{p.type} at {fmt_rate(p.rate_hz)}" for p in d.dronecan_subscribes],
-    } for d in spec.devices.values() if "dronecan" in d.protocols]
+    } for d in spec.devices.values() if DRONECAN.name in d.protocols]
     types = [{
         "name": t.name, "id": t.data_type_id, "signature": f"0x{t.signature:016X}", "description": t.description,
         "fields": [{"name": f.name, "type": str(f.type), "comment": f.comment or ("padding" if not f.name else "")}

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from sam_codegen.model.protocols.registry import protocol as protocol_of
 from sam_codegen.validate.resolve import Resolved
 from sam_codegen.validate.services import ServiceLink
 
@@ -80,7 +81,7 @@ def services_context(resolved: Resolved) -> dict[str, Any]:
             "data_type": rm.data_type, "data_type_id": rm.service_id, "protocol": m.protocol,
             "destination": destination,
             "timeout": f"{m.timeout_s:g} s", "failure": failure, "rows": rows,
-            "duty": m.duty, "protocol_label": "Cyphal" if m.protocol == "cyphal" else "DroneCAN",
+            "duty": m.duty, "protocol_label": protocol_of(m.protocol).label,
         })
     return {"services": {"srvs": srvs, "v0": v0, "cyphal": cyphal, "mappings": mappings}
             if srvs or v0 or cyphal or mappings else None}

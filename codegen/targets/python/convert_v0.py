@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import V0Struct
 from sam_codegen.render.filters import py_str
 from sam_codegen.render.templating import render
@@ -75,7 +76,7 @@ def used_types(resolved: Resolved) -> list[V0Struct]:
     names = {rm.dsdl_struct.name for rm in resolved.dronecan_mappings} | {t.name for t in resolved.dronecan_types
                                                                           if t.data_type_id is not None}
     for device in resolved.spec.devices.values():
-        if "dronecan" in device.protocols:
+        if DRONECAN.name in device.protocols:
             names |= {p.type for p in [*device.dronecan_publishes, *device.dronecan_subscribes]}
     result = []
     for name in sorted(names):

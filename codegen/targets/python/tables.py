@@ -13,12 +13,14 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sam_codegen.contracts import table_types
+from sam_codegen.model.protocols.cyphal import CYPHAL
+from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import UAVCAN_TO_ROS, Mapping, Port, Qos, V0Struct
 from sam_codegen.render.filters import py_number, py_str
 from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
 from sam_codegen.targets import dsdl_v0
 from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
-from sam_codegen.targets.python import table_types
 from sam_codegen.targets.python.convert_v0 import used_types
 from sam_codegen.targets.python.names import py_class_name, py_module
 from sam_codegen.targets.ros import build_order
@@ -58,7 +60,7 @@ def cyphal_context(resolved: Resolved) -> dict[str, Any]:
         "name": py_str(d.name), "node_id": str(d.node_id), "description": d.description,
         "publishes": [_port_info(resolved, p) for p in d.publishes],
         "subscribes": [_port_info(resolved, p) for p in d.subscribes],
-    } for d in spec.devices.values() if "cyphal" in d.protocols]
+    } for d in spec.devices.values() if CYPHAL.name in d.protocols]
     topics = []
     for topic in spec.topics.values():
         ros_type, module, cls = _ros_type_parts(topic.type)
@@ -155,7 +157,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
     types = {t.name: t for t in used_types(resolved)} if catalog is not None else {}
     devices = []
     for d in spec.devices.values():
-        if "dronecan" not in d.protocols:
+        if DRONECAN.name not in d.protocols:
             continue
         devices.append({
             "name": py_str(d.name), "node_id": str(d.node_id), "description": d.description,

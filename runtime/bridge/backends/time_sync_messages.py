@@ -13,7 +13,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["SyncMessage", "sync_message"]
+from sam_runtime.protocols import runtime_protocol
+
+__all__ = ["SyncMessage", "cyphal_sync_message", "dronecan_sync_message", "sync_message"]
 
 UINT56 = (1 << 56) - 1
 
@@ -28,13 +30,21 @@ class SyncMessage:
 
 
 def sync_message(protocol: str) -> SyncMessage:
-    if protocol == "dronecan":
-        import dronecan
+    """The time-sync message of a registered protocol (its bridge part's)."""
+    message: SyncMessage = runtime_protocol(protocol).bridge().sync_message()
+    return message
 
-        cls = dronecan.TYPENAMES["uavcan.protocol.GlobalTimeSync"]
-        return SyncMessage("uavcan.protocol.GlobalTimeSync", int(cls.default_dtid), cls,
-                           lambda us: cls(previous_transmission_timestamp_usec=us & UINT56),
-                           cls().MAX_BROADCASTING_PERIOD_MS / 1000.0)
+
+def dronecan_sync_message() -> SyncMessage:
+    import dronecan
+
+    cls = dronecan.TYPENAMES["uavcan.protocol.GlobalTimeSync"]
+    return SyncMessage("uavcan.protocol.GlobalTimeSync", int(cls.default_dtid), cls,
+                       lambda us: cls(previous_transmission_timestamp_usec=us & UINT56),
+                       cls().MAX_BROADCASTING_PERIOD_MS / 1000.0)
+
+
+def cyphal_sync_message() -> SyncMessage:
     import uavcan.time
 
     sync = uavcan.time.Synchronization_1_0

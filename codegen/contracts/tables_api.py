@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from sam_codegen.targets.python.table_types import (
+from sam_codegen.contracts.table_types import (
     DeviceInfo,
     DroneCanDeviceInfo,
     DroneCanMappingInfo,

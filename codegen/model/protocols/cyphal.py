@@ -1,0 +1,13 @@
+"""Cyphal (UAVCAN v1) as the generator sees it."""
+
+from __future__ import annotations
+
+from sam_codegen.model.protocols.description import ProtocolDescription
+
+__all__ = ["CYPHAL"]
+
+CYPHAL = ProtocolDescription(
+    name="cyphal", label="Cyphal", v0=False, mappings_key="mappings", mapping_noun="mapping",
+    liveness_type="uavcan.node.Heartbeat.1.0", node_ids=range(0, 128), transfer_id_modulo=2**64,
+    codec_package="codec", mappings_table="MAPPINGS", devices_table="DEVICES",
+    device_stamped_table="DEVICE_STAMPED_MAPPINGS", layout_mappings_field="cyphal_mappings", can_fd=True)
