@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from sam_codegen.frontend.bus import parse_bus
+from sam_codegen.frontend.device_params import parse_parameters
 from sam_codegen.frontend.element_links import element_link
 from sam_codegen.frontend.expr_parser import ExprSyntaxError, parse_expr
 from sam_codegen.frontend.reading import Reader, map_items, number, scalar, seq_items, str_list, text_of
@@ -264,7 +265,7 @@ def _v0_ports(node: YNode | None, what: str, diag: Diagnostics) -> list[V0Port]:
     return ports
 
 
-_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes")  # and each protocol's name
+_DEVICE_KEYS = ("node_id", "description", "protocol", "publishes", "subscribes", "parameters")  # and each protocol's
 
 
 def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
@@ -280,7 +281,8 @@ def parse_device(key: str, pos: Pos, node: YNode, diag: Diagnostics) -> Device:
     def device(ports: dict[str, list[Port]], v0_ports: dict[str, list[V0Port]], protocols: tuple[str, ...]) -> Device:
         return Device(key, node_id if node_id is not None else -1, text_of(r, "description"),
                       ports.get("publishes", []), ports.get("subscribes", []), pos, protocol, protocols,
-                      v0_ports.get("publishes", []), v0_ports.get("subscribes", []), protocol_pos)
+                      v0_ports.get("publishes", []), v0_ports.get("subscribes", []), protocol_pos,
+                      parse_parameters(r.node("parameters"), key, protocols, diag))
 
     if protocol not in known:
         diag.error(r.key_pos("protocol"), f"protocol {protocol!r} of {what} is unknown", " or ".join(known))

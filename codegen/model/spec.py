@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Final, Literal
 
+from sam_codegen.model.device_params import DeviceParameter
 from sam_codegen.model.diagnostics import NOWHERE, Pos
 from sam_codegen.model.expr import ExprSource, UavcanExpr
 from sam_codegen.model.types import DsdlType, RosType, split_composite_name
@@ -332,6 +333,7 @@ class Device:
     dronecan_publishes: list[V0Port] = field(default_factory=list)  # its DroneCAN ports
     dronecan_subscribes: list[V0Port] = field(default_factory=list)
     protocol_pos: dict[str, Pos] = field(default_factory=dict)  # where each protocol's ports are declared
+    parameters: tuple[DeviceParameter, ...] = ()  # the settings its board holds
 
 
 @dataclass(frozen=True)

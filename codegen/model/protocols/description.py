@@ -30,3 +30,10 @@ class ProtocolDescription:
     device_stamped_table: str  # the mappings whose stamps come from the device's clock,
     layout_mappings_field: str  # and the LayoutInfo field of the layout's mappings on this protocol
     can_fd: bool  # its frames use CAN FD's data phase when the bus has one
+    # A board's settings (model.device_params): what one is called ("register", "parameter"), how its name is
+    # checked and derived from the spec's name ("register": uavcan.register naming, the spec's name as it is;
+    # "upper": printable ASCII, the spec's name upper-cased), the longest name and string value the protocol carries.
+    setting_noun: str = "parameter"
+    setting_name_style: str = "register"
+    setting_name_max: int = 255
+    setting_string_max: int = 256

@@ -20,6 +20,8 @@ from collections.abc import Hashable, Iterable
 from pathlib import Path
 
 from sam_codegen.catalogs.ros_known import external_messages_to_generate
+from sam_codegen.model.device_params import DeviceParameter, ParamValue
+from sam_codegen.model.protocols.registry import protocol
 from sam_codegen.model.spec import QOS_PROFILES, Mapping, Node, Port, Qos, Spec, describe_sides, topic_profile
 from sam_codegen.targets.docs.graph import ROS_TO_UAVCAN, SVG_NAME, UAVCAN_TO_ROS, Graph, PortIndex, mermaid_context
 from sam_codegen.targets.docs.traffic import traffic_words
@@ -69,6 +71,7 @@ def markdown_context(resolved: Resolved, graph: Graph) -> dict[str, object]:
         "transforms": [{"parent": t.parent, "child": t.child, "publisher": t.publisher, "description": t.description}
                        for t in spec.transforms],
         "devices": _device_rows(spec),
+        "device_parameters": _device_parameter_rows(spec),
         "subjects": _subject_rows(spec, subject_types),
         "bridge": _bridge_summary(spec, topic_users, subject_types),
         "dsdl_types": _dsdl_type_rows(resolved),
@@ -243,6 +246,30 @@ def _device_rows(spec: Spec) -> list[Row]:
              "publishes": [_port_text(p) for p in d.publishes],
              "subscribes": [_port_text(p) for p in d.subscribes]}
             for d in spec.devices.values()]
+
+
+def _setting_value(p: DeviceParameter, value: ParamValue) -> str:
+    if p.type == "enum":
+        return f"{value} ({p.stored(value)})"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return fmt_number(value) if isinstance(value, (int, float)) else repr(value)
+
+
+def _device_parameter_rows(spec: Spec) -> list[Row]:
+    """Each board's settings (model.device_params) with the name its firmware knows each by on every protocol."""
+    rows = []
+    for d in spec.devices.values():
+        if not d.parameters:
+            continue
+        rows.append({"device": d.name, "node_id": d.node_id, "parameters": [{
+            "name": p.name, "type": p.type, "range": _range(p.minimum, p.maximum) if p.minimum is not None else "",
+            "choices": ", ".join(f"{name} ({number})" for name, number in p.values),
+            "max_length": p.max_length, "unit": p.unit, "default": _setting_value(p, p.default),
+            "restart": p.restart, "description": p.description,
+            "names": [f"{protocol(proto).label} {protocol(proto).setting_noun} `{wire}`" for proto, wire in p.names],
+        } for p in d.parameters]})
+    return rows
 
 
 def _subject_rows(spec: Spec, subject_types: dict[int, str]) -> list[Row]:
