@@ -130,6 +130,14 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:59:7: error: mapping 'valve': pass_nan: true acts on nothing: none of its values can carry a NaN into a UAVCAN float without limits (an integer or bool holds no NaN; a limited field rejects NaN either way) (expected no pass_nan here, or a float field without limits)",
         ),
     ),
+    Case(  # uint8 into uint8: nothing is ever out of range, so the policy decides nothing
+        'reject_policy_with_nothing_out_of_range',
+        '      destination_node_id: 11\n',
+        '      destination_node_id: 11\n      on_out_of_range: reject\n',
+        (
+            "minimal.yaml:54:5: error: mapping 'valve': on_out_of_range: reject acts on nothing: none of its values can be out of its target's range (each fits the field it goes into) (expected no on_out_of_range here)",
+        ),
+    ),
     Case(
         'table_default_on_a_ros_to_uavcan_mapping',
         '        data: open_pct\n',

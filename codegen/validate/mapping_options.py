@@ -5,7 +5,10 @@ never a silent no-op, since whoever wrote one believes it guards something.
   (an integer or bool field cannot hold NaN; a limited field rejects NaN either way);
 - a table's `default` in a ROS -> UAVCAN mapping (the reverse lookup rejects a ROS value no key gives; the default
   names the ROS value of unlisted UAVCAN values, which only a UAVCAN -> ROS mapping receives);
-- `limits` on an integer field whose whole range lies within them (they bound nothing).
+- `limits` on an integer field whose whole range lies within them (they bound nothing);
+- `on_out_of_range: reject` on a mapping none of whose values, in its direction, can be out of its target's range
+  (uint8 into uint8, float32 into float32...): the policy decides nothing there. Judged conservatively (a line whose
+  range is not known here, a timestamp, an expression, elements, a string, counts as one that may decide).
 
 Checked on the resolved mappings (both protocols), and only on a mapping whose lines all resolved: a line that
 failed is reported already, and without it whether an option acts is unknown."""
@@ -34,6 +37,40 @@ def _nan_reaches_float(step: Step) -> bool:
         target = uav.element if step.kind == "array" else uav
         return step.ros_type.base in ROS_FLOAT_BITS and target.kind == "float" and step.limits is None
     return False  # time, table, string, value: no float NaN on the way
+
+
+def _may_decide(step: Step, to_uavcan: bool) -> bool:
+    """Whether `on_out_of_range` can decide anything for this step in this direction: a value that may lie beyond
+    its target's range (conversion_plan.lowering plans a clamp there). True whenever unsure."""
+    uav = step.uavcan_type
+    if step.kind in ("value", "table"):  # a table's miss is rejected whatever the policy
+        return False
+    if step.kind not in ("number", "array") or uav is None or step.wrap:
+        return True
+    elem = uav.element if step.kind == "array" else uav
+    ros = step.ros_type.base
+    if to_uavcan and step.kind == "array":  # a length the UAVCAN array may not take
+        cap = uav.capacity or 0
+        if step.ros_type.array != "fixed" or (step.ros_type.capacity or 0) > cap or (
+                uav.array == "fixed" and step.ros_type.capacity != cap):
+            return True
+    if ros == "bool" or elem.kind == "bool":
+        return not (ros == "bool" and elem.kind == "bool")
+    if step.scale is not None or step.offset is not None or step.limits is not None:
+        return True
+    ros_int = ros in ROS_INT_RANGES
+    if not ros_int and ros not in ROS_FLOAT_BITS:
+        return True
+    if not to_uavcan:  # into ROS only a UAVCAN float into a ROS integer (`round`) has a range to meet
+        return elem.kind == "float" and ros_int
+    if ros_int and elem.kind in ("int", "uint", "byte"):
+        lo, hi = ROS_INT_RANGES[ros]
+        return not (elem.range[0] <= lo and hi <= elem.range[1])
+    if elem.kind == "float":  # a ROS integer into float16 may pass 65504; a float into a narrower float
+        if ros_int:
+            return elem.bits == 16 and max(abs(v) for v in ROS_INT_RANGES[ros]) > 65504
+        return elem.bits < ROS_FLOAT_BITS[ros]
+    return True
 
 
 def _links(mapping: Mapping) -> Iterator[tuple[FieldLink, str]]:
@@ -72,6 +109,11 @@ def check_mapping_options(resolved: Iterable[ResolvedMapping], diag: Diagnostics
                 diag.error(link.pos, f"{what}, field {name}: a table's default names the ROS value of the UAVCAN "
                            "values it does not list, which only a UAVCAN -> ROS mapping receives; a ROS -> UAVCAN "
                            "mapping rejects a ROS value no key gives", "no default in this table")
+        to_uavcan = m.direction == ROS_TO_UAVCAN
+        own = [s for s in rm.steps if (s.uavcan_path if to_uavcan else s.ros_path)]  # what its direction converts
+        if m.on_out_of_range == "reject" and own and not any(_may_decide(s, to_uavcan) for s in own):
+            diag.error(m.pos, f"{what}: on_out_of_range: reject acts on nothing: none of its values can be out of "
+                       "its target's range (each fits the field it goes into)", "no on_out_of_range here")
         for step in _limits_bind_nothing(rm.steps):
             lo, hi = ROS_INT_RANGES[step.ros_type.base]
             assert step.limits is not None

@@ -133,6 +133,9 @@ INPUTS: tuple[Input, ...] = (
     Input("spec a table default on a command", lambda d: _validate(_minimal(
         d, "        data: open_pct\n", "        data: {from: open_pct, table: {0: 0, 1: 100, default: 0}}\n")),
         "only a UAVCAN -> ROS mapping receives"),
+    Input("spec reject with nothing out of range", lambda d: _validate(_minimal(
+        d, "      destination_node_id: 11\n", "      destination_node_id: 11\n      on_out_of_range: reject\n")),
+        "on_out_of_range: reject acts on nothing"),
     Input("spec limits that bound nothing", lambda d: _validate(_minimal(
         d, "        data: open_pct\n", "        data: {from: open_pct, limits: [-5, 1000]}\n")), "bound nothing"),
     Input("replay a directory", lambda d: _replay(str(d)), "is a directory, not a recording", 2),
