@@ -13,7 +13,8 @@ Per transport (Cyphal/UDP on 127.0.0.1; Cyphal/CAN FD on python-can ``virtual``)
   subjects on UDP, own virtual bus on CAN), measured in the same run and interleaved with the bridge runs.
 - latency, paced at ``latency_hz``: UAVCAN publish -> ROS callback (the send time travels in the RawIMU
   timestamp, which the converter turns into header.stamp) and ROS publish -> UAVCAN receive (a sequence number
-  travels in the two float16 angles, inside their limits: bench.common.seq_angles; the ROS process returns its send times).
+  travels in the two float16 angles, inside their limits: bench.common.seq_angles; the ROS process returns its
+  send times).
 - CPU time of this process (os.times: all its threads) per 1000 messages of the throughput runs, split by thread
   (main = asyncio loop: the device publisher + pycyphal + the bridge's UAVCAN half; the bridge's rclpy thread;
   other = DDS and transport I/O threads); the ROS process's CPU beside it; resident memory (VmRSS) before and
