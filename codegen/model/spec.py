@@ -430,6 +430,7 @@ class Mapping:
     # ROS -> UAVCAN: a float NaN command is rejected (counted as `not_a_number`) unless the mapping says
     # `pass_nan: true`, for a device that reads NaN as a command of its own ("hold", "no setpoint").
     pass_nan: bool = False
+    pass_nan_pos: Pos | None = None  # where `pass_nan` is written (its errors point there)
 
     @property
     def enable_service_name(self) -> str:
