@@ -98,6 +98,11 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
     _add_wire_arg(p)
+    p.add_argument("--managed", action="store_true",
+                   help="a ROS 2 managed (lifecycle) node: start unconfigured and wait for a lifecycle manager "
+                        "(lifecycle_msgs change_state: configure opens the bus, activate bridges commands, "
+                        "deactivate drops them as 'inactive' while telemetry goes on, cleanup, shutdown exits); "
+                        "default: a plain node, bridging from the start")
     add_namespace_args(p)
     p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
     return p
@@ -123,8 +128,8 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
     from sam_runtime.cyphal_io.transport import TransportConfigError
     from sam_runtime.genpkg import GeneratedPackageError
 
-    async def run(stop: asyncio.Event) -> int:
-        bridge = Bridge(
+    def make(host: Any = None) -> Any:
+        return Bridge(
             generated_package(args),
             node_id=args.node_id,
             transport=TransportConfig(transport_kind(args), args.iface, args.mtu),
@@ -141,7 +146,13 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             wire=args.wire,
             namespace=namespace,
             time_sync=args.time_sync,
+            ros_host=host,
         )
+
+    async def run(stop: asyncio.Event) -> int:
+        if args.managed:
+            return await _run_managed(args, make, namespace, stop)
+        bridge = make()
         await bridge.start()
         print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
               f"wire={bridge.wire} namespace={namespace.namespace}", flush=True)
@@ -162,6 +173,43 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
 
     return serve("sam-bridge", run, (BridgeConfigError, GeneratedPackageError, TransportConfigError))
+
+
+async def _run_managed(args: argparse.Namespace, make: Any, namespace: Any, stop: asyncio.Event) -> int:
+    """``--managed``: the lifecycle node until a manager shuts it down (or a signal, or ``--duration``); the bridge
+    exists between configure and cleanup (sam_runtime.bridge.managed)."""
+    from sam_runtime.bridge.managed import ManagedBridge
+
+    probe = make()  # the arguments checked and the node's name known before any manager calls (nothing opened)
+    managed = ManagedBridge(probe.name, make, asyncio.get_running_loop(), stop.set,
+                            namespace=namespace.node_namespace, ros_args=args.ros_args)
+    del probe
+    managed.host.open()
+    print(f"READY bridge {managed.host.name} managed: unconfigured, waiting for a lifecycle manager "
+          f"namespace={namespace.namespace}", flush=True)
+    snapshot = None
+    try:
+        deadline = None if args.duration is None else time.monotonic() + args.duration
+        while not stop.is_set():
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
+                break
+            await wait_for_stop(stop, 1.0 if left is None else min(1.0, left))
+            bridge = managed.bridge
+            if args.stats_file and bridge is not None and bridge.reporter is not None:
+                write_json_atomic(args.stats_file, {**bridge.stats(), "lifecycle": managed.transitions})
+    finally:
+        # no transition from here on (off the loop: a transition in progress waits for the loop)
+        await asyncio.get_running_loop().run_in_executor(None, managed.host.stop_spinning)
+        bridge = managed.bridge
+        if bridge is not None:
+            snapshot = {**bridge.stats(), "lifecycle": managed.transitions}
+            managed.bridge = None
+            await bridge.close()
+        managed.host.close()
+        if args.stats_file and snapshot is not None:
+            write_json_atomic(args.stats_file, snapshot)
+    return EXIT_OK
 
 
 # ============================================================================================ sim
