@@ -35,9 +35,10 @@ asyncio loop, waiting for it; the hot path pays one bool read per command (:attr
 from __future__ import annotations
 
 import asyncio
+import functools
 import logging
 import threading
-from collections.abc import Awaitable, Callable, Sequence
+from collections.abc import Callable, Coroutine, Sequence
 from typing import Any
 
 from sam_runtime.bridge.counters import log
@@ -81,7 +82,7 @@ class ManagedNode:
 
         handler = self._transition
 
-        class _BridgeLifecycleNode(LifecycleNode):  # type: ignore[misc]
+        class _BridgeLifecycleNode(LifecycleNode):
             def on_configure(self, state: Any) -> Any:
                 return handler("configure")
 
@@ -150,7 +151,7 @@ class ManagedNode:
         for kind, destroy in _ENDPOINTS.items():
             for entity in list(getattr(self.node, kind)):
                 if id(entity) not in self._baseline[kind]:
-                    steps.append(lambda entity=entity, destroy=destroy: getattr(self.node, destroy)(entity))
+                    steps.append(functools.partial(getattr(self.node, destroy), entity))
         return steps
 
     def stop_spinning(self) -> None:
@@ -199,7 +200,7 @@ class ManagedBridge:
 
     def transition(self, name: str) -> bool:
         """The executor thread: do transition ``name`` on the loop and wait for it."""
-        steps: dict[str, Callable[[], Awaitable[bool]]] = {
+        steps: dict[str, Callable[[], Coroutine[Any, Any, bool]]] = {
             "configure": self._configure, "activate": self._activate, "deactivate": self._deactivate,
             "cleanup": self._close, "error": self._close, "shutdown": self._shutdown}
         ok = asyncio.run_coroutine_threadsafe(steps[name](), self._loop).result()

@@ -31,6 +31,7 @@ its own thread.
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
 import time
@@ -134,7 +135,7 @@ class RosSide:
         steps: list[Callable[[], Any]] = [
             lambda: self.node.remove_post_set_parameters_callback(self._after_set_parameters)]
         for node in self._extra_nodes:
-            steps += [lambda node=node: self.executor.remove_node(node), node.destroy_node]
+            steps += [functools.partial(self.executor.remove_node, node), node.destroy_node]
         steps += self.host.release_steps()
         for step in steps:
             try:

@@ -5,7 +5,8 @@ driven by an rclpy lifecycle client (lifecycle_msgs/srv/ChangeState and GetState
 unconfigured (no bridge topics) -> configure (inactive: telemetry flows, commands dropped as ``inactive``) ->
 activate (commands reach the bus) -> deactivate (telemetry flows on, every command after the transition's answer
 is dropped and counted ``inactive``, on /diagnostics too; none reaches the bus) -> activate (commands again) ->
-shutdown (the process exits 0).
+deactivate -> cleanup (the bridge's topics gone, the node stays) -> configure -> activate (a new bridge's commands
+reach the bus) -> shutdown (the process exits 0).
 
 Commands are /longitudinal_weight_position (one mapping on both protocols), telemetry /imu (100 Hz); what reached
 the bus is the bridge's ``published`` count of the command mapping in its stats file (written every second while
@@ -121,13 +122,9 @@ class LifecycleClient(SpunNode):
             self.pub.publish(msg)
 
 
-def _stats(path: Path) -> dict[str, Any] | None:
-    return read_json(path)
-
-
 def _command_counts(path: Path, mapping: str) -> tuple[int, int] | None:
     """(published, dropped as inactive) of the command mapping in the bridge's stats file, or None."""
-    s = _stats(path)
+    s = read_json(path)
     if not s or mapping not in s.get("mappings", {}):
         return None
     m = s["mappings"][mapping]
@@ -198,6 +195,26 @@ def _run(protocol: str, tmp: Path) -> dict[str, Any]:
         out["published_after_reactivate"] = again[0]
         out["dropped_inactive_final"] = again[1]
 
+        # deactivate, cleanup: the bridge's topics gone, the node still there; configure and activate a new bridge
+        out["deactivate_again"] = client.transition("deactivate again", DEACTIVATE)
+        out["cleanup"] = client.transition("cleanup", CLEANUP)
+        out["after_cleanup"] = client.state()
+        out["subscribed_after_cleanup"] = poll_until(
+            lambda: client.node.count_subscribers(COMMAND_TOPIC) == 0 and client.node.count_publishers(
+                TELEMETRY_TOPIC) == 0 and "gone", WAIT_S, "the bridge's topics gone after cleanup")
+        out["configure_again"] = client.transition("configure again", CONFIGURE)
+        out["activate_again"] = client.transition("activate again", ACTIVATE)
+        poll_until(lambda: client.node.count_subscribers(COMMAND_TOPIC), WAIT_S, "the new bridge's subscription")
+        client.send_commands(COMMANDS, 30.0)
+
+        def new_bridge_published() -> int:
+            s = read_json(stats)  # the new bridge's counters (the file of the closed one stays until then)
+            if not s or s.get("lifecycle", {}).get("configure") != 2:
+                return 0
+            return int(s["mappings"][mapping]["published"]) >= COMMANDS
+
+        out["new_bridge_published"] = bool(poll_until(new_bridge_published, WAIT_S, "commands from the new bridge"))
+
         # shutdown: the process exits
         out["shutdown"] = client.transition("shutdown", SHUTDOWN_FROM_ACTIVE)
         out["exit_code"] = bridge.wait(WAIT_S)
@@ -229,6 +246,8 @@ def test_the_managed_bridge_waits_unconfigured_then_follows_its_manager(run: dic
     assert run["activate"] and run["after_activate"] == ACTIVE
     assert run["deactivate"] and run["after_deactivate"] == INACTIVE
     assert run["reactivate"] and run["shutdown"]
+    assert run["deactivate_again"] and run["cleanup"] and run["after_cleanup"] == UNCONFIGURED
+    assert run["configure_again"] and run["activate_again"] and run["new_bridge_published"]
     assert run["exit_code"] == 0
 
 
