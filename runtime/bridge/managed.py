@@ -72,6 +72,7 @@ class ManagedNode:
         self._baseline: dict[str, set[int]] = {}  # the node's own endpoints (lifecycle, parameter services)
         self._future: Any = None
         self._thread: threading.Thread | None = None
+        self._results: tuple[Any, Any] = (True, False)  # rclpy's SUCCESS and FAILURE once open() imported them
 
     def open(self) -> None:
         import rclpy
