@@ -114,6 +114,22 @@ class LifecycleClient(SpunNode):
 
         return int(self._call(self.get, GetState.Request()).current_state.id)
 
+    def available_transitions(self) -> list[str]:
+        from lifecycle_msgs.srv import GetAvailableTransitions
+
+        client = self.node.create_client(GetAvailableTransitions, self.change.srv_name.replace(
+            "change_state", "get_available_transitions"))
+        return sorted(d.transition.label for d in self._call(client, GetAvailableTransitions.Request())
+                      .available_transitions)
+
+    def lifecycle_interface(self, node: str) -> bool:
+        """Every standard lifecycle service of the node and its transition_event topic are in the graph."""
+        services = {name for name, _ in self.node.get_service_names_and_types()}
+        topics = {name for name, _ in self.node.get_topic_names_and_types()}
+        wanted = {f"/{node}/{s}" for s in ("change_state", "get_state", "get_available_states",
+                                           "get_available_transitions", "get_transition_graph")}
+        return wanted <= services and f"/{node}/transition_event" in topics
+
     def send_commands(self, n: int, value: float) -> None:
         for _ in range(n):
             msg = self.command_cls()
@@ -155,6 +171,9 @@ def _run(protocol: str, tmp: Path) -> dict[str, Any]:
         sim.wait_line("READY", WAIT_S)
         client = LifecycleClient(node, gen, tables)
         out["initial"] = client.state()
+        out["available"] = client.available_transitions()
+        out["interface"] = poll_until(lambda: client.lifecycle_interface(node), WAIT_S,
+                                      "the lifecycle services and transition_event")
         out["subscribed_unconfigured"] = client.node.count_subscribers(COMMAND_TOPIC)
 
         # configure: the bus opened, telemetry flows, commands dropped as inactive
@@ -242,6 +261,7 @@ def test_the_managed_bridge_waits_unconfigured_then_follows_its_manager(run: dic
     print(f"\n{run['protocol']}: change_state round trips (ms) {run['round_trips_ms']}; dropped as inactive "
           f"{run['dropped_inactive_final']}")
     assert run["initial"] == UNCONFIGURED and run["subscribed_unconfigured"] == 0
+    assert run["interface"] and run["available"] == ["configure", "shutdown"]
     assert run["configure"] and run["after_configure"] == INACTIVE
     assert run["activate"] and run["after_activate"] == ACTIVE
     assert run["deactivate"] and run["after_deactivate"] == INACTIVE
