@@ -1,4 +1,5 @@
-"""The bridge as a ROS 2 managed (lifecycle) node (issue 30): ``sam-codegen bridge --managed``.
+"""The bridge as a ROS 2 managed (lifecycle) node (issue 30): ``sam-codegen bridge`` (active at once, as before) and
+``sam-codegen bridge --managed`` (waits unconfigured for a manager).
 
 A vehicle's bringup starts its drivers in order and must be able to stop a bridge from commanding the actuators
 without killing it. ROS 2 does this with managed nodes: the standard lifecycle_msgs services of the node
@@ -10,7 +11,8 @@ lifecycle events, nav2's lifecycle manager, a few lines of rclpy) drives.
 transition         what the bridge does
 =================  =================================================================================================
 (start)            the lifecycle node (rclpy.lifecycle.LifecycleNode, the bridge's name and namespace) and its
-                   executor thread; unconfigured: no bus, no topics, nothing but the lifecycle services
+                   executor thread; unconfigured: no bus, no topics, nothing but the lifecycle services (without
+                   ``--managed`` the node configures and activates itself at once: :meth:`ManagedNode.trigger`)
 ``configure``      the bridge: the generated tables loaded, the bus opened, every topic, service and /diagnostics
                    (:class:`~sam_runtime.bridge.composition.Bridge` made and started on the host's node);
                    inactive: telemetry (bus -> ROS) flows, every command (ROS -> bus) is dropped as ``inactive``
@@ -134,6 +136,11 @@ class ManagedNode:
             log.error("lifecycle %s failed: %s: %s", name, type(ex).__name__, ex)
         return self._results[0] if ok else self._results[1]
 
+    def trigger(self, name: str) -> bool:
+        """Make transition ``name`` (configure, activate, ...) from here, as a manager's change_state would (the node
+        configuring and activating itself); not on the asyncio loop's thread (the transition waits for the loop)."""
+        return bool(getattr(self.node, f"trigger_{name}")() == self._results[0])
+
     def _spin(self) -> None:
         while not self._future.done():
             try:
@@ -191,13 +198,18 @@ class ManagedBridge:
 
     def __init__(self, name: str, make: Callable[[ManagedNode], Any], loop: asyncio.AbstractEventLoop,
                  on_finalized: Callable[[], None], *, namespace: str | None = None,
-                 ros_args: Sequence[str] = ()) -> None:
+                 ros_args: Sequence[str] = (), autostart: bool = False) -> None:
         self.host = ManagedNode(name, namespace=namespace, ros_args=ros_args, on_transition=self.transition)
+        # A node that activates itself (no --managed) bridges commands from its first configure on: nothing is dropped
+        # between its own configure and activate (the commands a publisher kept for late subscribers, transient
+        # local, arrive in that window), as before lifecycles.
+        self._start_active = bool(autostart)
         self._make = make
         self._loop = loop
         self._on_finalized = on_finalized
         self.bridge: Any = None
         self.transitions: dict[str, int] = dict.fromkeys(TRANSITIONS, 0)  # succeeded, by name
+        self.error: Exception | None = None  # why the last configure failed
 
     def transition(self, name: str) -> bool:
         """The executor thread: do transition ``name`` on the loop and wait for it."""
@@ -215,11 +227,15 @@ class ManagedBridge:
             return True
         try:
             bridge = self._make(self.host)
+            if self._start_active:
+                bridge.active = True
             await bridge.start()  # (inactive: a managed bridge starts with commands off)
         except Exception as ex:
+            self.error = ex
             log.error("configure: the bridge did not start: %s: %s", type(ex).__name__, ex)
             return False
         self.bridge = bridge
+        self._start_active = False  # (a configure after a cleanup waits for activate, as a managed one does)
         return True
 
     async def _activate(self) -> bool:
