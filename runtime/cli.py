@@ -174,11 +174,7 @@ async def _run_managed(args: argparse.Namespace, make: Any, namespace: Any, stop
             print(f"READY bridge {managed.host.name} managed: unconfigured, waiting for a lifecycle manager "
                   f"namespace={namespace.namespace}", flush=True)
         else:
-            # (off the loop: each transition hands its work to the loop and waits for it)
-            if not await loop.run_in_executor(None, managed.host.trigger, "configure"):
-                raise managed.error or RuntimeError("the bridge did not configure")
-            if not await loop.run_in_executor(None, managed.host.trigger, "activate"):
-                raise RuntimeError("the bridge did not activate")
+            await managed.start_active()
             bridge = managed.bridge
             print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
                   f"wire={bridge.wire} namespace={namespace.namespace}", flush=True)

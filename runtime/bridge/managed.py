@@ -211,6 +211,24 @@ class ManagedBridge:
         self.transitions: dict[str, int] = dict.fromkeys(TRANSITIONS, 0)  # succeeded, by name
         self.error: Exception | None = None  # why the last configure failed
 
+    async def start_active(self) -> None:
+        """Configure and activate the node itself (``sam-codegen bridge`` without ``--managed``); raises why the bridge
+        did not start. The transitions run on a thread of their own that ends with them (they wait for this loop; a
+        pool's thread would stay for the life of the process)."""
+        done: asyncio.Future[bool] = self._loop.create_future()
+
+        def run() -> None:
+            try:
+                ok = self.host.trigger("configure") and self.host.trigger("activate")
+            except Exception as ex:  # (rclpy's own errors: never a wait without end)
+                self._loop.call_soon_threadsafe(done.set_exception, ex)
+                return
+            self._loop.call_soon_threadsafe(done.set_result, ok)
+
+        threading.Thread(target=run, name=f"{self.host.name}-start", daemon=True).start()
+        if not await done:
+            raise self.error or RuntimeError("the bridge did not activate")
+
     def transition(self, name: str) -> bool:
         """The executor thread: do transition ``name`` on the loop and wait for it."""
         steps: dict[str, Callable[[], Coroutine[Any, Any, bool]]] = {
