@@ -83,6 +83,8 @@ class Bridge:
         it at start (a copy of the codec module bound to it: sam_runtime.genpkg.bound_codec).
     :param time_sync: be the bus's time-sync master (:mod:`.time_sync`): True/False override the spec's
         ``bridge.time_sync`` (None: the spec's; on by default).
+    :param ros_host: a managed bridge's lifecycle node (sam_runtime.bridge.managed.ManagedNode): the bridge runs on
+        its node and executor and starts inactive (:attr:`active`).
     """
 
     def __init__(
@@ -106,6 +108,7 @@ class Bridge:
         wire: str = "codec",
         namespace: RosNamespace | None = None,
         time_sync: bool | None = None,
+        ros_host: Any = None,
     ) -> None:
         if wire not in WIRE_PATHS:
             raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
@@ -146,7 +149,9 @@ class Bridge:
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
                            rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
                            qos_depth=qos_depth, command_reliability=command_reliability,
-                           namespace=self.namespace.node_namespace)
+                           namespace=self.namespace.node_namespace, host=ros_host)
+        # commands to the bus: a managed bridge (ros_host) starts inactive, its lifecycle manager activates it
+        self._active = ros_host is None
         self.health = DeviceHealth(sel.devices, self.node_id)
         self.backend.on_device_status(self.health.on_status)
         self.link = LinkSupervisor(self.lifetime, self.backend)
@@ -164,6 +169,23 @@ class Bridge:
         layout (two bridges)."""
         base = str(self.tables.BRIDGE_NAME)
         return f"{base}_{self.selection.protocol}" if self.selection.shared else base
+
+    @property
+    def active(self) -> bool:
+        """Whether commands go to the bus (False: a managed bridge its lifecycle manager has not activated, or
+        deactivated: every command is dropped as ``inactive``; sam_runtime.bridge.managed)."""
+        return self._active
+
+    @active.setter
+    def active(self, value: bool) -> None:
+        """(on the loop)"""
+        self._active = bool(value)
+        if self.outbound is not None:
+            self.outbound.active = self._active
+        if self.services is not None:
+            self.services.active = self._active
+        if self.reporter is not None and self.lifetime.loop is not None:
+            self.reporter.publish_now()  # the state on /diagnostics at once
 
     async def start(self) -> None:
         """Import the converters, assemble the parts, start them in order."""
@@ -214,6 +236,7 @@ class Bridge:
                                                                    codec),
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
                                             backend=backend)
+        outbound.active = self._active
         for im in (im for g in inbound.groups.values() for im in g.mappings):
             im.switch = self.switches[im.info.name]
         for om in outbound.mappings.values():
@@ -249,6 +272,8 @@ class Bridge:
                                                diagnostics_period=self._diagnostics_period)
             self._duty_options(self.services)
             self.services.attach()
+        if self.services is not None:
+            self.services.active = self._active
         self.time_sync = self._time_sync()
         inbound.on_stamp = self.time_sync.on_stamp
         reporter.time_sync = self.time_sync

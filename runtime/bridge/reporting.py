@@ -146,6 +146,7 @@ class Reporter:
                 "errors": dict(self.lifetime.errors),
                 "link": self.link.snapshot(),
                 "log_lines": sum(self.rlog.lines.values()),
+                "active": self.outbound.active,  # False: a managed bridge not activated (commands dropped)
             },
             "mappings": mappings,
             "devices": devices,
