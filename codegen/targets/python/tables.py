@@ -251,4 +251,6 @@ def table_types_source() -> str:
 def tables_context(resolved: Resolved) -> dict[str, Any]:
     """Everything templates/python/tables.py.j2 renders."""
     return {"table_types": table_types_source(), **cyphal_context(resolved), **nodes_context(resolved),
-            **dronecan_context(resolved), "interface_hash": f"0x{interface_versions(resolved).whole:016x}"}
+            **dronecan_context(resolved), "interface_hash": f"0x{interface_versions(resolved).whole:016x}",
+            "interface_on_mismatch": py_str(resolved.spec.bridge.interface_on_mismatch
+                                            if resolved.spec.bridge is not None else "warn")}

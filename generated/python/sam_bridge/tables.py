@@ -2024,3 +2024,5 @@ DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
 # The whole spec's interface version (every board's; each board's is its DeviceInfo's interface_hash): the
 # hash rule is sam_codegen.validate.interface_version's.
 INTERFACE_HASH: int = 0x23669fe96266cb3c
+# A board that reports another one: "warn" (/diagnostics, counted) or "stop" (also its mappings' traffic).
+INTERFACE_ON_MISMATCH: str = 'warn'
