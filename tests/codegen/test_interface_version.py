@@ -12,12 +12,18 @@ import pytest
 import yaml
 
 from sam_codegen.frontend.loader import load_spec_file
+from sam_codegen.model.diagnostics import SpecError
+from sam_codegen.targets.python.convert import emit as emit_python
 from sam_codegen.validate.interface_version import InterfaceVersions, hash_form, hex_hash, interface_versions
 from sam_codegen.validate.resolve import validate
 
 ROOT = Path(__file__).resolve().parents[2]
 GLIDER = ROOT / "tests" / "specs" / "glider.yaml"
 LOLO = ROOT / "tests" / "specs" / "lolo_v0.yaml"
+
+
+def tables_py(resolved: Any) -> str:
+    return next(text for path, text in emit_python(resolved).items() if path.endswith("/tables.py"))
 
 
 def versions_of(data: dict[str, Any], tmp_path: Path, name: str = "spec.yaml") -> InterfaceVersions:
@@ -105,3 +111,28 @@ def test_dronecan_type_and_setting_changes(tmp_path: Path) -> None:
     # a setting's name on DroneCAN
     data["devices"]["esc_port"]["parameters"]["esc.poles"]["dronecan"] = "MOT_POLES"
     assert changed(after, versions_of(data, tmp_path, "name.yaml")) == {"esc_port"}
+
+
+@pytest.mark.parametrize(("value", "expected"), [(None, "warn"), ({"on_mismatch": "stop"}, "stop"),
+                                                 ({"on_mismatch": "warn"}, "warn")])
+def test_the_bridge_option(value: Any, expected: str, tmp_path: Path) -> None:
+    data = yaml.safe_load(GLIDER.read_text(encoding="utf-8"))
+    if value is not None:
+        data["bridge"]["interface_check"] = value
+    path = tmp_path / "spec.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    resolved = validate(load_spec_file(path))
+    assert resolved.spec.bridge is not None and resolved.spec.bridge.interface_on_mismatch == expected
+    assert f"INTERFACE_ON_MISMATCH: str = {expected!r}" in tables_py(resolved)
+
+
+def test_an_unknown_on_mismatch_is_an_error(tmp_path: Path) -> None:
+    data = yaml.safe_load(GLIDER.read_text(encoding="utf-8"))
+    data["bridge"]["interface_check"] = {"on_mismatch": "halt", "retries": 3}
+    path = tmp_path / "spec.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    with pytest.raises(SpecError) as info:
+        load_spec_file(path)
+    text = str(info.value)
+    assert "on_mismatch 'halt' of bridge interface_check is unknown (expected warn or stop)" in text
+    assert "retries" in text
