@@ -133,3 +133,38 @@ def test_a_failing_request_is_counted_not_raised() -> None:
 def test_on_mismatch_is_checked() -> None:
     with pytest.raises(ValueError, match="warn, stop"):
         InterfaceCheck({}, FakeAsk(), on_mismatch="halt")
+
+
+@pytest.mark.parametrize(("flag", "crc", "expected"), [(True, OTHER, OTHER), (False, OTHER, 0), (True, 0, 0)])
+def test_dronecan_reads_image_crc_only_under_its_flag(flag: bool, crc: int, expected: int) -> None:
+    dronecan = pytest.importorskip("dronecan")
+    from sam_runtime.bridge.backends.interface_ask import dronecan_ask
+
+    response = dronecan.TYPENAMES["uavcan.protocol.GetNodeInfo"].Response()
+    response.software_version.image_crc = crc
+    if flag:
+        response.software_version.optional_field_flags = response.software_version.OPTIONAL_FIELD_FLAG_IMAGE_CRC
+    requests: list[tuple[int, float]] = []
+
+    class Node:
+        def request(self, request: object, nid: int, callback: Callable[[object], None], timeout: float) -> None:
+            requests.append((nid, timeout))
+            callback(NS(response=response))
+
+    got: list[tuple[int | None, str]] = []
+    dronecan_ask(NS(node=Node(), node_loop=None))(11, lambda value, failure: got.append((value, failure)))
+    assert requests == [(11, 1.0)] and got == [(expected, "")]
+
+
+def test_dronecan_no_answer_and_link_down() -> None:
+    pytest.importorskip("dronecan")
+    from sam_runtime.bridge.backends.interface_ask import dronecan_ask
+
+    class Node:
+        def request(self, request: object, nid: int, callback: Callable[[object], None], timeout: float) -> None:
+            callback(None)  # dronecan's callback at the timeout
+
+    got: list[tuple[int | None, str]] = []
+    dronecan_ask(NS(node=Node(), node_loop=None))(11, lambda value, failure: got.append((value, failure)))
+    dronecan_ask(NS(node=None))(11, lambda value, failure: got.append((value, failure)))
+    assert got == [(None, "no answer within 1 s"), (None, "the DroneCAN link is down")]
