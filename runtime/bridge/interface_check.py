@@ -11,7 +11,8 @@ board swapped meanwhile), and compares with the tables' hash of that board. Verd
   (``stop``) or WARN (``warn``) "firmware interface <got> != spec <want>";
 - ``unknown``: the board reports none (0, or DroneCAN's flag unset): firmware that predates the hash; not a
   mismatch, said in the device's status message only;
-- ``no_answer``: it did not answer the request (counted); asked again at its next restart or return.
+- ``no_answer``: it did not answer the request (counted); asked again at a heartbeat :data:`RETRY_S` later, or at
+  its next restart or return.
 
 With the spec's ``bridge.interface_check.on_mismatch: stop`` (the default is ``warn``), a mismatched board's
 mappings stop: the :class:`~.switches.MappingSwitch` of every mapping whose only devices are mismatched boards
@@ -34,9 +35,10 @@ from typing import Any
 from sam_runtime.bridge.backend import DeviceStatus
 from sam_runtime.bridge.counters import log
 
-__all__ = ["MISMATCH_DROP", "Ask", "BoardVerdict", "InterfaceCheck", "board_switches", "hex_hash"]
+__all__ = ["MISMATCH_DROP", "RETRY_S", "Ask", "BoardVerdict", "InterfaceCheck", "board_switches", "hex_hash"]
 
 MISMATCH_DROP = "interface_mismatch"  # the drop reason of a stopped board's mappings
+RETRY_S = 10.0  # a board that did not answer is asked again at its first heartbeat this much later
 ON_MISMATCH = ("warn", "stop")
 
 # ask(node_id, done): request the board's interface hash; done(hash, "") with 0 for "reports none", or
@@ -96,9 +98,13 @@ class InterfaceCheck:
 
     # ------------------------------------------------------------------------------------------------ events in
     def on_status(self, st: DeviceStatus) -> None:
-        """Every heartbeat: a board never checked is asked now (first contact). A dict lookup per heartbeat."""
+        """Every heartbeat: a board never checked is asked now (first contact), one that did not answer again after
+        :data:`RETRY_S`. A dict lookup per heartbeat."""
         board = self.boards.get(st.node_id)
-        if board is not None and board.verdict == "unchecked":
+        if board is None:
+            return
+        if board.verdict == "unchecked" or (board.verdict == "no_answer" and board.asked_at is not None
+                                            and self._clock() - board.asked_at >= RETRY_S):
             self.check(st.node_id)
 
     def on_health(self, nid: int, event: str, device: bool) -> None:

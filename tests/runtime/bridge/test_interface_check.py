@@ -13,7 +13,7 @@ import pytest
 
 from sam_runtime.bridge.backend import DeviceStatus
 from sam_runtime.bridge.diagnostics import Naming, statuses
-from sam_runtime.bridge.interface_check import MISMATCH_DROP, InterfaceCheck, board_switches
+from sam_runtime.bridge.interface_check import MISMATCH_DROP, RETRY_S, InterfaceCheck, board_switches
 from sam_runtime.bridge.switches import MappingSwitch
 
 WANT = 0x1111_2222_3333_4444
@@ -110,7 +110,7 @@ def test_stop_holds_the_boards_own_mappings_until_a_match() -> None:
 
 
 def test_unknown_and_no_answer_are_no_mismatch() -> None:
-    check, ask, switches, _, _ = make("stop")
+    check, ask, switches, now, _ = make("stop")
     check.on_status(beat(11))
     check.on_status(beat(12))
     ask.answer(0)
@@ -119,6 +119,15 @@ def test_unknown_and_no_answer_are_no_mismatch() -> None:
     assert all(s.enabled for s in switches.values())
     assert check.status("imu") == ("OK", "firmware interface unknown (the board reports no hash)")
     assert check.snapshot()["boards"]["gps"]["verdict"] == "no_answer"
+    now[0] += RETRY_S - 0.1
+    check.on_status(beat(12))
+    check.on_status(beat(11))  # unknown: asked again only at a restart
+    assert ask.asked == [11, 12]
+    now[0] += 0.1
+    check.on_status(beat(12))  # no answer, RETRY_S ago: asked again
+    assert ask.asked == [11, 12, 12]
+    ask.answer(WANT)
+    assert check.boards[12].verdict == "match"
 
 
 def test_a_failing_request_is_counted_not_raised() -> None:
