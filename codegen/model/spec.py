@@ -542,6 +542,9 @@ class Bridge:
     service_mappings: list[ServiceMapping] = field(default_factory=list)
     time_sync: TimeSync = field(default_factory=TimeSync)
     node_services: list[NodeService] = field(default_factory=list)  # the device duties (all three by default)
+    # `interface_check: {on_mismatch: warn | stop}`: what the bridge does with a board whose firmware reports another
+    # interface version than the spec's (issue 28): warn, or also stop bridging its mappings
+    interface_on_mismatch: str = "warn"
 
     @property
     def all_mappings(self) -> list[Mapping]:

@@ -16,6 +16,7 @@ from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
+from sam_runtime.bridge.interface_check import InterfaceCheck, board_switches
 from sam_runtime.bridge.layout import select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.link import LinkSupervisor
@@ -162,6 +163,7 @@ class Bridge:
         self.reporter: Reporter | None = None
         self.duties: Any = None  # the protocol's built-in duties (DroneCAN: backends.dronecan_duties), if any
         self.services: ServiceMappingsRos | None = None  # the spec's service mappings of this protocol
+        self.interface_check: InterfaceCheck | None = None  # the boards' firmware interface versions (issue 28)
 
     @property
     def name(self) -> str:
@@ -250,6 +252,13 @@ class Bridge:
             health=health, link=link, inbound=inbound, outbound=outbound, silence=silence, ros=self.ros,
             period=self._diagnostics_period, switches=self.switches)
         health.add_handler(self._on_health)
+        self.interface_check = check = InterfaceCheck(
+            {info.node_id: (info.name, info.interface_hash) for info in sel.device_infos},
+            self.part.interface_ask(backend), on_mismatch=tables.INTERFACE_ON_MISMATCH,
+            switches=board_switches(sel.mappings, self.switches), on_verdict=reporter.publish_now)
+        backend.on_device_status(check.on_status)  # (after the tracker's: a first heartbeat is recorded first)
+        health.add_handler(check.on_health)
+        reporter.interface_check = check
         link.add_handler(lambda _event: reporter.publish_now())
         silence.add_handler(reporter.publish_now)
 

@@ -188,6 +188,11 @@ def statuses(snap: Mapping[str, Any], naming: Naming) -> list[Status]:
         else:
             level = (ok, warn, err)[min(max(int(d["level"]), 0), 2)]
             msg = f"{d['health']} {d['mode']}"
+        if d.get("interface") == "mismatch":  # firmware from another spec (issue 28: bridge.interface_check)
+            level = err if d.get("interface_on_mismatch") == "stop" or level == err else warn
+            msg += f"; firmware interface {d['interface_got']} != spec {d['interface_want']}"
+            if d.get("interface_on_mismatch") == "stop":
+                msg += ": its mappings are stopped"
         out.append((level, f"{naming.bridge}/device/{name}", msg, f"{proto} node {d['node_id']}",
                     {k: v for k, v in d.items() if k not in ("seen", "level")}))
     ts = snap.get("time_sync")

@@ -144,7 +144,7 @@ class Outbound:
                 st.drop("inactive")
                 continue
             if not om.switch.enabled:
-                st.drop("disabled")
+                st.drop(om.switch.drop_reason)
                 continue
             try:
                 obj = om.to_uavcan(msg, st)
@@ -207,7 +207,7 @@ class Outbound:
                 om.stats.drop("inactive")
                 continue
             if not om.switch.enabled:  # queued before the mapping was disabled
-                om.stats.drop("disabled")
+                om.stats.drop(om.switch.drop_reason)
                 continue
             outlet = om.outlet
             if outlet is None or not outlet.ready or not self._link_up():

@@ -49,6 +49,7 @@ class Reporter:
         self.naming = Naming(name, backend.protocol, backend.label, backend.stack)
         self._publisher: Any = None
         self.time_sync: Any = None  # the time-sync master and stamp watch (sam_runtime.bridge.time_sync)
+        self.interface_check: Any = None  # the boards' interface versions (sam_runtime.bridge.interface_check)
 
     def attach(self) -> None:
         """The /diagnostics publisher once the ROS node exists, and its period on the loop."""
@@ -136,6 +137,9 @@ class Reporter:
                 entry["ros_publishers"] = self.ros.matched(m.topic.name)
             mappings[m.name] = entry
         devices, others = self.health.snapshot()
+        if self.interface_check is not None:
+            for name, entry in self.interface_check.device_entries().items():
+                devices.setdefault(name, {}).update(entry)
         started = self.lifetime.started_monotonic
         return {
             "bridge": {

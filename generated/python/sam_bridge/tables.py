@@ -29,6 +29,8 @@ class DeviceInfo:
     description: str
     publishes: tuple[PortInfo, ...]
     subscribes: tuple[PortInfo, ...]
+    # The board's interface version (sam_codegen.validate.interface_version), what its firmware reports.
+    interface_hash: int = 0
 
 
 @dataclass(frozen=True)
@@ -115,6 +117,7 @@ class DroneCanDeviceInfo:
     description: str
     publishes: tuple[DroneCanPortInfo, ...]
     subscribes: tuple[DroneCanPortInfo, ...]
+    interface_hash: int = 0  # as DeviceInfo's
 
 
 @dataclass(frozen=True)
@@ -247,6 +250,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1100, 'sam.sensor.RawIMU.0.1', 'sam.sensor', 'RawIMU_0_1', 100.0),
         ),
         subscribes=(),
+        interface_hash=0xd637a59eaf89905f,
     ),
     DeviceInfo(
         name='magnetometer',
@@ -262,6 +266,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             ),
         ),
         subscribes=(),
+        interface_hash=0x91845a90d6c01c77,
     ),
     DeviceInfo(
         name='gps',
@@ -271,6 +276,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1102, 'sam.sensor.GNSSFix.0.1', 'sam.sensor', 'GNSSFix_0_1', 5.0),
         ),
         subscribes=(),
+        interface_hash=0xe085da2eaaafb1f9,
     ),
     DeviceInfo(
         name='pressure',
@@ -280,6 +286,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1103, 'sam.sensor.StaticPressure.0.1', 'sam.sensor', 'StaticPressure_0_1', 20.0),
         ),
         subscribes=(),
+        interface_hash=0x536d8a2339c45079,
     ),
     DeviceInfo(
         name='battery',
@@ -289,6 +296,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1104, 'sam.power.BatteryInfo.0.1', 'sam.power', 'BatteryInfo_0_1', 1.0),
         ),
         subscribes=(),
+        interface_hash=0xdd92abd4cbac74ed,
     ),
     DeviceInfo(
         name='altimeter',
@@ -298,6 +306,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1106, 'sam.sensor.Altitude.0.1', 'sam.sensor', 'Altitude_0_1', 10.0),
         ),
         subscribes=(),
+        interface_hash=0xe33abf430944c2b4,
     ),
     DeviceInfo(
         name='thruster_1',
@@ -309,6 +318,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1200, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
         ),
+        interface_hash=0xe8aa5843e87f68fc,
     ),
     DeviceInfo(
         name='thruster_2',
@@ -320,6 +330,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1201, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
         ),
+        interface_hash=0xb62a8c10aec1cb54,
     ),
     DeviceInfo(
         name='thrust_vector',
@@ -337,6 +348,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1202, 'sam.actuator.ThrustVector.0.1', 'sam.actuator', 'ThrustVector_0_1', 10.0),
         ),
+        interface_hash=0x4bd8faffe39569c2,
     ),
     DeviceInfo(
         name='ballast',
@@ -346,6 +358,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1203, 'sam.actuator.BallastAngles.0.1', 'sam.actuator', 'BallastAngles_0_1', 10.0),
         ),
+        interface_hash=0x6f1b373e3940c462,
     ),
     DeviceInfo(
         name='longitudinal_weight',
@@ -357,6 +370,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1204, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
         ),
+        interface_hash=0xe0f208d469bd0b99,
     ),
     DeviceInfo(
         name='buoyancy_piston',
@@ -368,6 +382,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1205, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
         ),
+        interface_hash=0xaff974292348d87e,
     ),
 )
 
@@ -1070,6 +1085,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.ahrs.RawIMU'], 100.0),
         ),
         subscribes=(),
+        interface_hash=0xd637a59eaf89905f,
     ),
     DroneCanDeviceInfo(
         name='magnetometer',
@@ -1079,6 +1095,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.ahrs.MagneticFieldStrength'], 50.0),
         ),
         subscribes=(),
+        interface_hash=0x91845a90d6c01c77,
     ),
     DroneCanDeviceInfo(
         name='gps',
@@ -1088,6 +1105,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.gnss.Fix2'], 5.0),
         ),
         subscribes=(),
+        interface_hash=0xe085da2eaaafb1f9,
     ),
     DroneCanDeviceInfo(
         name='pressure',
@@ -1097,6 +1115,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.air_data.StaticPressure'], 20.0),
         ),
         subscribes=(),
+        interface_hash=0x536d8a2339c45079,
     ),
     DroneCanDeviceInfo(
         name='battery',
@@ -1106,6 +1125,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.power.BatteryInfo'], 1.0),
         ),
         subscribes=(),
+        interface_hash=0xdd92abd4cbac74ed,
     ),
     DroneCanDeviceInfo(
         name='altimeter',
@@ -1115,6 +1135,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['sam.sensor.Altitude'], 10.0),
         ),
         subscribes=(),
+        interface_hash=0xe33abf430944c2b4,
     ),
     DroneCanDeviceInfo(
         name='thruster_1',
@@ -1126,6 +1147,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'], 10.0),
         ),
+        interface_hash=0xe8aa5843e87f68fc,
     ),
     DroneCanDeviceInfo(
         name='thruster_2',
@@ -1137,6 +1159,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'], 10.0),
         ),
+        interface_hash=0xb62a8c10aec1cb54,
     ),
     DroneCanDeviceInfo(
         name='thrust_vector',
@@ -1148,6 +1171,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0x4bd8faffe39569c2,
     ),
     DroneCanDeviceInfo(
         name='ballast',
@@ -1157,6 +1181,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0x6f1b373e3940c462,
     ),
     DroneCanDeviceInfo(
         name='longitudinal_weight',
@@ -1168,6 +1193,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0xe0f208d469bd0b99,
     ),
     DroneCanDeviceInfo(
         name='buoyancy_piston',
@@ -1179,6 +1205,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0xaff974292348d87e,
     ),
 )
 
@@ -1993,3 +2020,9 @@ DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
     'longitudinal_weight_feedback',
     'thrust_vector_feedback',
 })
+
+# The whole spec's interface version (every board's; each board's is its DeviceInfo's interface_hash): the
+# hash rule is sam_codegen.validate.interface_version's.
+INTERFACE_HASH: int = 0x23669fe96266cb3c
+# A board that reports another one: "warn" (/diagnostics, counted) or "stop" (also its mappings' traffic).
+INTERFACE_ON_MISMATCH: str = 'warn'
