@@ -43,8 +43,6 @@ __all__ = ["LOOPBACK_ADDRESS", "Acceptance", "LoopbackMulticastDriver"]
 
 LOOPBACK_ADDRESS = "127.0.0.1"
 OVERFLOW_CHECK_S = 0.05
-# Frames stamped with one reading of the clocks' offset at most (a 500 ppm NTP slew moves it by 0.5 us a ms)
-_OFFSET_REUSE = 64
 _RECV_SIZE = 2048  # more than the largest valid packet (74 bytes), so an oversized one is seen whole and rejected
 
 
@@ -134,12 +132,6 @@ class LoopbackMulticastDriver(AbstractDriver):
         self._poll = select.poll()
         self._poll.register(self._rx.fileno(), select.POLLIN)
         self._closed = False
-        # CLOCK_MONOTONIC - CLOCK_REALTIME (ns), to put the kernel's arrival stamps (realtime) on the monotonic
-        # clock: read at the first stamped frame after the socket was found empty (once per wake-up of a loop that
-        # drains it), and again after _OFFSET_REUSE frames, so that a socket never found empty (a flood) follows an
-        # NTP slew of the realtime clock too. None: read it at the next frame.
-        self._offset_ns: int | None = None
-        self._offset_uses = 0
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(bus={self.bus}, port={self.port})"
@@ -168,7 +160,6 @@ class LoopbackMulticastDriver(AbstractDriver):
             try:
                 data, ancdata, _flags, source = rx.recvmsg(_RECV_SIZE, _ANC_SIZE)
             except BlockingIOError:
-                self._offset_ns = None  # the next frame is another wake-up's: the clocks' offset is read again
                 if self._count_drops and time.monotonic() >= self._next_overflow_check:
                     self._count_overflow()
                 if drain or not self._wait_readable(deadline):
@@ -183,14 +174,7 @@ class LoopbackMulticastDriver(AbstractDriver):
                     sec, nsec = _TIMESPEC.unpack_from(cdata)
                     arrived_ns = sec * 1_000_000_000 + nsec
                     ts_real = arrived_ns * 1e-9
-                    # The arrival on the monotonic clock: the clocks' offset is read once per wake-up (see
-                    # _offset_ns), not twice per frame, the largest part of this loop's per-frame work.
-                    offset = self._offset_ns
-                    if offset is None or self._offset_uses <= 0:
-                        offset = self._offset_ns = time.monotonic_ns() - time.time_ns()
-                        self._offset_uses = _OFFSET_REUSE
-                    self._offset_uses -= 1
-                    ts_monotonic = (arrived_ns + offset) * 1e-9
+                    ts_monotonic = time.monotonic() - (time.time_ns() - arrived_ns) * 1e-9
             try:
                 frame = decode_packet(data, ts_monotonic, ts_real)
             except PacketError as ex:
