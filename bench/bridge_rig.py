@@ -108,8 +108,11 @@ def _ros_process(conn: Any, generated: str, in_topics: list[str], out_topic: str
     rclpy.init(args=[], context=ctx, signal_handler_options=SignalHandlerOptions.NO)
     node = Node("sam_bench_ros_side", context=ctx)
 
-    def qos(topic: str) -> Any:  # the spec's reliability and durability (the bridge's), a deep history
-        q = topic_info[topic].qos
+    def qos(topic: str, subscriber: bool = False) -> Any:
+        """The spec's reliability and durability for this side, a deep history: a subscription takes the topic's
+        subscriber QoS, as a vehicle's consumers do (REP 2003: sensor data best effort, while the bridge publishes
+        it reliable), so that the bridge's publishing costs what it costs on the vehicle (no acknowledgements)."""
+        q = (topic_info[topic].subscriber_qos or topic_info[topic].qos) if subscriber else topic_info[topic].qos
         return qos_profile(q.reliability, q.durability, 1000)
 
     state: dict[str, Any] = {"lat": None}
@@ -134,7 +137,7 @@ def _ros_process(conn: Any, generated: str, in_topics: list[str], out_topic: str
     # The cheapest consumer rclpy offers, so that the figures are the bridge's: no QoS-event waitables, and the
     # C++ events executor where this rclpy has it (the Python executor costs ~0.3 ms per message here).
     for i, t in enumerate(in_topics):
-        node.create_subscription(gen.ros_class(topic_info[t]), t, on_imu if i == imu_i else counter(i), qos(t),
+        node.create_subscription(gen.ros_class(topic_info[t]), t, on_imu if i == imu_i else counter(i), qos(t, True),
                                  event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
     cmd_cls = gen.ros_class(topic_info[out_topic])
     pub = node.create_publisher(cmd_cls, out_topic, qos(out_topic),

@@ -305,7 +305,7 @@ class Bridge:
             msg = self.part.sync_message()
             # (a port name with a dot: no mapping's, as mapping names are identifiers; the type's fixed port id, no
             # register)
-            outlet = self.backend.advertise("time.synchronization", msg.port_id, msg.dtype)
+            outlet = self.backend.advertise("time.synchronization", msg.port_id, msg.dtype, raw=msg.raw)
             outlet.fixed_port = True
             master = TimeSyncMaster(self.lifetime, outlet, msg.make, self.ros.receive_ns, self.time_sync_period,
                                     msg.max_interval_s, msg.label)

@@ -83,12 +83,23 @@ def statuses_cdr(sts: list[Status], stamp_ns: int) -> bytes:
     encoded = _ENCODED
     if len(encoded) > _ENCODED_MAX:  # (values that never repeat, such as ages and uptimes, are kept too: bounded)
         encoded.clear()
+    previous = _STATUSES
+    if len(previous) > _STATUSES_MAX:
+        previous.clear()
     for level, name, msg, hw, values in sts:
+        start = len(out)
         out.append(level)
         strings = [name, msg, hw]
         for k, v in values.items():
             strings.append(k if type(k) is str else str(k))
             strings.append(v if type(v) is str else str(v))
+        # Most statuses are the same text as in the previous message (an idle mapping's, a device's but its age):
+        # their bytes are copied whole. Same strings and the same alignment: the same bytes.
+        key = (name, start & 3)
+        same = previous.get(key)
+        if same is not None and same[0] == level and same[1] == strings:
+            out[start:] = same[2]
+            continue
         for i, text in enumerate(strings):
             if i == 3:  # the values' count, after hardware_id
                 out += _PADS[-len(out) & 3] + _U32.pack(len(values))
@@ -100,6 +111,7 @@ def statuses_cdr(sts: list[Status], stamp_ns: int) -> bytes:
             out += enc
         if len(strings) == 3:
             out += _PADS[-len(out) & 3] + _U32.pack(0)
+        previous[key] = (level, strings, bytes(out[start:]))
     return bytes(out)
 
 
@@ -112,6 +124,9 @@ _PADS = (b"", b"\0", b"\0\0", b"\0\0\0")
 # text -> its CDR string (length with the NUL, UTF-8 bytes, NUL); cleared when it outgrows the bound
 _ENCODED: dict[str, bytes] = {}
 _ENCODED_MAX = 20_000
+# (status name, its start's offset modulo 4) -> (level, its strings, its bytes) in the last message that had it
+_STATUSES: dict[tuple[str, int], tuple[int, list[str], bytes]] = {}
+_STATUSES_MAX = 4096
 
 
 def statuses(snap: Mapping[str, Any], naming: Naming) -> list[Status]:

@@ -97,16 +97,19 @@ class FrameGate(AbstractDriver):
         self.inner.close()
 
     def receive(self, timeout: float | None = None) -> CANFrame | None:
-        deadline = None if timeout is None else self._clock() + max(timeout, 0.0)
+        # receive(0), dronecan's spin(0) from a NodeLoop, per frame of the bus: no clock reading for a deadline
+        drain = timeout is not None and timeout <= 0
+        deadline = None if timeout is None or drain else self._clock() + timeout
+        inner, ready = self.inner, self._ready
         while True:
             if self._budget is not None and self._budget <= 0:
                 self.last_frame = None
                 return None
-            if self._ready:
-                frame: CANFrame | None = self._ready.popleft()
+            if ready:
+                frame: CANFrame | None = ready.popleft()
             else:
-                left = None if deadline is None else max(0.0, deadline - self._clock())
-                raw = self.inner.receive(left)
+                left = 0.0 if drain else None if deadline is None else max(0.0, deadline - self._clock())
+                raw = inner.receive(left)
                 if raw is None:
                     self.last_frame = None
                     self.drained = True

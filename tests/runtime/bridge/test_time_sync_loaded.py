@@ -234,7 +234,7 @@ def test_dronecan_mcast_lo_uses_the_drivers_transmission_window() -> None:
     async def go() -> dict[str, Any]:
         msg = sync_message("dronecan")
         backend = DroneCanBackend(iface, BRIDGE_NODE_ID, rlog=_rlog(), errors=collections.Counter())
-        outlet = backend.advertise("time.synchronization", msg.port_id, msg.dtype)
+        outlet = backend.advertise("time.synchronization", msg.port_id, msg.dtype, raw=msg.raw)
         master = _master(outlet, "dronecan")
         outlet.want_tx_times()
         witness = _witness_socket(group_for_bus(where.bus), where.port)

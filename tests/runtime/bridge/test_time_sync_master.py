@@ -208,3 +208,23 @@ def test_diagnostics_status_of_the_time_sync() -> None:
     st = next(s for s in diagnostic_array(snap, Naming("br", "cyphal", "C", "p"), None).status
               if s.name == "br/time_sync")
     assert st.level == b"\x02" and "the master is not sending" in st.message
+
+
+@pytest.mark.parametrize("us", [0, 1, 1_234_567_890_123, (1 << 56) - 1, 1 << 60])
+def test_dronecan_sync_payload_is_dronecans_own_encoding(us: int) -> None:
+    """The DroneCAN master sends GlobalTimeSync on the wire path (issue 26): its payload bytes are what dronecan
+    serializes for the message (the uint56 truncated as dronecan truncates it), and dronecan decodes them back."""
+    pytest.importorskip("dronecan")
+    import dronecan
+    from dronecan import transport
+
+    from sam_runtime.bridge.backends.time_sync_messages import UINT56, sync_message
+
+    msg = sync_message("dronecan")
+    cls = dronecan.TYPENAMES["uavcan.protocol.GlobalTimeSync"]
+    assert msg.raw and msg.port_id == cls.default_dtid
+    payload = msg.make(us)
+    assert payload == bytes(transport.Transfer(payload=cls(previous_transmission_timestamp_usec=us & UINT56)).payload)
+    decoded = cls()
+    decoded._unpack(transport.bits_from_bytes(bytearray(payload)), True)
+    assert int(decoded.previous_transmission_timestamp_usec) == us & UINT56
