@@ -13,6 +13,7 @@ from typing import Protocol
 
 from sam_codegen.contracts.table_types import (
     DeviceInfo,
+    DeviceParameterInfo,
     DroneCanDeviceInfo,
     DroneCanMappingInfo,
     DroneCanTypeInfo,
@@ -60,3 +61,4 @@ class TablesModule(Protocol):
     TIME_SYNC_PERIOD_S: float | None  # the bridge's time-sync master; None: off
     DEVICE_STAMPED_MAPPINGS: frozenset[str]  # Cyphal UAVCAN -> ROS mappings whose header.stamp is the device's
     DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str]  # the same of the DroneCAN mappings
+    DEVICE_PARAMETERS: tuple[DeviceParameterInfo, ...]  # every board's settings, device by device
