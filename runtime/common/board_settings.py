@@ -16,7 +16,16 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from sam_codegen.contracts.table_types import DeviceParameterInfo
 
-__all__ = ["BoardSettings", "Stored", "default_stored", "from_stored", "ros_problem", "stored_problem", "to_stored"]
+__all__ = [
+    "BoardSettings",
+    "Stored",
+    "default_stored",
+    "f32_shortest",
+    "from_stored",
+    "ros_problem",
+    "stored_problem",
+    "to_stored",
+]
 
 Stored = bool | int | float | str  # what a board holds: an enum's integer, every other type as it is
 
@@ -88,6 +97,23 @@ def from_stored(p: DeviceParameterInfo, value: Stored) -> Stored:
     if p.type == "enum" and not isinstance(value, str):
         names = {v: n for n, v in p.values}
         return names.get(int(value), str(value))
+    if p.type == "real" and isinstance(value, float) and math.isfinite(value):
+        return f32_shortest(value)
+    return value
+
+
+def f32_shortest(value: float) -> float:
+    """The shortest decimal that is the same float32 as `value`: a board's real32 0.0007999999797903 is 0.0008,
+    the value that was set.
+
+    >>> f32_shortest(0.0007999999797903001), f32_shortest(0.12)
+    (0.0008, 0.12)
+    """
+    target = _f32(value)
+    for digits in range(1, 10):
+        candidate = float(f"{value:.{digits}g}")
+        if _f32(candidate) == target:
+            return candidate
     return value
 
 
