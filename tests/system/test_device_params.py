@@ -14,10 +14,12 @@ their bridge, and an independent rclpy client of the standard parameter services
 
 from __future__ import annotations
 
+import json
 import statistics
 from typing import Any
 
 import pytest
+import yaml
 
 pytest.importorskip("pycyphal")
 pytest.importorskip("dronecan")
@@ -89,7 +91,21 @@ def dronecan(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         # 3 sets that reach the bridge (rclpy refuses the out-of-range one by its descriptor) and 20 timed
         poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("sets", 0)) >= 23, 20,
                    "the bridge's stats file counting the sets")
-        return {"first": result} | r.outcome()
+        # a board swap: save every board's settings, then restore them with changes (one the board cannot take)
+        saved_file = d / "boards.yaml"
+        save = r.start("save", runtime_cmd("params", "save", str(saved_file)))
+        assert save.wait(60) == 0, save.stderr_tail()
+        saved = yaml.safe_load(saved_file.read_text())
+        changed = json.loads(json.dumps(saved))
+        tree = changed["/sabre_bridge"]["ros__parameters"]
+        tree["esc_port"]["esc"]["poles"] = 14
+        tree["esc_port"]["esc"]["rpm_limit"] = 2600
+        tree["esc_stbd"]["esc"]["poles"] = 12  # a board that does not answer
+        saved_file.write_text(yaml.safe_dump(changed))
+        restore = r.start("restore", runtime_cmd("params", "restore", str(saved_file)))
+        restore_code = restore.wait(60)
+        return {"first": result, "saved": saved, "restore_code": restore_code,
+                "restore_lines": list(restore.lines)} | r.outcome()
 
 
 def test_cyphal_list_and_describe(cyphal: dict[str, Any]) -> None:
@@ -156,3 +172,14 @@ def test_dronecan_list_describe_and_sets(dronecan: dict[str, Any]) -> None:
     counts = dronecan["bridge_stats"]["device_parameters"]
     assert counts.get("refused_by_spec", 0) == 0 and counts["timeouts"] == 1 and counts["reads"] >= 4, counts
     assert "Traceback" not in dronecan["bridge_stderr"]
+
+
+def test_dronecan_params_save_and_restore(dronecan: dict[str, Any]) -> None:
+    saved = dronecan["saved"]["/sabre_bridge"]["ros__parameters"]
+    assert saved["esc_port"]["esc"] == {"index": 0, "poles": 28, "reverse": True, "rpm_limit": 2500}, saved
+    assert dronecan["restore_code"] == 1  # one setting refused
+    lines = dronecan["restore_lines"]
+    assert "esc_port.esc.poles: 28 -> 14" in lines and "esc_port.esc.rpm_limit: 2500 -> 2600" in lines, lines
+    refused = [line for line in lines if line.startswith("esc_stbd.esc.poles: 14 -> 12 REFUSED: ")]
+    assert refused and "did not answer within 1 s" in refused[0], lines
+    assert len(lines) == 3, lines  # unchanged settings are not set again
