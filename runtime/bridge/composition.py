@@ -237,6 +237,7 @@ class Bridge:
                                           sel.protocol, self.part.param_access(backend))
         self.device_params.attach()
         health.add_handler(self.device_params.on_health)
+        reporter.device_settings = self.device_params.differing_by_device
         EnableServices(lifetime, self.ros, self.switches, on_change=reporter.publish_now).attach()
         health.attach(lifetime)
         inbound.attach()

@@ -36,7 +36,7 @@ from typing import Any
 from sam_runtime.bridge.backends.param_access import ParamAccess, ParamIOError
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
-from sam_runtime.common.board_settings import Stored, from_stored, ros_problem, to_stored
+from sam_runtime.common.board_settings import Stored, default_stored, from_stored, ros_problem, to_stored
 
 __all__ = ["PARAM_TIMEOUT_S", "DeviceParams", "ros_parameter_name"]
 
@@ -223,9 +223,17 @@ class DeviceParams:
         for name, answer in self.board_values.items():
             s = self.settings[name]
             shown = from_stored(s.info, answer)
-            if not _same(s.info.type, answer, to_stored(s.info, s.info.default) or 0):
+            if not _same(s.info.type, answer, default_stored(s.info)):
                 out[name] = (shown, s.info.default)
         return out
+
+    def differing_by_device(self) -> dict[str, str]:
+        """device -> "setting value (spec default), ..." for the boards whose values differ from the spec's."""
+        out: dict[str, list[str]] = {}
+        for name, (value, default) in self.differing().items():
+            s = self.settings[name]
+            out.setdefault(s.device, []).append(f"{s.info.name} {value} (spec {default})")
+        return {device: ", ".join(items) for device, items in out.items()}
 
     def snapshot(self) -> dict[str, Any]:
         return {"count": len(self.settings), **dict(self.counts),

@@ -49,6 +49,8 @@ class Reporter:
         self.naming = Naming(name, backend.protocol, backend.label, backend.stack)
         self._publisher: Any = None
         self.time_sync: Any = None  # the time-sync master and stamp watch (sam_runtime.bridge.time_sync)
+        # device -> its settings whose board value differs from the spec's default, as text (device_params)
+        self.device_settings: Any = None
 
     def attach(self) -> None:
         """The /diagnostics publisher once the ROS node exists, and its period on the loop."""
@@ -136,6 +138,10 @@ class Reporter:
                 entry["ros_publishers"] = self.ros.matched(m.topic.name)
             mappings[m.name] = entry
         devices, others = self.health.snapshot()
+        if self.device_settings is not None:
+            for name, text in self.device_settings().items():
+                if name in devices:
+                    devices[name]["settings"] = text  # a /diagnostics value of the device, shown by the main job
         started = self.lifetime.started_monotonic
         return {
             "bridge": {

@@ -142,6 +142,9 @@ def test_cyphal_the_board_keeps_the_values_and_a_new_bridge_shows_them(cyphal: d
     assert again["get"]["pump.pump.direction"] == "inverted"
     differing = cyphal["bridge_stats"]["device_parameters"]["differing"]
     assert differing["pump.pump.direction"] == ["inverted", "normal"], differing
+    # on /diagnostics with the device (the main job's device table shows it)
+    settings = cyphal["bridge_stats"]["devices"]["pump"]["settings"]
+    assert "pump.direction inverted (spec normal)" in settings and "pump.volume_limit 0.0008 (spec 0.0005)" in settings
     assert "Traceback" not in cyphal["bridge_stderr"]
 
 
