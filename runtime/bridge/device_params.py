@@ -85,7 +85,7 @@ class DeviceParams:
     def attach(self) -> None:
         """After the ROS side's attach (its node exists at start)."""
         if self.settings:
-            self.lifetime.add_hooks("device parameters", start=self._start)
+            self.lifetime.add_hooks("device parameters", start=self._start, close=self._close)
 
     # ------------------------------------------------------------------------------------------------ ROS side
     def _start(self) -> None:
@@ -102,6 +102,10 @@ class DeviceParams:
                 node.declare_parameter(name, s.info.default, descriptor)
             finally:
                 self._local.quiet = False
+
+    def _close(self) -> None:
+        for task in list(self._tasks):  # reads in flight: their node is closing
+            task.cancel()
 
     @staticmethod
     def _description(s: _Setting) -> str:
