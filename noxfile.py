@@ -46,12 +46,15 @@ def _ros_install(session: nox.Session) -> None:
                 env=LOOPBACK)
 
 
-# pytest-xdist: one worker per core, each in a private network (tests/helpers/isolation.py). A module's tests stay on
-# one worker (by file): their module fixtures (a built spec, a running stack) are set up once; the long modules of
-# independent tests go test by test (tests/helpers/tiers.py, SPREAD_MODULES). In the order of the collection (system
-# tests first: tiers.system_first), not xdist's default of the scopes with most tests first, which left the long
-# single-test scopes (a colcon build, each spread property test) for the end.
-PARALLEL = ["-n", "auto", "--dist", "loadfile", "--no-loadscope-reorder"]
+# pytest-xdist: one worker per core and one more, each in a private network (tests/helpers/isolation.py). The system
+# tests fly simulated vehicles in real time and wait for discovery, so a worker per core left a fifth of the CPU idle
+# (157 % of 200 % over a CI run); the extra worker fills it (the Cyphal/DroneCAN system tests of tests/system that
+# took 155-164 s with 2 workers took 121-136 s with 3, 2026-11-28). A module's tests stay on one worker (by file):
+# their module fixtures (a built spec, a running stack) are set up once; the long modules of independent tests go test
+# by test (tests/helpers/tiers.py, SPREAD_MODULES). In the order of the collection (system tests first:
+# tiers.system_first), not xdist's default of the scopes with most tests first, which left the long single-test scopes
+# (a colcon build, each spread property test) for the end.
+PARALLEL = ["-n", str((os.cpu_count() or 1) + 1), "--dist", "loadfile", "--no-loadscope-reorder"]
 
 
 @nox.session(python="3.11")

@@ -13,7 +13,8 @@ Per transport (Cyphal/UDP on 127.0.0.1; Cyphal/CAN FD on python-can ``virtual``)
   subjects on UDP, own virtual bus on CAN), measured in the same run and interleaved with the bridge runs.
 - latency, paced at ``latency_hz``: UAVCAN publish -> ROS callback (the send time travels in the RawIMU
   timestamp, which the converter turns into header.stamp) and ROS publish -> UAVCAN receive (a sequence number
-  travels in the two float16 angles, exact below 2048; the ROS process returns its send times).
+  travels in the two float16 angles, inside their limits: bench.common.seq_angles; the ROS process returns its
+  send times).
 - CPU time of this process (os.times: all its threads) per 1000 messages of the throughput runs, split by thread
   (main = asyncio loop: the device publisher + pycyphal + the bridge's UAVCAN half; the bridge's rclpy thread;
   other = DDS and transport I/O threads); the ROS process's CPU beside it; resident memory (VmRSS) before and
@@ -200,7 +201,7 @@ def wire_steps(rig: Rig, pub: Any, t: Callable[[Any], float]) -> dict[str, float
     r2w = codec.CODECS[rig.cmd_map.name][1]
     payload = imu_payload(rig)
     cdr, _ = w2r(payload, 1, stats)
-    angles = rig.gen.ros_class(rig.cmd_map.topic)(thruster_vertical_radians=0.25, thruster_horizontal_radians=-0.5)
+    angles = rig.gen.ros_class(rig.cmd_map.topic)(thruster_vertical_radians=0.0625, thruster_horizontal_radians=-0.0625)
     cmd_cdr = serialize_message(angles)
     out = {f"wire path: generated {rig.imu_map.name}_wire_to_ros (payload {len(payload)} B -> CDR {len(cdr)} B)":
            t(lambda: w2r(payload, 1, stats))}

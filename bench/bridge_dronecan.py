@@ -27,7 +27,7 @@ real bus. The bridge's own node has no filter (it is the bridge's).
   decodes everything on receipt). Each repetition runs raw and bridge back to back (alternating order); the ratio
   is the median of the repetitions' ratios.
 - latency paced at ``latency_hz`` (the send time travels in the RawIMU timestamp; a sequence number in the two
-  float16 command values, exact below 2048), and the CPU of both processes over those runs (scheduler ns).
+  float16 command values: bench.common.seq_angles), and the CPU of both processes over those runs (scheduler ns).
 - CPU per 1000 messages of the throughput runs by thread (as bench/bridge.py), resident memory.
 - zero loss: RawIMU alone from node 11, paced at R msg/s for ``trial_s``, its frames encoded once per transfer id
   (:class:`PreEncoded`: the figure is the bridge's process, not dronecan's encoder standing in for a device's
@@ -67,7 +67,7 @@ from bench.bridge_rig import (
     rss_kib,
     thread_cpu,
 )
-from bench.common import log
+from bench.common import angles_seq, log, seq_angles
 
 RAW_IMU = "uavcan.equipment.ahrs.RawIMU"
 ARRAY_COMMAND = "uavcan.equipment.actuator.ArrayCommand"
@@ -204,7 +204,7 @@ class DroneCanReceiver:
             return
         values = {int(c.actuator_id): float(c.command_value) for c in msg.commands}
         if self.rx_at is not None:
-            self.rx_at[int(values[0]) * 2048 + int(values[1])] = now
+            self.rx_at[angles_seq(values[0], values[1])] = now
 
 
 class PreEncoded:
@@ -343,8 +343,7 @@ class DroneCanRig(Rig):
 
     async def _send_cmd_raw(self, seq: int) -> None:
         cmds = self.cmd_sample.commands
-        cmds[0].command_value = float(seq // 2048)
-        cmds[1].command_value = float(seq % 2048)
+        cmds[0].command_value, cmds[1].command_value = seq_angles(seq)
         self.raw_r2u_pub.broadcast(self.cmd_sample)
 
     async def paced_cpu(self, path: str, hz: float, seconds: float) -> dict[str, Any]:
@@ -507,7 +506,7 @@ def per_message_costs(rig: DroneCanRig, n: int = 1000) -> dict[str, float]:
 
     received_imu = decode(imu_frames)
     ros_imu = conv.imu_to_ros(received_imu, time.time_ns(), stats)
-    angles = rig.gen.ros_class(rig.cmd_map.topic)(thruster_vertical_radians=0.25, thruster_horizontal_radians=-0.5)
+    angles = rig.gen.ros_class(rig.cmd_map.topic)(thruster_vertical_radians=0.0625, thruster_horizontal_radians=-0.0625)
     pub = next((im.ros_publisher for g in rig.bridge.inbound.groups.values() for im in g.mappings
                 if im.info.name == rig.imu_map.name), None)
 

@@ -21,7 +21,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from bench.common import REPO, log, percentile, sample_uavcan
+from bench.common import REPO, angles_seq, log, percentile, sample_uavcan, seq_angles
 
 WINDOW = 32
 # The bridge's ROS history depth as `sam-bridge` deploys it (its --qos-depth default): a burst of WINDOW commands fits
@@ -157,8 +157,7 @@ def _ros_process(conn: Any, generated: str, in_topics: list[str], out_topic: str
 
     def publish(seq: int) -> None:
         msg = cmd_cls()
-        msg.thruster_vertical_radians = float(seq // 2048)
-        msg.thruster_horizontal_radians = float(seq % 2048)
+        msg.thruster_vertical_radians, msg.thruster_horizontal_radians = seq_angles(seq)
         pub.publish(msg)
 
     deadline = time.monotonic() + 30.0
@@ -287,7 +286,7 @@ class CyphalReceiver:
         if self.latencies_us is not None:
             self.latencies_us.append(int(now * 1e6) - msg.timestamp.microsecond)
         elif self.rx_at is not None:
-            self.rx_at[int(msg.vertical_radians) * 2048 + int(msg.horizontal_radians)] = now
+            self.rx_at[angles_seq(msg.vertical_radians, msg.horizontal_radians)] = now
 
 
 # ----------------------------------------------------------------------------------------------- rig
@@ -417,8 +416,7 @@ class Rig:
 
     async def _send_cmd_raw(self, seq: int) -> None:
         cmd = self.cmd_sample
-        cmd.vertical_radians = float(seq // 2048)
-        cmd.horizontal_radians = float(seq % 2048)
+        cmd.vertical_radians, cmd.horizontal_radians = seq_angles(seq)
         await self.raw_r2u_pub.publish(cmd)
 
     def _counter(self, path: str) -> Any:

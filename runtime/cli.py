@@ -99,6 +99,12 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--dna-server", action="store_true",
                    help="DroneCAN: run a dynamic node id allocation server (dronecan's CentralizedServer)")
     _add_wire_arg(p)
+    p.add_argument("--managed", action="store_true",
+                   help="a ROS 2 managed (lifecycle) node: start unconfigured and wait for a lifecycle manager "
+                        "(lifecycle_msgs change_state: configure opens the bus, activate bridges commands, "
+                        "deactivate drops them as 'inactive' while telemetry goes on, cleanup, shutdown exits); "
+                        "default: the same lifecycle node, configured and activated by itself at start (bridging "
+                        "from the start, and a manager may still deactivate it)")
     add_namespace_args(p)
     p.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="ROS arguments for the node")
     return p
@@ -124,8 +130,8 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
     from sam_runtime.cyphal_io.transport import TransportConfigError
     from sam_runtime.genpkg import GeneratedPackageError
 
-    async def run(stop: asyncio.Event) -> int:
-        bridge = Bridge(
+    def make(host: Any = None) -> Any:
+        return Bridge(
             generated_package(args),
             node_id=args.node_id,
             transport=TransportConfig(transport_kind(args), args.iface, args.mtu),
@@ -142,27 +148,58 @@ def bridge_main(argv: Sequence[str] | None = None) -> int:
             wire=args.wire,
             namespace=namespace,
             time_sync=args.time_sync,
+            ros_host=host,
         )
-        await bridge.start()
-        print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
-              f"wire={bridge.wire} namespace={namespace.namespace}", flush=True)
-        try:
-            deadline = None if args.duration is None else time.monotonic() + args.duration
-            while not stop.is_set():
-                left = None if deadline is None else deadline - time.monotonic()
-                if left is not None and left <= 0:
-                    break
-                await wait_for_stop(stop, 1.0 if left is None else min(1.0, left))
-                if args.stats_file:
-                    write_json_atomic(args.stats_file, bridge.stats())
-        finally:
-            snapshot = bridge.stats()
-            await bridge.close()
-            if args.stats_file:
-                write_json_atomic(args.stats_file, snapshot)
-        return EXIT_OK
+
+    async def run(stop: asyncio.Event) -> int:
+        return await _run_managed(args, make, namespace, stop)
 
     return serve("sam-bridge", run, (BridgeConfigError, GeneratedPackageError, TransportConfigError))
+
+
+async def _run_managed(args: argparse.Namespace, make: Any, namespace: Any, stop: asyncio.Event) -> int:
+    """The bridge's lifecycle node until a manager shuts it down (or a signal, or ``--duration``); the bridge exists
+    between configure and cleanup (sam_runtime.bridge.managed). Without ``--managed`` the node configures and
+    activates itself first (a configure that fails ends the process with its error, as before lifecycles)."""
+    from sam_runtime.bridge.managed import ManagedBridge
+
+    loop = asyncio.get_running_loop()
+    probe = make()  # the arguments checked and the node's name known before any manager calls (nothing opened)
+    managed = ManagedBridge(probe.name, make, loop, stop.set, namespace=namespace.node_namespace,
+                            ros_args=args.ros_args, autostart=not args.managed)
+    del probe
+    managed.host.open()
+    snapshot = None
+    try:
+        if args.managed:
+            print(f"READY bridge {managed.host.name} managed: unconfigured, waiting for a lifecycle manager "
+                  f"namespace={namespace.namespace}", flush=True)
+        else:
+            await managed.start_active()
+            bridge = managed.bridge
+            print(f"READY bridge {bridge.name} node_id={bridge.node_id} transport={bridge.backend.describe()} "
+                  f"wire={bridge.wire} namespace={namespace.namespace}", flush=True)
+        deadline = None if args.duration is None else time.monotonic() + args.duration
+        while not stop.is_set():
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
+                break
+            await wait_for_stop(stop, 1.0 if left is None else min(1.0, left))
+            bridge = managed.bridge
+            if args.stats_file and bridge is not None and bridge.reporter is not None:
+                write_json_atomic(args.stats_file, {**bridge.stats(), "lifecycle": managed.transitions})
+    finally:
+        # no transition from here on (off the loop: a transition in progress waits for the loop)
+        await asyncio.get_running_loop().run_in_executor(None, managed.host.stop_spinning)
+        bridge = managed.bridge
+        if bridge is not None:
+            snapshot = {**bridge.stats(), "lifecycle": managed.transitions}
+            managed.bridge = None
+            await bridge.close()
+        managed.host.close()
+        if args.stats_file and snapshot is not None:
+            write_json_atomic(args.stats_file, snapshot)
+    return EXIT_OK
 
 
 # ============================================================================================ sim

@@ -122,6 +122,38 @@ CASES: tuple[Case, ...] = (
             "minimal.yaml:59:17: error: 'pass_nan' of mapping 'valve' must be bool, found str 'sometimes' (expected bool)",
         ),
     ),
+    Case(  # issue 29: an option that would act on nothing is an error, never a silent no-op
+        'pass_nan_without_a_float_field',
+        '      destination_node_id: 11\n',
+        '      destination_node_id: 11\n      pass_nan: true\n',
+        (
+            "minimal.yaml:59:7: error: mapping 'valve': pass_nan: true acts on nothing: none of its values can carry a NaN into a UAVCAN float without limits (an integer or bool holds no NaN; a limited field rejects NaN either way) (expected no pass_nan here, or a float field without limits)",
+        ),
+    ),
+    Case(  # uint8 into uint8: nothing is ever out of range, so the policy decides nothing
+        'reject_policy_with_nothing_out_of_range',
+        '      destination_node_id: 11\n',
+        '      destination_node_id: 11\n      on_out_of_range: reject\n',
+        (
+            "minimal.yaml:54:5: error: mapping 'valve': on_out_of_range: reject acts on nothing: none of its values can be out of its target's range (each fits the field it goes into) (expected no on_out_of_range here)",
+        ),
+    ),
+    Case(
+        'table_default_on_a_ros_to_uavcan_mapping',
+        '        data: open_pct\n',
+        '        data: {from: open_pct, table: {0: 0, 1: 100, default: 0}}\n',
+        (
+            "minimal.yaml:60:9: error: mapping 'valve', field 'data': a table's default names the ROS value of the UAVCAN values it does not list, which only a UAVCAN -> ROS mapping receives; a ROS -> UAVCAN mapping rejects a ROS value no key gives (expected no default in this table)",
+        ),
+    ),
+    Case(
+        'limits_that_bound_nothing',
+        '        data: open_pct\n',
+        '        data: {from: open_pct, limits: [-5, 1000]}\n',
+        (
+            "minimal.yaml:60:9: error: mapping 'valve', field 'data': limits [-5, 1000] bound nothing: every uint8 value (0..255) lies within them (expected limits narrower than 0..255, or none)",
+        ),
+    ),
     Case(
         'unknown_top_field',
         'spec_version: 1',
@@ -802,6 +834,22 @@ CASES: tuple[Case, ...] = (
 
 # DroneCAN cases: each breaks tests/specs/minimal_v0.yaml one way (tests/test_v0_bad_specs.py runs them).
 V0_CASES: tuple[Case, ...] = (
+    Case(  # issue 29: float64 commands into integer rpm: NaN is rejected there whatever the mapping says
+        'v0_pass_nan_into_integers',
+        '      destination_node_ids: [20]\n',
+        '      destination_node_ids: [20]\n      pass_nan: true\n',
+        (
+            "minimal_v0.yaml:71:7: error: mapping 'motors': pass_nan: true acts on nothing: none of its values can carry a NaN into a UAVCAN float without limits (an integer or bool holds no NaN; a limited field rejects NaN either way) (expected no pass_nan here, or a float field without limits)",
+        ),
+    ),
+    Case(  # its only float field has limits, which reject NaN either way
+        'v0_pass_nan_into_a_limited_float',
+        '        data: "commands[actuator_id=2].command_value"\n      uavcan',
+        '        data: {from: "commands[actuator_id=2].command_value", limits: [-1, 1]}\n      pass_nan: true\n      uavcan',
+        (
+            "minimal_v0.yaml:81:7: error: mapping 'rudder': pass_nan: true acts on nothing: none of its values can carry a NaN into a UAVCAN float without limits (an integer or bool holds no NaN; a limited field rejects NaN either way) (expected no pass_nan here, or a float field without limits)",
+        ),
+    ),
     Case(
         'v0_array_capacity_beyond_transfer',
         '      - {name: pump_id, type: uint4}',

@@ -33,6 +33,8 @@ class DeviceInfo:
     description: str
     publishes: tuple[PortInfo, ...]
     subscribes: tuple[PortInfo, ...]
+    # The board's interface version (sam_codegen.validate.interface_version), what its firmware reports.
+    interface_hash: int = 0
 
 
 @dataclass(frozen=True)
@@ -119,6 +121,7 @@ class DroneCanDeviceInfo:
     description: str
     publishes: tuple[DroneCanPortInfo, ...]
     subscribes: tuple[DroneCanPortInfo, ...]
+    interface_hash: int = 0  # as DeviceInfo's
 
 
 @dataclass(frozen=True)

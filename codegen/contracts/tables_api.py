@@ -61,4 +61,6 @@ class TablesModule(Protocol):
     TIME_SYNC_PERIOD_S: float | None  # the bridge's time-sync master; None: off
     DEVICE_STAMPED_MAPPINGS: frozenset[str]  # Cyphal UAVCAN -> ROS mappings whose header.stamp is the device's
     DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str]  # the same of the DroneCAN mappings
+    INTERFACE_HASH: int  # the whole spec's interface version (every board's)
+    INTERFACE_ON_MISMATCH: str  # "warn" | "stop": bridge.interface_check.on_mismatch
     DEVICE_PARAMETERS: tuple[DeviceParameterInfo, ...]  # every board's settings, device by device

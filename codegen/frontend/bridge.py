@@ -215,6 +215,7 @@ def parse_mapping(name: str, pos: Pos, node: YNode, diag: Diagnostics, protocol:
         select, select_pos, any_node, any_pos, bool(dronecan and r.get("shares_data_type", bool, False)),
         **vars(parse_traffic(r, what, direction, diag)), uavcan_exprs=uavcan_exprs, ros_defaults=ros_defaults,
         pass_nan=bool(r.get("pass_nan", bool, False)),
+        pass_nan_pos=r.key_pos("pass_nan") if r.node("pass_nan") is not None else None,
     )
     if direction == UAVCAN_TO_ROS and r.node("pass_nan") is not None:
         diag.error(r.key_pos("pass_nan"), f"{what} goes UAVCAN->ROS: pass_nan is for commands (ros_to_uavcan); a "

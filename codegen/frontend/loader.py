@@ -226,7 +226,8 @@ def _bridge(bridge_node: YNode | None, package: str, diag: Diagnostics) -> Bridg
     if bridge_node is None:
         return None
     r = Reader(bridge_node, "bridge", diag, ("name", "node_id", *(p.mappings_key for p in registered()),
-                                             "panic_duty", "service_mappings", "time_sync", "node_services"))
+                                             "panic_duty", "service_mappings", "time_sync", "node_services",
+                                             "interface_check"))
     name, node_id = r.get("name", str) or "bridge", r.get("node_id", int) or 0
     mappings: dict[str, list[Mapping]] = {p.name: [] for p in registered()}
     for p in registered():
@@ -243,7 +244,25 @@ def _bridge(bridge_node: YNode | None, package: str, diag: Diagnostics) -> Bridg
                   service_mappings=service_mappings,
                   time_sync=parse_time_sync(r.node("time_sync"), "bridge time_sync", diag),
                   panic_duty=r.get("panic_duty", str, None), panic_duty_pos=r.key_pos("panic_duty"),
-                  node_services=parse_node_services(r.node("node_services"), bridge_node.pos, package, diag))
+                  node_services=parse_node_services(r.node("node_services"), bridge_node.pos, package, diag),
+                  interface_on_mismatch=_interface_check(r.node("interface_check"), diag))
+
+
+INTERFACE_ON_MISMATCH = ("warn", "stop")
+
+
+def _interface_check(node: YNode | None, diag: Diagnostics) -> str:
+    """`bridge.interface_check: {on_mismatch: warn | stop}` (default warn): the bridge's answer to a board whose
+    firmware reports another interface version than the spec's."""
+    if node is None:
+        return "warn"
+    r = Reader(node, "bridge interface_check", diag, ("on_mismatch",))
+    value = r.get("on_mismatch", str, "warn")
+    if value not in INTERFACE_ON_MISMATCH:
+        diag.error(r.key_pos("on_mismatch"), f"on_mismatch {value!r} of bridge interface_check is unknown",
+                   " or ".join(INTERFACE_ON_MISMATCH))
+        return "warn"
+    return str(value)
 
 
 def _ros_services(top: Reader, package: str, diag: Diagnostics) -> dict[str, RosService]:

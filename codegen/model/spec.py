@@ -430,6 +430,7 @@ class Mapping:
     # ROS -> UAVCAN: a float NaN command is rejected (counted as `not_a_number`) unless the mapping says
     # `pass_nan: true`, for a device that reads NaN as a command of its own ("hold", "no setpoint").
     pass_nan: bool = False
+    pass_nan_pos: Pos | None = None  # where `pass_nan` is written (its errors point there)
 
     @property
     def enable_service_name(self) -> str:
@@ -541,6 +542,9 @@ class Bridge:
     service_mappings: list[ServiceMapping] = field(default_factory=list)
     time_sync: TimeSync = field(default_factory=TimeSync)
     node_services: list[NodeService] = field(default_factory=list)  # the device duties (all three by default)
+    # `interface_check: {on_mismatch: warn | stop}`: what the bridge does with a board whose firmware reports another
+    # interface version than the spec's (issue 28): warn, or also stop bridging its mappings
+    interface_on_mismatch: str = "warn"
 
     @property
     def all_mappings(self) -> list[Mapping]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from sam_codegen.targets import docs, dsdl, dsdl_v0, nodes, ros
+from sam_codegen.targets import docs, dsdl, dsdl_v0, firmware, nodes, ros
 from sam_codegen.targets.python import convert, convert_v0
 from sam_codegen.targets.python import services as python_services
 from sam_codegen.targets.wire import codec, codec_v0
@@ -14,4 +14,5 @@ from sam_codegen.validate import Resolved
 Emitter = Callable[[Resolved], dict[str, str]]
 
 EMITTERS: tuple[Emitter, ...] = (ros.emit, dsdl.emit, dsdl_v0.emit, convert.emit, convert_v0.emit, nodes.emit,
-                                 docs.emit, codec.emit, codec_v0.emit, python_services.emit)
+                                 docs.emit, codec.emit, codec_v0.emit, python_services.emit,
+                                 firmware.emit)

@@ -33,6 +33,7 @@ from sam_codegen.model.types import (
 )
 from sam_codegen.validate.bus_budget import check_bus_budgets
 from sam_codegen.validate.dronecan import DronecanValidator, ResolvedLayout
+from sam_codegen.validate.mapping_options import check_mapping_options
 from sam_codegen.validate.mapping_rules import ResolvedMapping, RuleError, derive_message
 from sam_codegen.validate.mappings import MappingValidator
 from sam_codegen.validate.node_services import resolve_node_services
@@ -374,6 +375,8 @@ def validate(spec: Spec, *, ros_share_dirs: list[Path] | None = None, dsdl_roots
     dronecan_mappings = dronecan.resolve_mappings()
     check_panic_duty(spec, v.diag)
     layouts = dronecan.resolve_layouts(mappings, dronecan_mappings)
+    # options that would act on nothing (validate.mapping_options)
+    check_mapping_options([*mappings, *dronecan_mappings], v.diag, {d.pos for d in v.diag.items})
     service_mappings = services.resolve_mappings()
     service_mappings += resolve_node_services(spec, v.diag, v0.signed, ros.get)  # the duties (validate.node_services)
     check_routing(spec, v.diag)  # `any` node ids, `shares_data_type` (validate.routing)

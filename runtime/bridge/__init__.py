@@ -41,6 +41,8 @@ module                 job
 ``liveness``           the silence rules (grace per mapping, silent while the device is alive), used by ``silence``
 ``rate_limit``         ``max_rate_hz`` and ``deadline`` as pure logic on an injected clock (issue 19), driven by the
                        asyncio loop's timers from ``inbound`` and ``outbound``
+``managed``            the bridge as a ROS 2 managed (lifecycle) node: configure/activate/deactivate/cleanup/shutdown
+                       through the lifecycle_msgs services (``sam-codegen bridge --managed``)
 ``switches``           enable/disable per mapping: its state and its std_srvs/SetBool service (issue 19)
 ``time_sync``          the bus's time-sync master (both protocols; its message per protocol in
                        ``backends.time_sync_messages``) and the watch on the devices' stamps (unknown, off, error)
@@ -84,6 +86,8 @@ reason                 when
 ``coalesced``          ROS -> UAVCAN: likewise for a command
 ``expired``            ROS -> UAVCAN: a command older than the mapping's ``deadline`` when it would have been sent
 ``disabled``           the mapping was disabled (``enabled: false`` in the spec, or its SetBool service)
+``inactive``           ROS -> UAVCAN: a managed bridge (``--managed``, :mod:`.managed`) not in its active lifecycle
+                       state (configured, or deactivated by its manager); telemetry goes on meanwhile
 ``transfer_id_jump``   a transfer whose id is further ahead of its source's previous one than the time between
                        them allows (issue 29; 64-bit ids): a restart with another counter or a spoof. Not
                        published, not counted as ``lost``, the source's sequence kept (see :mod:`.loss`)

@@ -17,6 +17,7 @@ from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, lo
 from sam_runtime.bridge.device_params import DeviceParams
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
+from sam_runtime.bridge.interface_check import InterfaceCheck, board_switches
 from sam_runtime.bridge.layout import select
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.link import LinkSupervisor
@@ -84,6 +85,8 @@ class Bridge:
         it at start (a copy of the codec module bound to it: sam_runtime.genpkg.bound_codec).
     :param time_sync: be the bus's time-sync master (:mod:`.time_sync`): True/False override the spec's
         ``bridge.time_sync`` (None: the spec's; on by default).
+    :param ros_host: a managed bridge's lifecycle node (sam_runtime.bridge.managed.ManagedNode): the bridge runs on
+        its node and executor and starts inactive (:attr:`active`).
     """
 
     def __init__(
@@ -107,6 +110,7 @@ class Bridge:
         wire: str = "codec",
         namespace: RosNamespace | None = None,
         time_sync: bool | None = None,
+        ros_host: Any = None,
     ) -> None:
         if wire not in WIRE_PATHS:
             raise BridgeConfigError(f"wire path {wire!r}: expected one of {', '.join(WIRE_PATHS)}")
@@ -147,7 +151,9 @@ class Bridge:
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
                            rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
                            qos_depth=qos_depth, command_reliability=command_reliability,
-                           namespace=self.namespace.node_namespace)
+                           namespace=self.namespace.node_namespace, host=ros_host)
+        # commands to the bus: a managed bridge (ros_host) starts inactive, its lifecycle manager activates it
+        self._active = ros_host is None
         self.health = DeviceHealth(sel.devices, self.node_id)
         self.backend.on_device_status(self.health.on_status)
         self.link = LinkSupervisor(self.lifetime, self.backend)
@@ -158,6 +164,7 @@ class Bridge:
         self.reporter: Reporter | None = None
         self.duties: Any = None  # the protocol's built-in duties (DroneCAN: backends.dronecan_duties), if any
         self.services: ServiceMappingsRos | None = None  # the spec's service mappings of this protocol
+        self.interface_check: InterfaceCheck | None = None  # the boards' firmware interface versions (issue 28)
         self.device_params: DeviceParams | None = None  # the boards' settings as ROS parameters
 
     @property
@@ -166,6 +173,23 @@ class Bridge:
         layout (two bridges)."""
         base = str(self.tables.BRIDGE_NAME)
         return f"{base}_{self.selection.protocol}" if self.selection.shared else base
+
+    @property
+    def active(self) -> bool:
+        """Whether commands go to the bus (False: a managed bridge its lifecycle manager has not activated, or
+        deactivated: every command is dropped as ``inactive``; sam_runtime.bridge.managed)."""
+        return self._active
+
+    @active.setter
+    def active(self, value: bool) -> None:
+        """(on the loop)"""
+        self._active = bool(value)
+        if self.outbound is not None:
+            self.outbound.active = self._active
+        if self.services is not None:
+            self.services.active = self._active
+        if self.reporter is not None and self.lifetime.loop is not None:
+            self.reporter.publish_now()  # the state on /diagnostics at once
 
     async def start(self) -> None:
         """Import the converters, assemble the parts, start them in order."""
@@ -216,6 +240,7 @@ class Bridge:
                                                                    codec),
                                             lambda: link.up, queue_size=self._queue_size, ros=self.ros,
                                             backend=backend)
+        outbound.active = self._active
         for im in (im for g in inbound.groups.values() for im in g.mappings):
             im.switch = self.switches[im.info.name]
         for om in outbound.mappings.values():
@@ -229,6 +254,13 @@ class Bridge:
             health=health, link=link, inbound=inbound, outbound=outbound, silence=silence, ros=self.ros,
             period=self._diagnostics_period, switches=self.switches)
         health.add_handler(self._on_health)
+        self.interface_check = check = InterfaceCheck(
+            {info.node_id: (info.name, info.interface_hash) for info in sel.device_infos},
+            self.part.interface_ask(backend), on_mismatch=tables.INTERFACE_ON_MISMATCH,
+            switches=board_switches(sel.mappings, self.switches), on_verdict=reporter.publish_now)
+        backend.on_device_status(check.on_status)  # (after the tracker's: a first heartbeat is recorded first)
+        health.add_handler(check.on_health)
+        reporter.interface_check = check
         link.add_handler(lambda _event: reporter.publish_now())
         silence.add_handler(reporter.publish_now)
 
@@ -256,6 +288,8 @@ class Bridge:
                                                diagnostics_period=self._diagnostics_period)
             self._duty_options(self.services)
             self.services.attach()
+        if self.services is not None:
+            self.services.active = self._active
         self.time_sync = self._time_sync()
         inbound.on_stamp = self.time_sync.on_stamp
         reporter.time_sync = self.time_sync

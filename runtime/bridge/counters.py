@@ -25,10 +25,12 @@ DEFAULT_LOG_INTERVAL_S = DEFAULT_INTERVAL_S
 DROP_REASONS = ("unknown_source", "rejected", "convert_error", "bad_cdr", "handler_error", "publish_error",
                 "not_sent", "not_a_number", "queue_full", "link_down", "shutdown", "lost", "lost_link_down",
                 "transfer_id_jump", "unselected",
-                "rate_limited", "coalesced", "expired", "disabled")
-# Drops the spec asked for (max_rate_hz, a disabled mapping): counted like the others, but no sign of trouble, so
-# they do not make the mapping WARN on /diagnostics (an expired command does: it waited too long somewhere).
-INTENDED_DROPS = frozenset({"rate_limited", "coalesced", "disabled"})
+                "rate_limited", "coalesced", "expired", "disabled", "inactive",
+                "interface_mismatch")  # (a board whose firmware is from another spec: bridge.interface_check)
+# Drops the spec or the operator asked for (max_rate_hz, a disabled mapping, a managed bridge deactivated by its
+# lifecycle manager): counted like the others, but no sign of trouble, so they do not make the mapping WARN on
+# /diagnostics (an expired command does: it waited too long somewhere; nor is a board's mismatched firmware).
+INTENDED_DROPS = frozenset({"rate_limited", "coalesced", "disabled", "inactive"})
 
 
 class MappingStats:

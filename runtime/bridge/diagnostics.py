@@ -126,10 +126,13 @@ def statuses(snap: Mapping[str, Any], naming: Naming) -> list[Status]:
     bmsg = f"{len(snap['mappings'])} mappings, {total_drop} dropped"
     if not link["up"]:
         bmsg = f"{naming.label} link {link['state']}; " + bmsg
+    if not b.get("active", True):  # a managed bridge its manager has not activated: commands are dropped
+        bmsg = "inactive (lifecycle): commands dropped; " + bmsg
     out.append((ok if link["up"] else err, naming.bridge, bmsg, f"{proto} node {b['node_id']}",
                 {"node_id": b["node_id"], "transport": b["transport"], "uptime_s": b["uptime_s"],
                  "dropped_total": total_drop, "link_up": link["up"], "link_state": link["state"],
                  "link_outages": link["outages"], "link_down_s": link["down_s"],
+                 "active": b.get("active", True),
                  **{f"error.{k}": v for k, v in sorted(b["errors"].items())}}))
     for name, m in snap["mappings"].items():
         values: dict[str, Any] = {
@@ -185,6 +188,11 @@ def statuses(snap: Mapping[str, Any], naming: Naming) -> list[Status]:
         else:
             level = (ok, warn, err)[min(max(int(d["level"]), 0), 2)]
             msg = f"{d['health']} {d['mode']}"
+        if d.get("interface") == "mismatch":  # firmware from another spec (issue 28: bridge.interface_check)
+            level = err if d.get("interface_on_mismatch") == "stop" or level == err else warn
+            msg += f"; firmware interface {d['interface_got']} != spec {d['interface_want']}"
+            if d.get("interface_on_mismatch") == "stop":
+                msg += ": its mappings are stopped"
         out.append((level, f"{naming.bridge}/device/{name}", msg, f"{proto} node {d['node_id']}",
                     {k: v for k, v in d.items() if k not in ("seen", "level")}))
     ts = snap.get("time_sync")

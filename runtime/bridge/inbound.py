@@ -315,7 +315,7 @@ class Inbound:
             rlog.note((name, "lost_link_down"), logging.WARNING, "about %d transfers from node %s missed "
                       "while the link was down (estimated from the nominal rate)", lost_est, src, count=lost_est)
         if out is _DISABLED:
-            st.drop("disabled")
+            st.drop(im.switch.drop_reason)
             return
         if error is not None:
             st.drop("convert_error")
@@ -332,7 +332,7 @@ class Inbound:
         if not im.switch.enabled:  # held for its rate slot while the mapping was disabled
             if not received:
                 st.receive()
-            st.drop("disabled")
+            st.drop(im.switch.drop_reason)
             return
         try:
             im.ros_publisher.publish(out)  # CDR bytes on the wire path: rclpy publishes them raw

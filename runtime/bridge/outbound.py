@@ -15,6 +15,10 @@ that was queued or held when it was disabled, as ``disabled``. With ``max_rate_h
 newer one counted as ``coalesced``. With ``deadline_s`` each command carries the monotonic time the rclpy callback
 took it, and the worker drops it as ``expired`` when it is older than the deadline at the moment it would be sent
 (after waiting in the hand-off, the pacer or the queue). What is held when the bridge closes counts as ``shutdown``.
+
+A managed bridge that is not active (:mod:`.managed`: configured but not activated, or deactivated) drops every
+command as ``inactive`` (:attr:`Outbound.active`: one bool read per command, in the rclpy thread and again by the
+worker before it sends, so nothing queued or held at the deactivation reaches the bus after it).
 """
 
 from __future__ import annotations
@@ -87,6 +91,9 @@ class Outbound:
                                  functools.partial(count_superseded, om.stats, "coalesced"))
         self._timed = {topic: any(om.deadline_s is not None for om in oms) for topic, oms in self.by_topic.items()}
         self.clock: Callable[[], float] = time.monotonic  # of the deadline check (tests may set their own)
+        # False while a managed bridge is not active (sam_runtime.bridge.managed): every command is dropped as
+        # ``inactive``, at the subscription and again before sending (what was queued or held when it was deactivated)
+        self.active = True
 
     def attach(self) -> None:
         """Subscribe the command topics, advertise the ports, start the workers when the bridge starts (before the
@@ -133,8 +140,11 @@ class Outbound:
         for om in oms:
             st = om.stats
             st.receive()
+            if not self.active:
+                st.drop("inactive")
+                continue
             if not om.switch.enabled:
-                st.drop("disabled")
+                st.drop(om.switch.drop_reason)
                 continue
             try:
                 obj = om.to_uavcan(msg, st)
@@ -193,8 +203,11 @@ class Outbound:
                     rlog.note((name, "expired"), logging.WARNING, "a command older than its deadline (%.3f s) was "
                               "not sent", om.deadline_s)
                     continue
+            if not self.active:  # queued or held before the bridge was deactivated
+                om.stats.drop("inactive")
+                continue
             if not om.switch.enabled:  # queued before the mapping was disabled
-                om.stats.drop("disabled")
+                om.stats.drop(om.switch.drop_reason)
                 continue
             outlet = om.outlet
             if outlet is None or not outlet.ready or not self._link_up():

@@ -49,6 +49,7 @@ class Reporter:
         self.naming = Naming(name, backend.protocol, backend.label, backend.stack)
         self._publisher: Any = None
         self.time_sync: Any = None  # the time-sync master and stamp watch (sam_runtime.bridge.time_sync)
+        self.interface_check: Any = None  # the boards' interface versions (sam_runtime.bridge.interface_check)
         # device -> its settings whose board value differs from the spec's default, as text (device_params)
         self.device_settings: Any = None
 
@@ -138,6 +139,9 @@ class Reporter:
                 entry["ros_publishers"] = self.ros.matched(m.topic.name)
             mappings[m.name] = entry
         devices, others = self.health.snapshot()
+        if self.interface_check is not None:
+            for name, entry in self.interface_check.device_entries().items():
+                devices.setdefault(name, {}).update(entry)
         if self.device_settings is not None:
             for name, text in self.device_settings().items():
                 if name in devices:
@@ -152,6 +156,7 @@ class Reporter:
                 "errors": dict(self.lifetime.errors),
                 "link": self.link.snapshot(),
                 "log_lines": sum(self.rlog.lines.values()),
+                "active": self.outbound.active,  # False: a managed bridge not activated (commands dropped)
             },
             "mappings": mappings,
             "devices": devices,

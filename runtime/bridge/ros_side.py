@@ -21,10 +21,17 @@ its own thread.
   of the bridge's ROS nodes but the service mappings' (their calls wait for a device, on threads of their own):
   the node duties (sam_runtime.bridge.backends.dronecan_duties) add their node to it (:meth:`RosSide.add_node`).
   An exception out of a callback is counted (``spin_error``) and the executor goes on.
+- Managed (``host``, sam_runtime.bridge.managed.ManagedNode): the node, its context and its executor thread belong to
+  the host and outlive the bridge (a lifecycle node exists from start to shutdown; a bridge is made at each
+  configure and closed at each cleanup). The bridge then uses the host's node and executor, starts no spinner, and
+  at close destroys only what it created on the node (the host's baseline of endpoints stays) and the other parts'
+  nodes. The spec's parameters are declared on the first configure and kept, as a lifecycle node keeps its
+  parameters across cleanup and configure.
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
 import time
@@ -48,7 +55,7 @@ class RosSide:
 
     def __init__(self, lifetime: Lifetime, name: str, *, ros_args: Sequence[str] = (), parameters: Sequence[Any] = (),
                  rules: Sequence[Any] = (), overrides: Mapping[str, Any] | None = None, qos_depth: int | None = None,
-                 command_reliability: str | None = None, namespace: str | None = None) -> None:
+                 command_reliability: str | None = None, namespace: str | None = None, host: Any = None) -> None:
         if command_reliability not in (None, "reliable", "best_effort"):
             raise BridgeConfigError(f"command_reliability must be reliable or best_effort, not {command_reliability!r}")
         self.lifetime = lifetime
@@ -71,6 +78,7 @@ class RosSide:
         self._spin_thread: threading.Thread | None = None
         self._stop_spin = threading.Event()
         self._extra_nodes: list[Any] = []  # other parts' ROS nodes on this executor (RosSide.add_node)
+        self.host = host  # a ManagedNode: its node, context and executor (see the module's doc)
 
     def attach(self) -> None:
         """The node first when the bridge starts; destroyed last."""
@@ -78,6 +86,9 @@ class RosSide:
 
     # -------------------------------------------------------------------------------------------- lifetime
     def _open(self) -> None:
+        if self.host is not None:
+            self._open_hosted()
+            return
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
@@ -106,6 +117,32 @@ class RosSide:
             self._events = False
         self.executor.add_node(self.node)
 
+    def _open_hosted(self) -> None:
+        host = self.host
+        self.context, self.node, self.executor, self._events = host.context, host.node, host.executor, host.events
+        self.clock = self.node.get_clock()
+        self.ros_time_active = bool(self.clock.ros_time_is_active)
+        self.node.add_post_set_parameters_callback(self._after_set_parameters)
+        if not host.parameters_declared:
+            try:
+                declare_parameters(self.node, self._parameters, self._rules, overrides=self._overrides)
+            except ParameterConfigError as ex:
+                raise BridgeConfigError(str(ex)) from None
+            host.parameters_declared = True
+
+    def _close_hosted(self) -> None:
+        """Destroy what this bridge made on the host's node and its parts' nodes; the host keeps the node."""
+        steps: list[Callable[[], Any]] = [
+            lambda: self.node.remove_post_set_parameters_callback(self._after_set_parameters)]
+        for node in self._extra_nodes:
+            steps += [functools.partial(self.executor.remove_node, node), node.destroy_node]
+        steps += self.host.release_steps()
+        for step in steps:
+            try:
+                step()
+            except Exception:
+                pass
+
     def add_node(self, node: Any) -> None:
         """Another ROS node of the bridge on this executor (before the spinner starts); destroyed at close, before
         the bridge's node."""
@@ -114,6 +151,9 @@ class RosSide:
 
     def _close(self) -> None:
         """After everything else: the executor, the nodes, the context (each may already be gone)."""
+        if self.host is not None:
+            self._close_hosted()
+            return
         steps = [lambda: self.executor.shutdown(timeout_sec=1.0) if self.executor is not None else None,
                  *[node.destroy_node for node in self._extra_nodes],
                  lambda: self.node.destroy_node() if self.node is not None else None,
@@ -127,6 +167,8 @@ class RosSide:
     def attach_spinner(self) -> None:
         """Spin the executor in its own thread from here on in the start order (attach it last: it stops first,
         so no hand-off happens after that)."""
+        if self.host is not None:
+            return  # the host's executor thread spins from before configure to shutdown
         self.lifetime.add_hooks("rclpy executor", start=self._start_spinning, close=self._stop_spinning)
 
     def _start_spinning(self) -> None:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from sam_runtime.bridge.counters import log
@@ -28,7 +28,11 @@ __all__ = ["EnableServices", "MappingSwitch", "switches_of"]
 
 @dataclass
 class MappingSwitch:
-    """One mapping's switch: its state, its service name, how often the service changed it."""
+    """One mapping's switch: its state, its service name, how often the service changed it.
+
+    ``enabled`` is what the paths read: the service's wish (``wanted``) unless the bridge holds the mapping off
+    (:meth:`hold`: the interface check's ``stop`` of a board whose firmware is from another spec), and
+    ``drop_reason`` the counter a dropped message goes to (``disabled``, or the hold's reason)."""
 
     name: str
     service: str = ""
@@ -36,20 +40,41 @@ class MappingSwitch:
     changes: int = 0
     requests: int = 0
     resolved: str = ""  # the service's full name once the node created it (namespace, ~ expanded)
+    wanted: bool = field(default=True, init=False)  # the service's (or the tables') state
+    held: str = field(default="", init=False)  # why the bridge holds it off ("" : not held)
+    drop_reason: str = field(default="disabled", init=False)
+
+    def __post_init__(self) -> None:
+        self.wanted = self.enabled
 
     def set(self, value: bool) -> str:
         """Set the state; the answer for the caller."""
         self.requests += 1
-        was, self.enabled = self.enabled, bool(value)
-        state = "enabled" if self.enabled else "disabled"
-        if was == self.enabled:
-            return f"mapping {self.name}: already {state}"
+        was, self.wanted = self.wanted, bool(value)
+        self._apply()
+        state = "enabled" if self.wanted else "disabled"
+        held = f" (held off: {self.held})" if self.held and self.wanted else ""
+        if was == self.wanted:
+            return f"mapping {self.name}: already {state}{held}"
         self.changes += 1
-        return f"mapping {self.name}: {state}"
+        return f"mapping {self.name}: {state}{held}"
+
+    def hold(self, reason: str) -> None:
+        """Hold the mapping off for ``reason`` (its drops are counted under it), or release it (``""``)."""
+        self.held = reason
+        self._apply()
+
+    def _apply(self) -> None:
+        # drop_reason first: a path that sees enabled False already counts under the right reason
+        self.drop_reason = self.held if self.held else "disabled"
+        self.enabled = self.wanted and not self.held
 
     def snapshot(self) -> dict[str, Any]:
-        return {"enabled": self.enabled, "enable_service": self.resolved or self.service,
-                "enable_changes": self.changes}
+        out: dict[str, Any] = {"enabled": self.enabled, "enable_service": self.resolved or self.service,
+                               "enable_changes": self.changes}
+        if self.held:
+            out["held"] = self.held
+        return out
 
 
 def switches_of(mappings: Any) -> dict[str, MappingSwitch]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ["PROTOCOL_SUFFIXES", "bridge_lines", "status_key"]
+__all__ = ["PROTOCOL_SUFFIXES", "bridge_lines", "interface_line", "status_key"]
 
 PROTOCOL_SUFFIXES = ("cyphal", "dronecan")
 
@@ -46,3 +46,26 @@ def bridge_lines(diagnostics: Mapping[str, Mapping[str, Any]], bridge: str) -> l
     lines += [f"bridge {p}: {diagnostics[f'{bridge}_{p}']['message']}" for p in PROTOCOL_SUFFIXES
               if f"{bridge}_{p}" in diagnostics]
     return lines or ["bridge: no /diagnostics yet"]
+
+
+def interface_line(diagnostics: Mapping[str, Mapping[str, Any]], bridge: str, devices: list[str]) -> str | None:
+    """The boards' firmware interface versions (issue 28: the bridge's interface check, in each device's status
+    values) in one line; None before any board was checked.
+
+    >>> d = {"b/device/imu": {"values": {"interface": "mismatch", "interface_mismatches": "2"}},
+    ...      "b/device/gps": {"values": {"interface": "match"}}, "b/device/dvl": {"values": {}}}
+    >>> interface_line(d, "b", ["imu", "gps", "dvl"])
+    'firmware interface: 2 boards checked, 1 match, 1 mismatch (imu: 2 seen)'
+    >>> interface_line({}, "b", ["imu"]) is None
+    True
+    """
+    values = {name: diagnostics.get(f"{bridge}/device/{name}", {}).get("values", {}) for name in devices}
+    verdicts = {name: v.get("interface") for name, v in values.items()}
+    checked = [n for n, verdict in verdicts.items() if verdict in ("match", "mismatch", "unknown")]
+    if not checked:
+        return None
+    counts = [f"{sum(verdicts[n] == kind for n in checked)} {kind}" for kind in ("match", "mismatch", "unknown")
+              if any(verdicts[n] == kind for n in checked)]
+    bad = [f"{n}: {values[n].get('interface_mismatches', '?')} seen" for n in checked if verdicts[n] == "mismatch"]
+    return (f"firmware interface: {len(checked)} boards checked, {', '.join(counts)}"
+            + (f" ({'; '.join(bad)})" if bad else ""))

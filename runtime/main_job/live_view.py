@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.main_job.demo import demo_message
-from sam_runtime.main_job.diag_view import bridge_lines, status_key
+from sam_runtime.main_job.diag_view import bridge_lines, interface_line, status_key
 from sam_runtime.main_job.vehicle_view import VehicleView
 
 if TYPE_CHECKING:
@@ -238,6 +238,9 @@ class LiveView:
                 status += f"; settings: {v['settings']}"
             lines.append(f"{d.name:22} {d.node_id:4d} {age_txt:>10} {v.get('health', '-'):9} "
                          f"{v.get('mode', '-'):12} {status}")
+        line = interface_line(self.diagnostics, bridge, [d.name for d in self.tables.DEVICES])
+        if line is not None:
+            lines.append(line)
         warnings = []  # mappings not OK: recent drops, or silent while their device is alive
         for n, d in sorted(self.diagnostics.items()):
             if n.startswith(f"{bridge}/mapping/") and d["level"] != 0:

@@ -46,6 +46,23 @@ class SimConfig(VehicleOptions):
     # A reboot (ExecuteCommand RESTART, RestartNode): the device is silent this long (its reset, bootloader and
     # firmware start) before its new node (uptime and transfer ids from 0) comes up
     reboot_s: float = 1.0
+    # Boards whose firmware was built from another spec (issue 28 part 4): each reports another interface hash than
+    # its spec's (every bit of it inverted: nonzero, never the spec's), as a board flashed from an older spec would.
+    stale_firmware: tuple[str, ...] = field(default=(), metadata=cli_field(
+        Flag("--stale-firmware", "comma-separated devices whose firmware is from another (older) spec: they report "
+             "another interface hash than the spec's (default: none)", metavar="DEVICES", default=",".join),
+        value=lambda a: tuple(d.strip() for d in (a.stale_firmware or "").split(",") if d.strip())))
+
+    def firmware_hash(self, device: str, spec_hash: int) -> int:
+        """The interface hash `device`'s simulated firmware reports (Cyphal GetInfo software_vcs_revision_id,
+        DroneCAN GetNodeInfo software_version.image_crc): its spec's, or another for a stale board.
+
+        >>> SimConfig(stale_firmware=("imu",)).firmware_hash("imu", 0x0123456789abcdef) == 0xfedcba9876543210
+        True
+        >>> SimConfig().firmware_hash("imu", 5)
+        5
+        """
+        return spec_hash ^ 0xFFFF_FFFF_FFFF_FFFF if device in self.stale_firmware else spec_hash
 
     def make_vehicle(self) -> SimulatedVehicle:
         """The vehicle of these options (raises ValueError on an impossible start, e.g. below the sea floor)."""

@@ -66,6 +66,8 @@ class CyphalDevices:
         else:
             dev.node = make_node(name, dev.info.node_id, cfg.kind, iface=cfg.iface, mtu=cfg.mtu)
         dev.node.heartbeat_publisher.mode = uavcan.node.Mode_1_0.OPERATIONAL
+        # its firmware's interface version (issue 28), what the bridge compares with its spec's
+        dev.node.info.software_vcs_revision_id = cfg.firmware_hash(dev.info.name, dev.info.interface_hash)
         self._serve_duties(dev)
         self._serve_settings(dev)
         for sp in dev.subs:

@@ -213,6 +213,12 @@ class DroneCanDevices:
         info.software_version.major = 1
         info.hardware_version.major = 1
         info.hardware_version.unique_id = hashlib.sha256(name.encode()).digest()[:16]
+        # its firmware's interface version (issue 28), what the bridge compares with its spec's; the flag says the
+        # field holds it (a board without one reports no flag: "unknown")
+        image_crc = self.sim.config.firmware_hash(dev.info.name, dev.info.interface_hash)
+        if image_crc:
+            info.software_version.image_crc = image_crc
+            info.software_version.optional_field_flags |= info.software_version.OPTIONAL_FIELD_FLAG_IMAGE_CRC
         sync_id = {int(dronecan.TYPENAMES[TIME_SYNC].default_dtid)} if dev.clock is not None else set()
         accept = Acceptance(dev.info.node_id, frozenset({sp.ident for sp in dev.subs} | sync_id))
         driver = make_driver(self.iface, accept=accept) if self._kind == "mcast-lo" else make_driver(self.iface)

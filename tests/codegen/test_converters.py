@@ -223,7 +223,13 @@ if WORKER:
 
     def float_range_strategy(width: int, lo: float = -math.inf, hi: float = math.inf) -> st.SearchStrategy[float]:
         bound = {16: FLOAT16_MAX, 32: RCLPY_FLOAT32_MAX, 64: sys.float_info.max}[width]
-        return st.floats(max(lo, -bound), min(hi, bound), allow_nan=False, allow_infinity=False, width=width)
+        lo, hi = max(lo, -bound), min(hi, bound)
+        if width < 64:  # a spec's limits (+-0.12) need not be floats of the width: the nearest ones inside them
+            kind = np.float16 if width == 16 else np.float32
+            f_lo, f_hi = kind(lo), kind(hi)
+            lo = float(f_lo if f_lo >= lo else np.nextafter(f_lo, kind(math.inf)))
+            hi = float(f_hi if f_hi <= hi else np.nextafter(f_hi, kind(-math.inf)))
+        return st.floats(lo, hi, allow_nan=False, allow_infinity=False, width=width)
 
     def utf8_strategy(capacity: int) -> st.SearchStrategy[str]:
         """Text that fits `capacity` bytes of UTF-8; no NUL, which ends a ROS (CDR) string."""
@@ -487,7 +493,7 @@ if WORKER:
         import sam.power
         import sam.sensor
         import uavcan.time
-        from sam_msgs.msg import PercentStamped, ThrusterAngles, ThrusterRPMs
+        from sam_msgs.msg import BallastAngles, PercentStamped, ThrusterAngles, ThrusterRPMs
         from sensor_msgs.msg import BatteryState, Imu, NavSatFix
 
         def test_rpm_saturates_to_int18_and_is_counted() -> None:
@@ -586,10 +592,19 @@ if WORKER:
 
         def test_float16_saturation_and_nan() -> None:
             stats = convert.ConversionStats()
+            # out of range and +-inf saturate to the spec's limits (the nozzle's +-0.12 rad; issue 29: no longer
+            # float16's +-65504 rad)
             out = convert.thrust_vector_to_uavcan(
                 ThrusterAngles(thruster_vertical_radians=1e6, thruster_horizontal_radians=-math.inf), stats)
-            assert (out.vertical_radians, out.horizontal_radians) == (65504.0, -65504.0)
+            assert (out.vertical_radians, out.horizontal_radians) == (0.12, -0.12)  # (float16 on the wire)
             assert stats.saturated == {"thrust_vector.vertical_radians": 1, "thrust_vector.horizontal_radians": 1}
+            out = convert.ballast_to_uavcan(
+                BallastAngles(weight_1_offset_radians=math.inf, weight_2_offset_radians=-2.0), stats)
+            assert (out.weight_1_offset_radians, out.weight_2_offset_radians) == (1.5708, -1.5708)
+            out = convert.thrust_vector_to_uavcan(ThrusterAngles(thruster_vertical_radians=0.0625), stats)
+            assert out.vertical_radians == 0.0625  # inside: unchanged, not counted
+            assert stats.saturated == {"thrust_vector.vertical_radians": 1, "thrust_vector.horizontal_radians": 1,
+                                       "ballast.weight_1_offset_radians": 1, "ballast.weight_2_offset_radians": 1}
             # NaN is a float16 value, but no setpoint: a NaN command is rejected and counted (issue 29)
             assert convert.thrust_vector_to_uavcan(ThrusterAngles(thruster_vertical_radians=math.nan), stats) is None
             assert stats.rejected == {"thrust_vector.vertical_radians": 1}

@@ -474,12 +474,12 @@ if WORKER:
         def test_float16_infinity_saturates_in_an_actuator_item() -> None:
             stats = convert.ConversionStats()
             cmd = wire(convert.thrust_vector_to_uavcan(
-                ThrusterAngles(thruster_vertical_radians=0.25, thruster_horizontal_radians=math.inf), stats))
+                ThrusterAngles(thruster_vertical_radians=0.0625, thruster_horizontal_radians=math.inf), stats))
             items = {c.actuator_id: (c.command_type, c.command_value) for c in cmd.commands}
-            assert items == {0: (1, 0.25), 1: (1, 65504.0)}
+            assert items == {0: (1, 0.0625), 1: (1, 0.1199951171875)}  # the spec's limit (+-0.12) as float16
             assert stats.saturated == {"thrust_vector.commands[actuator_id=1].command_value": 1}
             cmd = wire(convert.ballast_to_uavcan(BallastAngles(weight_1_offset_radians=-math.inf), stats))
-            assert [(c.actuator_id, c.command_value) for c in cmd.commands] == [(2, -65504.0), (3, 0.0)]
+            assert [(c.actuator_id, c.command_value) for c in cmd.commands] == [(2, -1.5703125), (3, 0.0)]  # -1.5708
 
         def test_items_by_actuator_id_in_any_order() -> None:
             command = T("uavcan.equipment.actuator.Command")

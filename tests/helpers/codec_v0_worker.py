@@ -416,12 +416,13 @@ if WORKER:
                                                                                  thruster_2_rpm=-7)), stats)
             assert list(dronecan_decode(MAPPINGS["thruster_rpms"], out).rpm) == [131071, -7]
             assert stats.saturated == {"thruster_rpms.rpm[0]": 1}
-            out = codec.thrust_vector_ros_to_wire(serialize_message(ThrusterAngles(thruster_vertical_radians=0.25,
+            out = codec.thrust_vector_ros_to_wire(serialize_message(ThrusterAngles(thruster_vertical_radians=0.0625,
                                                                                    thruster_horizontal_radians=math.inf)),
                                                   stats)
             cmd = dronecan_decode(MAPPINGS["thrust_vector"], out)
-            assert [(c.actuator_id, c.command_type, c.command_value) for c in cmd.commands] == [(0, 1, 0.25),
-                                                                                                 (1, 1, 65504.0)]
+            # +inf: the spec's limit, 0.12 as float16
+            got = [(c.actuator_id, c.command_type, c.command_value) for c in cmd.commands]
+            assert got == [(0, 1, 0.0625), (1, 1, 0.1199951171875)]
             assert codec.WIRE_MATCHES["thrust_vector"](out) and not codec.WIRE_MATCHES["ballast"](out)
 
         def test_timestamp_zero_is_the_receive_time() -> None:

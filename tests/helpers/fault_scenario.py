@@ -634,7 +634,7 @@ async def can_commands(bridge: Any, sim: Any, probe: Probe) -> dict[str, Any]:
     sent = [
         ("/thruster_rpms", {"thruster_1_rpm": 200_000, "thruster_2_rpm": -200_000}),
         ("/thruster_angles", {"thruster_vertical_radians": math.inf, "thruster_horizontal_radians": -math.inf}),
-        # NaN is no setpoint: this one is dropped (not_a_number, issue 29); the next one's 1e6 saturates
+        # NaN is no setpoint: this one is dropped (not_a_number, issue 29); the next one's 1e6 saturates to the limit
         ("/ballast_angles", {"weight_1_offset_radians": math.nan, "weight_2_offset_radians": 0.0}),
         ("/ballast_angles", {"weight_1_offset_radians": 0.5, "weight_2_offset_radians": 1e6}),
         ("/longitudinal_weight_position", {"percent": math.nan}),

@@ -20,6 +20,7 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 import argparse
 import asyncio
 import json
+import struct
 import sys
 import time
 from pathlib import Path
@@ -32,6 +33,28 @@ QUEUE_SIZE = 32
 PACED_CHUNKS, CHUNK = 8, 20
 BURST = 400
 SIM_CLOCK_NS = 1_234_000_000_000 + 5678
+
+
+# A sequence number (below 2048**2) travels in the thrust vector's two float16 angles: each half as a float16
+# normal's bit pattern 0x0400 + half (2**-14 .. 0.00025 rad), exact in float16, float32 and float64 and well inside
+# the spec's limits (+-0.12 rad, which saturate anything larger).
+def seq_angles(seq: int) -> tuple[float, float]:
+    """The two angles of ``seq``.
+
+    >>> [angles_seq(*seq_angles(s)) for s in (0, 1, 2047, 2048, 2048 * 2048 - 1)], max(seq_angles(2048 * 2048 - 1))
+    ([0, 1, 2047, 2048, 4194303], 0.00024402141571044922)
+    """
+    hi, lo = divmod(seq, 2048)
+    return (struct.unpack("<e", struct.pack("<H", 0x0400 + hi))[0],
+            struct.unpack("<e", struct.pack("<H", 0x0400 + lo))[0])
+
+
+def angles_seq(vertical: float, horizontal: float) -> int:
+    """The sequence number of :func:`seq_angles`' two angles."""
+    def half(x: float) -> int:
+        return int(struct.unpack("<H", struct.pack("<e", float(x)))[0]) - 0x0400
+
+    return half(vertical) * 2048 + half(horizontal)
 
 
 class Probe(ThreadedProbe):
@@ -75,7 +98,7 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
     at_actuator: list[int] = []
 
     def on_cmd(msg: Any, transfer: Any) -> None:
-        at_actuator.append(int(msg.horizontal_radians) + 2048 * int(msg.vertical_radians))
+        at_actuator.append(angles_seq(msg.vertical_radians, msg.horizontal_radians))
 
     cmd_sub = nodes[0].make_subscriber(gen.dsdl_class(cmd_map.port), cmd_map.port.subject_id)
     cmd_sub.receive_in_background(on_cmd)
@@ -95,8 +118,9 @@ async def main(args: argparse.Namespace) -> dict[str, Any]:
 
     def command() -> None:
         nonlocal seq
-        probe.publish("/thruster_angles", {"thruster_vertical_radians": float(seq // 2048),
-                                           "thruster_horizontal_radians": float(seq % 2048)})
+        vertical, horizontal = seq_angles(seq)
+        probe.publish("/thruster_angles", {"thruster_vertical_radians": vertical,
+                                           "thruster_horizontal_radians": horizontal})
         seq += 1
 
     try:

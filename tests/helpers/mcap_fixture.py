@@ -2,8 +2,10 @@
 messages), written with mcap_ros2's writer: the report's test input until a real recording is at hand.
 
 The dive: 60 s, down to 3 m along x toward a goal at (20, 5, -3), back up; /tf world->odom (2 Hz) and
-odom->base_link (25 Hz), /nav_goal, /pressure, /altitude, the command topics, /battery_state, /abort (an abort at
-45 s) and /diagnostics of the nodes (the controller WARN from 30 to 35 s).
+odom->base_link (25 Hz), /nav_goal, /pressure, /altitude, the command topics, both thrusters' feedback (alike),
+/battery_state, /abort (an abort at 45 s) and /diagnostics of the nodes (the controller WARN from 30 to 35 s, the
+dead reckoning's speed) and of the bridge (deactivated 20-25 s, a device lost, one never heard, drops: see
+_bridge_statuses).
 """
 
 from __future__ import annotations
@@ -65,6 +67,7 @@ TYPES = {
     "/ballast_angles": "sam_msgs/msg/BallastAngles", "/buoyancy_piston_position": "sam_msgs/msg/PercentStamped",
     "/longitudinal_weight_position": "sam_msgs/msg/PercentStamped", "/battery_state": "sensor_msgs/msg/BatteryState",
     "/abort": "sam_msgs/msg/Abort", "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray",
+    "/thruster_1/feedback": "sam_msgs/msg/ThrusterFeedback", "/thruster_2/feedback": "sam_msgs/msg/ThrusterFeedback",
 }
 T0_NS = 1_764_000_000_000_000_000
 
@@ -98,6 +101,30 @@ def _namespaced(msg: Any, prefix: str) -> Any:
             out[key] = prefix + out[key]
     if "level" in out and out.get("name"):
         out["name"] = prefix + out["name"]
+    return out
+
+
+def _kv(values: dict[str, Any]) -> list[dict[str, str]]:
+    return [{"key": k, "value": str(v)} for k, v in values.items()]
+
+
+def _bridge_statuses(t: float) -> list[dict[str, Any]]:
+    """The bridge's statuses at ``t``: deactivated by its lifecycle manager from 20 to 25 s (commands dropped as
+    inactive), thruster_1 lost from 20 to 30 s (ERROR), the GPS never heard before 10 s (STALE), the IMU losing
+    transfers from 10 s on."""
+    active = not 20 <= t < 25
+    lost = max(0, int(2 * (t - 10))) if t >= 10 else 0
+    inactive = 0 if t < 20 else min(50, int(10 * (t - 20)))
+    out = [{"level": 0, "name": "uavcan_ros_bridge", "hardware_id": "",
+            "message": ("" if active else "inactive (lifecycle): commands dropped; ") + "3 mappings",
+            "values": _kv({"dropped_total": lost + inactive, "active": active})}]
+    for device, level in (("imu", 0), ("thruster_1", 2 if 20 <= t < 30 else 0), ("gps", 3 if t < 10 else 0)):
+        out.append({"level": level, "name": f"uavcan_ros_bridge/device/{device}", "message": "", "hardware_id": "",
+                    "values": _kv({"alive": level == 0})})
+    for mapping, drops in (("imu", {"lost": lost}), ("thruster_1_rpm", {"inactive": inactive}), ("pressure", {})):
+        out.append({"level": 0, "name": f"uavcan_ros_bridge/mapping/{mapping}", "message": "", "hardware_id": "",
+                    "values": _kv({"dropped": sum(drops.values()),
+                                   **{f"dropped.{k}": v for k, v in drops.items()}})})
     return out
 
 
@@ -142,6 +169,9 @@ def write_dive(path: Path, *, seconds: float = 60.0, skip: tuple[str, ...] = (),
                                        "weight_2_offset_radians": 0.0})
             add(t, "/buoyancy_piston_position", {"header": _header(t), "percent": 100.0 if ascent else 30.0})
             add(t, "/longitudinal_weight_position", {"header": _header(t), "percent": 50.0 + 10 * math.sin(t / 8)})
+            for n in (1, 2):  # both thrusters alike: equal series, each must stay visible
+                add(t, f"/thruster_{n}/feedback", {"header": _header(t), "rpm": 0 if t >= 46 else 1180,
+                                                    "current": 0.2 if t >= 46 else 2.5, "temperature_c": 20})
         if k % 25 == 0:
             add(t, "/battery_state", {"header": _header(t), "voltage": 16.0, "temperature": 20.0, "current": -3.0,
                                       "charge": math.nan, "capacity": math.nan, "design_capacity": math.nan,
@@ -153,8 +183,11 @@ def write_dive(path: Path, *, seconds: float = 60.0, skip: tuple[str, ...] = (),
             for name in ("dead_reckoning", "slam", "motion_planner", "controller", "performance_monitor"):
                 level = 1 if name == "controller" and 30 <= t < 35 else 2 if name == "performance_monitor" \
                     and t >= 45 else 0
+                values = [{"key": "speed", "value": f"{0.6 if t < 45 else 0.0:.3g}"}] if name == "dead_reckoning" \
+                    else []
                 statuses.append({"level": level, "name": name, "message": "ok", "hardware_id": "",
-                                 "values": []})
+                                 "values": values})
+            statuses += _bridge_statuses(t)
             add(t, "/diagnostics", {"header": _header(t), "status": statuses})
     for t in (0.5, 1.0):  # sent again, as the mission does until the planner has it
         add(t, "/nav_goal", {"header": _header(t, "world"),

@@ -217,9 +217,12 @@ def command_plan(tables: Any, n: int) -> dict[str, list[dict[str, Any]]]:
             if t == "/thruster_rpms":
                 items.append({"thruster_1_rpm": 100 * i - 500, "thruster_2_rpm": -50 * i})
             elif t == "/thruster_angles":
-                items.append({"thruster_vertical_radians": 0.01 * i, "thruster_horizontal_radians": -0.02 * i})
+                # (inside the nozzle's +-0.12 rad for any n; the ballast's +-1.5708)
+                items.append({"thruster_vertical_radians": 0.01 * (i % 12),
+                              "thruster_horizontal_radians": -0.01 * (i % 12)})
             elif t == "/ballast_angles":
-                items.append({"weight_1_offset_radians": 0.1 + 0.01 * i, "weight_2_offset_radians": -0.05 * i})
+                items.append({"weight_1_offset_radians": 0.1 + 0.01 * (i % 100),
+                              "weight_2_offset_radians": -0.05 * (i % 30)})
             elif t == "/longitudinal_weight_position":
                 items.append({"percent": float(5 * i)})
             elif t == "/buoyancy_piston_position":
@@ -227,6 +230,10 @@ def command_plan(tables: Any, n: int) -> dict[str, list[dict[str, Any]]]:
         if items:
             if t == "/thruster_rpms":
                 items[-1] = {"thruster_1_rpm": 1_000_000, "thruster_2_rpm": -1_000_000}
+            elif t == "/thruster_angles":  # beyond the spec's limits
+                items[-1] = {"thruster_vertical_radians": 0.5, "thruster_horizontal_radians": -1e6}
+            elif t == "/ballast_angles":
+                items[-1] = {"weight_1_offset_radians": 2.0, "weight_2_offset_radians": -1e6}
             elif t == "/longitudinal_weight_position":
                 items[-1] = {"percent": 150.0}
             elif t == "/buoyancy_piston_position":

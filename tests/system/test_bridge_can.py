@@ -94,9 +94,8 @@ def _check(res: dict[str, Any], record: Path) -> None:
     assert devs["buoyancy_piston"]["commands"]["1205"]["last"] == {"percent": 0.0}  # -20 % -> 0
     last_tv = plan["/thruster_angles"][-1]
     assert devs["thrust_vector"]["commands"]["1202"]["last"] == {
-        "vertical_radians": f16(last_tv["thruster_vertical_radians"]),
-        "horizontal_radians": f16(last_tv["thruster_horizontal_radians"]),
-    }
+        "vertical_radians": f16(0.12), "horizontal_radians": f16(-0.12)}  # the last: 0.5 and -1e6, the spec's limits
+    assert last_tv == {"thruster_vertical_radians": 0.5, "thruster_horizontal_radians": -1e6}
     total_rejected = sum(c["rejected"] for d in devs.values() for c in d["commands"].values())
     assert total_rejected == rogue["count"]
     assert devs["thruster_1"]["commands"][str(rogue["command_subject"])]["rejected_sources"] == {

@@ -107,7 +107,8 @@ async def _scenario(gen: Any, iface: str, wire: str) -> dict[str, Any]:
 
         # ROS -> UAVCAN.
         probe.publish("/thruster_rpms", {"thruster_1_rpm": 1000, "thruster_2_rpm": 200000})
-        probe.publish("/thruster_angles", {"thruster_vertical_radians": 0.25, "thruster_horizontal_radians": -0.5})
+        probe.publish("/thruster_angles", {"thruster_vertical_radians": 0.0625,  # inside the limits (+-0.12)
+                                           "thruster_horizontal_radians": -0.09375})
         probe.publish("/buoyancy_piston_position", {"percent": 150.0})
         await until(lambda: listener.got("uavcan.equipment.esc.RPMCommand")
                     and len(listener.got("uavcan.equipment.actuator.ArrayCommand")) >= 2, 10, "the commands")
@@ -172,7 +173,7 @@ def test_esc_status_routed_by_node_and_esc_index(run: dict[str, Any]) -> None:
 def test_commands_reach_a_plain_listener_with_index_id_and_saturation(run: dict[str, Any]) -> None:
     assert run["rpm"] == [(BRIDGE_ID, [1000, 131071])]
     arrays = sorted(run["array"])
-    assert arrays == [(BRIDGE_ID, [(0, 1, 0.25), (1, 1, -0.5)]), (BRIDGE_ID, [(5, 0, 1.0)])]
+    assert arrays == [(BRIDGE_ID, [(0, 1, 0.0625), (1, 1, -0.09375)]), (BRIDGE_ID, [(5, 0, 1.0)])]
     m = run["stats"]["mappings"]
     assert m["thruster_rpms"]["saturated"] == {"thruster_rpms.rpm[1]": 1} and m["thruster_rpms"]["published"] == 1
     assert m["buoyancy_piston"]["saturated_total"] == 1 and m["buoyancy_piston"]["destination_node_ids"] == [26]

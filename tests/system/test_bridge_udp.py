@@ -349,10 +349,12 @@ def test_udp_commands_reach_the_actuators(command_run: dict[str, Any]) -> None:
     expect: dict[int, list[dict[str, Any]]] = {
         1200: [{"rpm": int(_clip(c["thruster_1_rpm"], -131072, 131071))} for c in plan["/thruster_rpms"]],
         1201: [{"rpm": int(_clip(c["thruster_2_rpm"], -131072, 131071))} for c in plan["/thruster_rpms"]],
-        1202: [{"vertical_radians": f16(c["thruster_vertical_radians"]),
-                "horizontal_radians": f16(c["thruster_horizontal_radians"])} for c in plan["/thruster_angles"]],
-        1203: [{"weight_1_offset_radians": f16(c["weight_1_offset_radians"]),
-                "weight_2_offset_radians": f16(c["weight_2_offset_radians"])} for c in plan["/ballast_angles"]],
+        1202: [{"vertical_radians": f16(_clip(c["thruster_vertical_radians"], -0.12, 0.12)),  # the spec's limits
+                "horizontal_radians": f16(_clip(c["thruster_horizontal_radians"], -0.12, 0.12))}
+               for c in plan["/thruster_angles"]],
+        1203: [{"weight_1_offset_radians": f16(_clip(c["weight_1_offset_radians"], -1.5708, 1.5708)),
+                "weight_2_offset_radians": f16(_clip(c["weight_2_offset_radians"], -1.5708, 1.5708))}
+               for c in plan["/ballast_angles"]],
         1204: [{"percent": f16(_clip(c["percent"], 0, 100))} for c in plan["/longitudinal_weight_position"]],
         1205: [{"percent": f16(_clip(c["percent"], 0, 100))} for c in plan["/buoyancy_piston_position"]],
     }
@@ -370,6 +372,9 @@ def test_udp_commands_reach_the_actuators(command_run: dict[str, Any]) -> None:
     assert sat["thruster_1_rpm"]["saturated"] == {"thruster_1_rpm.rpm": 1}
     assert sat["longitudinal_weight"]["saturated"] == {"longitudinal_weight.percent": 1}
     assert sat["buoyancy_piston"]["saturated"] == {"buoyancy_piston.percent": 1}
+    assert sat["thrust_vector"]["saturated"] == {"thrust_vector.vertical_radians": 1,
+                                                 "thrust_vector.horizontal_radians": 1}
+    assert sat["ballast"]["saturated"] == {"ballast.weight_1_offset_radians": 1, "ballast.weight_2_offset_radians": 1}
     assert run["stats"]["bridge"]["transport"].startswith("env(")  # configured by UAVCAN__UDP__IFACE
 
 

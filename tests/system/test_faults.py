@@ -45,6 +45,8 @@ pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 BRIDGE = "uavcan_ros_bridge"
 F16_MAX = 65504.0
+# The spec's limits of the thrust vector (+-0.12 rad) and the ballast (+-1.5708 rad), as float16 on the bus
+NOZZLE_F16, BALLAST_F16 = 0.1199951171875, 1.5703125
 
 
 def _figures(title: str, data: Any) -> None:
@@ -285,7 +287,7 @@ def test_out_of_range_commands_through_the_running_bridge(can_run: dict[str, Any
                    for m, x in b.items()}})
     assert last["thruster_1_rpm"] == {"rpm": 131071} and last["thruster_2_rpm"] == {"rpm": -131072}  # int18
     assert b["thruster_1_rpm"]["saturated"] == {"thruster_1_rpm.rpm": 1}
-    assert last["thrust_vector"] == {"vertical_radians": F16_MAX, "horizontal_radians": -F16_MAX}  # +-inf
+    assert last["thrust_vector"] == {"vertical_radians": NOZZLE_F16, "horizontal_radians": -NOZZLE_F16}  # +-inf
     assert b["thrust_vector"]["saturated"] == {"thrust_vector.vertical_radians": 1,
                                                "thrust_vector.horizontal_radians": 1}
     assert last["buoyancy_piston"] == {"percent": 100.0} and b["buoyancy_piston"]["saturated"] == {
@@ -296,8 +298,9 @@ def test_out_of_range_commands_through_the_running_bridge(can_run: dict[str, Any
     assert b["longitudinal_weight"]["dropped"] == {"not_a_number": 1}
     assert b["longitudinal_weight"]["rejected_fields"] == {"longitudinal_weight.percent": 1}
     assert b["ballast"]["dropped"] == {"not_a_number": 1}
-    # float16 without limits: 1e6 saturates to 65504.
-    assert last["ballast"] == {"weight_1_offset_radians": 0.5, "weight_2_offset_radians": F16_MAX}
+    # 1e6 saturates to the spec's limit (issue 29: no longer float16's 65504).
+    assert last["ballast"] == {"weight_1_offset_radians": 0.5, "weight_2_offset_radians": BALLAST_F16}
+    assert b["ballast"]["saturated"] == {"ballast.weight_2_offset_radians": 1}
     lw = ph["diagnostics"]["longitudinal_weight"]["values"]
     assert lw["dropped.not_a_number"] == "1" and lw["rejected.longitudinal_weight.percent"] == "1"
     t1 = ph["diagnostics"]["thruster_1_rpm"]["values"]

@@ -25,6 +25,7 @@ from sam_codegen.targets.docs.graph import SVG_NAME, build_graph
 from sam_codegen.targets.docs.markdown import markdown_context
 from sam_codegen.targets.docs.services import services_context
 from sam_codegen.targets.docs.svg import svg_context
+from sam_codegen.validate.interface_version import hex_hash, interface_versions
 from sam_codegen.validate.resolve import Resolved
 
 MD_PATH = "docs/interfaces.md"
@@ -37,9 +38,19 @@ def emit(resolved: Resolved) -> dict[str, str]:
     return {
         MD_PATH: render("docs/interfaces.md.j2", **markdown_context(resolved, graph),
                         **dronecan_context(resolved), **budget_context(resolved),
-                        **services_context(resolved)).rstrip("\n") + "\n",
+                        **services_context(resolved),
+                        interface_version=_interface_version_context(resolved)).rstrip("\n") + "\n",
         SVG_PATH: render("docs/dataflow.svg.j2", **svg_context(resolved, graph)),
     }
+
+
+def _interface_version_context(resolved: Resolved) -> dict[str, object]:
+    """The interface version section: the whole spec's hash and each board's (validate.interface_version)."""
+    versions = interface_versions(resolved)
+    devices = resolved.spec.devices
+    return {"whole": hex_hash(versions.whole),
+            "boards": [{"name": name, "node_id": devices[name].node_id, "protocols": devices[name].protocols,
+                        "hash": hex_hash(value)} for name, value in versions.boards]}
 
 
 __all__ = ["MD_PATH", "SVG_PATH", "emit"]

@@ -24,6 +24,7 @@ from sam_codegen.targets.nodes import nodes_package, params_file, static_transfo
 from sam_codegen.targets.python.convert_v0 import used_types
 from sam_codegen.targets.python.names import py_class_name, py_module
 from sam_codegen.targets.ros import build_order
+from sam_codegen.validate.interface_version import interface_versions
 from sam_codegen.validate.mapping_rules import format_path
 from sam_codegen.validate.nodes import class_name, node_topic_qos
 from sam_codegen.validate.panic_duty import panic_duty
@@ -56,8 +57,10 @@ def _traffic(m: Mapping) -> dict[str, str]:
 def cyphal_context(resolved: Resolved) -> dict[str, Any]:
     """The Cyphal part of tables.py and what every spec has (topics, parameters, frames, the bridge)."""
     spec = resolved.spec
+    versions = interface_versions(resolved)
     devices = [{
         "name": py_str(d.name), "node_id": str(d.node_id), "description": d.description,
+        "interface_hash": f"0x{versions.of(d.name):016x}",
         "publishes": [_port_info(resolved, p) for p in d.publishes],
         "subscribes": [_port_info(resolved, p) for p in d.subscribes],
     } for d in spec.devices.values() if CYPHAL.name in d.protocols]
@@ -154,6 +157,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
     """The DroneCAN entries of tables.py (empty for a spec without DroneCAN) and the layouts."""
     spec = resolved.spec
     catalog = resolved.dronecan
+    versions = interface_versions(resolved)
     types = {t.name: t for t in used_types(resolved)} if catalog is not None else {}
     devices = []
     for d in spec.devices.values():
@@ -161,6 +165,7 @@ def dronecan_context(resolved: Resolved) -> dict[str, Any]:
             continue
         devices.append({
             "name": py_str(d.name), "node_id": str(d.node_id), "description": d.description,
+            "interface_hash": f"0x{versions.of(d.name):016x}",
             "publishes": [_dronecan_port_info(types[p.type], p.rate_hz) for p in d.dronecan_publishes],
             "subscribes": [_dronecan_port_info(types[p.type], p.rate_hz) for p in d.dronecan_subscribes],
         })
@@ -260,4 +265,7 @@ def table_types_source() -> str:
 def tables_context(resolved: Resolved) -> dict[str, Any]:
     """Everything templates/python/tables.py.j2 renders."""
     return {"table_types": table_types_source(), **cyphal_context(resolved), **nodes_context(resolved),
-            **dronecan_context(resolved), **device_parameters_context(resolved)}
+            **dronecan_context(resolved), "interface_hash": f"0x{interface_versions(resolved).whole:016x}",
+            "interface_on_mismatch": py_str(resolved.spec.bridge.interface_on_mismatch
+                                            if resolved.spec.bridge is not None else "warn"),
+            **device_parameters_context(resolved)}

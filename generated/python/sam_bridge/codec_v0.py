@@ -1181,22 +1181,22 @@ def thrust_vector_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | No
     if commands_actuator_id_0_command_value != commands_actuator_id_0_command_value:  # NaN
         stats.reject_nan('thrust_vector.commands[actuator_id=0].command_value')
         return None
-    if commands_actuator_id_0_command_value > 65504.0:
+    if commands_actuator_id_0_command_value < -0.12:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
-        commands_actuator_id_0_command_value = 65504.0
-    elif commands_actuator_id_0_command_value < -65504.0:
+        commands_actuator_id_0_command_value = -0.12
+    elif commands_actuator_id_0_command_value > 0.12:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
-        commands_actuator_id_0_command_value = -65504.0
+        commands_actuator_id_0_command_value = 0.12
     commands_actuator_id_1_command_value = thruster_horizontal_radians
     if commands_actuator_id_1_command_value != commands_actuator_id_1_command_value:  # NaN
         stats.reject_nan('thrust_vector.commands[actuator_id=1].command_value')
         return None
-    if commands_actuator_id_1_command_value > 65504.0:
+    if commands_actuator_id_1_command_value < -0.12:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
-        commands_actuator_id_1_command_value = 65504.0
-    elif commands_actuator_id_1_command_value < -65504.0:
+        commands_actuator_id_1_command_value = -0.12
+    elif commands_actuator_id_1_command_value > 0.12:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
-        commands_actuator_id_1_command_value = -65504.0
+        commands_actuator_id_1_command_value = 0.12
     return _K55.pack(
         0, 1, _f16(commands_actuator_id_0_command_value), 1, 1, _f16(commands_actuator_id_1_command_value),
     )
@@ -1251,22 +1251,22 @@ def ballast_ros_to_wire(cdr: bytes | memoryview, stats: Any) -> bytes | None:
     if commands_actuator_id_2_command_value != commands_actuator_id_2_command_value:  # NaN
         stats.reject_nan('ballast.commands[actuator_id=2].command_value')
         return None
-    if commands_actuator_id_2_command_value > 65504.0:
+    if commands_actuator_id_2_command_value < -1.5708:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
-        commands_actuator_id_2_command_value = 65504.0
-    elif commands_actuator_id_2_command_value < -65504.0:
+        commands_actuator_id_2_command_value = -1.5708
+    elif commands_actuator_id_2_command_value > 1.5708:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
-        commands_actuator_id_2_command_value = -65504.0
+        commands_actuator_id_2_command_value = 1.5708
     commands_actuator_id_3_command_value = weight_2_offset_radians
     if commands_actuator_id_3_command_value != commands_actuator_id_3_command_value:  # NaN
         stats.reject_nan('ballast.commands[actuator_id=3].command_value')
         return None
-    if commands_actuator_id_3_command_value > 65504.0:
+    if commands_actuator_id_3_command_value < -1.5708:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
-        commands_actuator_id_3_command_value = 65504.0
-    elif commands_actuator_id_3_command_value < -65504.0:
+        commands_actuator_id_3_command_value = -1.5708
+    elif commands_actuator_id_3_command_value > 1.5708:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
-        commands_actuator_id_3_command_value = -65504.0
+        commands_actuator_id_3_command_value = 1.5708
     return _K55.pack(
         2, 1, _f16(commands_actuator_id_2_command_value), 3, 1, _f16(commands_actuator_id_3_command_value),
     )

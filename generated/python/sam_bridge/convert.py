@@ -1388,22 +1388,22 @@ def thrust_vector_to_uavcan(
     if vertical_radians != vertical_radians:  # NaN
         stats.reject_nan('thrust_vector.vertical_radians')
         return None
-    if vertical_radians > 65504.0:
+    if vertical_radians < -0.12:
         stats.saturate('thrust_vector.vertical_radians')
-        vertical_radians = 65504.0
-    elif vertical_radians < -65504.0:
+        vertical_radians = -0.12
+    elif vertical_radians > 0.12:
         stats.saturate('thrust_vector.vertical_radians')
-        vertical_radians = -65504.0
+        vertical_radians = 0.12
     horizontal_radians = src.thruster_horizontal_radians
     if horizontal_radians != horizontal_radians:  # NaN
         stats.reject_nan('thrust_vector.horizontal_radians')
         return None
-    if horizontal_radians > 65504.0:
+    if horizontal_radians < -0.12:
         stats.saturate('thrust_vector.horizontal_radians')
-        horizontal_radians = 65504.0
-    elif horizontal_radians < -65504.0:
+        horizontal_radians = -0.12
+    elif horizontal_radians > 0.12:
         stats.saturate('thrust_vector.horizontal_radians')
-        horizontal_radians = -65504.0
+        horizontal_radians = 0.12
     return _new_sam_actuator_ThrustVector_0_1(
         vertical_radians=vertical_radians,
         horizontal_radians=horizontal_radians,
@@ -1435,22 +1435,22 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> sam.actuato
     if weight_1_offset_radians != weight_1_offset_radians:  # NaN
         stats.reject_nan('ballast.weight_1_offset_radians')
         return None
-    if weight_1_offset_radians > 65504.0:
+    if weight_1_offset_radians < -1.5708:
         stats.saturate('ballast.weight_1_offset_radians')
-        weight_1_offset_radians = 65504.0
-    elif weight_1_offset_radians < -65504.0:
+        weight_1_offset_radians = -1.5708
+    elif weight_1_offset_radians > 1.5708:
         stats.saturate('ballast.weight_1_offset_radians')
-        weight_1_offset_radians = -65504.0
+        weight_1_offset_radians = 1.5708
     weight_2_offset_radians = src.weight_2_offset_radians
     if weight_2_offset_radians != weight_2_offset_radians:  # NaN
         stats.reject_nan('ballast.weight_2_offset_radians')
         return None
-    if weight_2_offset_radians > 65504.0:
+    if weight_2_offset_radians < -1.5708:
         stats.saturate('ballast.weight_2_offset_radians')
-        weight_2_offset_radians = 65504.0
-    elif weight_2_offset_radians < -65504.0:
+        weight_2_offset_radians = -1.5708
+    elif weight_2_offset_radians > 1.5708:
         stats.saturate('ballast.weight_2_offset_radians')
-        weight_2_offset_radians = -65504.0
+        weight_2_offset_radians = 1.5708
     return _new_sam_actuator_BallastAngles_0_1(
         weight_1_offset_radians=weight_1_offset_radians,
         weight_2_offset_radians=weight_2_offset_radians,

@@ -703,22 +703,22 @@ def thrust_vector_to_uavcan(src: ThrusterAngles, stats: ConversionStats) -> Any 
     if commands_actuator_id_0_command_value != commands_actuator_id_0_command_value:  # NaN
         stats.reject_nan('thrust_vector.commands[actuator_id=0].command_value')
         return None
-    if commands_actuator_id_0_command_value > 65504.0:
+    if commands_actuator_id_0_command_value < -0.12:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
-        commands_actuator_id_0_command_value = 65504.0
-    elif commands_actuator_id_0_command_value < -65504.0:
+        commands_actuator_id_0_command_value = -0.12
+    elif commands_actuator_id_0_command_value > 0.12:
         stats.saturate('thrust_vector.commands[actuator_id=0].command_value')
-        commands_actuator_id_0_command_value = -65504.0
+        commands_actuator_id_0_command_value = 0.12
     commands_actuator_id_1_command_value = src.thruster_horizontal_radians
     if commands_actuator_id_1_command_value != commands_actuator_id_1_command_value:  # NaN
         stats.reject_nan('thrust_vector.commands[actuator_id=1].command_value')
         return None
-    if commands_actuator_id_1_command_value > 65504.0:
+    if commands_actuator_id_1_command_value < -0.12:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
-        commands_actuator_id_1_command_value = 65504.0
-    elif commands_actuator_id_1_command_value < -65504.0:
+        commands_actuator_id_1_command_value = -0.12
+    elif commands_actuator_id_1_command_value > 0.12:
         stats.saturate('thrust_vector.commands[actuator_id=1].command_value')
-        commands_actuator_id_1_command_value = -65504.0
+        commands_actuator_id_1_command_value = 0.12
     return _TYPENAMES['uavcan.equipment.actuator.ArrayCommand'](
         commands=[
             _TYPENAMES['uavcan.equipment.actuator.Command'](
@@ -766,22 +766,22 @@ def ballast_to_uavcan(src: BallastAngles, stats: ConversionStats) -> Any | None:
     if commands_actuator_id_2_command_value != commands_actuator_id_2_command_value:  # NaN
         stats.reject_nan('ballast.commands[actuator_id=2].command_value')
         return None
-    if commands_actuator_id_2_command_value > 65504.0:
+    if commands_actuator_id_2_command_value < -1.5708:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
-        commands_actuator_id_2_command_value = 65504.0
-    elif commands_actuator_id_2_command_value < -65504.0:
+        commands_actuator_id_2_command_value = -1.5708
+    elif commands_actuator_id_2_command_value > 1.5708:
         stats.saturate('ballast.commands[actuator_id=2].command_value')
-        commands_actuator_id_2_command_value = -65504.0
+        commands_actuator_id_2_command_value = 1.5708
     commands_actuator_id_3_command_value = src.weight_2_offset_radians
     if commands_actuator_id_3_command_value != commands_actuator_id_3_command_value:  # NaN
         stats.reject_nan('ballast.commands[actuator_id=3].command_value')
         return None
-    if commands_actuator_id_3_command_value > 65504.0:
+    if commands_actuator_id_3_command_value < -1.5708:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
-        commands_actuator_id_3_command_value = 65504.0
-    elif commands_actuator_id_3_command_value < -65504.0:
+        commands_actuator_id_3_command_value = -1.5708
+    elif commands_actuator_id_3_command_value > 1.5708:
         stats.saturate('ballast.commands[actuator_id=3].command_value')
-        commands_actuator_id_3_command_value = -65504.0
+        commands_actuator_id_3_command_value = 1.5708
     return _TYPENAMES['uavcan.equipment.actuator.ArrayCommand'](
         commands=[
             _TYPENAMES['uavcan.equipment.actuator.Command'](

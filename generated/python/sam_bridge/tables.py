@@ -29,6 +29,8 @@ class DeviceInfo:
     description: str
     publishes: tuple[PortInfo, ...]
     subscribes: tuple[PortInfo, ...]
+    # The board's interface version (sam_codegen.validate.interface_version), what its firmware reports.
+    interface_hash: int = 0
 
 
 @dataclass(frozen=True)
@@ -115,6 +117,7 @@ class DroneCanDeviceInfo:
     description: str
     publishes: tuple[DroneCanPortInfo, ...]
     subscribes: tuple[DroneCanPortInfo, ...]
+    interface_hash: int = 0  # as DeviceInfo's
 
 
 @dataclass(frozen=True)
@@ -274,6 +277,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1100, 'sam.sensor.RawIMU.0.1', 'sam.sensor', 'RawIMU_0_1', 100.0),
         ),
         subscribes=(),
+        interface_hash=0xd637a59eaf89905f,
     ),
     DeviceInfo(
         name='magnetometer',
@@ -289,6 +293,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             ),
         ),
         subscribes=(),
+        interface_hash=0x91845a90d6c01c77,
     ),
     DeviceInfo(
         name='gps',
@@ -298,6 +303,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1102, 'sam.sensor.GNSSFix.0.1', 'sam.sensor', 'GNSSFix_0_1', 5.0),
         ),
         subscribes=(),
+        interface_hash=0xe085da2eaaafb1f9,
     ),
     DeviceInfo(
         name='pressure',
@@ -307,6 +313,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1103, 'sam.sensor.StaticPressure.0.1', 'sam.sensor', 'StaticPressure_0_1', 20.0),
         ),
         subscribes=(),
+        interface_hash=0x536d8a2339c45079,
     ),
     DeviceInfo(
         name='battery',
@@ -316,6 +323,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1104, 'sam.power.BatteryInfo.0.1', 'sam.power', 'BatteryInfo_0_1', 1.0),
         ),
         subscribes=(),
+        interface_hash=0xdd92abd4cbac74ed,
     ),
     DeviceInfo(
         name='altimeter',
@@ -325,6 +333,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
             PortInfo(1106, 'sam.sensor.Altitude.0.1', 'sam.sensor', 'Altitude_0_1', 10.0),
         ),
         subscribes=(),
+        interface_hash=0xe33abf430944c2b4,
     ),
     DeviceInfo(
         name='thruster_1',
@@ -336,6 +345,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1200, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
         ),
+        interface_hash=0xe8aa5843e87f68fc,
     ),
     DeviceInfo(
         name='thruster_2',
@@ -347,6 +357,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1201, 'sam.actuator.ThrusterRPM.0.1', 'sam.actuator', 'ThrusterRPM_0_1', 10.0),
         ),
+        interface_hash=0xb62a8c10aec1cb54,
     ),
     DeviceInfo(
         name='thrust_vector',
@@ -364,6 +375,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1202, 'sam.actuator.ThrustVector.0.1', 'sam.actuator', 'ThrustVector_0_1', 10.0),
         ),
+        interface_hash=0x4bd8faffe39569c2,
     ),
     DeviceInfo(
         name='ballast',
@@ -373,6 +385,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1203, 'sam.actuator.BallastAngles.0.1', 'sam.actuator', 'BallastAngles_0_1', 10.0),
         ),
+        interface_hash=0x6f1b373e3940c462,
     ),
     DeviceInfo(
         name='longitudinal_weight',
@@ -384,6 +397,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1204, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
         ),
+        interface_hash=0xe0f208d469bd0b99,
     ),
     DeviceInfo(
         name='buoyancy_piston',
@@ -395,6 +409,7 @@ DEVICES: tuple[DeviceInfo, ...] = (
         subscribes=(
             PortInfo(1205, 'sam.actuator.PercentCommand.0.1', 'sam.actuator', 'PercentCommand_0_1', 10.0),
         ),
+        interface_hash=0xaff974292348d87e,
     ),
 )
 
@@ -1097,6 +1112,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.ahrs.RawIMU'], 100.0),
         ),
         subscribes=(),
+        interface_hash=0xd637a59eaf89905f,
     ),
     DroneCanDeviceInfo(
         name='magnetometer',
@@ -1106,6 +1122,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.ahrs.MagneticFieldStrength'], 50.0),
         ),
         subscribes=(),
+        interface_hash=0x91845a90d6c01c77,
     ),
     DroneCanDeviceInfo(
         name='gps',
@@ -1115,6 +1132,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.gnss.Fix2'], 5.0),
         ),
         subscribes=(),
+        interface_hash=0xe085da2eaaafb1f9,
     ),
     DroneCanDeviceInfo(
         name='pressure',
@@ -1124,6 +1142,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.air_data.StaticPressure'], 20.0),
         ),
         subscribes=(),
+        interface_hash=0x536d8a2339c45079,
     ),
     DroneCanDeviceInfo(
         name='battery',
@@ -1133,6 +1152,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.power.BatteryInfo'], 1.0),
         ),
         subscribes=(),
+        interface_hash=0xdd92abd4cbac74ed,
     ),
     DroneCanDeviceInfo(
         name='altimeter',
@@ -1142,6 +1162,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
             DroneCanPortInfo(_DRONECAN_TYPE['sam.sensor.Altitude'], 10.0),
         ),
         subscribes=(),
+        interface_hash=0xe33abf430944c2b4,
     ),
     DroneCanDeviceInfo(
         name='thruster_1',
@@ -1153,6 +1174,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'], 10.0),
         ),
+        interface_hash=0xe8aa5843e87f68fc,
     ),
     DroneCanDeviceInfo(
         name='thruster_2',
@@ -1164,6 +1186,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.esc.RPMCommand'], 10.0),
         ),
+        interface_hash=0xb62a8c10aec1cb54,
     ),
     DroneCanDeviceInfo(
         name='thrust_vector',
@@ -1175,6 +1198,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0x4bd8faffe39569c2,
     ),
     DroneCanDeviceInfo(
         name='ballast',
@@ -1184,6 +1208,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0x6f1b373e3940c462,
     ),
     DroneCanDeviceInfo(
         name='longitudinal_weight',
@@ -1195,6 +1220,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0xe0f208d469bd0b99,
     ),
     DroneCanDeviceInfo(
         name='buoyancy_piston',
@@ -1206,6 +1232,7 @@ DRONECAN_DEVICES: tuple[DroneCanDeviceInfo, ...] = (
         subscribes=(
             DroneCanPortInfo(_DRONECAN_TYPE['uavcan.equipment.actuator.ArrayCommand'], 10.0),
         ),
+        interface_hash=0xaff974292348d87e,
     ),
 )
 
@@ -2020,6 +2047,12 @@ DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
     'longitudinal_weight_feedback',
     'thrust_vector_feedback',
 })
+
+# The whole spec's interface version (every board's; each board's is its DeviceInfo's interface_hash): the
+# hash rule is sam_codegen.validate.interface_version's.
+INTERFACE_HASH: int = 0x23669fe96266cb3c
+# A board that reports another one: "warn" (/diagnostics, counted) or "stop" (also its mappings' traffic).
+INTERFACE_ON_MISMATCH: str = 'warn'
 
 # Every board's settings (a device's `parameters:`), device by device; the bridge's ROS parameters
 # `<device>.<name>` (sam_runtime.bridge.device_params).

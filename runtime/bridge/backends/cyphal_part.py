@@ -10,10 +10,12 @@ from typing import Any
 from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.backends.cyphal import CyphalBackend
 from sam_runtime.bridge.backends.cyphal_services import CyphalServices
+from sam_runtime.bridge.backends.interface_ask import cyphal_ask
 from sam_runtime.bridge.backends.param_access import CyphalParamAccess, ParamAccess
 from sam_runtime.bridge.backends.part import BackendSettings
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import SyncMessage, cyphal_sync_message
+from sam_runtime.bridge.interface_check import Ask
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.cyphal_io.transport import quiet_late_media_completions
 from sam_runtime.genpkg import GeneratedPackage
@@ -46,6 +48,9 @@ class CyphalPart:
 
     def prepare_replay(self, gen: GeneratedPackage) -> None:
         gen.compile_dsdl()  # the inbound groups name the ports' compiled classes
+
+    def interface_ask(self, backend: Backend) -> Ask:
+        return cyphal_ask(backend)
 
 
 PART = CyphalPart()

@@ -10,10 +10,12 @@ from typing import Any
 from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
 from sam_runtime.bridge.backends.dronecan_services import DroneCanServices
+from sam_runtime.bridge.backends.interface_ask import dronecan_ask
 from sam_runtime.bridge.backends.param_access import DroneCanParamAccess, ParamAccess
 from sam_runtime.bridge.backends.part import BackendSettings
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import SyncMessage, dronecan_sync_message
+from sam_runtime.bridge.interface_check import Ask
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.genpkg import GeneratedPackage
 
@@ -50,6 +52,9 @@ class DroneCanPart:
 
     def prepare_replay(self, gen: GeneratedPackage) -> None:
         pass  # the v0 codecs read the payload bytes with the spec's own layouts
+
+    def interface_ask(self, backend: Backend) -> Ask:
+        return dronecan_ask(backend)
 
 
 PART = DroneCanPart()

@@ -15,6 +15,7 @@ from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportC
 from sam_runtime.bridge.backends.param_access import ParamAccess
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import SyncMessage
+from sam_runtime.bridge.interface_check import Ask
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.common.rate_log import RateLimitedLog
 from sam_runtime.genpkg import GeneratedPackage
@@ -60,3 +61,6 @@ class BridgePart(Protocol):
 
     def prepare_replay(self, gen: GeneratedPackage) -> None:
         """What replaying recorded transfers through the codecs needs loaded first."""
+
+    def interface_ask(self, backend: Backend) -> Ask:
+        """The request for a board's interface version (issue 28: sam_runtime.bridge.interface_check)."""

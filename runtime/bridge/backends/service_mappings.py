@@ -194,6 +194,9 @@ class ServiceMappingsRos:
         self.health: Any = None
         self.unserved: set[str] = set()  # duties whose srv type is not installed
         self.status_prefix = ros.name  # /diagnostics names: the bridge's, with its namespace (composition sets it)
+        # False while a managed bridge is not active (sam_runtime.bridge.managed): no request goes to the bus, each
+        # call fails at once as ``failed.inactive``
+        self.active = True
 
     def send(self, m: Any, nid: int, values: dict[str, Any], call: Call) -> None:
         raise NotImplementedError
@@ -264,6 +267,9 @@ class ServiceMappingsRos:
         st = self.stats[m.name]
         with self._lock:
             st.counts["calls"] += 1
+        if not self.active:
+            return self._fail(m, response, "inactive", "the bridge is not active (its lifecycle manager has not "
+                              "activated it)")
         saturated: list[str] = []
         try:
             values = to_uavcan(m, request, saturated)

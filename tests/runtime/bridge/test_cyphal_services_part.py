@@ -173,6 +173,17 @@ def test_a_duty_refuses_a_node_that_is_no_device(duty_part: cyphal_services.Cyph
     assert part.stats[INFO_DUTY.name].counts == {"calls": 1, "failed.bad_node_id": 1}
 
 
+def test_an_inactive_bridge_sends_no_request(duty_part: cyphal_services.CyphalServices) -> None:
+    """A managed bridge its lifecycle manager has not activated (issue 30): every call fails at once as inactive,
+    before anything is converted or handed to the bus."""
+    part = duty_part
+    part.devices = {31: "charger"}
+    part.active = False
+    response = part.serve(INFO_DUTY, NS(node_id=31), NS(success=True, message=""))
+    assert response.success is False and "not active" in response.message
+    assert part.stats[INFO_DUTY.name].counts == {"calls": 1, "failed.inactive": 1}
+
+
 def test_restart_status_zero_is_success() -> None:
     from sam_runtime.bridge.backends.service_mappings import from_uavcan
 

@@ -8,7 +8,8 @@ transport, no ROS node, no wall clock in any verdict.
 - inbound (UAVCAN -> ROS): rate_limited drops, the held message published when its slot comes, a disabled mapping
   converting nothing and counting ``disabled``, a held message dropped when the mapping is disabled meanwhile;
 - outbound (ROS -> UAVCAN): commands coalesced, expired ones not sent (the worker's injected clock), disabled ones
-  dropped before conversion and in the queue;
+  dropped before conversion and in the queue; a managed bridge's inactive outbound (issue 30) sends nothing it
+  takes, queued or held, and counts it ``inactive`` without a WARN;
 - switches: the SetBool answer; diagnostics: intended drops do not WARN, an expired command does.
 """
 
@@ -296,6 +297,38 @@ def test_outbound_worker_drops_expired_and_disabled_commands() -> None:
     assert st["last_drop_age_s"] is not None  # an expired command is trouble: WARN on /diagnostics
 
 
+def test_an_inactive_outbound_sends_nothing_taken_queued_or_held_and_counts_it() -> None:
+    """A managed bridge deactivated (sam_runtime.bridge.managed): the command taken after it, the one queued before
+    it and the one its pacer held are all dropped as ``inactive``; active again, commands go out."""
+    out, om, loop = _outbound(2.0, None)
+    outlet = om.outlet = FakeOutlet()
+    out.on_ros([om], "queued")  # the pacer lets the first out at once: queued
+    out.on_ros([om], "held")  # held for its slot
+    out.active = False
+    out.on_ros([om], "taken")  # dropped before conversion
+    loop.advance(loop.now + 1.0)  # the held one reaches the queue after the deactivation
+
+    async def main() -> None:
+        assert om.queue is not None
+        worker = asyncio.create_task(out._worker(om))
+        await asyncio.sleep(0)
+        await asyncio.sleep(0)
+        assert om.queue.empty()
+        out.active = True
+        out.on_ros([om], "again")
+        loop.advance(loop.now + 1.0)
+        await asyncio.sleep(0)
+        await asyncio.sleep(0)
+        worker.cancel()
+        await asyncio.gather(worker, return_exceptions=True)
+
+    asyncio.run(main())
+    assert outlet.sent == ["again"]
+    st = om.stats.snapshot()
+    assert st["dropped"] == {"inactive": 3} and st["published"] == 1 and st["received"] == 4
+    assert st["last_drop_age_s"] is None  # asked for by the lifecycle manager: no WARN
+
+
 # ============================================================================================ diagnostics
 def test_diagnostics_show_the_traffic_control() -> None:
     pytest.importorskip("diagnostic_msgs")
@@ -315,6 +348,13 @@ def test_diagnostics_show_the_traffic_control() -> None:
     assert values["max_rate_hz"] == "2.0" and values["deadline_s"] == "0.25"
     assert values["dropped.coalesced"] == "5" and values["dropped.disabled"] == "2"
     assert status.level == b"\x00" and status.message.startswith("disabled (std_srvs/SetBool ~/enable_valve)")
+    bridge = next(s for s in arr.status if s.name == "bridge")
+    assert "inactive" not in bridge.message and {kv.key: kv.value for kv in bridge.values}["active"] == "True"
+    snap["bridge"]["active"] = False  # a managed bridge not activated (issue 30)
+    bridge = next(s for s in diagnostic_array(snap, Naming("bridge", "cyphal", "Cyphal", "pycyphal"), None).status
+                  if s.name == "bridge")
+    assert bridge.message.startswith("inactive (lifecycle): commands dropped")
+    assert {kv.key: kv.value for kv in bridge.values}["active"] == "False" and bridge.level == b"\x00"
 
 
 # ============================================================================================ SetBool services

@@ -259,6 +259,24 @@ def test_transfer_crc_missing_frames_duplicates_and_transfer_ids() -> None:
     assert errs["TRANSFER_EXPIRED"] == 2
 
 
+def test_a_spoofed_frame_of_a_transfer_in_flight_spoils_that_transfer_alone() -> None:
+    """What the receive path cannot prevent (README, issue 29 d): a header-valid frame with the device's node id,
+    its in-flight transfer id and an index the device also sends takes that index's place (before or after the
+    device's frame: the later is kept), so the transfer fails its CRC. Nothing more: counted as one INTEGRITY_ERROR,
+    the device's next transfers delivered, its expected transfer id untouched."""
+    payload = bytes(range(150))
+    real = _transfer(payload, mtu=64, tid=10)
+    assert len(real) == 3
+    spoof = _frame(b"x" * 64, tid=10, index=1, eot=False)
+    # (the spoofed frame after the device's: the transfer is lost; before it: the device's frame wins)
+    for dgs, spoiled in (([real[0], real[1], spoof, real[2]], True), ([real[0], spoof, real[1], real[2]], False)):
+        got = _with_port(_timed([*dgs, *_transfer(payload, mtu=64, tid=11), _single(b"next", tid=12)]))
+        assert [t[:3] for t in got.transfers] == [*([] if spoiled else [(payload, 11, 10)]),
+                                                 (payload, 11, 11), (b"next", 11, 12)]
+        errs = got.stats.reassembly_errors_per_source_node_id.get(11, {})
+        assert {getattr(e, "name", e): n for e, n in errs.items()} == ({"INTEGRITY_ERROR": 1} if spoiled else {})
+
+
 def test_transfer_id_timeout() -> None:
     """A transfer id that went back is refused within pycyphal's 2 s transfer-id timeout, accepted after it."""
     dgs = [_single(b"a", tid=50), _single(b"b", tid=5), _single(b"c", tid=5), _single(b"d", tid=6)]

@@ -303,7 +303,12 @@ def _reader_threads() -> list[str]:
 
 
 def test_services_and_heartbeats_on_the_loop_with_a_plain_pycyphal_peer() -> None:
+    from sam_runtime.cyphal_io.dsdl_cache import ensure_compiled
     from sam_runtime.cyphal_io.transport import make_node, make_transport
+
+    # The standard types on the path here, not left to an earlier test of the worker (alone, or first in the unit
+    # tier, `import uavcan` found nothing).
+    ensure_compiled([], Path(__file__).resolve().parents[3] / ".cache" / "dsdl")
 
     async def go() -> None:
         import uavcan.node

@@ -34,12 +34,14 @@ def test_the_flags_defaults_are_the_fields_defaults() -> None:
     defaults = SimConfig()
     parsed = options_from(SimConfig, _parser().parse_args([]))
     assert parsed == {name: getattr(defaults, name) for name in parsed}
-    assert set(parsed) == VEHICLE_FIELDS - {"params", "noise"} | {"time_scale", "truth_file", "truth_rate_hz"}
+    assert set(parsed) == VEHICLE_FIELDS - {"params", "noise"} | {"time_scale", "truth_file", "truth_rate_hz",
+                                                                  "stale_firmware"}
 
 
 def test_the_main_job_forwards_what_its_sim_reads_back() -> None:
     argv = ["--seed", "7", "--sea-floor", "0:25,60:6", "--sea-floor-axis", "0.5", "--start", "1,2,3,0.25",
-            "--battery-start", "50", "--battery-health", "25", "--gps-origin", "58.1,11.2", "--truth-rate", "2.5"]
+            "--battery-start", "50", "--battery-health", "25", "--gps-origin", "58.1,11.2", "--truth-rate", "2.5",
+            "--stale-firmware", "imu, gps"]
     run = _parser(main_job=True).parse_args(argv)
     assert not hasattr(run, "time_scale")  # the main job's nodes run on the wall clock
     sim = options_from(SimConfig, _parser().parse_args(forwarded_argv(SimConfig, run)))
@@ -47,6 +49,7 @@ def test_the_main_job_forwards_what_its_sim_reads_back() -> None:
     config = SimConfig("can", **sim)
     assert (config.kind, config.sea_floor, config.start, config.battery_health_pct) == (
         "can", SeaFloor(25.0, ((0.0, 25.0), (60.0, 6.0)), 0.5), (1.0, 2.0, 3.0, 0.25), 25)
+    assert config.stale_firmware == ("imu", "gps")
 
 
 def test_a_bad_option_is_one_line() -> None:

@@ -183,6 +183,7 @@ def test_closing_while_a_response_is_sent_logs_no_traceback(caplog: pytest.LogCa
     if gen.tables().VEHICLE != "sam":
         pytest.skip("SAM's devices")
     caplog.set_level(logging.INFO)
+    gen.compile_dsdl()  # the types on the path here, not left to the other test of the module (alone it failed)
     with cyphal_udp_lock():
         out = _run(_close_during_a_response(gen))
     assert out["closing_seen"] and out["response"] is None, out  # unanswered: the device went off
