@@ -80,6 +80,7 @@ class DeviceParams:
         self._local = threading.local()  # .quiet: the loop's own update of a parameter (no write back)
         self._loop: asyncio.AbstractEventLoop | None = None
         self._reading: set[int] = set()
+        self._node: Any = None  # the ROS node the parameters are declared on
         self._tasks: set[asyncio.Task[None]] = set()
 
     def attach(self) -> None:
@@ -92,9 +93,11 @@ class DeviceParams:
         from rcl_interfaces.msg import ParameterDescriptor
 
         self._loop = asyncio.get_running_loop()
-        node = self.ros.node
+        node = self._node = self.ros.node
         node.add_on_set_parameters_callback(self._on_set)
         for name, s in self.settings.items():
+            if node.has_parameter(name):  # a managed bridge configured again: its lifecycle node keeps them
+                continue
             descriptor = ParameterDescriptor(name=name, description=self._description(s), read_only=False)
             self._ranges(descriptor, s.info)
             self._local.quiet = True
@@ -106,6 +109,12 @@ class DeviceParams:
     def _close(self) -> None:
         for task in list(self._tasks):  # reads in flight: their node is closing
             task.cancel()
+        if self._node is not None:  # a managed bridge's node outlives this bridge (cleanup, configure again)
+            try:
+                self._node.remove_on_set_parameters_callback(self._on_set)
+            except Exception:  # the node is already destroyed (a plain bridge closes it after this)
+                pass
+            self._node = None
 
     @staticmethod
     def _description(s: _Setting) -> str:
