@@ -191,7 +191,7 @@ def _wait_timeout_arg(p: argparse.ArgumentParser, what: str) -> None:
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="sam-codegen", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, nodes, run, record, replay."
+    parser.epilog = "Runtime commands (see `sam-codegen run --help`): bridge, sim, nodes, run, record, replay, params."
     sub = parser.add_subparsers(dest="command", required=True)
 
     def common(p: argparse.ArgumentParser) -> None:
@@ -225,7 +225,7 @@ def make_parser() -> argparse.ArgumentParser:
     return parser
 
 
-RUNTIME_COMMANDS = ("bridge", "sim", "nodes", "run", "record", "replay")
+RUNTIME_COMMANDS = ("bridge", "sim", "nodes", "run", "record", "replay", "params")
 
 
 def main(argv: list[str] | None = None) -> int:

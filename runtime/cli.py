@@ -1,5 +1,6 @@
 """Command line of the runtime: ``bridge``, ``sim``, ``nodes`` (the node host), ``run`` (the main job), ``record``
-and ``replay`` (sam_runtime.main_job.record_replay).
+and ``replay`` (sam_runtime.main_job.record_replay), ``params`` (save and restore the boards' settings:
+sam_runtime.main_job.params_file).
 
 Console scripts: ``sam-bridge`` = :func:`bridge_main`, ``sam-sim`` = :func:`sim_main`, ``sam-nodes`` =
 :func:`nodes_main`, ``sam-run`` = :func:`run_main`, ``sam-record`` = :func:`record_main`, ``sam-replay`` =
@@ -492,9 +493,16 @@ def replay_main(argv: Sequence[str] | None = None) -> int:
     return main(argv)
 
 
+def params_main(argv: Sequence[str] | None = None) -> int:
+    """``sam-codegen params save|restore FILE``: sam_runtime.main_job.params_file."""
+    from sam_runtime.main_job.params_file import params_main as main
+
+    return main(argv)
+
+
 # ============================================================================================ dispatch
 _COMMANDS = {"bridge": bridge_main, "sim": sim_main, "nodes": nodes_main, "run": run_main, "record": record_main,
-             "replay": replay_main}
+             "replay": replay_main, "params": params_main}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -231,3 +231,30 @@ class ParameterRuleInfo:
     op: str
     right: str
     description: str
+
+
+@dataclass(frozen=True)
+class DeviceParameterInfo:
+    """A setting a board holds (a device's `parameters:`): a register on Cyphal, a param on DroneCAN.
+
+    `default` is the spec's value (an enum's name); `values` map an enum's names to the integers the board
+    stores; `minimum`/`maximum` bound an integer or a real; `max_length` a string's UTF-8 bytes; `names` give
+    its name on each protocol the board speaks. The bridge exposes it as the ROS parameter `<device>.<name>`.
+    """
+
+    device: str
+    name: str
+    type: str  # "bool" | "integer" | "real" | "string" | "enum"
+    default: bool | int | float | str
+    description: str
+    minimum: int | float | None
+    maximum: int | float | None
+    unit: str
+    values: tuple[tuple[str, int], ...]
+    max_length: int | None
+    restart: bool
+    names: tuple[tuple[str, str], ...]  # (protocol, its name there)
+
+    def name_on(self, protocol: str) -> str:
+        """Its name on `protocol` (one the board speaks)."""
+        return dict(self.names)[protocol]

@@ -13,6 +13,7 @@ from typing import Protocol
 
 from sam_codegen.contracts.table_types import (
     DeviceInfo,
+    DeviceParameterInfo,
     DroneCanDeviceInfo,
     DroneCanMappingInfo,
     DroneCanTypeInfo,
@@ -62,3 +63,4 @@ class TablesModule(Protocol):
     DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str]  # the same of the DroneCAN mappings
     INTERFACE_HASH: int  # the whole spec's interface version (every board's)
     INTERFACE_ON_MISMATCH: str  # "warn" | "stop": bridge.interface_check.on_mismatch
+    DEVICE_PARAMETERS: tuple[DeviceParameterInfo, ...]  # every board's settings, device by device

@@ -14,6 +14,7 @@ from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportC
 from sam_runtime.bridge.backends.part import BackendSettings, BridgePart
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
+from sam_runtime.bridge.device_params import DeviceParams
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
 from sam_runtime.bridge.interface_check import InterfaceCheck, board_switches
@@ -164,6 +165,7 @@ class Bridge:
         self.duties: Any = None  # the protocol's built-in duties (DroneCAN: backends.dronecan_duties), if any
         self.services: ServiceMappingsRos | None = None  # the spec's service mappings of this protocol
         self.interface_check: InterfaceCheck | None = None  # the boards' firmware interface versions (issue 28)
+        self.device_params: DeviceParams | None = None  # the boards' settings as ROS parameters
 
     @property
     def name(self) -> str:
@@ -263,6 +265,11 @@ class Bridge:
         silence.add_handler(reporter.publish_now)
 
         self.ros.attach()
+        self.device_params = DeviceParams(lifetime, self.ros, sel.devices, tables.DEVICE_PARAMETERS,
+                                          sel.protocol, self.part.param_access(backend))
+        self.device_params.attach()
+        health.add_handler(self.device_params.on_health)
+        reporter.device_settings = self.device_params.differing_by_device
         EnableServices(lifetime, self.ros, self.switches, on_change=reporter.publish_now).attach()
         health.attach(lifetime)
         inbound.attach()
@@ -313,6 +320,8 @@ class Bridge:
         return StampWatch(self.lifetime, self.protocol.device_stamped(self.tables), self.selection.devices, master)
 
     def _on_health(self, nid: int, event: str, device: bool) -> None:
+        if event == "first":
+            return  # (device_params reads the board's settings)
         if event == "restarted":
             self._forget_stamps(nid)  # its clock may have restarted: its next stamp is no out_of_order
         elif device:
@@ -332,6 +341,8 @@ class Bridge:
         snapshot["wire"] = self.wire  # the path the mappings run on: "codec", or "object" (chosen, or fallen back)
         if self.services is not None:
             snapshot["services"] = self.services.snapshot()
+        if self.device_params is not None and self.device_params.settings:
+            snapshot["device_parameters"] = self.device_params.snapshot()
         return snapshot
 
     def diagnostics_message(self) -> Any:

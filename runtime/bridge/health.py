@@ -37,7 +37,7 @@ __all__ = ["OFFLINE_TIMEOUT_S", "DeviceHealth", "NodeRecord"]
 
 OFFLINE_TIMEOUT_S = 3.0
 
-# handler(node_id, event, is_device): event is "lost", "back" or "restarted"
+# handler(node_id, event, is_device): event is "first" (its first heartbeat), "lost", "back" or "restarted"
 HealthHandler = Callable[[int, str, bool], None]
 
 
@@ -99,6 +99,8 @@ class DeviceHealth:
             if nid not in self.devices and nid != self.own_node_id:  # a tool (yakut, ...): noted once
                 log.info("node %d (no device of the spec) appeared on the bus", nid)
             self._arm(rec)
+            if nid in self.devices:  # first contact (the bridge reads the board's settings then)
+                self._notify(nid, "first")
             return
         if not rec.alive or now - rec.last_seen >= self.offline_timeout:
             rec.alive_since = now  # back (possibly before its timer noticed it was gone)

@@ -50,6 +50,8 @@ class Reporter:
         self._publisher: Any = None
         self.time_sync: Any = None  # the time-sync master and stamp watch (sam_runtime.bridge.time_sync)
         self.interface_check: Any = None  # the boards' interface versions (sam_runtime.bridge.interface_check)
+        # device -> its settings whose board value differs from the spec's default, as text (device_params)
+        self.device_settings: Any = None
 
     def attach(self) -> None:
         """The /diagnostics publisher once the ROS node exists, and its period on the loop."""
@@ -140,6 +142,10 @@ class Reporter:
         if self.interface_check is not None:
             for name, entry in self.interface_check.device_entries().items():
                 devices.setdefault(name, {}).update(entry)
+        if self.device_settings is not None:
+            for name, text in self.device_settings().items():
+                if name in devices:
+                    devices[name]["settings"] = text  # a /diagnostics value of the device, shown by the main job
         started = self.lifetime.started_monotonic
         return {
             "bridge": {

@@ -234,6 +234,8 @@ class LiveView:
             age = v.get("age_s")
             age_txt = f"{float(age) + (now - diag['at']):.1f} s" if age not in (None, "") else "never"
             status = "ok" if diag["level"] == 0 else diag["message"]
+            if v.get("settings"):  # the board's settings differ from the spec's defaults (the bridge read them)
+                status += f"; settings: {v['settings']}"
             lines.append(f"{d.name:22} {d.node_id:4d} {age_txt:>10} {v.get('health', '-'):9} "
                          f"{v.get('mode', '-'):12} {status}")
         line = interface_line(self.diagnostics, bridge, [d.name for d in self.tables.DEVICES])

@@ -15,7 +15,9 @@ import asyncio
 import logging
 from typing import Any
 
+from sam_runtime.common.board_settings import BoardSettings
 from sam_runtime.common.tasks import cancel_and_wait
+from sam_runtime.cyphal_io.registers import register_stored, register_value
 from sam_runtime.cyphal_io.transport import aclose, make_node, quiet_late_media_completions, transport_from_env
 from sam_runtime.sim.devices import PHYSICS, SAM_ACTUATORS, generic_fill, physics_key
 from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
@@ -25,6 +27,9 @@ __all__ = ["CyphalDevices"]
 
 _log = logging.getLogger("sam_runtime.sim.simulator")
 _RESTART_DELAY_S = 0.1  # a restart waits this long, so that its ExecuteCommand response goes out first
+# uavcan.node.ExecuteCommand.1.1's standard commands a board's settings answer to
+_COMMAND_STORE = 65530  # COMMAND_STORE_PERSISTENT_STATES: save the registers (a reboot keeps them)
+_COMMAND_FACTORY_RESET = 65532  # COMMAND_FACTORY_RESET: the spec's defaults, now and after a reboot
 
 
 class CyphalDevices:
@@ -35,6 +40,8 @@ class CyphalDevices:
     def __init__(self, sim: DeviceHost) -> None:
         self.sim = sim
         self._restarts: set[asyncio.Task[None]] = set()
+        # each board's settings, kept across its node's reboots (their saved values are its non-volatile memory)
+        self.settings: dict[str, BoardSettings] = {}
 
     def prepare(self) -> None:
         self.sim.gen.compile_dsdl()
@@ -62,6 +69,7 @@ class CyphalDevices:
         # its firmware's interface version (issue 28), what the bridge compares with its spec's
         dev.node.info.software_vcs_revision_id = cfg.firmware_hash(dev.info.name, dev.info.interface_hash)
         self._serve_duties(dev)
+        self._serve_settings(dev)
         for sp in dev.subs:
             sp.subscriber = dev.node.make_subscriber(sp.dtype, sp.port.subject_id)
             sp.subscriber.receive_in_background(
@@ -87,6 +95,12 @@ class CyphalDevices:
         execute = uavcan.node.ExecuteCommand_1_1
 
         async def on_command(request: Any, meta: Any) -> Any:
+            board = self.settings.get(dev.info.name)
+            if request.command in (_COMMAND_STORE, _COMMAND_FACTORY_RESET) and board is not None:
+                board.save() if request.command == _COMMAND_STORE else _factory_reset(board)
+                _log.info("%s: command %d from node %s: settings %s", dev.info.name, request.command,
+                          meta.client_node_id, "saved" if request.command == _COMMAND_STORE else "reset")
+                return execute.Response(status=execute.Response.STATUS_SUCCESS)
             if request.command != execute.Request.COMMAND_RESTART:
                 return execute.Response(status=execute.Response.STATUS_BAD_COMMAND)
             _log.info("%s: restart requested by node %s: rebooting", dev.info.name, meta.client_node_id)
@@ -105,6 +119,27 @@ class CyphalDevices:
 
         node.get_server(execute).serve_in_background(on_command)
         node.get_server(uavcan.node.GetTransportStatistics_0_1).serve_in_background(on_stats)
+
+    def _serve_settings(self, dev: SimDevice) -> None:
+        """The board's settings as registers of its node (served by pycyphal's uavcan.register.Access / List): a
+        write the board refuses (a bad type, out of range) leaves the value as it was, which the Access response
+        shows, as real firmware does; with each the standard read-only "<name><", "<name>>" and "<name>=" (its
+        minimum, maximum and default). A reboot (open again) runs with the saved values."""
+        params = tuple(p for p in self.sim.tables.DEVICE_PARAMETERS if p.device == dev.info.name)
+        if not params:
+            return
+        board = self.settings.get(dev.info.name)
+        if board is None:
+            board = self.settings[dev.info.name] = BoardSettings(params, self.protocol)
+        board.reboot()
+        registry = dev.node.registry
+        for name, p in board.params.items():
+            registry[name] = (lambda name=name, p=p: register_value(p.type, board.values[name]),
+                              lambda v, name=name, p=p: _write(dev.info.name, board, name, p.type, v))
+            registry[name + "="] = lambda name=name, p=p: register_value(p.type, board.defaults[name])
+            for suffix, bound in (("<", p.minimum), (">", p.maximum)):
+                if bound is not None:
+                    registry[name + suffix] = lambda p=p, bound=bound: register_value(p.type, bound)
 
     def _restart(self, dev: SimDevice) -> None:
         task = asyncio.get_running_loop().create_task(self.sim.restart(dev.info.name),
@@ -158,6 +193,19 @@ class CyphalDevices:
         if transmitted:  # the values as transmitted (float16 rounding etc.)
             obj = pycyphal.dsdl.deserialize(type(obj), list(pycyphal.dsdl.serialize(obj)))
         return {"subject": port.port.subject_id, "value": pycyphal.dsdl.to_builtin(obj)}
+
+
+def _factory_reset(board: BoardSettings) -> None:
+    board.erase()
+    board.reboot()
+
+
+def _write(device: str, board: BoardSettings, name: str, kind: str, value: Any) -> None:
+    """A register write (pycyphal converted it to the register's type): stored unless the board refuses it."""
+    new = register_stored(kind, value)
+    problem = f"not a {kind}" if new is None else board.write(name, new)
+    if problem is not None:  # counted (board.refused); the Access response shows the value kept
+        _log.info("%s: register %s: write refused: %s", device, name, problem)
 
 
 async def _stop_serving(nodes: list[Any], timeout: float = 2.0) -> None:

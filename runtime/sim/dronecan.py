@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS
+from sam_runtime.common.board_settings import BoardSettings
 from sam_runtime.dronecan_io import Acceptance, FrameGate, HandlerError, NodeLoop, make_driver, parse_iface
 from sam_runtime.dronecan_io.node_loop import close_node
 from sam_runtime.dronecan_io.types import ensure_types, type_problems
@@ -51,6 +52,7 @@ from sam_runtime.sim.devices_dronecan import (
     sam_command_fields,
     to_builtin_v0,
 )
+from sam_runtime.sim.params_dronecan import PARAM_GETSET, PARAM_OPCODE, param_getset_handler, param_opcode_handler
 from sam_runtime.sim.ports import DeviceHost, PubPort, SimDevice, SubPort
 from sam_runtime.sim.time_sync import DRONECAN_MAX_INTERVAL_S
 
@@ -132,6 +134,8 @@ class DroneCanDevices:
         self.iface = sim.config.dronecan_iface
         self._kind = parse_iface(self.iface).kind  # IfaceError (a ValueError) for a bad or refused URI
         self._restarts: set[asyncio.Task[None]] = set()
+        # each board's settings, kept across its node's reboots (their saved values are its non-volatile memory)
+        self.settings: dict[str, BoardSettings] = {}
         if sim.bridge_node_id is not None and not 1 <= sim.bridge_node_id <= 127:
             raise ValueError(f"a DroneCAN node id is 1..127, not the bridge's {sim.bridge_node_id}")
         for dev in sim.devices:
@@ -231,6 +235,10 @@ class DroneCanDevices:
             node.add_transfer_hook(lambda transfer: counts.__setitem__(
                 transfer.direction, counts.get(transfer.direction, 0) + 1))
             loop.add_handler(dronecan.TYPENAMES[TRANSPORT_STATS], self._stats_handler(counts, loop))
+            board = self._board(dev)
+            if board is not None:
+                loop.add_handler(dronecan.TYPENAMES[PARAM_GETSET], param_getset_handler(dev.info.name, board))
+                loop.add_handler(dronecan.TYPENAMES[PARAM_OPCODE], param_opcode_handler(dev.info.name, board))
             loop.start()
         except BaseException:
             gate.close()
@@ -265,6 +273,17 @@ class DroneCanDevices:
                 raise HandlerError(f"{dev.info.name}: {type(ex).__name__}: {ex}") from ex
 
         return on_transfer
+
+    def _board(self, dev: SimDevice) -> BoardSettings | None:
+        """The device's settings, as a (re)boot loads them; None if the spec gives it none."""
+        params = tuple(p for p in self.sim.tables.DEVICE_PARAMETERS if p.device == dev.info.name)
+        if not params:
+            return None
+        board = self.settings.get(dev.info.name)
+        if board is None:
+            board = self.settings[dev.info.name] = BoardSettings(params, self.protocol)
+        board.reboot()
+        return board
 
     def _stats_handler(self, counts: dict[str, int], loop: NodeLoop) -> Any:
         import dronecan

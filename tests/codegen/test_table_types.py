@@ -39,7 +39,7 @@ def test_the_classes_are_copied_verbatim(tmp_path: Path) -> None:
     text, module = _generated_tables(tmp_path)
     assert table_types_source() in text
     classes = {n.name for n in ast.parse(Path(table_types.__file__).read_text()).body if isinstance(n, ast.ClassDef)}
-    assert len(classes) == 16
+    assert len(classes) == 17
     assert all(isinstance(getattr(module, name), type) for name in classes)
 
 

@@ -18,7 +18,7 @@ from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.model.spec import UAVCAN_TO_ROS, Mapping, Port, Qos, V0Struct
 from sam_codegen.render.filters import py_number, py_str
-from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal
+from sam_codegen.render.pysource import Call, float_literal, frozenset_literal, py_literal, text_literal
 from sam_codegen.targets import dsdl_v0
 from sam_codegen.targets.nodes import nodes_package, params_file, static_transforms
 from sam_codegen.targets.python.convert_v0 import used_types
@@ -30,8 +30,8 @@ from sam_codegen.validate.nodes import class_name, node_topic_qos
 from sam_codegen.validate.panic_duty import panic_duty
 from sam_codegen.validate.resolve import Resolved
 
-__all__ = ["cyphal_context", "dronecan_context", "nodes_context", "table_types_source", "tables_context",
-           "time_sync_context"]
+__all__ = ["cyphal_context", "device_parameters_context", "dronecan_context", "nodes_context", "table_types_source",
+           "tables_context", "time_sync_context"]
 
 
 def _ros_type_parts(full: str) -> tuple[str, str, str]:
@@ -241,6 +241,20 @@ def nodes_context(resolved: Resolved) -> dict[str, Any]:
     }
 
 
+def device_parameters_context(resolved: Resolved) -> dict[str, Any]:
+    """Every board's settings (DEVICE_PARAMETERS), device by device in spec order."""
+    keywords = ("device", "name", "type", "default", "description", "minimum", "maximum", "unit", "values",
+                "max_length", "restart", "names")
+    calls = []
+    for device in resolved.spec.devices.values():
+        for p in device.parameters:
+            args = (py_str(device.name), py_str(p.name), py_str(p.type), py_literal(p.default),
+                    text_literal(p.description, 20), py_literal(p.minimum), py_literal(p.maximum), py_str(p.unit),
+                    repr(tuple(p.values)), py_literal(p.max_length), py_literal(p.restart), repr(tuple(p.names)))
+            calls.append(Call("DeviceParameterInfo", args, keywords))
+    return {"device_parameters": calls}
+
+
 def table_types_source() -> str:
     """The classes of table_types.py as source text: the module after its docstring, copied into tables.py."""
     assert table_types.__file__ is not None
@@ -253,4 +267,5 @@ def tables_context(resolved: Resolved) -> dict[str, Any]:
     return {"table_types": table_types_source(), **cyphal_context(resolved), **nodes_context(resolved),
             **dronecan_context(resolved), "interface_hash": f"0x{interface_versions(resolved).whole:016x}",
             "interface_on_mismatch": py_str(resolved.spec.bridge.interface_on_mismatch
-                                            if resolved.spec.bridge is not None else "warn")}
+                                            if resolved.spec.bridge is not None else "warn"),
+            **device_parameters_context(resolved)}

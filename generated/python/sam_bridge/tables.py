@@ -229,6 +229,33 @@ class ParameterRuleInfo:
     description: str
 
 
+@dataclass(frozen=True)
+class DeviceParameterInfo:
+    """A setting a board holds (a device's `parameters:`): a register on Cyphal, a param on DroneCAN.
+
+    `default` is the spec's value (an enum's name); `values` map an enum's names to the integers the board
+    stores; `minimum`/`maximum` bound an integer or a real; `max_length` a string's UTF-8 bytes; `names` give
+    its name on each protocol the board speaks. The bridge exposes it as the ROS parameter `<device>.<name>`.
+    """
+
+    device: str
+    name: str
+    type: str  # "bool" | "integer" | "real" | "string" | "enum"
+    default: bool | int | float | str
+    description: str
+    minimum: int | float | None
+    maximum: int | float | None
+    unit: str
+    values: tuple[tuple[str, int], ...]
+    max_length: int | None
+    restart: bool
+    names: tuple[tuple[str, str], ...]  # (protocol, its name there)
+
+    def name_on(self, protocol: str) -> str:
+        """Its name on `protocol` (one the board speaks)."""
+        return dict(self.names)[protocol]
+
+
 VEHICLE = 'sam'
 ROS_PACKAGE = 'sam_msgs'
 DSDL_ROOT_NAMESPACE = 'sam'
@@ -2026,3 +2053,207 @@ DRONECAN_DEVICE_STAMPED_MAPPINGS: frozenset[str] = frozenset({
 INTERFACE_HASH: int = 0x23669fe96266cb3c
 # A board that reports another one: "warn" (/diagnostics, counted) or "stop" (also its mappings' traffic).
 INTERFACE_ON_MISMATCH: str = 'warn'
+
+# Every board's settings (a device's `parameters:`), device by device; the bridge's ROS parameters
+# `<device>.<name>` (sam_runtime.bridge.device_params).
+DEVICE_PARAMETERS: tuple[DeviceParameterInfo, ...] = (
+    DeviceParameterInfo(
+        device='imu',
+        name='imu.rate_hz',
+        type='integer',
+        default=100,
+        description='Output rate.',
+        minimum=10,
+        maximum=400,
+        unit='Hz',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'imu.rate_hz'), ('dronecan', 'IMU_RATE_HZ')),
+    ),
+    DeviceParameterInfo(
+        device='imu',
+        name='imu.gyro_range',
+        type='enum',
+        default='dps500',
+        description='Gyroscope full scale in degrees per second.',
+        minimum=None,
+        maximum=None,
+        unit='',
+        values=(('dps250', 250), ('dps500', 500), ('dps1000', 1000), ('dps2000', 2000)),
+        max_length=None,
+        restart=True,
+        names=(('cyphal', 'imu.gyro_range'), ('dronecan', 'IMU_GYRO_RANGE')),
+    ),
+    DeviceParameterInfo(
+        device='thruster_1',
+        name='motor.pole_count',
+        type='integer',
+        default=14,
+        description='Magnet poles of the motor.',
+        minimum=2,
+        maximum=48,
+        unit='',
+        values=(),
+        max_length=None,
+        restart=True,
+        names=(('cyphal', 'motor.pole_count'), ('dronecan', 'MOTOR_POLE_COUNT')),
+    ),
+    DeviceParameterInfo(
+        device='thruster_1',
+        name='motor.direction',
+        type='enum',
+        default='forward',
+        description='Propeller sense (the two thrusters counter-rotate).',
+        minimum=None,
+        maximum=None,
+        unit='',
+        values=(('forward', 1), ('reverse', -1)),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'motor.direction'), ('dronecan', 'MOTOR_DIRECTION')),
+    ),
+    DeviceParameterInfo(
+        device='thruster_1',
+        name='esc.index',
+        type='integer',
+        default=0,
+        description='Its index in uavcan.equipment.esc.RPMCommand.',
+        minimum=0,
+        maximum=19,
+        unit='',
+        values=(),
+        max_length=None,
+        restart=True,
+        names=(('cyphal', 'esc.index'), ('dronecan', 'ESC_INDEX')),
+    ),
+    DeviceParameterInfo(
+        device='thruster_2',
+        name='motor.pole_count',
+        type='integer',
+        default=14,
+        description='Magnet poles of the motor.',
+        minimum=2,
+        maximum=48,
+        unit='',
+        values=(),
+        max_length=None,
+        restart=True,
+        names=(('cyphal', 'motor.pole_count'), ('dronecan', 'MOTOR_POLE_COUNT')),
+    ),
+    DeviceParameterInfo(
+        device='thruster_2',
+        name='motor.direction',
+        type='enum',
+        default='reverse',
+        description='Propeller sense (the two thrusters counter-rotate).',
+        minimum=None,
+        maximum=None,
+        unit='',
+        values=(('forward', 1), ('reverse', -1)),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'motor.direction'), ('dronecan', 'MOTOR_DIRECTION')),
+    ),
+    DeviceParameterInfo(
+        device='thruster_2',
+        name='esc.index',
+        type='integer',
+        default=1,
+        description='Its index in uavcan.equipment.esc.RPMCommand.',
+        minimum=0,
+        maximum=19,
+        unit='',
+        values=(),
+        max_length=None,
+        restart=True,
+        names=(('cyphal', 'esc.index'), ('dronecan', 'ESC_INDEX')),
+    ),
+    DeviceParameterInfo(
+        device='thrust_vector',
+        name='servo.vertical.trim',
+        type='real',
+        default=0.0,
+        description="Added to every vertical command (the nozzle's mechanical zero).",
+        minimum=-0.1,
+        maximum=0.1,
+        unit='rad',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'servo.vertical.trim'), ('dronecan', 'SERVO_VERTICAL_TRIM')),
+    ),
+    DeviceParameterInfo(
+        device='thrust_vector',
+        name='servo.horizontal.trim',
+        type='real',
+        default=0.0,
+        description='Added to every horizontal command.',
+        minimum=-0.1,
+        maximum=0.1,
+        unit='rad',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'servo.horizontal.trim'), ('dronecan', 'SERVO_HORIZONTAL_TRIM')),
+    ),
+    DeviceParameterInfo(
+        device='thrust_vector',
+        name='servo.limit',
+        type='real',
+        default=0.12,
+        description='The largest deflection either servo is driven to.',
+        minimum=0.02,
+        maximum=0.2,
+        unit='rad',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'servo.limit'), ('dronecan', 'SERVO_LIMIT')),
+    ),
+    DeviceParameterInfo(
+        device='buoyancy_piston',
+        name='pid.kp',
+        type='real',
+        default=4.0,
+        description=(
+                        "Proportional gain of the piston's position loop (motor duty per unit of position "
+                        'error).'
+                    ),
+        minimum=0.0,
+        maximum=50.0,
+        unit='1',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'pid.kp'), ('dronecan', 'PID_KP')),
+    ),
+    DeviceParameterInfo(
+        device='buoyancy_piston',
+        name='pid.ki',
+        type='real',
+        default=0.5,
+        description='Integral gain.',
+        minimum=0.0,
+        maximum=10.0,
+        unit='1/s',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'pid.ki'), ('dronecan', 'PID_KI')),
+    ),
+    DeviceParameterInfo(
+        device='buoyancy_piston',
+        name='pid.kd',
+        type='real',
+        default=0.05,
+        description='Derivative gain.',
+        minimum=0.0,
+        maximum=5.0,
+        unit='s',
+        values=(),
+        max_length=None,
+        restart=False,
+        names=(('cyphal', 'pid.kd'), ('dronecan', 'PID_KD')),
+    ),
+)

@@ -11,6 +11,7 @@ from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.backends.cyphal import CyphalBackend
 from sam_runtime.bridge.backends.cyphal_services import CyphalServices
 from sam_runtime.bridge.backends.interface_ask import cyphal_ask
+from sam_runtime.bridge.backends.param_access import CyphalParamAccess, ParamAccess
 from sam_runtime.bridge.backends.part import BackendSettings
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import SyncMessage, cyphal_sync_message
@@ -38,6 +39,9 @@ class CyphalPart:
     def services(self, lifetime: Lifetime, backend: Backend, ros: Any, mappings: Sequence[Any], *,
                  diagnostics_period: float) -> ServiceMappingsRos:
         return CyphalServices(lifetime, backend, ros, mappings, diagnostics_period=diagnostics_period)
+
+    def param_access(self, backend: Backend) -> ParamAccess:
+        return CyphalParamAccess(backend)
 
     def sync_message(self) -> SyncMessage:
         return cyphal_sync_message()

@@ -11,6 +11,7 @@ from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.backends.dronecan_duties import DroneCanDuties
 from sam_runtime.bridge.backends.dronecan_services import DroneCanServices
 from sam_runtime.bridge.backends.interface_ask import dronecan_ask
+from sam_runtime.bridge.backends.param_access import DroneCanParamAccess, ParamAccess
 from sam_runtime.bridge.backends.part import BackendSettings
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import SyncMessage, dronecan_sync_message
@@ -42,6 +43,9 @@ class DroneCanPart:
     def services(self, lifetime: Lifetime, backend: Backend, ros: Any, mappings: Sequence[Any], *,
                  diagnostics_period: float) -> ServiceMappingsRos:
         return DroneCanServices(lifetime, backend, ros, mappings, diagnostics_period=diagnostics_period)
+
+    def param_access(self, backend: Backend) -> ParamAccess:
+        return DroneCanParamAccess(backend)
 
     def sync_message(self) -> SyncMessage:
         return dronecan_sync_message()

@@ -12,6 +12,7 @@ from typing import Any, Protocol
 
 from sam_runtime.bridge.backend import Backend
 from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportConfig
+from sam_runtime.bridge.backends.param_access import ParamAccess
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.backends.time_sync_messages import SyncMessage
 from sam_runtime.bridge.interface_check import Ask
@@ -51,6 +52,9 @@ class BridgePart(Protocol):
     def services(self, lifetime: Lifetime, backend: Backend, ros: Any, mappings: Sequence[Any], *,
                  diagnostics_period: float) -> ServiceMappingsRos:
         """The spec's service mappings of this protocol, served (not attached yet)."""
+
+    def param_access(self, backend: Backend) -> ParamAccess:
+        """Reads and writes of the boards' settings (the bridge's ROS parameters <device>.<setting>)."""
 
     def sync_message(self) -> SyncMessage:
         """The time-sync master's message."""

@@ -132,12 +132,21 @@ def _status(nid: int, uptime: int, health: str = "NOMINAL", level: int = 0) -> D
     return DeviceStatus(nid, health, level, "OPERATIONAL", uptime, 0)
 
 
-def _health() -> tuple[DeviceHealth, FakeTimers, list[tuple[int, str, bool]]]:
+def _health(first: bool = False) -> tuple[DeviceHealth, FakeTimers, list[tuple[int, str, bool]]]:
+    """The tracker and the events its handler heard (a device's "first" contact only when asked for)."""
     t = FakeTimers()
     h = DeviceHealth({11: "imu", 13: "gps"}, 100, clock=t.clock, call_later=t.call_later)
     events: list[tuple[int, str, bool]] = []
-    h.add_handler(lambda nid, ev, dev: events.append((nid, ev, dev)))
+    h.add_handler(lambda nid, ev, dev: events.append((nid, ev, dev)) if first or ev != "first" else None)
     return h, t, events
+
+
+def test_health_first_contact_is_an_event_of_devices_only() -> None:
+    h, _t, events = _health(first=True)
+    h.on_status(_status(11, 0))
+    h.on_status(_status(11, 1))
+    h.on_status(_status(99, 0))  # a tool: no first-contact event
+    assert events == [(11, "first", True)]
 
 
 def test_health_timeout_lost_back_and_restart(caplog: pytest.LogCaptureFixture) -> None:
@@ -223,7 +232,7 @@ def test_health_a_timer_that_fires_early_is_rearmed() -> None:
 
     h = DeviceHealth({11: "imu"}, 100, clock=t.clock, call_later=call_later)
     events: list[Any] = []
-    h.add_handler(lambda *a: events.append(a))
+    h.add_handler(lambda *a: events.append(a) if a[1] != "first" else None)
     h.on_status(_status(11, 1))
     t.advance(3.0 - 5e-7)  # the timer fired 1 us before 3 s: not lost yet, re-armed
     assert events == [] and h.entry(11)["alive"]
