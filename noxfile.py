@@ -46,6 +46,18 @@ def _ros_install(session: nox.Session) -> None:
                 env=LOOPBACK)
 
 
+def _yakut(session: nox.Session) -> dict[str, str]:
+    """yakut, the Cyphal command-line tool, in a virtual environment of its own (its pycyphal is its own business):
+    the tests that call it (register access on a simulated board, GetInfo of the bridge's loop transport) find it by
+    SAM_YAKUT (tests/helpers/yakut_tool.py)."""
+    venv = Path(session.virtualenv.location) / "yakut"
+    exe = venv / "bin" / "yakut"
+    if not exe.exists():
+        session.run("python", "-m", "venv", str(venv))
+        session.run(str(venv / "bin" / "python"), "-m", "pip", "install", "-q", "yakut~=0.14.2", external=True)
+    return {"SAM_YAKUT": str(exe)}
+
+
 # pytest-xdist: one worker per core and one more, each in a private network (tests/helpers/isolation.py). The system
 # tests fly simulated vehicles in real time and wait for discovery, so a worker per core left a fifth of the CPU idle
 # (157 % of 200 % over a CI run); the extra worker fills it (the Cyphal/DroneCAN system tests of tests/system that
@@ -65,9 +77,10 @@ def tests(session: nox.Session) -> None:
     _static_checks(session)
     session.run("sam-codegen", "build", "--check")
     _ros_install(session)
+    tools = _yakut(session)
     # The per-test times land in .nox/tests/junit.xml: `python tests/helpers/durations.py` tables them per folder.
     report = f"--junitxml={session.virtualenv.location}/junit.xml"
-    session.run("pytest", *(session.posargs or ["-q", *PARALLEL, report]), env=LOOPBACK)
+    session.run("pytest", *(session.posargs or ["-q", *PARALLEL, report]), env={**LOOPBACK, **tools})
 
 
 @nox.session(python="3.11")

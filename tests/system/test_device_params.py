@@ -8,8 +8,9 @@ their bridge, and an independent rclpy client of the standard parameter services
 - set in range: written, read back by the bridge from the board, and kept by the board (a new read shows it);
 - set out of range / a bad enum name: refused by the spec before any bus traffic, the board unchanged;
 - a board that does not answer (not simulated): the set fails with the timeout as its reason;
-- the set round-trip time (median of 20).
-(yakut is not installed in the test environment, so no yakut register access here.)
+- the set round-trip time (median of 20);
+- yakut, the tool a Cyphal user has (tests/helpers/yakut_tool.py; skipped where it is not installed), reads the
+  register the ROS set wrote and writes another, which a new bridge then shows.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from helpers.dronecan_support import private_iface
 from helpers.runtime_support import cyphal_udp_lock, helper_cmd, poll_until, runtime_cmd
 from helpers.service_run import ServiceRun
 from helpers.spec_build import spec_workdir
+from helpers.yakut_tool import yakut, yakut_env, yakut_exe
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -60,6 +62,12 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                          "--set", "pump.pump.volume_limit=0.0008", "--set", "pump.pump.direction=\"inverted\"",
                          "--set", "pump.pump.volume_limit=0.002", "--set", "pump.pump.direction=\"sideways\"",
                          "--set", "ctd.ctd.sample_rate=4", "--rtt", "pump.pump.rate_limit=3e-5,4e-5")
+        exe = yakut_exe()
+        by_yakut: dict[str, Any] = {}
+        if exe is not None:  # the board's registers as yakut sees them (node 21: glider's pump)
+            env_y = yakut_env(42)
+            by_yakut["read"] = yakut(exe, env_y, "register-access", "21", "pump.volume_limit")
+            by_yakut["write"] = yakut(exe, env_y, "register-access", "21", "pump.rate_limit", "3.5e-05")
         # a new bridge reads the board's values on first contact: the ones set above, not the spec's defaults
         r.bridge_proc.stop()
         r.procs.remove(r.bridge_proc)
@@ -68,9 +76,18 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         bridge.wait_line("READY", 90)
         again = _client(r, "--node", "/glider_bridge", "--prefix", "pump",
                         "--wait-value", "pump.pump.volume_limit=0.0008")
-        poll_until(lambda: (r.bridge_stats() or {}).get("device_parameters", {}).get("differing"), 20,
-                   "the new bridge's view of the differing settings")
-        return {"first": result, "again": again} | r.outcome()
+        # every setting the board holds apart from the spec read (the bridge reads them one by one: "some differ"
+        # was true after the first read, before the direction was read, on a loaded machine)
+        wanted = {"pump.pump.direction", "pump.pump.volume_limit", "pump.pump.rate_limit"}
+
+        def differing_read() -> bool:
+            stats = r.bridge_stats() or {}
+            settings = stats.get("devices", {}).get("pump", {}).get("settings", "")
+            return (wanted <= set(stats.get("device_parameters", {}).get("differing", {}))
+                    and all(f"{name.split('.', 1)[1]} " in settings for name in wanted))
+
+        poll_until(differing_read, 20, "the new bridge's view of the differing settings")
+        return {"first": result, "again": again, "yakut": by_yakut} | r.outcome()
 
 
 @pytest.fixture(scope="module")
@@ -146,6 +163,17 @@ def test_cyphal_the_board_keeps_the_values_and_a_new_bridge_shows_them(cyphal: d
     settings = cyphal["bridge_stats"]["devices"]["pump"]["settings"]
     assert "pump.direction inverted (spec normal)" in settings and "pump.volume_limit 0.0008 (spec 0.0005)" in settings
     assert "Traceback" not in cyphal["bridge_stderr"]
+
+
+def test_yakut_reads_and_writes_the_boards_registers(cyphal: dict[str, Any]) -> None:
+    if not cyphal["yakut"]:
+        pytest.skip("yakut is not installed (nox -s tests installs it; or /tmp/yakut-venv, SAM_YAKUT)")
+    # yakut prints a one-element register value as the element
+    read, write = cyphal["yakut"]["read"], cyphal["yakut"]["write"]
+    assert read == pytest.approx(0.0008, rel=1e-6), read  # what the ROS set wrote to the board (real32)
+    assert write == pytest.approx(3.5e-5, rel=1e-6), write  # the board's answer to yakut's write
+    # a new bridge reads it on first contact: a setting changed behind its back by another tool is what it shows
+    assert cyphal["again"]["get"]["pump.pump.rate_limit"] == pytest.approx(3.5e-5, rel=1e-6), cyphal["again"]["get"]
 
 
 def test_cyphal_set_round_trip(cyphal: dict[str, Any]) -> None:

@@ -16,8 +16,6 @@
 from __future__ import annotations
 
 import asyncio
-import os
-import shutil
 import socket
 import subprocess
 import threading
@@ -29,6 +27,7 @@ import pytest
 pytest.importorskip("pycyphal")
 
 from helpers.runtime_support import cyphal_udp_lock
+from helpers.yakut_tool import yakut_env, yakut_exe, yakut_lock
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pycyphal.transport import (
@@ -349,28 +348,18 @@ def test_services_and_heartbeats_on_the_loop_with_a_plain_pycyphal_peer() -> Non
         asyncio.run(go())
 
 
-def _yakut() -> str | None:
-    exe = os.environ.get("SAM_YAKUT") or "/tmp/yakut-venv/bin/yakut"
-    return exe if Path(exe).exists() else shutil.which("yakut")
-
-
 @pytest.mark.system  # yakut is another process
 def test_yakut_calls_a_node_on_the_loop_transport() -> None:
-    exe = _yakut()
+    exe = yakut_exe()
     if exe is None:
-        pytest.skip("yakut is not installed (python -m venv /tmp/yakut-venv && /tmp/yakut-venv/bin/pip install yakut)")
-    from sam_codegen.project.cyphal_path import default_search_dirs
+        pytest.skip("yakut is not installed (nox -s tests installs it; or /tmp/yakut-venv, SAM_YAKUT)")
     from sam_runtime.cyphal_io.transport import make_node, make_transport
 
-    dsdl = [str(d) for d in default_search_dirs() if (Path(d) / "uavcan").is_dir()]
-    if not dsdl:
-        pytest.skip("no uavcan DSDL for yakut")
+    env = yakut_env(42)
 
     async def go() -> str:
         node = make_node("org.sam.test.yakut", LOCAL,
                          transport=make_transport("udp", node_id=LOCAL, iface="127.0.0.1", loop_rx=True))
-        env = dict(os.environ, UAVCAN__UDP__IFACE="127.0.0.1", UAVCAN__NODE__ID="42", CYPHAL_PATH=":".join(dsdl),
-                   YAKUT_PATH=str(Path(os.environ.get("TMPDIR", "/tmp")) / "yakut-compiled"))
         try:
             proc = await asyncio.create_subprocess_exec(
                 exe, "--format", "json", "call", "--timeout", "5", str(LOCAL), "uavcan.node.getinfo", "{}",
@@ -381,6 +370,6 @@ def test_yakut_calls_a_node_on_the_loop_transport() -> None:
         finally:
             node.close()
 
-    with cyphal_udp_lock():
+    with cyphal_udp_lock(), yakut_lock():
         out = asyncio.run(go())
     assert "org.sam.test.yakut" in out
