@@ -189,6 +189,7 @@ class DroneCanTaps(TransferTaps):
 class _Counts:
     ros: Counter[str] = field(default_factory=Counter)
     transfers: Counter[str] = field(default_factory=Counter)
+    services: Counter[int] = field(default_factory=Counter)  # Cyphal service transfers recorded, by kind
     callback_errors: int = 0
 
 
@@ -393,6 +394,8 @@ class Recorder:
                                  int(tr.priority), now, payload, kind=kind, destination_node_id=destination)
                     if self.writer.write(CYPHAL_TOPIC, encode_transfer(t), now, now):
                         self.counts.transfers["cyphal"] += 1
+                        if kind != KIND_MESSAGE:
+                            self.counts.services[kind] += 1
                 except Exception as ex:
                     self.counts.callback_errors += 1
                     log.error("recording subject %d: %s: %s", sid, type(ex).__name__, ex)

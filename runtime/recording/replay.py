@@ -38,6 +38,7 @@ Invariants:
 
 from __future__ import annotations
 
+import bisect
 import time
 from collections import Counter
 from collections.abc import Iterable, Sequence
@@ -286,19 +287,15 @@ def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher,
 
     The ROS side of a recording starts when the recorder's subscriptions have matched the bridge's publishers, its
     bus side before: the bus holds transfers whose publications the recording does not. The bridge publishes a
-    transfer after the listener received it, so the first recorded message comes from one of the last transfers
-    received before it (by the listener's clock, which may lag the bridge's by some milliseconds): of the offsets
-    within :data:`_ALIGN_WINDOW` of that guess, the one after which most pairs are the same (identical or
+    transfer after the listener received it, so a recorded message comes from one of the last transfers received
+    before it (by the listener's clock, which may lag the bridge's by some milliseconds): of the offsets within
+    :data:`_ALIGN_WINDOW` of that guess (:func:`_guess`), the one after which most pairs are the same (identical or
     receive-time only) wins, the nearest on a tie; when none is (a changed conversion), the one whose pairs have the
     most equal fields. A negative offset means the first recorded messages have no transfer (a recording whose bus
     side began later)."""
     if not recorded or not replayed:
         return 0, 0
-    first = recorded[0].log_time
-    # ``follows``: the replayed side comes after the recorded one (a command's transfer after the command): the first
-    # replayed at or after the first recorded; else the last one before it
-    guess = sum(1 for o in replayed if o.log_time < first) if follows else \
-        max(0, sum(1 for o in replayed if o.log_time <= first) - 1)
+    guess = _guess(recorded, replayed, follows)
     best, best_score = guess, 0
     for off in sorted(range(guess - _ALIGN_WINDOW, guess + _ALIGN_WINDOW + 1), key=lambda o: abs(o - guess)):
         i0, j0 = max(0, -off), max(0, off)
@@ -311,6 +308,23 @@ def _align(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher,
     if best_score == 0:  # no pair is the same anywhere (a changed conversion): the offset where most fields agree
         best = _align_by_fields(recorded, replayed, matcher, guess)
     return max(0, -best), max(0, best)
+
+
+_GUESS_SPAN = 100  # recorded messages whose receive times estimate the offset
+
+
+def _guess(recorded: Sequence[Any], replayed: Sequence[_Out], follows: bool) -> int:
+    """The offset (replayed index - recorded index) the receive times say: for each of the first
+    :data:`_GUESS_SPAN` recorded messages, the replayed messages received before it (``follows``: the replayed side
+    comes after the recorded one, a command's transfer after the command: those received before it) less its index;
+    the least of them. A recorded message's log time is when the recorder's callback ran, which a loaded machine
+    delays by up to seconds at the start (its first messages then arrive in one burst, each one's guess too high
+    by the messages received meanwhile: a run guessed 42 past the offset, beyond the window); a delay only ever
+    raises a guess, so the least is the one the delay spared."""
+    times = sorted(o.log_time for o in replayed)
+    if follows:
+        return min(bisect.bisect_left(times, m.log_time) - i for i, m in enumerate(recorded[:_GUESS_SPAN]))
+    return min(bisect.bisect_right(times, m.log_time) - 1 - i for i, m in enumerate(recorded[:_GUESS_SPAN]))
 
 
 def _align_by_fields(recorded: Sequence[Any], replayed: Sequence[_Out], matcher: _Matcher, guess: int) -> int:
@@ -489,23 +503,23 @@ class _PayloadMatcher(_Matcher):
 
 def _align_commands(sent: Sequence[_Sent], bus: Sequence[_Out]) -> tuple[int, int]:
     """(i, j): the first command and the transfer that carried it. A controller repeats one command, so many offsets
-    give equal payloads: of those within :data:`_ALIGN_WINDOW` of the first transfer after the first command, the
-    one with the most equal payloads wins, on a tie the one with the most transfers after their commands, then the
-    one whose transfers are nearest their commands (the median delay; a transfer never before its command by more
-    than :data:`_COMMAND_EARLY_NS`)."""
+    give equal payloads: of those within :data:`_ALIGN_WINDOW` of the receive times' guess (:func:`_guess`), the
+    one with the most equal payloads wins, on a tie the one with the most transfers not before their commands
+    (by more than :data:`_COMMAND_EARLY_NS`), then the one whose transfers are nearest their commands (the median
+    delay). The times only break ties: the recorder's callbacks run late on a loaded machine, which puts a
+    command's log time after its transfer's by up to seconds at the start (a run had every varying payload of two
+    ports differ when such offsets were excluded)."""
     if not sent or not bus:
         return 0, 0
-    guess = sum(1 for o in bus if o.log_time < sent[0].log_time)
-    best, best_key = (0, guess), (-1, -1, 0.0)
+    guess = _guess(sent, bus, follows=True)
+    best, best_key = (0, max(0, guess)), (-1, -1, 0.0)
     for off in range(guess - _ALIGN_WINDOW, guess + _ALIGN_WINDOW + 1):
         i0, j0 = max(0, -off), max(0, off)
         pairs = list(zip(sent[i0:i0 + _ALIGN_PROBE], bus[j0:j0 + _ALIGN_PROBE], strict=False))
         if not pairs:
             continue
         delays = sorted(b.log_time - c.log_time for c, b in pairs)
-        if delays[0] < -_COMMAND_EARLY_NS:
-            continue  # a transfer before its command: not this offset
-        key = (sum(1 for c, b in pairs if c.data == b.cdr), sum(1 for x in delays if x >= 0),
+        key = (sum(1 for c, b in pairs if c.data == b.cdr), sum(1 for x in delays if x >= -_COMMAND_EARLY_NS),
                -abs(float(delays[len(delays) // 2])))
         if key > best_key:
             best, best_key = (i0, j0), key

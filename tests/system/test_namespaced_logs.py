@@ -257,6 +257,7 @@ async def _service_scenario(gen: Any, path: Path, bridge_id: int, imu: int) -> N
 
     from sam_runtime.cyphal_io.transport import make_transport
     from sam_runtime.recording.recorder import Recorder, RecorderConfig
+    from sam_runtime.recording.schemas import KIND_REQUEST, KIND_RESPONSE
 
     recorder = Recorder(gen, RecorderConfig(path, layout="default", ros=False))
     await recorder.start()
@@ -271,9 +272,9 @@ async def _service_scenario(gen: Any, path: Path, bridge_id: int, imu: int) -> N
         ask = a.get_output_session(OutputSessionSpecifier(req, imu), PayloadMetadata(1024))
         answer = b.get_output_session(OutputSessionSpecifier(res, bridge_id), PayloadMetadata(1024))
 
-        def recorded() -> int:
+        def recorded() -> bool:  # a request and a response (the response's listener may lag the request's)
             recorder.tick()
-            return recorder.counts.transfers["cyphal"]
+            return recorder.counts.services[KIND_REQUEST] >= 1 and recorder.counts.services[KIND_RESPONSE] >= 1
 
         for tid in range(3):  # the recorder's sessions may join their groups a moment after start
             await ask.send(Transfer(Timestamp.now(), Priority.NOMINAL, tid, [memoryview(b"")]), loop.time() + 2)
@@ -282,9 +283,9 @@ async def _service_scenario(gen: Any, path: Path, bridge_id: int, imu: int) -> N
             await answer.send(Transfer(Timestamp.now(), Priority.NOMINAL, tid, [memoryview(b"info")]),
                               loop.time() + 2)
             assert await client.receive(loop.time() + 10) is not None, "the bridge's transport got no response"
-            if recorded() >= 2:
+            if recorded():
                 break
-        await until(lambda: recorded() >= 2, 10, "the request and the response in the recording")
+        await until(recorded, 10, "the request and the response in the recording")
     finally:
         for t in (a, b):
             t.close()

@@ -241,6 +241,30 @@ def test_the_report_classifies_every_message(tmp_path: Path) -> None:
     assert "DIFFERENT" in extra.lines()[-1]
 
 
+def test_a_recorder_that_ran_late_at_the_start_is_still_matched(tmp_path: Path) -> None:
+    """The recorder's callbacks may run late on a loaded machine: its first messages then carry log times long
+    after their transfers', in one burst (a CI run had 0.4 s). The receive times that were not delayed say where
+    the recorded messages stand among the replayed ones; the burst's would put them 60 messages too late."""
+    path, step = tmp_path / "late.mcap", 10_000_000  # 100 Hz
+    w = RecordingWriter(path)
+    w.add_channel("/imu", IMU, "ros2msg", ros2msg_definition(IMU, ros_share_dirs()),
+                  metadata={"offered_qos_profiles": qos_yaml("best_effort", "volatile", 10)})
+    w.add_channel(CYPHAL_TOPIC, TRANSFER_TYPE, "ros2msg", TRANSFER_MSG)
+    w.add_metadata("sam_codegen.recording", {"format": "sam-recording/1"})
+    rows = []
+    for i in range(200):
+        t = 1_000_000_000 + i * step
+        rows.append((t, CYPHAL_TOPIC, encode_transfer(_transfer(i))))  # the converter publishes _imu_cdr(tid)
+        if i >= 20:  # the ROS side began at the 20th transfer; the first 60 it got were handed over at once
+            late = 1_000_000_000 + 80 * step + 500_000 + i * 1_000 if i < 80 else t + 1_000_000
+            rows.append((late, "/imu", _imu_cdr(i)))
+    for t, topic, data in sorted(rows, key=lambda r: r[0]):
+        w.write(topic, data, t, t)
+    w.close()
+    imu = replay(path, [_FakeConverter({})]).topics["/imu"]
+    assert (imu.identical, imu.differing, imu.missing, imu.extra, imu.before) == (180, 0, 0, 0, 20)
+
+
 def test_field_differences_names_paths() -> None:
     schema = Schema(id=1, name=IMU, encoding="ros2msg", data=ros2msg_definition(IMU, ros_share_dirs()).encode())
     dec = DecoderFactory().decoder_for("cdr", schema)
