@@ -42,7 +42,7 @@ from pycyphal.transport.commons.high_overhead_transport import TransferCRC, Tran
 from pycyphal.transport.udp import PromiscuousUDPInputSession, PromiscuousUDPInputSessionStatistics, UDPFrame
 from pycyphal.transport.udp._ip._endpoint_mapping import message_data_specifier_to_multicast_group
 
-from sam_runtime.cyphal_io.crc32c import crc32c_register
+from sam_runtime.cyphal_io.crc32c import IMPLEMENTATION, crc32c_register, crc32c_register_python
 from sam_runtime.cyphal_io.udp_receiver import (
     ANONYMOUS_INTEGRITY,
     ANONYMOUS_MULTIFRAME,
@@ -393,7 +393,13 @@ def test_crc32c_is_pycyphals_transfer_crc(data: bytes, start: int) -> None:
     ref = CRC32C()
     ref._value = start  # pycyphal's register, from any state: the word steps must agree with its byte steps
     ref.add(data)
-    assert crc32c_register(data, start) == ref._value
+    assert crc32c_register(data, start) == crc32c_register_python(data, start) == ref._value
+
+
+def test_the_crc_is_computed_in_c_where_the_runtime_is_installed() -> None:
+    # google_crc32c is a runtime dependency with wheels for x86-64 and aarch64: the Python fallback here would
+    # mean the dependency went missing (a silent ~12 % more CPU on a Cyphal bridge)
+    assert IMPLEMENTATION == "c"
 
 
 def test_the_transfer_id_timeout_is_pycyphals() -> None:
