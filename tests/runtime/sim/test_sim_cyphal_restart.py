@@ -116,6 +116,7 @@ def test_a_restart_reboots_the_device_quietly(caplog: pytest.LogCaptureFixture) 
     if gen.tables().VEHICLE != "sam":
         pytest.skip("SAM's devices")
     caplog.set_level(logging.INFO)
+    gen.compile_dsdl()  # the types on the path before _scenario imports them (CI ran this test first in its worker)
     with cyphal_udp_lock():
         out = _run(_scenario(gen))
     execute_status = {"success": 0, "bad_command": 3}
@@ -183,7 +184,7 @@ def test_closing_while_a_response_is_sent_logs_no_traceback(caplog: pytest.LogCa
     if gen.tables().VEHICLE != "sam":
         pytest.skip("SAM's devices")
     caplog.set_level(logging.INFO)
-    gen.compile_dsdl()  # the types on the path here, not left to the other test of the module (alone it failed)
+    gen.compile_dsdl()  # as above: each test puts the types on the path itself
     with cyphal_udp_lock():
         out = _run(_close_during_a_response(gen))
     assert out["closing_seen"] and out["response"] is None, out  # unanswered: the device went off
