@@ -170,7 +170,9 @@ class DeviceParams:
         from std_srvs.srv import Trigger
 
         base = self.ros.name
-        node = Node(f"{base}_settings", namespace=self.ros.node.get_namespace(), context=self.ros.context)
+        # (no parameter services of its own: the settings are the bridge node's parameters, not this node's)
+        node = Node(f"{base}_settings", namespace=self.ros.node.get_namespace(), context=self.ros.context,
+                    start_parameter_services=False)
         group = ReentrantCallbackGroup()
         for device in self.devices:
             node.create_service(Trigger, f"{device}/{STORE_SERVICE}", self._store_callback(device),
