@@ -9,7 +9,7 @@ and its device duty ``uavcan_restart_node`` (the board's reboot: Cyphal ExecuteC
 - store_settings of a board that does not answer fails with the reason; both are counted;
 - ``--ros-args --params-file F`` at the bridge's start (Cyphal/UDP): an override that differs from the board's value
   is written to the board after its first read (logged ``name: board -> override``), one the spec refuses is logged
-  with the reason; both counted, no traceback.
+  with the reason; both counted, no traceback; the bridge's ``--param <device>.<setting>=V`` likewise (DroneCAN).
 """
 
 from __future__ import annotations
@@ -101,10 +101,12 @@ def dronecan(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     iface = private_iface()
     with ServiceRun(env, d) as r:
         sim = r.start("sim", runtime_cmd("sim", "--devices", "esc_port", "--dronecan-iface", iface))
-        bridge = r.bridge("--protocol", "dronecan", "--dronecan-iface", iface)
+        # an override by the bridge's own --param (its parameter_overrides), as a params file's
+        bridge = r.bridge("--protocol", "dronecan", "--dronecan-iface", iface, "--param", "esc_port.esc.index=3")
         sim.wait_line("READY", 90)
         bridge.wait_line("READY", 90)
-        poll_until(lambda: _counts(r).get("reads", 0) >= 4, 30, "the bridge reading esc_port's settings")
+        poll_until(lambda: _counts(r).get("reads", 0) >= 4 and _counts(r).get("overrides_applied", 0) >= 1, 30,
+                   "the bridge reading esc_port's settings and writing the override")
         _up_for(r, "esc_port", 3)
         first = _client(r, "--node", "/sabre_bridge", "--prefix", "esc_port",
                         "--set", "esc_port.esc.poles=28", "--trigger", "/esc_port/store_settings",
@@ -158,6 +160,13 @@ def test_dronecan_a_stored_value_survives_the_reboot_an_unsaved_one_does_not(dro
     counts = dronecan["bridge_stats"]["device_parameters"]
     assert counts["stores"] == 1 and counts.get("store_failures", 0) == 0, counts
     assert "Traceback" not in dronecan["bridge_stderr"]
+
+
+def test_dronecan_a_param_override_is_written_to_the_board(dronecan: dict[str, Any]) -> None:
+    assert "esc_port.esc.index: 0 -> 3 (the override written to the board)" in dronecan["bridge_stderr"]
+    assert dronecan["first"]["get"]["esc_port.esc.index"] == 3
+    assert dronecan["again"]["get"]["esc_port.esc.index"] == 3  # stored with the others: kept across the reboot
+    assert dronecan["bridge_stats"]["device_parameters"]["overrides_applied"] == 1
 
 
 def test_cyphal_a_set_to_a_silent_board_holds_the_executor_for_the_timeout(cyphal: dict[str, Any]) -> None:
