@@ -78,7 +78,8 @@ def _bridge_parser() -> argparse.ArgumentParser:
     p.add_argument("--node-id", type=int, default=None,
                    help="Cyphal node id (default: UAVCAN__NODE__ID with --transport env, else the spec's)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="initial value of a spec parameter (range and rules are checked)")
+                   help="initial value of a spec parameter (range and rules are checked), or of a board's setting "
+                        "<device>.<setting> (written to the board after its first read when it differs)")
     p.add_argument("--qos-depth", type=int, default=100)
     p.add_argument("--command-qos", choices=("reliable", "best_effort"), default="reliable")
     p.add_argument("--rx-queue-size", type=int, default=None,

@@ -14,7 +14,7 @@ from sam_runtime.bridge.backends.cyphal import DEFAULT_RX_QUEUE_SIZE, TransportC
 from sam_runtime.bridge.backends.part import BackendSettings, BridgePart
 from sam_runtime.bridge.backends.service_mappings import ServiceMappingsRos
 from sam_runtime.bridge.counters import DEFAULT_LOG_INTERVAL_S, MappingStats, log
-from sam_runtime.bridge.device_params import DeviceParams
+from sam_runtime.bridge.device_params import DeviceParams, ros_parameter_name
 from sam_runtime.bridge.health import DeviceHealth
 from sam_runtime.bridge.inbound import Inbound
 from sam_runtime.bridge.interface_check import InterfaceCheck, board_switches
@@ -148,8 +148,14 @@ class Bridge:
             period = (period or DEFAULT_TIME_SYNC_PERIOD_S) if override else None
         self.time_sync_period: float | None = period
         self.time_sync: StampWatch | None = None
+        # overrides of the boards' settings (<device>.<setting>) go to device_params, the rest to the node's own
+        settings = {ros_parameter_name(p.device, p.name) for p in tables.DEVICE_PARAMETERS
+                    if p.device in sel.devices.values()}
+        given = dict(parameter_overrides or {})
+        self._setting_overrides = {k: v for k, v in given.items() if k in settings}
         self.ros = RosSide(self.lifetime, self.name, ros_args=ros_args, parameters=tables.PARAMETERS,
-                           rules=tables.PARAMETER_RULES, overrides=parameter_overrides,
+                           rules=tables.PARAMETER_RULES,
+                           overrides={k: v for k, v in given.items() if k not in settings},
                            qos_depth=qos_depth, command_reliability=command_reliability,
                            namespace=self.namespace.node_namespace, host=ros_host)
         # commands to the bus: a managed bridge (ros_host) starts inactive, its lifecycle manager activates it
@@ -266,7 +272,8 @@ class Bridge:
 
         self.ros.attach()
         self.device_params = DeviceParams(lifetime, self.ros, sel.devices, tables.DEVICE_PARAMETERS,
-                                          sel.protocol, self.part.param_access(backend))
+                                          sel.protocol, self.part.param_access(backend),
+                                          overrides=self._setting_overrides)
         self.device_params.attach()
         health.add_handler(self.device_params.on_health)
         reporter.device_settings = self.device_params.differing_by_device

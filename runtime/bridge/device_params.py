@@ -20,6 +20,23 @@ On first contact (the device's first heartbeat), when it is back and after a res
 setting of the board (one request at a time, no timer of its own) and shows the board's value as the parameter's
 (an update the on-set callback lets through without writing it back). Counted: ``sets``, ``refused_by_spec``,
 ``refused_by_board``, ``timeouts``, ``reads``, ``read_failures``.
+
+Saving: a value written is lost at the board's next reboot unless the board saves it. Each board with settings gets a
+std_srvs/Trigger service ``<device>/store_settings`` (relative: under the bridge's namespace, as the device duties'
+``uavcan_restart_node``), which asks the board to save (backends.param_access ``store``) and answers success only on
+the board's OK, else the reason (no answer, refused, the link down); counted ``stores``, ``store_failures``. The
+services live on a node of their own (``<bridge>_settings``) spun by a two-thread executor, as the service mappings':
+a store waits up to STORE_TIMEOUT_S for a flash write, which the bridge's single executor thread must not.
+
+Overrides at start (``--ros-args --params-file F`` or rclpy parameter_overrides naming ``<device>.<setting>``): the
+parameter is declared with the override, and after the board's first read of it the override is written to the
+board when it differs (logged ``name: board -> override``, counted ``overrides_applied``); one the spec refuses is
+not declared (the spec's default is), one the board refuses or does not answer shows the board's value; both are
+logged with the reason and counted ``overrides_refused``. Once per start: a board's later reboots are not written
+again (what it saved is what it runs with).
+
+The timeout of a read or write is PARAM_TIMEOUT_S: the spec has no per-device or bridge-wide request timeout
+(``timeout`` exists only per service mapping and per node-service duty), so none is taken from it.
 """
 
 from __future__ import annotations
@@ -34,13 +51,19 @@ from dataclasses import dataclass
 from typing import Any
 
 from sam_runtime.bridge.backends.param_access import ParamAccess, ParamIOError
+from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.common.board_settings import Stored, default_stored, from_stored, ros_problem, to_stored
 
-__all__ = ["PARAM_TIMEOUT_S", "DeviceParams", "ros_parameter_name"]
+__all__ = ["PARAM_TIMEOUT_S", "STORE_SERVICE", "STORE_TIMEOUT_S", "DeviceParams", "ros_parameter_name"]
 
 PARAM_TIMEOUT_S = 1.0  # a board's answer to one read or write
+# A store writes the board's flash: an STM32F4 erases a 128 KiB sector in 1-2 s before it answers, so a store waits
+# longer than a read or write (on the store services' own threads: nothing else waits with it).
+STORE_TIMEOUT_S = 3.0
+STORE_SERVICE = "store_settings"  # <device>/store_settings, relative: under the bridge's namespace
+_STORE_THREADS = 2  # two boards' stores at once; a third call waits for a free thread
 
 
 def ros_parameter_name(device: str, setting: str) -> str:
@@ -66,10 +89,12 @@ def _same(kind: str, a: Stored, b: Stored) -> bool:
 class DeviceParams:
     """:param devices: node id -> device name of this bridge's devices (its layout's protocol).
     :param params: the tables' DEVICE_PARAMETERS; those of other devices are left out.
-    :param access: the protocol's bus access (backends.param_access)."""
+    :param access: the protocol's bus access (backends.param_access).
+    :param overrides: initial values by ROS name (the bridge's parameter_overrides), before the node's own."""
 
     def __init__(self, lifetime: Lifetime, ros: Any, devices: Mapping[int, str], params: Sequence[Any],
-                 protocol: str, access: ParamAccess, *, timeout: float = PARAM_TIMEOUT_S) -> None:
+                 protocol: str, access: ParamAccess, *, timeout: float = PARAM_TIMEOUT_S,
+                 overrides: Mapping[str, Any] | None = None) -> None:
         self.lifetime, self.ros, self.access, self.timeout = lifetime, ros, access, float(timeout)
         nids = {name: nid for nid, name in devices.items()}
         self.settings = {ros_parameter_name(p.device, p.name): _Setting(p.device, nids[p.device], p,
@@ -82,6 +107,15 @@ class DeviceParams:
         self._reading: set[int] = set()
         self._node: Any = None  # the ROS node the parameters are declared on
         self._tasks: set[asyncio.Task[None]] = set()
+        self._given = dict(overrides or {})
+        self._store_spinner: SpinThread | None = None
+        # --params-file / constructor overrides of the boards' settings not yet written: ROS name -> board's form
+        self.pending_overrides: dict[str, Stored] = {}
+
+    @property
+    def devices(self) -> dict[str, int]:
+        """The boards with settings: device name -> node id."""
+        return {s.device: s.nid for s in self.settings.values()}
 
     def attach(self) -> None:
         """After the ROS side's attach (its node exists at start)."""
@@ -95,18 +129,72 @@ class DeviceParams:
         self._loop = asyncio.get_running_loop()
         node = self._node = self.ros.node
         node.add_on_set_parameters_callback(self._on_set)
+        # rclpy's overrides of the node (--params-file, parameter_overrides): rclpy keeps them in this attribute
+        # only (node_support reads it the same way)
+        overrides = {n: p.value for n, p in (getattr(node, "_parameter_overrides", {}) or {}).items()}
+        overrides.update(self._given)
         for name, s in self.settings.items():
             if node.has_parameter(name):  # a managed bridge configured again: its lifecycle node keeps them
                 continue
             descriptor = ParameterDescriptor(name=name, description=self._description(s), read_only=False)
             self._ranges(descriptor, s.info)
+            value = s.info.default
+            if name in overrides:
+                value = self._override(name, s, overrides[name])
             self._local.quiet = True
             try:
-                node.declare_parameter(name, s.info.default, descriptor)
+                # ignore_override: the override was checked above (a bad one would raise out of rclpy here)
+                node.declare_parameter(name, value, descriptor, ignore_override=True)
             finally:
                 self._local.quiet = False
+        self._serve_stores()
+
+    def _override(self, name: str, s: _Setting, value: Any) -> Any:
+        """An override of a board's setting: the value to declare (the override, to be written to the board after
+        its first read; the spec's default when the spec refuses it: logged and counted, the bridge goes on)."""
+        problem = ros_problem(s.info, value)
+        stored = to_stored(s.info, value)
+        if problem is not None or stored is None:
+            self.counts["overrides_refused"] += 1
+            log.warning("%s: the override %r is refused by the spec: %s", name, value, problem)
+            return s.info.default
+        self.pending_overrides[name] = stored
+        return float(value) if s.info.type == "real" else value  # (a real given as 3 is declared a double)
+
+    def _serve_stores(self) -> None:
+        """A std_srvs/Trigger ``<device>/store_settings`` per board with settings, on a node and threads of their own
+        (as the service mappings': a call waits for the board, which the bridge's one executor thread must not)."""
+        from rclpy.callback_groups import ReentrantCallbackGroup
+        from rclpy.executors import MultiThreadedExecutor
+        from rclpy.node import Node
+        from std_srvs.srv import Trigger
+
+        base = self.ros.name
+        # (no parameter services of its own: the settings are the bridge node's parameters, not this node's)
+        node = Node(f"{base}_settings", namespace=self.ros.node.get_namespace(), context=self.ros.context,
+                    start_parameter_services=False)
+        group = ReentrantCallbackGroup()
+        for device in self.devices:
+            node.create_service(Trigger, f"{device}/{STORE_SERVICE}", self._store_callback(device),
+                                callback_group=group)
+        executor = MultiThreadedExecutor(num_threads=_STORE_THREADS, context=self.ros.context)
+        self._store_spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-settings",
+                                         "settings_spin_error", "the boards' store services")
+        self._store_spinner.start()
+
+    def _store_callback(self, device: str) -> Any:
+        def on_call(_request: Any, response: Any) -> Any:
+            problem = self.store(device)
+            response.success = problem is None
+            response.message = problem or f"{device} stored its settings"
+            return response
+
+        return on_call
 
     def _close(self) -> None:
+        if self._store_spinner is not None:
+            self._store_spinner.close()
+            self._store_spinner = None
         for task in list(self._tasks):  # reads in flight: their node is closing
             task.cancel()
         if self._node is not None:  # a managed bridge's node outlives this bridge (cleanup, configure again)
@@ -182,7 +270,37 @@ class DeviceParams:
         if not _same(s.info.type, answer, stored):
             self.counts["refused_by_board"] += 1
             return f"refused by {s.device} (node {s.nid}): it keeps {from_stored(s.info, answer)!r}"
+        self.pending_overrides.pop(name, None)  # a value set since the start is newer than the start's override
         return None
+
+    def store(self, device: str) -> str | None:
+        """Ask board `device` to save its current values (the store service's thread; waits for its answer): None
+        on its OK, else the reason (no answer, refused, the link down). Counted: ``stores``, ``store_failures``."""
+        self.counts["stores"] += 1
+        nid = self.devices.get(device)
+        loop = self._loop
+        problem: str | None = None
+        if nid is None:
+            problem = f"{device} is no board with settings of this bridge"
+        elif loop is None or loop.is_closed() or self.lifetime.closed:
+            problem = "the bridge is not running"
+        else:
+            future = asyncio.run_coroutine_threadsafe(self.access.store(nid, STORE_TIMEOUT_S), loop)
+            try:
+                future.result(STORE_TIMEOUT_S + 2.0)  # the access's own timeout ends it; this guards the loop
+            except ParamIOError as ex:
+                problem = f"{device}: {ex}"
+            except TimeoutError:
+                future.cancel()
+                problem = f"the bridge's loop did not answer within {STORE_TIMEOUT_S + 2.0:g} s"
+            except Exception as ex:  # a bug: the caller gets it as the reason, never a traceback
+                problem = f"{device}: {type(ex).__name__}: {ex}"
+        if problem is not None:
+            self.counts["store_failures"] += 1
+            log.warning("storing the settings of %s: %s", device, problem)
+        else:
+            log.info("%s (node %s) stored its settings", device, nid)
+        return problem
 
     # ------------------------------------------------------------------------------------------------ reads
     def on_health(self, nid: int, event: str, device: bool) -> None:
@@ -211,9 +329,35 @@ class DeviceParams:
                     continue
                 self.counts["reads"] += 1
                 self.board_values[name] = answer
+                if name in self.pending_overrides:
+                    answer = await self._write_override(name, s, answer)
                 self._show(name, from_stored(s.info, answer))
         finally:
             self._reading.discard(nid)
+
+    async def _write_override(self, name: str, s: _Setting, board: Stored) -> Stored:
+        """The override of setting `name` written to its board after the board's first read, when it differs from
+        the board's value (the loop's thread): logged ``name: board -> override`` and counted
+        (``overrides_applied``; ``overrides_refused`` with the reason). Once per bridge start: an override the
+        board refused is not tried again. Returns the board's value after it."""
+        wanted = self.pending_overrides.pop(name, None)  # (None: a ROS set since took its place, another thread)
+        if wanted is None or _same(s.info.type, board, wanted):
+            return board
+        change = f"{name}: {from_stored(s.info, board)!r} -> {from_stored(s.info, wanted)!r}"
+        try:
+            answer = await self.access(s.nid, s.bus_name, s.info.type, wanted, self.timeout)
+        except Exception as ex:  # ParamIOError; anything else is a bug, counted and logged, never raised
+            self.counts["overrides_refused"] += 1
+            log.warning("%s REFUSED: %s", change, ex if isinstance(ex, ParamIOError) else f"{type(ex).__name__}: {ex}")
+            return board
+        self.board_values[name] = answer
+        if not _same(s.info.type, answer, wanted):
+            self.counts["overrides_refused"] += 1
+            log.warning("%s REFUSED: %s (node %s) keeps %r", change, s.device, s.nid, from_stored(s.info, answer))
+            return answer
+        self.counts["overrides_applied"] += 1
+        log.info("%s (the override written to the board)", change)
+        return answer
 
     def _show(self, name: str, value: Stored) -> None:
         from rclpy.parameter import Parameter

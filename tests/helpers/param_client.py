@@ -3,15 +3,19 @@ rcl parameter services only (rclpy's AsyncParameterClient: list_parameters, desc
 set_parameters). Writes what it got as JSON to --out (also when it fails part way); every wait shares one deadline.
 
 python param_client.py --out r.json --node /glider_bridge --prefix pump --get pump.pump.direction \
-    --set pump.pump.volume_limit=0.0008 --set ... [--wait-value NAME=JSON] [--rtt NAME=A,B]
+    --set pump.pump.volume_limit=0.0008 --set ... [--trigger /pump/store_settings] \
+    [--restart glider_msgs/srv/UavcanRestartNode=21@/uavcan_restart_node] [--wait-value NAME=JSON] [--rtt NAME=A,B]
   Lists the parameters under --prefix, describes and gets them; waits until --wait-value's parameter shows that
-  value (the board's, read on first contact); each --set (a JSON value) in order, its result (successful, reason,
-  seconds) and the value got afterwards; --rtt sets NAME 20 times alternating A and B and records each duration.
+  value (the board's, read on first contact); then the steps in the order given: each --set (a JSON value), its
+  result (successful, reason, seconds) and the value got afterwards ("sets"); each --trigger, a std_srvs/Trigger
+  call of that service (success, message, seconds: "triggers"); each --restart, the device duty restart_node's srv
+  called with that node id ("restarts"); --rtt sets NAME 20 times alternating A and B and records each duration.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 import time
@@ -24,12 +28,21 @@ def _value(v: Any) -> Any:
     return parameter_value_to_python(v)
 
 
+class _Step(argparse.Action):
+    """--set, --trigger and --restart share one list, so that they run in the order given."""
+
+    def __call__(self, parser: Any, namespace: Any, values: Any, option_string: Any = None) -> None:
+        namespace.steps.append((self.const, values))
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", required=True)
     ap.add_argument("--node", required=True)
     ap.add_argument("--prefix", action="append", default=[])
-    ap.add_argument("--set", action="append", default=[], dest="sets")
+    ap.add_argument("--set", action=_Step, const="set", default=[], dest="steps")
+    ap.add_argument("--trigger", action=_Step, const="trigger", dest="steps")
+    ap.add_argument("--restart", action=_Step, const="restart", dest="steps")
     ap.add_argument("--wait-value", action="append", default=[])
     ap.add_argument("--rtt", default="")
     ap.add_argument("--deadline", type=float, default=60.0)
@@ -50,6 +63,15 @@ def main() -> int:
         if not future.done():
             raise TimeoutError("deadline")
         return future.result()
+
+    def call(srv_type: Any, service: str, request: Any) -> Any:
+        cli = node.create_client(srv_type, service)
+        try:
+            if not cli.wait_for_service(timeout_sec=max(0.0, end - time.monotonic())):
+                raise TimeoutError(f"no service {service}")
+            return wait(cli.call_async(request))
+        finally:
+            node.destroy_client(cli)
 
     try:
         if not client.wait_for_services(timeout_sec=max(0.0, end - time.monotonic())):
@@ -74,15 +96,29 @@ def main() -> int:
             result.setdefault("waited", {})[name] = got
         result["get"] = {n: _value(v) for n, v in zip(listed, wait(client.get_parameters(listed)).values,
                                                          strict=True)}
-        result["sets"] = []
-        for item in args.sets:
-            name, text = item.split("=", 1)
+        result["sets"], result["triggers"], result["restarts"] = [], [], []
+        for kind, item in args.steps:
             started = time.monotonic()
-            res = wait(client.set_parameters([Parameter(name, value=json.loads(text))])).results[0]
-            seconds = time.monotonic() - started
-            after = _value(wait(client.get_parameters([name])).values[0])
-            result["sets"].append({"name": name, "value": json.loads(text), "successful": res.successful,
-                                   "reason": res.reason, "seconds": seconds, "after": after})
+            if kind == "set":
+                name, text = item.split("=", 1)
+                res = wait(client.set_parameters([Parameter(name, value=json.loads(text))])).results[0]
+                seconds = time.monotonic() - started
+                after = _value(wait(client.get_parameters([name])).values[0])
+                result["sets"].append({"name": name, "value": json.loads(text), "successful": res.successful,
+                                       "reason": res.reason, "seconds": seconds, "after": after})
+            elif kind == "trigger":
+                from std_srvs.srv import Trigger
+
+                answer = call(Trigger, item, Trigger.Request())
+                result["triggers"].append({"service": item, "success": answer.success, "message": answer.message,
+                                           "seconds": time.monotonic() - started})
+            else:
+                srv, rest = item.split("=", 1)
+                nid, service = rest.split("@", 1)
+                package, _, name = srv.split("/")
+                srv_type = getattr(importlib.import_module(f"{package}.srv"), name)
+                answer = call(srv_type, service, srv_type.Request(node_id=int(nid)))
+                result["restarts"].append({"service": service, "success": answer.success, "message": answer.message})
         if args.rtt:
             name, pair = args.rtt.split("=", 1)
             values = [json.loads(v) for v in pair.split(",")]

@@ -1,10 +1,13 @@
 """The bridge's ROS parameter sets of the boards' settings (sam_runtime.bridge.device_params), without ROS or a bus:
 a fake bus access in a real asyncio loop thread. A set is refused by the spec without bus traffic; a board that keeps
-another value, or does not answer, fails the set with the reason; a real confirmed through float32 succeeds."""
+another value, or does not answer, fails the set with the reason; a real confirmed through float32 succeeds. A store
+answers None only on the board's OK, else the reason; an override (--params-file) is written after the board's first
+read when it differs, once, and a refusal is logged and counted."""
 
 from __future__ import annotations
 
 import asyncio
+import logging
 import threading
 from collections.abc import Iterator
 from types import SimpleNamespace
@@ -33,6 +36,8 @@ class FakeBoard:
         self.refuse: set[str] = set()
         self.silent: set[int] = set()
         self.requests: list[tuple[int, str, Any]] = []
+        self.stores: list[int] = []
+        self.refuse_store: set[int] = set()
 
     async def __call__(self, nid: int, name: str, kind: str, value: Any, timeout: float) -> Any:
         self.requests.append((nid, name, value))
@@ -43,6 +48,13 @@ class FakeBoard:
             self.values[name] = float(f"{value:.7g}") + 1e-9 if kind == "real" else value
         return self.values[name]
 
+    async def store(self, nid: int, timeout: float) -> None:
+        self.stores.append(nid)
+        if nid in self.silent:
+            raise ParamIOError(f"node {nid} did not answer within {timeout:g} s")
+        if nid in self.refuse_store:
+            raise ParamIOError(f"node {nid} refused to store its settings: status 1 (FAILURE)")
+
 
 @pytest.fixture
 def setup() -> Iterator[tuple[DeviceParams, FakeBoard]]:
@@ -50,8 +62,9 @@ def setup() -> Iterator[tuple[DeviceParams, FakeBoard]]:
     thread = threading.Thread(target=loop.run_forever, daemon=True)
     thread.start()
     board = FakeBoard()
-    params = DeviceParams(SimpleNamespace(closed=False), None, {21: "thruster_1", 23: "thrust_vector"},
-                          (POLES, DIRECTION, LIMIT), "dronecan", board, timeout=0.5)
+    params = DeviceParams(SimpleNamespace(closed=False), SimpleNamespace(node=None),
+                          {21: "thruster_1", 23: "thrust_vector"}, (POLES, DIRECTION, LIMIT), "dronecan", board,
+                          timeout=0.5)
     params._loop = loop  # (what _start sets, without a ROS node)
     try:
         yield params, board
@@ -96,3 +109,55 @@ def test_only_the_devices_of_the_bridge_are_parameters() -> None:
                           FakeBoard())
     assert list(params.settings) == ["thruster_1.motor.pole_count"]
     assert params.settings["thruster_1.motor.pole_count"].bus_name == "motor.pole_count"
+
+
+def test_a_store_succeeds_only_on_the_boards_ok(setup: tuple[DeviceParams, FakeBoard]) -> None:
+    params, board = setup
+    board.refuse_store.add(21)
+    board.silent.add(23)
+    assert params.store("thruster_1") == "thruster_1: node 21 refused to store its settings: status 1 (FAILURE)"
+    assert params.store("thrust_vector") == "thrust_vector: node 23 did not answer within 3 s"
+    assert params.store("nobody") == "nobody is no board with settings of this bridge"
+    board.refuse_store.clear()
+    assert params.store("thruster_1") is None
+    assert board.stores == [21, 23, 21]
+    assert params.counts["stores"] == 4 and params.counts["store_failures"] == 3
+
+
+def _read(params: DeviceParams, nid: int) -> None:
+    assert params._loop is not None
+    asyncio.run_coroutine_threadsafe(params._read_board(nid), params._loop).result(5)
+
+
+def test_an_override_is_written_after_the_first_read_when_it_differs(setup: tuple[DeviceParams, FakeBoard],
+                                                                     caplog: pytest.LogCaptureFixture) -> None:
+    params, board = setup
+    caplog.set_level(logging.INFO)
+    poles, direction = "thruster_1.motor.pole_count", "thruster_1.motor.direction"
+    assert params._override(poles, params.settings[poles], 20) == 20
+    assert params._override(direction, params.settings[direction], "forward") == "forward"  # the board's already
+    _read(params, 21)
+    assert [r for r in board.requests if r[2] is not None] == [(21, "MOTOR_POLE_COUNT", 20)]
+    assert "thruster_1.motor.pole_count: 14 -> 20" in caplog.messages[-1]
+    assert params.counts["overrides_applied"] == 1 and params.pending_overrides == {}
+    _read(params, 21)  # a later read (the board restarted): written once per start only
+    assert len([r for r in board.requests if r[2] is not None]) == 1
+
+
+def test_a_refused_override_is_logged_and_counted(setup: tuple[DeviceParams, FakeBoard],
+                                                  caplog: pytest.LogCaptureFixture) -> None:
+    params, board = setup
+    poles, limit = "thruster_1.motor.pole_count", "thrust_vector.servo.limit"
+    # the spec refuses it: the default is declared, nothing is written
+    assert params._override(poles, params.settings[poles], 60) == 14 and poles not in params.pending_overrides
+    assert "the override 60 is refused by the spec: 60 is outside 2..48" in caplog.messages[-1]
+    assert params._override(poles, params.settings[poles], 30) == 30
+    board.refuse.add("MOTOR_POLE_COUNT")
+    _read(params, 21)
+    assert caplog.messages[-1] == "thruster_1.motor.pole_count: 14 -> 30 REFUSED: thruster_1 (node 21) keeps 14"
+    assert params.counts["overrides_refused"] == 2
+    # a board that does not answer the read: the override waits for its next read
+    assert params._override(limit, params.settings[limit], 0.1) == 0.1
+    board.silent.add(23)
+    _read(params, 23)
+    assert params.pending_overrides == {limit: 0.1} and params.counts["read_failures"] == 1
