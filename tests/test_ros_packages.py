@@ -64,3 +64,19 @@ def test_packages_current_in_the_venv_are_used_as_they_are() -> None:
     if not all(ros_packages.current_in_venv(p) for p in packages):
         pytest.skip("generated/ros is not installed in this venv (`sam-codegen ros-install`; nox's tests session)")
     assert ros_packages.built_prefix(packages) == Path(sys.prefix).absolute()
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+def test_the_tests_builds_hold_the_c_and_python_type_supports_and_no_cpp() -> None:
+    """python_only.cmake leaves the C++ generators out of the tests' builds (the users' builds keep them)."""
+    from helpers.spec_build import built_spec
+
+    if ros_packages.missing_tools() is not None:
+        pytest.skip(str(ros_packages.missing_tools()))
+    built = built_spec("glider")  # built by other tests anyway: cached by content
+    libs = sorted(p.name for p in (built.prefix / "lib").glob("lib*.so"))
+    kinds = {lib.split("__", 1)[1].removesuffix(".so") for lib in libs}
+    assert kinds == {"rosidl_generator_c", "rosidl_generator_py", "rosidl_typesupport_c",
+                     "rosidl_typesupport_fastrtps_c", "rosidl_typesupport_introspection_c"}, libs
+    assert not list((built.prefix / "include").rglob("*.hpp")), "C++ headers generated"
