@@ -40,16 +40,17 @@ RULES: tuple[tuple[str, re.Pattern[str]], ...] = (
     ("codec / converters (generated)", re.compile(r"sam_bridge/(codec|codec_v0|convert|convert_v0|"
                                                   r"conversion_support)\.py")),
     ("rclpy publish", re.compile(r"rclpy/publisher\.py|Publisher\.publish")),
-    ("diagnostics", re.compile(r"sam_runtime/bridge/(diagnostics|reporting|health|liveness|silence)\.py|"
-                                           r"write_json_atomic|Bridge\.stats|sam_runtime/bridge/counters\.py")),
-    ("time sync", re.compile(r"sam_runtime/bridge/time_sync\.py")),
+    ("diagnostics", re.compile(r"(?:sam_)?runtime/bridge/(diagnostics|reporting|health|liveness|silence)\.py|"
+                                           r"write_json_atomic|Bridge\.stats|(?:sam_)?runtime/bridge/counters\.py")),
+    ("time sync", re.compile(r"(?:sam_)?runtime/bridge/time_sync\.py")),
     ("transport receive (pycyphal UDP / dronecan driver, FrameGate)",
      re.compile(r"pycyphal/transport/|dronecan_io/(loopback|frame_gate|mcast_packet|can_id|wire)\.py|"
-                r"dronecan/driver/")),
+                r"cyphal_io/(udp_receiver|crc32c|multicast)\.py|dronecan/driver/")),
     ("library decoding (pycyphal DSDL / dronecan transfers)",
      re.compile(r"pycyphal/dsdl|nunavut|/uavcan/|dronecan/(transport|dsdl)|dronecan/node\.py")),
     ("pycyphal presentation / application", re.compile(r"pycyphal/(presentation|application)")),
-    ("bridge inbound / outbound", re.compile(r"sam_runtime/bridge/|sam_runtime/dronecan_io/|sam_runtime/cyphal_io/")),
+    # (sam_)runtime/: the runtime as installed (sam_runtime/) or editable from the checkout (runtime/)
+    ("bridge inbound / outbound", re.compile(r"(?:sam_)?runtime/(bridge|dronecan_io|cyphal_io)/")),
     ("rclpy executor", re.compile(r"rclpy/")),
     ("asyncio event loop", re.compile(r"asyncio/|selectors\.py")),
 )

@@ -83,6 +83,11 @@ def test_profile_attribution(tmp_path: Path) -> None:
     assert subsystem([base, "Publisher.publish (rclpy/publisher.py:70)"]) == "rclpy publish"
     assert subsystem([base, "UDPFrame.parse (pycyphal/transport/udp/_frame.py:134)"]).startswith("transport receive")
     assert subsystem([base, "mystery (nowhere.py:1)"]) == "other"
+    # the runtime from the checkout (an editable install: runtime/...) as well as installed (sam_runtime/...)
+    for root in ("runtime", "sam_runtime", "/work/p/runtime"):
+        assert subsystem([base, f"Inbound._one ({root}/bridge/inbound.py:236)"]) == "bridge inbound / outbound"
+        assert subsystem([base, f"SubjectPort.feed ({root}/cyphal_io/udp_receiver.py:250)"]).startswith("transport")
+        assert subsystem([base, f"statuses_cdr ({root}/bridge/diagnostics.py:77)"]) == "diagnostics"
     prof = tmp_path / "profile.txt"
     prof.write_text("thread (1): MainThread;" + base + ";Publisher.publish (rclpy/publisher.py:70) 3\n"
                     "thread (2): PromiscuousUDPInputSession(x);" + base
