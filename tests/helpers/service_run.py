@@ -48,6 +48,17 @@ class ServiceRun:
         result: dict[str, Any] = json.loads(out.read_text())
         return result
 
+    def param_client(self, *args: str, timeout: float = 120.0) -> dict[str, Any]:
+        """Run param_client.py (the standard parameter services) with these arguments to its end (it must exit 0):
+        the JSON it wrote."""
+        out = self.d / "params.json"
+        out.unlink(missing_ok=True)
+        client = self.start("client", helper_cmd("param_client.py", "--out", str(out), *args))
+        assert client.wait(timeout) == 0, (client.stderr_tail(), out.read_text() if out.exists() else "")
+        result: dict[str, Any] = json.loads(out.read_text())
+        self.procs.remove(client)
+        return result
+
     def assert_bridge_alive(self) -> None:
         assert self.bridge_proc.proc.poll() is None, self.bridge_proc.stderr_tail()  # nothing raised into the bridge
 

@@ -27,7 +27,7 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
-from helpers.runtime_support import cyphal_udp_lock, helper_cmd, poll_until, runtime_cmd
+from helpers.runtime_support import cyphal_udp_lock, poll_until, runtime_cmd
 from helpers.service_run import ServiceRun
 from helpers.spec_build import spec_workdir
 from helpers.yakut_tool import yakut, yakut_env, yakut_exe
@@ -37,15 +37,6 @@ pytestmark = [pytest.mark.ros, pytest.mark.slow]
 UDP = ["--transport", "udp", "--iface", "127.0.0.1"]
 
 
-def _client(r: ServiceRun, *args: str) -> dict[str, Any]:
-    out = r.d / "params.json"
-    client = r.start("client", helper_cmd("param_client.py", "--out", str(out), *args))
-    assert client.wait(120) == 0, (client.stderr_tail(), out.read_text() if out.exists() else "")
-    import json
-
-    result: dict[str, Any] = json.loads(out.read_text())
-    r.procs.remove(client)
-    return result
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +49,7 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         bridge.wait_line("READY", 90)
         poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("reads", 0)) >= 3, 30,
                    "the bridge reading the pump's settings on first contact")
-        result = _client(r, "--node", "/glider_bridge", "--prefix", "pump", "--prefix", "ctd",
+        result = r.param_client("--node", "/glider_bridge", "--prefix", "pump", "--prefix", "ctd",
                          "--set", "pump.pump.volume_limit=0.0008", "--set", "pump.pump.direction=\"inverted\"",
                          "--set", "pump.pump.volume_limit=0.002", "--set", "pump.pump.direction=\"sideways\"",
                          "--set", "ctd.ctd.sample_rate=4", "--rtt", "pump.pump.rate_limit=3e-5,4e-5")
@@ -74,7 +65,7 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         (d / "bridge.json").unlink(missing_ok=True)
         bridge = r.bridge(*UDP)
         bridge.wait_line("READY", 90)
-        again = _client(r, "--node", "/glider_bridge", "--prefix", "pump",
+        again = r.param_client("--node", "/glider_bridge", "--prefix", "pump",
                         "--wait-value", "pump.pump.volume_limit=0.0008")
         # every setting the board holds apart from the spec read (the bridge reads them one by one: "some differ"
         # was true after the first read, before the direction was read, on a loaded machine)
@@ -101,7 +92,7 @@ def dronecan(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         bridge.wait_line("READY", 90)
         poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("reads", 0)) >= 4, 30,
                    "the bridge reading esc_port's settings on first contact")
-        result = _client(r, "--node", "/sabre_bridge", "--prefix", "esc_port", "--prefix", "esc_stbd",
+        result = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port", "--prefix", "esc_stbd",
                          "--set", "esc_port.esc.poles=28", "--set", "esc_port.esc.reverse=true",
                          "--set", "esc_port.esc.poles=50", "--set", "esc_stbd.esc.poles=12",
                          "--rtt", "esc_port.esc.rpm_limit=2000,2500")

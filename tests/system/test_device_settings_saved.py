@@ -24,7 +24,7 @@ pytest.importorskip("dronecan")
 pytest.importorskip("rclpy")
 
 from helpers.dronecan_support import private_iface
-from helpers.runtime_support import cyphal_udp_lock, helper_cmd, poll_until, runtime_cmd
+from helpers.runtime_support import cyphal_udp_lock, poll_until, runtime_cmd
 from helpers.service_run import ServiceRun
 from helpers.spec_build import spec_workdir
 
@@ -33,16 +33,6 @@ pytestmark = [pytest.mark.ros, pytest.mark.slow]
 UDP = ["--transport", "udp", "--iface", "127.0.0.1"]
 
 
-def _client(r: ServiceRun, *args: str) -> dict[str, Any]:
-    import json
-
-    out = r.d / "params.json"
-    out.unlink(missing_ok=True)
-    client = r.start("client", helper_cmd("param_client.py", "--out", str(out), *args))
-    assert client.wait(120) == 0, (client.stderr_tail(), out.read_text() if out.exists() else "")
-    result: dict[str, Any] = json.loads(out.read_text())
-    r.procs.remove(client)
-    return result
 
 
 def _counts(r: ServiceRun) -> dict[str, Any]:
@@ -85,12 +75,12 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         poll_until(lambda: _counts(r).get("reads", 0) >= 3 and _counts(r).get("overrides_applied", 0) >= 1, 30,
                    "the bridge reading the pump's settings and writing the override")
         _up_for(r, "pump", 3)
-        first = _client(r, "--node", "/glider_bridge", "--prefix", "pump", "--set", "ctd.ctd.sample_rate=4",
+        first = r.param_client("--node", "/glider_bridge", "--prefix", "pump", "--set", "ctd.ctd.sample_rate=4",
                         "--set", "pump.pump.volume_limit=0.0008", "--trigger", "/pump/store_settings",
                         "--trigger", "/ctd/store_settings", "--set", "pump.pump.direction=\"inverted\"",
                         "--restart", "glider_msgs/srv/UavcanRestartNode=21@/uavcan_restart_node")
         _restarted_and_read(r, "pump", 6)
-        again = _client(r, "--node", "/glider_bridge", "--prefix", "pump")
+        again = r.param_client("--node", "/glider_bridge", "--prefix", "pump")
         poll_until(lambda: _counts(r).get("stores", 0) >= 2, 20, "the bridge's stats file counting the stores")
         return {"first": first, "again": again} | r.outcome()
 
@@ -108,12 +98,12 @@ def dronecan(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         poll_until(lambda: _counts(r).get("reads", 0) >= 4 and _counts(r).get("overrides_applied", 0) >= 1, 30,
                    "the bridge reading esc_port's settings and writing the override")
         _up_for(r, "esc_port", 3)
-        first = _client(r, "--node", "/sabre_bridge", "--prefix", "esc_port",
+        first = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port",
                         "--set", "esc_port.esc.poles=28", "--trigger", "/esc_port/store_settings",
                         "--set", "esc_port.esc.rpm_limit=2500",
                         "--restart", "sabre_msgs/srv/UavcanRestartNode=50@/uavcan_restart_node")
         _restarted_and_read(r, "esc_port", 8)
-        again = _client(r, "--node", "/sabre_bridge", "--prefix", "esc_port")
+        again = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port")
         poll_until(lambda: _counts(r).get("stores", 0) >= 1, 20, "the bridge's stats file counting the store")
         return {"first": first, "again": again} | r.outcome()
 
