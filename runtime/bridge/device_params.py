@@ -19,7 +19,9 @@ most the timeout): a set holds up the bridge's other ROS callbacks that long, wh
 On first contact (the device's first heartbeat), when it is back and after a restart, the loop reads each
 setting of the board (one request at a time, no timer of its own) and shows the board's value as the parameter's
 (an update the on-set callback lets through without writing it back). Counted: ``sets``, ``refused_by_spec``,
-``refused_by_board``, ``timeouts``, ``reads``, ``read_failures``.
+``refused_by_board``, ``timeouts``, ``reads``, ``read_failures``. An atomic set (set_parameters_atomically) is all
+or nothing: checked whole against the spec first; when a board fails one setting after others were written, those
+are written back to what their boards held (``rollbacks``, ``rollback_failures``; the reason names both).
 
 Saving: a value written is lost at the board's next reboot unless the board saves it. Each board with settings gets a
 std_srvs/Trigger service ``<device>/store_settings`` (relative: under the bridge's namespace, as the device duties'
@@ -228,17 +230,60 @@ class DeviceParams:
 
     def _on_set(self, parameters: list[Any]) -> Any:
         """The on-set callback (the executor thread): every board setting among ``parameters`` checked, written
-        and confirmed; the first failure ends the set with its reason."""
+        and confirmed; the first failure ends the set with its reason.
+
+        rclpy calls it once per parameter for set_parameters and once with all of them for
+        set_parameters_atomically. For the atomic set, all or nothing: every value is checked against the spec
+        before any is written, and when a board fails one after others were written, those are written back to
+        the values their boards held (counted ``rollbacks``; a rollback that fails is named in the reason)."""
         from rcl_interfaces.msg import SetParametersResult
 
         ours = [p for p in parameters if p.name in self.settings]
         if not ours or getattr(self._local, "quiet", False):
             return SetParametersResult(successful=True)
         for parameter in ours:
+            problem = ros_problem(self.settings[parameter.name].info, parameter.value)
+            if problem is not None:
+                self.counts["sets"] += 1
+                self.counts["refused_by_spec"] += 1
+                return SetParametersResult(successful=False,
+                                           reason=f"{parameter.name}: refused by the spec: {problem}")
+        written: list[tuple[str, Any]] = []  # (name, what its board held before)
+        for parameter in ours:
+            before = self.board_values.get(parameter.name)
             problem = self._set_one(parameter.name, parameter.value)
             if problem is not None:
-                return SetParametersResult(successful=False, reason=f"{parameter.name}: {problem}")
+                return SetParametersResult(successful=False,
+                                           reason=f"{parameter.name}: {problem}{self._roll_back(written)}")
+            written.append((parameter.name, before))
         return SetParametersResult(successful=True)
+
+    def _roll_back(self, written: list[tuple[str, Any]]) -> str:
+        """The settings of a failed atomic set that were written, written back (last first): what to add to its
+        reason."""
+        if not written:
+            return ""
+        back, failed = [], []
+        for name, before in reversed(written):
+            s = self.settings[name]
+            if before is None:
+                failed.append(f"{name} (its earlier value was never read)")
+                continue
+            self.counts["rollbacks"] += 1
+            answer, problem = self._write(s, before)
+            if problem is None and answer is not None:
+                self.board_values[name] = answer
+                if _same(s.info.type, answer, before):
+                    back.append(name)
+                    continue
+                problem = f"it keeps {from_stored(s.info, answer)!r}"
+                # rclpy keeps the parameter's old value for a failed set: show the board's once the set is over
+                if self._loop is not None and not self._loop.is_closed():
+                    self._loop.call_soon_threadsafe(self._show, name, from_stored(s.info, answer))
+            self.counts["rollback_failures"] += 1
+            failed.append(f"{name} ({problem})")
+        text = f"; written back: {', '.join(back)}" if back else ""
+        return text + (f"; NOT written back: {', '.join(failed)}" if failed else "")
 
     def _set_one(self, name: str, value: Any) -> str | None:
         s = self.settings[name]
@@ -249,29 +294,36 @@ class DeviceParams:
             return f"refused by the spec: {problem}"
         stored = to_stored(s.info, value)
         assert stored is not None
-        loop = self._loop
-        if loop is None or loop.is_closed() or self.lifetime.closed:
-            return "the bridge is not running"
-        future = asyncio.run_coroutine_threadsafe(self.access(s.nid, s.bus_name, s.info.type, stored,
-                                                              self.timeout), loop)
-        try:
-            answer = future.result(self.timeout + 2.0)  # the access's own timeout ends it; this guards the loop
-        except ParamIOError as ex:
-            self.counts["timeouts" if "did not answer" in str(ex) else "failures"] += 1
-            return f"{s.device}: {ex}"
-        except TimeoutError:
-            future.cancel()
-            self.counts["timeouts"] += 1
-            return f"the bridge's loop did not answer within {self.timeout + 2.0:g} s"
-        except Exception as ex:
-            self.counts["failures"] += 1
-            return f"{s.device}: {type(ex).__name__}: {ex}"
+        answer, problem = self._write(s, stored)
+        if problem is not None:
+            return problem
         self.board_values[name] = answer
         if not _same(s.info.type, answer, stored):
             self.counts["refused_by_board"] += 1
             return f"refused by {s.device} (node {s.nid}): it keeps {from_stored(s.info, answer)!r}"
         self.pending_overrides.pop(name, None)  # a value set since the start is newer than the start's override
         return None
+
+    def _write(self, s: _Setting, stored: Any) -> tuple[Any, str | None]:
+        """Write ``stored`` to the board of ``s`` on the loop and wait for its answer (from the executor thread):
+        (the value the board answered with, None) or (None, why there is none; counted)."""
+        loop = self._loop
+        if loop is None or loop.is_closed() or self.lifetime.closed:
+            return None, "the bridge is not running"
+        future = asyncio.run_coroutine_threadsafe(self.access(s.nid, s.bus_name, s.info.type, stored,
+                                                              self.timeout), loop)
+        try:
+            return future.result(self.timeout + 2.0), None  # the access's own timeout ends it; this guards the loop
+        except ParamIOError as ex:
+            self.counts["timeouts" if "did not answer" in str(ex) else "failures"] += 1
+            return None, f"{s.device}: {ex}"
+        except TimeoutError:
+            future.cancel()
+            self.counts["timeouts"] += 1
+            return None, f"the bridge's loop did not answer within {self.timeout + 2.0:g} s"
+        except Exception as ex:
+            self.counts["failures"] += 1
+            return None, f"{s.device}: {type(ex).__name__}: {ex}"
 
     def store(self, device: str) -> str | None:
         """Ask board `device` to save its current values (the store service's thread; waits for its answer): None

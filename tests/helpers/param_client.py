@@ -7,9 +7,11 @@ python param_client.py --out r.json --node /glider_bridge --prefix pump --get pu
     [--restart glider_msgs/srv/UavcanRestartNode=21@/uavcan_restart_node] [--wait-value NAME=JSON] [--rtt NAME=A,B]
   Lists the parameters under --prefix, describes and gets them; waits until --wait-value's parameter shows that
   value (the board's, read on first contact); then the steps in the order given: each --set (a JSON value), its
-  result (successful, reason, seconds) and the value got afterwards ("sets"); each --trigger, a std_srvs/Trigger
-  call of that service (success, message, seconds: "triggers"); each --restart, the device duty restart_node's srv
-  called with that node id ("restarts"); --rtt sets NAME 20 times alternating A and B and records each duration.
+  result (successful, reason, seconds) and the value got afterwards ("sets"); each --atomic "N=V;N=V", one
+  set_parameters_atomically of them, its result and the values got afterwards ("atomic"); each --trigger, a
+  std_srvs/Trigger call of that service (success, message, seconds: "triggers"); each --restart, the device duty
+  restart_node's srv called with that node id ("restarts"); --rtt sets NAME 20 times alternating A and B and
+  records each duration.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ def main() -> int:
     ap.add_argument("--node", required=True)
     ap.add_argument("--prefix", action="append", default=[])
     ap.add_argument("--set", action=_Step, const="set", default=[], dest="steps")
+    ap.add_argument("--atomic", action=_Step, const="atomic", dest="steps")
     ap.add_argument("--trigger", action=_Step, const="trigger", dest="steps")
     ap.add_argument("--restart", action=_Step, const="restart", dest="steps")
     ap.add_argument("--wait-value", action="append", default=[])
@@ -106,6 +109,16 @@ def main() -> int:
                 after = _value(wait(client.get_parameters([name])).values[0])
                 result["sets"].append({"name": name, "value": json.loads(text), "successful": res.successful,
                                        "reason": res.reason, "seconds": seconds, "after": after})
+            elif kind == "atomic":  # NAME=JSON;NAME=JSON: one set_parameters_atomically
+                pairs = [pair.split("=", 1) for pair in item.split(";")]
+                parameters = [Parameter(name, value=json.loads(text)) for name, text in pairs]
+                res = wait(client.set_parameters_atomically(parameters)).result
+                seconds = time.monotonic() - started
+                names = [name for name, _ in pairs]
+                after = {n: _value(v) for n, v in zip(names, wait(client.get_parameters(names)).values, strict=True)}
+                result.setdefault("atomic", []).append({"values": {n: json.loads(t) for n, t in pairs},
+                                                        "successful": res.successful, "reason": res.reason,
+                                                        "seconds": seconds, "after": after})
             elif kind == "trigger":
                 from std_srvs.srv import Trigger
 

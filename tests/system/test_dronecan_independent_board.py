@@ -6,7 +6,8 @@ loopback bus, and an rclpy client of the standard parameter services (tests/help
 - the bridge reads the board's values on first contact: ROS shows the board's value, not the spec's default;
 - a set is written to the board (the board's own state shows it) and confirmed by its answer;
 - a setting the board keeps (read-only in its firmware) fails with the board's reason, the board's value unchanged;
-- <device>/store_settings reaches the board as ExecuteOpcode SAVE and succeeds on its ok.
+- <device>/store_settings reaches the board as ExecuteOpcode SAVE and succeeds on its ok;
+- an atomic set (set_parameters_atomically) that the board fails part way is written back: all or nothing.
 """
 
 from __future__ import annotations
@@ -54,10 +55,11 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         result = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port",
                                 "--wait-value", "esc_port.esc.poles=20",
                                 "--set", "esc_port.esc.poles=28", "--set", "esc_port.esc.reverse=true",
-                                "--set", "esc_port.esc.rpm_limit=2500", "--trigger", "/esc_port/store_settings")
+                                "--set", "esc_port.esc.rpm_limit=2500", "--trigger", "/esc_port/store_settings",
+                                "--atomic", "esc_port.esc.poles=30;esc_port.esc.rpm_limit=2500")
         # the stats file follows the bridge's counters once a second: 3 sets reached the board, 1 store
-        poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("stores", 0)) >= 1, 20,
-                   "the bridge's stats file counting the store")
+        poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("rollbacks", 0)) >= 1, 20,
+                   "the bridge's stats file counting the store and the atomic set's rollback")
         return {"before": before, "after": _state(state), "client": result} | r.outcome()
 
 
@@ -84,9 +86,9 @@ def test_a_setting_the_board_keeps_fails_with_its_reason(run: dict[str, Any]) ->
     assert not kept["successful"], kept
     assert "refused by esc_port (node 50): it keeps 3000" in kept["reason"], kept
     assert kept["after"] == 3000 and run["after"]["values"]["ESC_MAX_RPM"] == 3000
-    assert run["after"]["seen"]["set_kept"] == 1, run["after"]["seen"]
+    assert run["after"]["seen"]["set_kept"] == 2, run["after"]["seen"]  # the set's, the atomic set's
     counts = run["bridge_stats"]["device_parameters"]
-    assert counts.get("refused_by_board") == 1 and counts.get("sets") == 3, counts
+    assert counts.get("refused_by_board") == 2 and counts.get("sets") == 5, counts
 
 
 def test_store_settings_saves_on_the_board(run: dict[str, Any]) -> None:
@@ -95,3 +97,13 @@ def test_store_settings_saves_on_the_board(run: dict[str, Any]) -> None:
     assert run["after"]["seen"]["save"] == 1
     assert run["after"]["saved"] == {"ESC_INDEX": 0, "ESC_NUM_POLES": 28, "ESC_REV": True, "ESC_MAX_RPM": 3000}
     assert "Traceback" not in run["bridge_stderr"]
+
+
+def test_an_atomic_set_the_board_fails_part_way_is_written_back(run: dict[str, Any]) -> None:
+    atomic = run["client"]["atomic"][0]
+    assert not atomic["successful"], atomic
+    assert atomic["reason"] == ("esc_port.esc.rpm_limit: refused by esc_port (node 50): it keeps 3000; "
+                                "written back: esc_port.esc.poles"), atomic
+    assert atomic["after"] == {"esc_port.esc.poles": 28, "esc_port.esc.rpm_limit": 3000}
+    assert run["after"]["values"]["ESC_NUM_POLES"] == 28  # on the board: 30 was written, then 28 again
+    assert run["bridge_stats"]["device_parameters"].get("rollbacks") == 1

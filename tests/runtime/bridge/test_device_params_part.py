@@ -34,6 +34,7 @@ class FakeBoard:
     def __init__(self) -> None:
         self.values: dict[str, Any] = {"MOTOR_POLE_COUNT": 14, "MOTOR_DIRECTION": 1, "SERVO_LIMIT": 0.12}
         self.refuse: set[str] = set()
+        self.accept_once: set[str] = set()  # the first write taken, every later one refused
         self.silent: set[int] = set()
         self.requests: list[tuple[int, str, Any]] = []
         self.stores: list[int] = []
@@ -46,6 +47,8 @@ class FakeBoard:
         if value is not None and name not in self.refuse:
             # a real comes back as float32
             self.values[name] = float(f"{value:.7g}") + 1e-9 if kind == "real" else value
+            if name in self.accept_once:
+                self.refuse.add(name)
         return self.values[name]
 
     async def store(self, nid: int, timeout: float) -> None:
@@ -161,3 +164,47 @@ def test_a_refused_override_is_logged_and_counted(setup: tuple[DeviceParams, Fak
     board.silent.add(23)
     _read(params, 23)
     assert params.pending_overrides == {limit: 0.1} and params.counts["read_failures"] == 1
+
+
+def _atomic(params: DeviceParams, **values: Any) -> Any:
+    """The on-set callback as rclpy calls it for set_parameters_atomically: every parameter at once."""
+    return params._on_set([SimpleNamespace(name=n.replace("__", "."), value=v) for n, v in values.items()])
+
+
+def test_an_atomic_set_is_checked_whole_before_anything_is_written(setup: tuple[DeviceParams, FakeBoard]) -> None:
+    params, board = setup
+    result = _atomic(params, thruster_1__motor__pole_count=20, thrust_vector__servo__limit=0.5)
+    assert not result.successful and result.reason.startswith("thrust_vector.servo.limit: refused by the spec")
+    assert board.requests == []
+
+
+def test_an_atomic_set_that_a_board_fails_is_written_back(setup: tuple[DeviceParams, FakeBoard]) -> None:
+    params, board = setup
+    for nid in (21, 23):
+        _read(params, nid)  # what the boards hold: known from their first read
+    board.requests.clear()
+    board.refuse.add("SERVO_LIMIT")
+    result = _atomic(params, thruster_1__motor__pole_count=20, thruster_1__motor__direction="reverse",
+                     thrust_vector__servo__limit=0.15)
+    assert not result.successful
+    assert result.reason == ("thrust_vector.servo.limit: refused by thrust_vector (node 23): it keeps 0.12; "
+                             "written back: thruster_1.motor.direction, thruster_1.motor.pole_count"), result.reason
+    assert board.values["MOTOR_POLE_COUNT"] == 14 and board.values["MOTOR_DIRECTION"] == 1
+    assert board.requests == [(21, "MOTOR_POLE_COUNT", 20), (21, "MOTOR_DIRECTION", -1), (23, "SERVO_LIMIT", 0.15),
+                              (21, "MOTOR_DIRECTION", 1), (21, "MOTOR_POLE_COUNT", 14)]
+    assert params.counts["rollbacks"] == 2 and params.counts["rollback_failures"] == 0
+
+
+def test_a_rollback_that_fails_is_named(setup: tuple[DeviceParams, FakeBoard]) -> None:
+    params, board = setup
+    _read(params, 21)
+    board.silent.add(23)
+    board.accept_once.add("MOTOR_POLE_COUNT")  # takes 20, then keeps it
+    result = _atomic(params, thruster_1__motor__pole_count=20, thruster_1__motor__direction="reverse",
+                     thrust_vector__servo__limit=0.15)
+    assert result.reason == ("thrust_vector.servo.limit: thrust_vector: node 23 did not answer within 0.5 s; "
+                             "written back: thruster_1.motor.direction; NOT written back: "
+                             "thruster_1.motor.pole_count (it keeps 20)"), result.reason
+    assert board.values["MOTOR_POLE_COUNT"] == 20 and params.counts["rollback_failures"] == 1
+    # shown as it is: the parameter's value follows what the board answered
+    assert params.board_values["thruster_1.motor.pole_count"] == 20
