@@ -27,8 +27,9 @@ Saving: a value written is lost at the board's next reboot unless the board save
 std_srvs/Trigger service ``<device>/store_settings`` (relative: under the bridge's namespace, as the device duties'
 ``uavcan_restart_node``), which asks the board to save (backends.param_access ``store``) and answers success only on
 the board's OK, else the reason (no answer, refused, the link down); counted ``stores``, ``store_failures``. The
-services live on a node of their own (``<bridge>_settings``) spun by a two-thread executor, as the service mappings':
-a store waits up to STORE_TIMEOUT_S for a flash write, which the bridge's single executor thread must not.
+services live on a node of their own (``<bridge>_settings``) on the bridge's executor of waiting calls (shared with
+the service mappings': backends.spin_thread.WaitingCalls): a store waits up to STORE_TIMEOUT_S for a flash write,
+which the bridge's single executor thread must not.
 
 Overrides at start (``--ros-args --params-file F`` or rclpy parameter_overrides naming ``<device>.<setting>``): the
 parameter is declared with the override, and after the board's first read of it the override is written to the
@@ -53,7 +54,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from sam_runtime.bridge.backends.param_access import ParamAccess, ParamIOError
-from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.common.board_settings import Stored, default_stored, from_stored, ros_problem, to_stored
@@ -65,7 +65,6 @@ PARAM_TIMEOUT_S = 1.0  # a board's answer to one read or write
 # longer than a read or write (on the store services' own threads: nothing else waits with it).
 STORE_TIMEOUT_S = 3.0
 STORE_SERVICE = "store_settings"  # <device>/store_settings, relative: under the bridge's namespace
-_STORE_THREADS = 2  # two boards' stores at once; a third call waits for a free thread
 
 
 def ros_parameter_name(device: str, setting: str) -> str:
@@ -110,7 +109,7 @@ class DeviceParams:
         self._node: Any = None  # the ROS node the parameters are declared on
         self._tasks: set[asyncio.Task[None]] = set()
         self._given = dict(overrides or {})
-        self._store_spinner: SpinThread | None = None
+        self._store_node: Any = None  # the store services' node, on the bridge's executor of waiting calls
         # --params-file / constructor overrides of the boards' settings not yet written: ROS name -> board's form
         self.pending_overrides: dict[str, Stored] = {}
 
@@ -164,10 +163,9 @@ class DeviceParams:
         return float(value) if s.info.type == "real" else value  # (a real given as 3 is declared a double)
 
     def _serve_stores(self) -> None:
-        """A std_srvs/Trigger ``<device>/store_settings`` per board with settings, on a node and threads of their own
-        (as the service mappings': a call waits for the board, which the bridge's one executor thread must not)."""
+        """A std_srvs/Trigger ``<device>/store_settings`` per board with settings, on a node of its own on the
+        executor of waiting calls (a call waits for the board, which the bridge's one executor thread must not)."""
         from rclpy.callback_groups import ReentrantCallbackGroup
-        from rclpy.executors import MultiThreadedExecutor
         from rclpy.node import Node
         from std_srvs.srv import Trigger
 
@@ -179,10 +177,8 @@ class DeviceParams:
         for device in self.devices:
             node.create_service(Trigger, f"{device}/{STORE_SERVICE}", self._store_callback(device),
                                 callback_group=group)
-        executor = MultiThreadedExecutor(num_threads=_STORE_THREADS, context=self.ros.context)
-        self._store_spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-settings",
-                                         "settings_spin_error", "the boards' store services")
-        self._store_spinner.start()
+        self._store_node = node
+        self.ros.waiting_calls.add(self.ros.context, node)
 
     def _store_callback(self, device: str) -> Any:
         def on_call(_request: Any, response: Any) -> Any:
@@ -194,9 +190,9 @@ class DeviceParams:
         return on_call
 
     def _close(self) -> None:
-        if self._store_spinner is not None:
-            self._store_spinner.close()
-            self._store_spinner = None
+        node, self._store_node = self._store_node, None
+        if node is not None:
+            self.ros.waiting_calls.remove(node)
         for task in list(self._tasks):  # reads in flight: their node is closing
             task.cancel()
         if self._node is not None:  # a managed bridge's node outlives this bridge (cleanup, configure again)

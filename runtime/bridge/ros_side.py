@@ -39,6 +39,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from sam_runtime.bridge.backend import BridgeConfigError
+from sam_runtime.bridge.backends.spin_thread import WaitingCalls
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.node_support import ParameterConfigError, declare_parameters, qos_profile
 
@@ -79,6 +80,8 @@ class RosSide:
         self._stop_spin = threading.Event()
         self._extra_nodes: list[Any] = []  # other parts' ROS nodes on this executor (RosSide.add_node)
         self.host = host  # a ManagedNode: its node, context and executor (see the module's doc)
+        # the one executor thread of the parts whose callbacks wait for a device (service mappings, board stores)
+        self.waiting_calls = WaitingCalls(lifetime, f"{name}-calls")
 
     def attach(self) -> None:
         """The node first when the bridge starts; destroyed last."""

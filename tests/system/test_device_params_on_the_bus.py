@@ -50,9 +50,9 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("reads", 0)) >= 3, 30,
                    "the bridge reading the pump's settings on first contact")
         result = r.param_client("--node", "/glider_bridge", "--prefix", "pump", "--prefix", "ctd",
-                         "--set", "pump.pump.volume_limit=0.0008", "--set", "pump.pump.direction=\"inverted\"",
-                         "--set", "pump.pump.volume_limit=0.002", "--set", "pump.pump.direction=\"sideways\"",
-                         "--set", "ctd.ctd.sample_rate=4", "--rtt", "pump.pump.rate_limit=3e-5,4e-5")
+                                "--set", "pump.pump.volume_limit=0.0008", "--set", "pump.pump.direction=\"inverted\"",
+                                "--set", "pump.pump.volume_limit=0.002", "--set", "pump.pump.direction=\"sideways\"",
+                                "--set", "ctd.ctd.sample_rate=4", "--rtt", "pump.pump.rate_limit=3e-5,4e-5")
         exe = yakut_exe()
         by_yakut: dict[str, Any] = {}
         if exe is not None:  # the board's registers as yakut sees them (node 21: glider's pump)
@@ -65,10 +65,9 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         (d / "bridge.json").unlink(missing_ok=True)
         bridge = r.bridge(*UDP)
         bridge.wait_line("READY", 90)
-        again = r.param_client("--node", "/glider_bridge", "--prefix", "pump",
-                        "--wait-value", "pump.pump.volume_limit=0.0008")
-        # every setting the board holds apart from the spec read (the bridge reads them one by one: "some differ"
-        # was true after the first read, before the direction was read, on a loaded machine)
+        # every setting the board holds apart from the spec read before the client gets them (the bridge reads them
+        # one by one: "some differ" was true after the first read, before the direction was read, on a loaded
+        # machine; so was a get of the direction right after the volume limit showed)
         wanted = {"pump.pump.direction", "pump.pump.volume_limit", "pump.pump.rate_limit"}
 
         def differing_read() -> bool:
@@ -77,7 +76,10 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             return (wanted <= set(stats.get("device_parameters", {}).get("differing", {}))
                     and all(f"{name.split('.', 1)[1]} " in settings for name in wanted))
 
-        poll_until(differing_read, 20, "the new bridge's view of the differing settings")
+        poll_until(differing_read, 30, "the new bridge's view of the differing settings")
+        again = r.param_client("--node", "/glider_bridge", "--prefix", "pump",
+                               "--wait-value", "pump.pump.volume_limit=0.0008",
+                               "--wait-value", 'pump.pump.direction="inverted"')
         return {"first": result, "again": again, "yakut": by_yakut} | r.outcome()
 
 
@@ -93,9 +95,9 @@ def dronecan(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("reads", 0)) >= 4, 30,
                    "the bridge reading esc_port's settings on first contact")
         result = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port", "--prefix", "esc_stbd",
-                         "--set", "esc_port.esc.poles=28", "--set", "esc_port.esc.reverse=true",
-                         "--set", "esc_port.esc.poles=50", "--set", "esc_stbd.esc.poles=12",
-                         "--rtt", "esc_port.esc.rpm_limit=2000,2500")
+                                "--set", "esc_port.esc.poles=28", "--set", "esc_port.esc.reverse=true",
+                                "--set", "esc_port.esc.poles=50", "--set", "esc_stbd.esc.poles=12",
+                                "--rtt", "esc_port.esc.rpm_limit=2000,2500")
         # 3 sets that reach the bridge (rclpy refuses the out-of-range one by its descriptor) and 20 timed
         poll_until(lambda: ((r.bridge_stats() or {}).get("device_parameters", {}).get("sets", 0)) >= 23, 20,
                    "the bridge's stats file counting the sets")

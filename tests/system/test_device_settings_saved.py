@@ -76,9 +76,9 @@ def cyphal(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                    "the bridge reading the pump's settings and writing the override")
         _up_for(r, "pump", 3)
         first = r.param_client("--node", "/glider_bridge", "--prefix", "pump", "--set", "ctd.ctd.sample_rate=4",
-                        "--set", "pump.pump.volume_limit=0.0008", "--trigger", "/pump/store_settings",
-                        "--trigger", "/ctd/store_settings", "--set", "pump.pump.direction=\"inverted\"",
-                        "--restart", "glider_msgs/srv/UavcanRestartNode=21@/uavcan_restart_node")
+                               "--set", "pump.pump.volume_limit=0.0008", "--trigger", "/pump/store_settings",
+                               "--trigger", "/ctd/store_settings", "--set", "pump.pump.direction=\"inverted\"",
+                               "--restart", "glider_msgs/srv/UavcanRestartNode=21@/uavcan_restart_node")
         _restarted_and_read(r, "pump", 6)
         again = r.param_client("--node", "/glider_bridge", "--prefix", "pump")
         poll_until(lambda: _counts(r).get("stores", 0) >= 2, 20, "the bridge's stats file counting the stores")
@@ -99,9 +99,9 @@ def dronecan(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                    "the bridge reading esc_port's settings and writing the override")
         _up_for(r, "esc_port", 3)
         first = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port",
-                        "--set", "esc_port.esc.poles=28", "--trigger", "/esc_port/store_settings",
-                        "--set", "esc_port.esc.rpm_limit=2500",
-                        "--restart", "sabre_msgs/srv/UavcanRestartNode=50@/uavcan_restart_node")
+                               "--set", "esc_port.esc.poles=28", "--trigger", "/esc_port/store_settings",
+                               "--set", "esc_port.esc.rpm_limit=2500",
+                               "--restart", "sabre_msgs/srv/UavcanRestartNode=50@/uavcan_restart_node")
         _restarted_and_read(r, "esc_port", 8)
         again = r.param_client("--node", "/sabre_bridge", "--prefix", "esc_port")
         poll_until(lambda: _counts(r).get("stores", 0) >= 1, 20, "the bridge's stats file counting the store")

@@ -2,9 +2,10 @@
 ``services.py`` (generated from the spec's ``bridge.service_mappings``) answered by a request to its device, which a
 protocol's subclass sends (``dronecan_services``, ``cyphal_services``).
 
-Threads: the ROS services live on a ROS node of their own, served by a MultiThreadedExecutor with a reentrant
-callback group (max(4, 2 per mapping) threads: more calls at once wait for a free one), so one slow device holds
-one executor thread for at most its mapping's timeout and never another call, the bridge's topics (another
+Threads: the ROS services live on a ROS node of their own, served by the bridge's executor of waiting calls
+(backends.spin_thread.WaitingCalls: one thread and a pool of up to 16, shared with the boards' store services) with
+a reentrant callback group, so one slow device holds one pool thread for at most its mapping's timeout and never
+another call, the bridge's topics (another
 executor) or its UAVCAN loop. A call converts the ROS request (in that thread), hands it to the asyncio loop's
 thread, which owns the UAVCAN node (``call_soon_threadsafe`` of the subclass's ``send``), and waits for the
 response or the timeout; the subclass ends the :class:`Call` in the loop's thread (values or a failure).
@@ -36,7 +37,6 @@ from collections.abc import Sequence
 from typing import Any
 
 from sam_codegen.model.text import cut_utf8, encode_text
-from sam_runtime.bridge.backends.spin_thread import SpinThread
 from sam_runtime.bridge.counters import log
 from sam_runtime.bridge.diagnostics import Status, statuses_cdr
 from sam_runtime.bridge.lifetime import Lifetime
@@ -44,7 +44,6 @@ from sam_runtime.bridge.lifetime import Lifetime
 __all__ = ["Call", "MappingStats", "ServiceMappingsRos", "from_uavcan", "set_field", "to_uavcan"]
 
 WARN_AFTER_PROBLEM_S = 10.0
-_EXECUTOR_THREADS = 4
 
 
 def _number(link: Any, value: float, towards_uavcan: bool, saturated: list[str]) -> Any:
@@ -183,7 +182,7 @@ class ServiceMappingsRos:
         self._lock = threading.Lock()
         self.stats = {m.name: MappingStats(m) for m in self.mappings}
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._spinner: SpinThread | None = None  # the services' node on its executor thread
+        self._node: Any = None  # the services' node, on the bridge's executor of waiting calls
         self._diag_pub: Any = None
         # The device duties (mappings with a ``duty``) answer for these nodes only (node id -> device name: the
         # devices the layout puts on this bridge's protocol); ``duty_suffix`` ("_dronecan" in a mixed layout, where
@@ -219,7 +218,6 @@ class ServiceMappingsRos:
     # ------------------------------------------------------------------------------------------------ ROS side
     def _start(self) -> None:
         from rclpy.callback_groups import ReentrantCallbackGroup
-        from rclpy.executors import MultiThreadedExecutor
         from rclpy.node import Node
 
         self._loop = asyncio.get_running_loop()
@@ -245,19 +243,17 @@ class ServiceMappingsRos:
             from diagnostic_msgs.msg import DiagnosticArray
 
             self._diag_pub = node.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        threads = max(_EXECUTOR_THREADS, 2 * len(self.mappings))  # two calls in flight per mapping at least
-        executor = MultiThreadedExecutor(num_threads=threads, context=self.ros.context)
-        self._spinner = SpinThread(self.lifetime, self.ros.context, executor, node, f"{base}-services",
-                                   "service_executor_error", "service mappings")
-        self._spinner.start()
+        self._node = node
+        self.ros.waiting_calls.add(self.ros.context, node)
 
     def service_name(self, m: Any) -> str:
         """The ROS name a mapping is served under (a duty's with the layout's protocol suffix)."""
         return m.service + self.duty_suffix if getattr(m, "duty", None) is not None else m.service
 
     def _close(self) -> None:
-        if self._spinner is not None:
-            self._spinner.close()
+        node, self._node = self._node, None
+        if node is not None:
+            self.ros.waiting_calls.remove(node)
 
     def _callback(self, m: Any) -> Any:
         return lambda request, response: self.serve(m, request, response)

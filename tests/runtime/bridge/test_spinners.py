@@ -22,7 +22,7 @@ pytest.importorskip("rclpy")
 from helpers.dronecan_support import until
 from helpers.runtime_support import domain_id
 
-from sam_runtime.bridge.backends.spin_thread import SpinThread
+from sam_runtime.bridge.backends.spin_thread import SpinThread, WaitingCalls
 from sam_runtime.bridge.lifetime import Lifetime
 from sam_runtime.bridge.ros_side import RosSide
 from sam_runtime.common.rate_log import RateLimitedLog
@@ -142,6 +142,48 @@ def test_the_service_thread_waits_without_polling_and_close_ends_it(private_doma
         started = time.monotonic()
         spinner.close()
         assert not spinner.thread.is_alive() and time.monotonic() - started < 1.9
+        assert lt.errors == {}
+        client_executor.shutdown()
+        client_node.destroy_node()
+    finally:
+        context.shutdown()
+
+
+def test_the_parts_that_wait_for_devices_share_one_thread(private_domain: None) -> None:
+    """WaitingCalls: the service mappings' and the store services' nodes on one executor thread, which starts with
+    the first node and ends with the last (a managed bridge's cleanup leaves none); both nodes are served."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from std_srvs.srv import Trigger
+
+    def threads() -> list[str]:
+        return [t.name for t in threading.enumerate() if t.name == "wait_test-calls"]
+
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    try:
+        lt = _lifetime()
+        calls = WaitingCalls(lt, "wait_test-calls")
+        nodes = [Node(f"wait_test_{k}", context=context) for k in ("services", "settings")]
+        for k, node in enumerate(nodes):
+            node.create_service(Trigger, f"/wait_test/trigger_{k}",
+                                lambda req, resp: setattr(resp, "message", threading.current_thread().name) or resp)
+            calls.add(context, node)
+        assert threads() == ["wait_test-calls"] and set(calls.nodes) == set(nodes)  # (rclpy keeps a set)
+        client_node = Node("wait_test_client", context=context)
+        client_executor = SingleThreadedExecutor(context=context)
+        client_executor.add_node(client_node)
+        for k in range(2):  # both served (the second node was added while the thread was spinning)
+            client = client_node.create_client(Trigger, f"/wait_test/trigger_{k}")
+            assert client.wait_for_service(timeout_sec=10.0)
+            future = client.call_async(Trigger.Request())
+            client_executor.spin_until_future_complete(future, timeout_sec=10.0)
+            assert future.done() and future.result() is not None, k
+        calls.remove(nodes[0])
+        assert threads() == ["wait_test-calls"] and calls.nodes == [nodes[1]]
+        calls.remove(nodes[1])
+        assert threads() == [] and calls.nodes == []
         assert lt.errors == {}
         client_executor.shutdown()
         client_node.destroy_node()
