@@ -25,6 +25,7 @@ from sam_runtime.genpkg import GeneratedPackage
 GENERATED = Path(__file__).resolve().parents[3] / "generated"
 
 
+@pytest.mark.ros  # the bridge's parts load SAM's ROS messages (sam_msgs): not in the unit tier, which builds none
 @pytest.mark.parametrize(("layout", "services"), [("dronecan", []), ("default", ["Cyphal service statistics"])])
 @pytest.mark.parametrize("diagnostics_period", [1.0, 0.0])
 def test_one_housekeeping_round_a_second(layout: str, services: list[str], diagnostics_period: float) -> None:
