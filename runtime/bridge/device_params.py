@@ -238,12 +238,10 @@ class DeviceParams:
         if not ours or getattr(self._local, "quiet", False):
             return SetParametersResult(successful=True)
         for parameter in ours:
-            problem = ros_problem(self.settings[parameter.name].info, parameter.value)
-            if problem is not None:
+            refusal = self._spec_refusal(self.settings[parameter.name], parameter.value)
+            if refusal is not None:
                 self.counts["sets"] += 1
-                self.counts["refused_by_spec"] += 1
-                return SetParametersResult(successful=False,
-                                           reason=f"{parameter.name}: refused by the spec: {problem}")
+                return SetParametersResult(successful=False, reason=f"{parameter.name}: {refusal}")
         written: list[tuple[str, Any]] = []  # (name, what its board held before)
         for parameter in ours:
             before = self.board_values.get(parameter.name)
@@ -281,13 +279,20 @@ class DeviceParams:
         text = f"; written back: {', '.join(back)}" if back else ""
         return text + (f"; NOT written back: {', '.join(failed)}" if failed else "")
 
+    def _spec_refusal(self, s: _Setting, value: Any) -> str | None:
+        """Why the spec refuses ``value`` for ``s`` (counted ``refused_by_spec``), or None."""
+        problem = ros_problem(s.info, value)
+        if problem is None:
+            return None
+        self.counts["refused_by_spec"] += 1
+        return f"refused by the spec: {problem}"
+
     def _set_one(self, name: str, value: Any) -> str | None:
         s = self.settings[name]
         self.counts["sets"] += 1
-        problem = ros_problem(s.info, value)
-        if problem is not None:
-            self.counts["refused_by_spec"] += 1
-            return f"refused by the spec: {problem}"
+        refusal = self._spec_refusal(s, value)
+        if refusal is not None:
+            return refusal
         stored = to_stored(s.info, value)
         assert stored is not None
         answer, problem = self._write(s, stored)

@@ -3,12 +3,12 @@
 protocol's subclass sends (``dronecan_services``, ``cyphal_services``).
 
 Threads: the ROS services live on a ROS node of their own, served by the bridge's executor of waiting calls
-(backends.spin_thread.WaitingCalls: one thread and a pool of up to 16, shared with the boards' store services) with
-a reentrant callback group, so one slow device holds one pool thread for at most its mapping's timeout and never
-another call, the bridge's topics (another
-executor) or its UAVCAN loop. A call converts the ROS request (in that thread), hands it to the asyncio loop's
-thread, which owns the UAVCAN node (``call_soon_threadsafe`` of the subclass's ``send``), and waits for the
-response or the timeout; the subclass ends the :class:`Call` in the loop's thread (values or a failure).
+(backends.spin_thread.WaitingCalls: one thread and a pool of up to 16, shared with the boards' store services) with a
+reentrant callback group, so one slow device holds one pool thread for at most its mapping's timeout and never another
+call, the bridge's topics (another executor) or its UAVCAN loop. A call converts the ROS request (in that thread),
+hands it to the asyncio loop's thread, which owns the UAVCAN node (``call_soon_threadsafe`` of the subclass's
+``send``), and waits for the response or the timeout; the subclass ends the :class:`Call` in the loop's thread (values
+or a failure).
 
 A device duty (a mapping with ``duty``, of the spec's ``bridge.node_services``) whose srv type is not installed (a
 spec whose ROS package was not built, its other interfaces all standard) is not served: logged once, counted as the
