@@ -15,7 +15,9 @@ import importlib
 import importlib.abc
 import importlib.util
 import json
+import os
 import sys
+import time
 from types import ModuleType
 from typing import ClassVar
 
@@ -50,6 +52,7 @@ sys.meta_path.insert(0, _SourceFolderAlias())
 
 _GUARD = pytest.StashKey["tiers.ChildProcessGuard"]()
 _CPU = pytest.StashKey[float]()
+_START = pytest.StashKey[float]()
 _WORKER_ISOLATION: list[dict[str, object]] = []  # what each xdist worker reported (the controller's summary)
 _SERIAL_FALLBACK: list[str] = []  # why the run was made serial, if it was
 
@@ -129,6 +132,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> object:
     item.stash[_CPU] = durations.cpu_seconds()
+    item.stash[_START] = time.time()
     if not item.config.getoption("--unit-tier"):
         yield
         return
@@ -143,6 +147,10 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) ->
         # Before the report is made: junit writes the teardown report's properties (.nox/tests/junit.xml), so the
         # work a test cost (this process and the children it reaped) can be tabled beside its wall time.
         item.user_properties.append((durations.CPU_PROPERTY, round(durations.cpu_seconds() - item.stash[_CPU], 3)))
+        now = time.time()
+        item.user_properties += [(durations.WORKER_PROPERTY, os.environ.get("PYTEST_XDIST_WORKER", "")),
+                                 (durations.END_PROPERTY, round(now, 3)),
+                                 (durations.BUSY_PROPERTY, round(now - item.stash[_START], 3))]
     outcome = yield
     guard = item.stash.get(_GUARD, None)
     if guard is not None:

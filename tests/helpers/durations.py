@@ -28,6 +28,11 @@ from pathlib import Path
 # The junit property the root conftest.py gives every test: CPU seconds of the worker and of the children it reaped
 # during the test (setup to teardown).
 CPU_PROPERTY = "cpu_s"
+# ... and the xdist worker that ran it and when it ended (s since the epoch): how busy each worker was, and how long
+# the last ones ran alone at the end (a long module scheduled late).
+WORKER_PROPERTY = "worker"
+END_PROPERTY = "end_s"
+BUSY_PROPERTY = "busy_s"  # setup to teardown, wall
 LINE = re.compile(r"^\s*(\d+(?:\.\d+)?)s\s+(setup|call|teardown)\s+(\S.*?)\s*$")
 
 
@@ -63,6 +68,30 @@ def parse_junit(path: Path, what: str = "time") -> dict[str, float]:
             seconds = sum(float(p.get("value") or 0.0) for p in case.iter("property") if p.get("name") == what)
         out[test_id] = out.get(test_id, 0.0) + seconds
     return out
+
+
+def workers(path: Path) -> str:
+    """Per xdist worker of a JUnit report: tests, busy seconds (setup to teardown, summed) and when its last test
+    ended, counted from the first test's start; the gap between the first and the last worker to end is the run's
+    tail, when some cores had nothing left to do."""
+    import xml.etree.ElementTree as ET
+
+    rows: dict[str, list[float]] = {}
+    starts: list[float] = []
+    for case in ET.parse(path).getroot().iter("testcase"):
+        props = {p.get("name"): p.get("value") or "" for p in case.iter("property")}
+        if END_PROPERTY not in props:
+            continue
+        end, busy = float(props[END_PROPERTY]), float(props.get(BUSY_PROPERTY) or case.get("time") or 0.0)
+        row = rows.setdefault(props.get(WORKER_PROPERTY) or "-", [0, 0.0, 0.0])
+        row[0], row[1], row[2] = row[0] + 1, row[1] + busy, max(row[2], end)
+        starts.append(end - busy)
+    if not rows:
+        return "(no worker properties in this report)"
+    t0 = min(starts)
+    lines = ["| worker | tests | busy s | last end s |", "|---|---:|---:|---:|"]
+    lines += [f"| {w} | {n:.0f} | {busy:.0f} | {end - t0:.0f} |" for w, (n, busy, end) in sorted(rows.items())]
+    return "\n".join(lines)
 
 
 def parse(lines: Iterable[str]) -> dict[str, float]:
@@ -115,11 +144,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--top", type=int, default=0, help="also list the N slowest tests of the last log")
     parser.add_argument("--cpu", action="store_true",
                         help="CPU seconds (JUnit reports of this suite) instead of wall seconds")
+    parser.add_argument("--workers", action="store_true",
+                        help="per xdist worker of the last (JUnit) report: busy time and when it ended")
     args = parser.parse_args(argv)
     what = CPU_PROPERTY if args.cpu else "time"
     logs = [(p.stem, parse_junit(p, what) if p.suffix == ".xml" else parse(p.read_text(errors="replace").splitlines()))
             for p in args.logs]
     print(table(logs))
+    if args.workers:
+        print()
+        print(workers(args.logs[-1]))
     if args.top:
         print()
         print(slowest(logs[-1][1], args.top))

@@ -23,6 +23,7 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 import argparse
 import asyncio
+import contextlib
 import json
 import logging
 import sys
@@ -66,6 +67,7 @@ class ScriptedDevice:
         self.last_stamp_us = 0
         self.stamps: list[tuple[int, int]] = []  # (boot, stamp) of every message sent
         self._task: asyncio.Task[None] | None = None
+        self._stop = asyncio.Event()
 
     def clock_us(self) -> int:
         return 1 + int((time.monotonic() - self.booted) * 1e6)
@@ -92,21 +94,25 @@ class ScriptedDevice:
             self.stamps.append((self.boots, stamp))
 
     def start_publishing(self) -> None:
+        stop = self._stop = asyncio.Event()
+
         async def loop() -> None:
             period = 1.0 / self.port.rate_hz
             nxt = time.monotonic()
-            while True:
+            while not stop.is_set():
                 await self.send()
                 nxt += period
-                await asyncio.sleep(max(0.0, nxt - time.monotonic()))
+                with contextlib.suppress(asyncio.TimeoutError):
+                    await asyncio.wait_for(stop.wait(), max(0.0, nxt - time.monotonic()))
 
         self._task = asyncio.create_task(loop())
 
     async def stop_publishing(self) -> None:
-        from sam_runtime.common.tasks import cancel_and_wait
-
+        """Stops between two messages, never inside one: a publication cancelled after its frames left but before
+        it was counted would make ``sent`` lag what the bridge received (the restart phase waits on that count)."""
         if self._task is not None:
-            await cancel_and_wait([self._task])
+            self._stop.set()
+            await self._task
             self._task = None
 
     async def power_off(self) -> None:
