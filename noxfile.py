@@ -58,15 +58,16 @@ def _yakut(session: nox.Session) -> dict[str, str]:
     return {"SAM_YAKUT": str(exe)}
 
 
-# pytest-xdist: one worker per core and one more, each in a private network (tests/helpers/isolation.py). The system
-# tests fly simulated vehicles in real time and wait for discovery, so a worker per core left a fifth of the CPU idle
-# (157 % of 200 % over a CI run); the extra worker fills it (the Cyphal/DroneCAN system tests of tests/system that
-# took 155-164 s with 2 workers took 121-136 s with 3, 2026-11-28). A module's tests stay on one worker (by file):
+# pytest-xdist: one worker per core and two more, each in a private network (tests/helpers/isolation.py). The system
+# tests fly simulated vehicles in real time and wait for discovery, so a worker per core left the CPU idle part of the
+# time: 2 workers used 157 % of 200 %, 3 workers 170 % (1,333 CPU s in a 784 s pytest stage, 2026-11-28), 4 workers
+# 186 % (1,165 CPU s in 627 s, the ROS packages already built; the workers ended within 23 s of each other). A
+# module's tests stay on one worker (by file):
 # their module fixtures (a built spec, a running stack) are set up once; the long modules of independent tests go test
 # by test (tests/helpers/tiers.py, SPREAD_MODULES). In the order of the collection (system tests first:
 # tiers.system_first), not xdist's default of the scopes with most tests first, which left the long single-test scopes
 # (a colcon build, each spread property test) for the end.
-PARALLEL = ["-n", str((os.cpu_count() or 1) + 1), "--dist", "loadfile", "--no-loadscope-reorder"]
+PARALLEL = ["-n", str((os.cpu_count() or 1) + 2), "--dist", "loadfile", "--no-loadscope-reorder"]
 
 
 @nox.session(python="3.11")

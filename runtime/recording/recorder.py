@@ -66,6 +66,7 @@ from sam_runtime.recording.schemas import (
     KIND_MESSAGE,
     KIND_REQUEST,
     KIND_RESPONSE,
+    ROS_LOST_METADATA,
     TRANSFER_MSG,
     TRANSFER_TYPE,
     Transfer,
@@ -188,6 +189,7 @@ class DroneCanTaps(TransferTaps):
 @dataclass
 class _Counts:
     ros: Counter[str] = field(default_factory=Counter)
+    ros_lost: Counter[str] = field(default_factory=Counter)  # topic -> publisher sequence numbers never received
     transfers: Counter[str] = field(default_factory=Counter)
     services: Counter[int] = field(default_factory=Counter)  # Cyphal service transfers recorded, by kind
     callback_errors: int = 0
@@ -207,6 +209,7 @@ class Recorder:
         self._node: Any = None
         self._executor: Any = None
         self._spin: threading.Thread | None = None
+        self._last_seq: dict[str, int] = {}  # topic -> the publication sequence number of its last message
         self._transport: Any = None
         self._tasks: list[asyncio.Task[None]] = []
         self._dronecan_stop = threading.Event()
@@ -331,11 +334,26 @@ class Recorder:
                 source = int(info.get("source_timestamp", 0)) or received
                 if self.writer.write(topic, data, received, source):
                     self.counts.ros[topic] += 1
+                self._check_sequence(topic, info.get("publication_sequence_number"))
             except Exception as ex:  # never into rclpy's executor
                 self.counts.callback_errors += 1
                 log.error("recording %s: %s: %s", topic, type(ex).__name__, ex)
 
         return on_message
+
+    def _check_sequence(self, topic: str, seq: int | None) -> None:
+        """Count the messages of ``topic`` the middleware lost before this one: a gap in its publisher's sequence
+        numbers. Only for a topic with one publisher: rclpy gives no publisher id with a message, and the numbers of
+        several publishers interleave (a lower one only starts the count again)."""
+        if not seq:  # (an RMW that does not give it)
+            return
+        last = self._last_seq.get(topic)
+        self._last_seq[topic] = seq
+        if last is not None and seq > last + 1 and self._node is not None and \
+                self._node.count_publishers(topic) == 1:
+            self.counts.ros_lost[topic] += seq - last - 1
+            log.warning("%s: %d message(s) lost before the recorder got them (publisher sequence %d -> %d)", topic,
+                        seq - last - 1, last, seq)
 
     def ros_publishers(self) -> dict[str, int]:
         """topic -> publishers the recorder's node sees (for waiting on discovery)."""
@@ -461,9 +479,12 @@ class Recorder:
         await asyncio.gather(*self._tasks, return_exceptions=True)
         if self._dronecan_thread is not None:
             await asyncio.get_running_loop().run_in_executor(None, self._dronecan_thread.join, 2.0)
+        if self._ctx is not None:  # (written also when nothing was lost: the recording was checked)
+            self.writer.add_metadata(ROS_LOST_METADATA, {t: str(n) for t, n in sorted(self.counts.ros_lost.items())})
         self.writer.close()
         out = self.writer.summary()
         out["ros_not_recorded"] = self.ros_errors
+        out["ros_lost"] = dict(self.counts.ros_lost)
         out["callback_errors"] = self.counts.callback_errors
         if self._taps is not None:
             out["dronecan_crc_failures"] = dict(self._taps.crc_failures)

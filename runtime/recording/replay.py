@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from sam_runtime.recording.reading import Recording, read_recording
-from sam_runtime.recording.schemas import KIND_MESSAGE, TRANSFER_TYPE, qos_yaml
+from sam_runtime.recording.schemas import KIND_MESSAGE, ROS_LOST_METADATA, TRANSFER_TYPE, qos_yaml
 from sam_runtime.recording.writer import RecordingWriter
 
 __all__ = ["Converter", "ReplayReport", "TopicDiff", "field_differences", "replay"]
@@ -92,16 +92,21 @@ class TopicDiff:
     # commands: a gap is what a live run has (a transfer the listener lost under load, a command rate-limited),
     # counted and shown, but only a differing payload makes the replay differ
     gaps_allowed: bool = False
+    # messages of the topic the recorder knows it never got (the recording's ROS_LOST_METADATA): that many extra
+    # replayed messages are the recording's loss, shown but no difference
+    lost_by_recorder: int = 0
 
     @property
     def same(self) -> bool:
-        """Nothing but receive-time fields differs, and nothing is missing or extra (unless gaps are allowed)."""
-        return not (self.differing or (not self.gaps_allowed and (self.missing or self.extra)))
+        """Nothing but receive-time fields differs, and nothing is missing or extra (unless gaps are allowed), beyond
+        what the recorder lost."""
+        return not (self.differing or (not self.gaps_allowed and (self.missing or self.extra > self.lost_by_recorder)))
 
     def as_dict(self) -> dict[str, Any]:
         return {"recorded": self.recorded, "replayed": self.replayed, "identical": self.identical,
                 "receive_time_only": self.receive_time, "differing": self.differing, "missing": self.missing,
-                "extra": self.extra, "outside_ros_recording": self.before + self.after,
+                "extra": self.extra, "lost_by_recorder": self.lost_by_recorder,
+                "outside_ros_recording": self.before + self.after,
                 "differing_fields": dict(self.fields),
                 "first_differing_values": {k: {"index": i, "recorded": old, "replayed": new}
                                            for k, (i, old, new) in sorted(self.first_values.items())},
@@ -151,6 +156,10 @@ class ReplayReport:
         if rt:
             out.append(f"receive-time fields (differ only because the recorder's receive time is not the bridge's): "
                        f"{', '.join(rt)}")
+        lost = [f"{t} {d.lost_by_recorder}" for t, d in sorted(self.topics.items()) if d.lost_by_recorder]
+        if lost:
+            out.append(f"lost by the recorder (gaps in the publisher's sequence numbers; as many EXTRA are no "
+                       f"difference): {', '.join(lost)}")
         for proto, st in sorted(self.bridge.items()):  # the offline bridge's own counters, as the live one reports
             maps = st.get("mappings", {}).values()
             drops: Counter[str] = Counter()
@@ -481,6 +490,9 @@ def replay(path: Path, converters: Iterable[Converter], *, out: Path | None = No
     diffs = {t: _diff_topic(t, recorded.get(t, []), replayed.get(t, []),
                             _Matcher(rec.schema_of(t), schema_new.get(t) or rec.schema_of(t), decoders))
              for t in topics}
+    for t, n in rec.metadata.get(ROS_LOST_METADATA, {}).items():
+        if t in diffs and n.isdigit():
+            diffs[t].lost_by_recorder = int(n)
     commands = _compare_commands(by_protocol.values(), recorded, transfers)
     span = (transfers[-1][0].log_time - first_log) * 1e-9 if transfers else 0.0
     return ReplayReport(str(path), None if out is None else str(out), len(transfers), span, elapsed, diffs,

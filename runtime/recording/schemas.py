@@ -31,6 +31,7 @@ __all__ = [
     "KIND_MESSAGE",
     "KIND_REQUEST",
     "KIND_RESPONSE",
+    "ROS_LOST_METADATA",
     "TRANSFER_MSG",
     "TRANSFER_TYPE",
     "MessageDefinitionError",
@@ -49,6 +50,11 @@ DRONECAN_TOPIC = "/uavcan/dronecan/transfers"
 HEARTBEAT_SUBJECT = 7509
 HEARTBEAT_TYPE = "uavcan.node.Heartbeat.1.0"
 KIND_MESSAGE, KIND_REQUEST, KIND_RESPONSE = 0, 1, 2
+# The recording's metadata record of the ROS messages the recorder knows it did not get, per topic: the gaps in the
+# publisher's sequence numbers of a topic with one publisher (a best-effort subscription loses messages silently on
+# a loaded machine). Written when the recorder closes; replay counts that many replayed messages as the recording's
+# loss, not as a difference.
+ROS_LOST_METADATA = "sam_recording.ros_lost"
 
 TRANSFER_MSG = """\
 # One UAVCAN transfer as a sniffer on the bus received it (sam-codegen record).

@@ -241,7 +241,8 @@ def test_replay_through_the_same_spec_reproduces_the_recorded_topics(recorded: R
     bridged = _bridged(recorded.gen.tables())
     assert set(report["topics"]) == bridged
     for topic, d in report["topics"].items():
-        assert d["differing"] == d["missing"] == d["extra"] == 0, (topic, d)
+        # (a message the recorder lost under load, counted from the publisher's sequence numbers, is replayed: extra)
+        assert d["differing"] == d["missing"] == 0 and d["extra"] == d["lost_by_recorder"], (topic, d)
         assert d["identical"] + d["receive_time_only"] == d["recorded"] >= MIN_PER_TOPIC, (topic, d)
         # the only fields allowed to differ: the stamp the bridge takes from its own clock
         assert set(d["receive_time_fields"]) <= {"header.stamp.sec", "header.stamp.nanosec"}, (topic, d)

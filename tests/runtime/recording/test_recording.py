@@ -28,6 +28,7 @@ from sam_runtime.recording.reading import MCAP_MAGIC, read_recording, rosbag2_fo
 from sam_runtime.recording.replay import field_differences, replay
 from sam_runtime.recording.schemas import (
     CYPHAL_TOPIC,
+    ROS_LOST_METADATA,
     TRANSFER_MSG,
     TRANSFER_TYPE,
     Transfer,
@@ -239,6 +240,36 @@ def test_the_report_classifies_every_message(tmp_path: Path) -> None:
     extra = replay(path, [_FakeConverter({9: "twice"})])
     assert extra.topics["/imu"].extra == 1
     assert "DIFFERENT" in extra.lines()[-1]
+
+
+def test_messages_the_recorder_lost_are_no_difference_up_to_its_count(tmp_path: Path) -> None:
+    """A best-effort subscription loses messages silently on a loaded machine; the recorder counts the gaps in the
+    publisher's sequence numbers (ROS_LOST_METADATA). Replay shows those messages as extra, and only as many as the
+    recorder counted are no difference."""
+
+    def recording(name: str, skip: set[int], lost: dict[str, str] | None) -> Path:
+        path = tmp_path / name
+        w = RecordingWriter(path)
+        w.add_channel("/imu", IMU, "ros2msg", ros2msg_definition(IMU, ros_share_dirs()),
+                      metadata={"offered_qos_profiles": qos_yaml("best_effort", "volatile", 10)})
+        w.add_channel(CYPHAL_TOPIC, TRANSFER_TYPE, "ros2msg", TRANSFER_MSG)
+        for i in range(60):
+            if i not in skip:
+                w.write("/imu", _imu_cdr(i), 1_000_000_000 + i, 999_000_000 + i)
+            w.write(CYPHAL_TOPIC, encode_transfer(_transfer(i)), 1_000_000_000 + i)
+        if lost is not None:
+            w.add_metadata(ROS_LOST_METADATA, lost)
+        w.close()
+        return path
+
+    counted = replay(recording("counted.mcap", {30}, {"/imu": "1"}), [_FakeConverter({})])
+    imu = counted.topics["/imu"]
+    assert (imu.identical, imu.missing, imu.extra, imu.lost_by_recorder, counted.same) == (59, 0, 1, 1, True)
+    assert any("lost by the recorder" in line and "/imu 1" in line for line in counted.lines())
+    uncounted = replay(recording("uncounted.mcap", {30}, {}), [_FakeConverter({})])
+    assert uncounted.topics["/imu"].extra == 1 and not uncounted.same
+    more = replay(recording("more.mcap", {30, 40}, {"/imu": "1"}), [_FakeConverter({})])
+    assert more.topics["/imu"].extra == 2 and not more.same
 
 
 def test_a_recorder_that_ran_late_at_the_start_is_still_matched(tmp_path: Path) -> None:
