@@ -60,9 +60,10 @@ def _yakut(session: nox.Session) -> dict[str, str]:
 
 # pytest-xdist: one worker per core and two more, each in a private network (tests/helpers/isolation.py). The system
 # tests fly simulated vehicles in real time and wait for discovery, so a worker per core left the CPU idle part of the
-# time: 2 workers used 157 % of 200 %, 3 workers 170 % (1,333 CPU s in a 784 s pytest stage, 2026-11-28), 4 workers
-# 186 % (1,165 CPU s in 627 s, the ROS packages already built; the workers ended within 23 s of each other). A
-# module's tests stay on one worker (by file):
+# time: 2 workers used 157 % of 200 %, 3 workers 170 % (fresh clone: 1,333 CPU s in a 784 s pytest stage,
+# 2026-11-28), 4 workers 183 % (fresh clone: 1,478 CPU s in 809 s; with the test ROS packages already built 1,165 CPU s
+# in 645 s). The workers end within ~20 s of each other: the stage is CPU-bound, a fifth worker has nothing to fill
+# (`python tests/helpers/durations.py --workers .nox/tests/junit.xml`). A module's tests stay on one worker (by file):
 # their module fixtures (a built spec, a running stack) are set up once; the long modules of independent tests go test
 # by test (tests/helpers/tiers.py, SPREAD_MODULES). In the order of the collection (system tests first:
 # tiers.system_first), not xdist's default of the scopes with most tests first, which left the long single-test scopes
