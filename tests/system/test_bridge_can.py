@@ -122,9 +122,10 @@ def test_virtual_can_fd_one_process(tmp_path: Path) -> None:
     imu_dev = res["sim"]["devices"]["imu"]
     sent, late = imu_dev["published"]["1100"], imu_dev["late"].get("1100", 0)
     assert sent == res["expected"]["/imu"] and sent + late >= 0.95 * 300, imu_dev
-    # How many of the ticks it made is the CPU's business (146 of 300 with another process burning a core): the
-    # floor only says a real multi-frame stream flowed.
-    assert sent >= 0.1 * 300, imu_dev
+    # How many of the ticks it made is the CPU's business (146 of 300 with another process burning a core, 13 in a
+    # CI-like run on a machine twice as slow with 4 workers: a floor in ticks failed there): the floor only says a
+    # real multi-frame stream flowed, several transfers (each transfer id in turn) reassembled and checked above.
+    assert sent >= 5, imu_dev
 
 
 def test_virtual_classic_can_one_process_from_env_registers(tmp_path: Path) -> None:
