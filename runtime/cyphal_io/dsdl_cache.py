@@ -11,6 +11,12 @@ the cost of hashing (a few ms).
 A compile happens in a private temporary directory which is renamed into place atomically, so a crashed
 or concurrent compile never leaves a half-written cache entry; concurrent processes additionally serialize
 on an ``flock`` so only one of them does the work.
+
+The lookup roots that the caller did not give (``uavcan``, ``reg``: the standard types, ~4 CPU s of the ~4.5 a
+compile takes) are compiled once per content into ``roots/<name>-<hash>`` beside the entries and copied into each
+entry that needs them: a changed spec recompiles its own namespace only. Such a root's code depends on its own
+types and on those it refers to, all in the roots the caller did not give (a root that refers to one the caller
+gave is compiled in the entry, not shared); its key hashes every one of those roots.
 """
 
 from __future__ import annotations
@@ -45,6 +51,7 @@ CACHE_ENV_VAR = "SAM_DSDL_CACHE"
 # Bump when the layout or the compile rule of a cache entry changes.
 _CACHE_FORMAT = f"sam-dsdl-cache-1;nunavut-fix-{FIX_VERSION}"
 _COMPLETE_MARKER = ".complete"
+_SHARED_ROOTS = "roots"  # the cache's folder of shared library roots (see the module's docstring)
 _STALE_TMP_AGE_S = 3600.0
 try:
     import fcntl as _fcntl
@@ -82,12 +89,17 @@ def _dsdl_files(root: Path) -> list[Path]:
 
 
 def _content_hash(targets: Sequence[Path], lookups: Sequence[Path]) -> str:
+    # What is compiled (by name) matters, not only what is visible.
+    return _hash("targets:" + ",".join(t.name for t in targets), lookups)
+
+
+def _hash(what: str, roots: Sequence[Path]) -> str:
+    """The cache format, the compilers' versions, ``what`` and every byte of every definition in ``roots``."""
     h = hashlib.sha256()
     h.update(_CACHE_FORMAT.encode())
     h.update(_versions().encode())
-    # What is compiled (by name) matters, not only what is visible.
-    h.update(("targets:" + ",".join(t.name for t in targets)).encode())
-    for root in lookups:
+    h.update(what.encode())
+    for root in roots:
         for f in _dsdl_files(root):
             rel = f.relative_to(root.parent).as_posix()
             data = f.read_bytes()
@@ -153,40 +165,89 @@ def _referenced_roots(models: Sequence[object]) -> set[str]:
     return out
 
 
-def _compile_into(out_dir: Path, targets: Sequence[Path], lookups: Sequence[Path]) -> list[str]:
-    """Compile targets, then every further lookup root they reference, transitively. Returns the names."""
+def _compile_root(root: Path, lookups: Sequence[Path], out_dir: Path) -> set[str] | None:
+    """Compile one root namespace into ``out_dir``; the root namespaces its types refer to (None: it is empty)."""
     import pycyphal.dsdl
     import pydsdl
 
+    try:
+        with warnings.catch_warnings():
+            # nunavut 2.3 templates use pydsdl APIs deprecated in pydsdl 1.25 (string_like): noise only.
+            warnings.simplefilter("ignore", DeprecationWarning)
+            info = pycyphal.dsdl.compile(root, list(lookups), output_directory=out_dir)
+    except pydsdl.InvalidDefinitionError as ex:
+        raise DsdlCompileError(f"invalid DSDL in root namespace {root.name!r}: {ex}") from None
+    except pydsdl.Error as ex:
+        raise DsdlCompileError(f"pydsdl failed on root namespace {root.name!r}: {ex}") from None
+    except (OSError, ValueError, TypeError, KeyError, RuntimeError) as ex:
+        # nunavut/jinja failures and file-system problems: keep the cause for debugging.
+        raise DsdlCompileError(
+            f"compiling root namespace {root.name!r} ({root}) failed: {type(ex).__name__}: {ex}"
+        ) from ex
+    return None if info is None else _referenced_roots(info.models)
+
+
+def _shared_root(root: Path, lookups: Sequence[Path], library: Sequence[Path], base: Path,
+                 out_dir: Path) -> tuple[bool, set[str] | None]:
+    """Put the compiled ``root`` (one of ``library``, the roots the caller did not give) into ``out_dir`` from its
+    shared compile under ``base``/roots, compiling that first if there is none. Returns (shared, the roots it
+    refers to); not shared (nothing copied) when it refers to a root outside ``library``."""
+    shared = base / _SHARED_ROOTS
+    key = f"{root.name}-{_hash('root:' + root.name, library)}"
+    entry = shared / key
+    names = {r.name for r in library}
+    if not (entry / _COMPLETE_MARKER).is_file():
+        shared.mkdir(parents=True, exist_ok=True)
+        with _flock(shared / f".lock-{key}"):
+            if not (entry / _COMPLETE_MARKER).is_file():
+                _rmtree(entry)
+                _sweep_stale_tmp(shared, key)
+                tmp = Path(tempfile.mkdtemp(prefix=f".tmp-{key}-", dir=shared))
+                try:
+                    refs = _compile_root(root, lookups, tmp)
+                    if refs is not None and not refs - {root.name} <= names:
+                        return False, None  # its code depends on a root the caller gave: compiled in the entry
+                    (tmp / _COMPLETE_MARKER).write_text(
+                        "references=" + ("-" if refs is None else ",".join(sorted(refs))) + "\n")
+                    os.rename(tmp, entry)
+                finally:
+                    if tmp.exists():
+                        _rmtree(tmp)
+    line = (entry / _COMPLETE_MARKER).read_text().splitlines()[0].split("=", 1)[1]
+    if line == "-":
+        return True, None
+    if (entry / root.name).is_dir():
+        shutil.copytree(entry / root.name, out_dir / root.name)
+    return True, set(line.split(",")) if line else set()
+
+
+def _compile_into(out_dir: Path, targets: Sequence[Path], lookups: Sequence[Path], *,
+                  given: Sequence[str] = (), base: Path | None = None) -> list[str]:
+    """Compile targets, then every further lookup root they reference, transitively (a root not ``given``, from
+    its shared compile under ``base`` when one is given). Returns the names."""
     by_name = {r.name: r for r in lookups}
+    library = [r for r in lookups if r.name not in given]
     queue = list(targets)
     done: list[str] = []
     while queue:
         root = queue.pop(0)
         if root.name in done:
             continue
-        try:
-            with warnings.catch_warnings():
-                # nunavut 2.3 templates use pydsdl APIs deprecated in pydsdl 1.25 (string_like): noise only.
-                warnings.simplefilter("ignore", DeprecationWarning)
-                info = pycyphal.dsdl.compile(root, list(lookups), output_directory=out_dir)
-        except pydsdl.InvalidDefinitionError as ex:
-            raise DsdlCompileError(f"invalid DSDL in root namespace {root.name!r}: {ex}") from None
-        except pydsdl.Error as ex:
-            raise DsdlCompileError(f"pydsdl failed on root namespace {root.name!r}: {ex}") from None
-        except (OSError, ValueError, TypeError, KeyError, RuntimeError) as ex:
-            # nunavut/jinja failures and file-system problems: keep the cause for debugging.
-            raise DsdlCompileError(
-                f"compiling root namespace {root.name!r} ({root}) failed: {type(ex).__name__}: {ex}"
-            ) from ex
+        shared, refs = (False, None)
+        if base is not None and root.name not in given:
+            shared, refs = _shared_root(root, lookups, library, base, out_dir)
+        if not shared:
+            refs = _compile_root(root, lookups, out_dir)
         done.append(root.name)
-        if info is None:  # empty namespace: pycyphal generates nothing
+        if refs is None:  # empty namespace: pycyphal generates nothing
             continue
-        for name in sorted(_referenced_roots(info.models) - set(done)):
+        for name in sorted(refs - set(done)):
             if name in by_name:
                 queue.append(by_name[name])
     # compile() of an empty namespace does not emit nunavut_support; make sure it exists.
     if not (out_dir / "nunavut_support.py").exists():
+        import pycyphal.dsdl
+
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             pycyphal.dsdl.compile(None, output_directory=out_dir)
@@ -266,7 +327,8 @@ def ensure_compiled(namespace_dirs: Sequence[Path], cache_dir: Path | None = Non
             started = time.monotonic()
             # the first compile takes tens of seconds: a progress line on a terminal (issue 30)
             with TerminalProgress(f"compiling DSDL ({', '.join(t.name for t in targets) or 'uavcan'})"):
-                done = _compile_into(tmp, targets, lookups)
+                given = [Path(d).expanduser().resolve().name for d in namespace_dirs]
+                done = _compile_into(tmp, targets, lookups, given=given, base=base)
             (tmp / _COMPLETE_MARKER).write_text(
                 f"namespaces={','.join(done)}\nseconds={time.monotonic() - started:.2f}\n{_versions()}\n"
             )

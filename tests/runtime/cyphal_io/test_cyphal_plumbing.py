@@ -68,7 +68,7 @@ def isolated_imports() -> Iterator[None]:
     yield
     sys.path[:] = saved_path
     for name in set(sys.modules) - saved_modules:
-        if name.split(".")[0] in {"demo", "extra", "unused"}:
+        if name.split(".")[0] in {"demo", "extra", "unused", "other"}:
             del sys.modules[name]
 
 
@@ -194,7 +194,40 @@ def test_compile_cache_reuse_and_invalidation(
     assert out3 not in (out1, out2)
     # No half-written or temporary entries are left behind.
     assert not [p for p in cache.iterdir() if p.name.startswith(".tmp-")]
-    assert all((p / ".complete").is_file() for p in cache.iterdir() if p.is_dir())
+    assert all((p / ".complete").is_file() for p in cache.iterdir() if p.is_dir() and p.name != "roots")
+    assert all((p / ".complete").is_file() for p in (cache / "roots").iterdir() if p.is_dir())
+
+
+def test_the_roots_not_given_are_compiled_once_and_shared(
+    tmp_path: Path, tiny_cyphal_path: Path, isolated_imports: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two specs' namespaces in one cache: uavcan and a referenced library root compile once (roots/<name>-<hash>)
+    and each entry gets a copy; a changed library root compiles anew."""
+    import sam_runtime.cyphal_io.dsdl_cache as dc
+
+    compiled: list[str] = []
+    real = dc._compile_root
+    monkeypatch.setattr(dc, "_compile_root", lambda root, *a: compiled.append(root.name) or real(root, *a))
+    cache = tmp_path / "cache"
+    first = _write(tmp_path / "a" / "demo" / "UsesExtra.1.0.dsdl", "extra.Thing.1.0 thing\n@sealed\n").parent
+    second = _write(tmp_path / "b" / "other" / "UsesExtra.1.0.dsdl", "extra.Thing.1.0 thing\n@sealed\n").parent
+    out1 = ensure_compiled([first], cache)
+    out2 = ensure_compiled([second], cache)
+    assert out1 != out2 and sorted(compiled) == ["demo", "extra", "other", "uavcan"], compiled
+    for out in (out1, out2):
+        assert (out / "uavcan" / "primitive").is_dir() and (out / "extra" / "__init__.py").is_file()
+        assert (out / "nunavut_support.py").is_file()
+    shared = sorted(p.name.split("-")[0] for p in (cache / "roots").iterdir() if p.is_dir())
+    assert shared == ["extra", "uavcan"], shared
+
+    import other
+
+    assert other.UsesExtra_1_0().thing.value == 0
+
+    _write(tiny_cyphal_path / "extra" / "Thing.1.0.dsdl", "uint7 value\n# changed\n@sealed\n")
+    compiled.clear()
+    ensure_compiled([first], cache)
+    assert sorted(compiled) == ["demo", "extra", "uavcan"], compiled  # the key hashes every library root
 
 
 def test_leftovers_of_a_crashed_compile_are_replaced(tmp_path: Path, tiny_cyphal_path: Path) -> None:
@@ -210,7 +243,7 @@ def test_leftovers_of_a_crashed_compile_are_replaced(tmp_path: Path, tiny_cyphal
     finally:
         sys.path[:] = saved
     assert (entry / ".complete").is_file() and "half" not in (entry / "demo" / "__init__.py").read_text()
-    assert sorted(p.name for p in cache.iterdir()) == sorted([entry.name, f".lock-{entry.name}"])
+    assert sorted(p.name for p in cache.iterdir()) == sorted([entry.name, f".lock-{entry.name}", "roots"])
 
 
 def test_referenced_lookup_root_is_compiled(
@@ -279,7 +312,9 @@ def test_concurrent_compiles_share_one_entry(tmp_path: Path, tiny_cyphal_path: P
     assert len({r["out"] for r in results}) == 1
     entry = Path(results[0]["out"])
     assert all(r["demo"].startswith(str(entry)) for r in results)
-    assert [p for p in cache.iterdir() if not p.name.startswith(".lock-")] == [entry]
+    assert [p for p in cache.iterdir() if not p.name.startswith(".lock-") and p.name != "roots"] == [entry]
+    shared = [p for p in (cache / "roots").iterdir() if not p.name.startswith(".lock-")]
+    assert [p.name.split("-")[0] for p in shared] == ["uavcan"]  # one compile of it, no temporary left
 
 
 # ------------------------------------------------------------------------------------------- transports
