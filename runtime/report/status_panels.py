@@ -25,8 +25,8 @@ from sam_runtime.report.plot_support import (
 )
 from sam_runtime.report.recording import Recording
 
-__all__ = ["INACTIVE", "device_states", "draw_devices", "draw_drops", "draw_states", "drops", "node_states",
-           "state_legend"]
+__all__ = ["INACTIVE", "device_states", "draw_devices", "draw_drops", "draw_states", "drops", "held_spans",
+           "node_states", "state_legend"]
 
 INACTIVE = -1  # a managed bridge's status while it is not active (its level is OK: drawn in its own colour)
 _DEVICE = "/device/"
@@ -99,11 +99,26 @@ def drops(rec: Recording) -> tuple[dict[str, list[tuple[float, int]]], dict[str,
 
 
 def _bars(ax: Any, rows: dict[str, list[tuple[float, int]]], names: list[str], end: float) -> None:
+    """One row of coloured spans per name. A state held over many samples is one span, and a row's spans of one
+    colour are one call: a long run has thousands of samples, and one call each made the picture take minutes."""
     colours = {**{level: colour for level, (_, colour) in LEVELS.items()}, INACTIVE: INACTIVE_COLOUR}
     for k, name in enumerate(names):
-        samples = rows[name]
-        for (a, level), (b, _) in zip(samples, [*samples[1:], (end, 0)], strict=True):
-            ax.broken_barh([(a, max(b - a, 0.01))], (k - 0.4, 0.8), color=colours.get(level, "#000000"), lw=0)
+        spans: dict[str, list[tuple[float, float]]] = {}
+        for a, b, level in held_spans(rows[name], end):
+            spans.setdefault(colours.get(level, "#000000"), []).append((a, max(b - a, 0.01)))
+        for colour, xranges in spans.items():
+            ax.broken_barh(xranges, (k - 0.4, 0.8), color=colour, lw=0)
+
+
+def held_spans(samples: list[tuple[float, int]], end: float) -> list[tuple[float, float, int]]:
+    """(from, to, level) for each stretch of one level: each sample holds until the next, the last until end."""
+    held: list[tuple[float, float, int]] = []
+    for (a, level), (b, _) in zip(samples, [*samples[1:], (end, 0)][:len(samples)], strict=True):
+        if held and held[-1][2] == level and held[-1][1] == a:
+            held[-1] = (held[-1][0], b, level)
+        else:
+            held.append((a, b, level))
+    return held
 
 
 def state_legend(fig: Any, y: float) -> None:

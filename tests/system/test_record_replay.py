@@ -48,6 +48,7 @@ pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 START_TIMEOUT_S = 240.0  # four Python processes starting on a loaded 2-core machine, then discovery
 STOP_BOUND_S = CHILD_STOP_TIMEOUT_S + CHILD_KILL_TIMEOUT_S + 20.0
+PICTURE_BOUND_S = 300.0  # the report picture of a few minutes' recording, on a loaded 2-core machine
 MIN_PER_TOPIC = 10  # messages of every bridged topic before the run is stopped (the slowest is 1 Hz)
 
 
@@ -116,7 +117,12 @@ def recorded(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Recorded]:
             recorder_pid = int(header.split("recorder pid ")[1].split()[0])
             started = start_time(recorder_pid) or 0
             os.kill(run.pid, signal.SIGTERM)  # as Ctrl-C: a clean stop of every child
-            assert run.wait(timeout=STOP_BOUND_S) == 0, output()[-3000:]
+            # The children's stop is bounded; the report picture drawn after it takes time in proportion to the
+            # recording (minutes of it here on a loaded machine), so it has a bound of its own.
+            poll_until(lambda: any(ln.startswith("logs: ") for ln in output().splitlines()), STOP_BOUND_S,
+                       "the main job's children to stop (its 'logs:' line)", interval=0.2)
+            assert run.wait(timeout=PICTURE_BOUND_S) == 0, output()[-3000:]
+            assert f"report: {run_path.with_suffix('.png')}" in output(), output()[-3000:]
             assert not wait_gone({recorder_pid: started}, 10.0), "the recorder outlived the main job"
             text = output()
         finally:

@@ -216,7 +216,10 @@ def test_two_vehicles_fly_side_by_side_and_no_message_crosses(tmp_path: Path) ->
         probe = Probe(int(domain))
 
         def logs() -> str:
-            return "\n".join(f"--- {n} (exit {p.proc.poll()}):\n{p.stderr_tail(15)}" for n, p in procs.items())
+            # the processes that ended last, with more of their logs: a failure's report shows its end first
+            order = sorted(procs.items(), key=lambda item: item[1].proc.poll() is not None)
+            return "\n".join(f"--- {n} (exit {p.proc.poll()}):\n{p.stderr_tail(15 if p.proc.poll() is None else 60)}"
+                             for n, p in order)
 
         def missions_complete() -> bool:
             assert probe is not None

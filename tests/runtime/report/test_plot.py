@@ -20,7 +20,7 @@ from sam_runtime.report.motion_panels import attitude, estimated_speed, odom_poi
 from sam_runtime.report.plot import TOPICS, limits_from_params, node_states, plot_run, track
 from sam_runtime.report.plot_support import Run, poses
 from sam_runtime.report.recording import RecordingError, read_recording
-from sam_runtime.report.status_panels import INACTIVE, device_states, drops
+from sam_runtime.report.status_panels import INACTIVE, device_states, drops, held_spans
 
 REPO = Path(__file__).resolve().parents[3]
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -79,6 +79,14 @@ def test_the_state_panels_read_devices_drops_and_an_inactive_bridge(dive: Path) 
     assert series["imu"][-1][1] == 100 and reasons["imu"] == {"lost": 100}
     assert reasons["thruster_1_rpm"] == {"inactive": 50} and series["pressure"][-1][1] == 0
     assert total[-1][1] == 150
+
+
+def test_a_state_held_over_many_samples_is_one_span() -> None:
+    """A long run's state rows hold thousands of samples (ten a second): one bar each made the picture take
+    longer than the run's stop. A stretch of one level is one span; each sample holds until the next."""
+    samples = [(t / 10, 0) for t in range(3000)] + [(300.0, 2), (300.5, 2), (301.0, 0)]
+    assert held_spans(samples, 310.0) == [(0.0, 300.0, 0), (300.0, 301.0, 2), (301.0, 310.0, 0)]
+    assert held_spans([], 5.0) == [] and held_spans([(1.0, 3)], 5.0) == [(1.0, 5.0, 3)]
 
 
 def test_attitude_and_speed_come_from_the_transforms(dive: Path) -> None:
