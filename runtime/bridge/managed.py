@@ -44,6 +44,7 @@ from collections.abc import Callable, Coroutine, Sequence
 from typing import Any
 
 from sam_runtime.bridge.counters import log
+from sam_runtime.common.executors import make_executor
 
 __all__ = ["TRANSITIONS", "ManagedBridge", "ManagedNode"]
 
@@ -78,7 +79,6 @@ class ManagedNode:
 
     def open(self) -> None:
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
         from rclpy.signals import SignalHandlerOptions
         from rclpy.task import Future
@@ -116,13 +116,7 @@ class ManagedNode:
         self.node = _BridgeLifecycleNode(self.name, namespace=self.namespace, context=self.context,
                                          cli_args=cli_args)
         self._baseline = {kind: {id(e) for e in getattr(self.node, kind)} for kind in _ENDPOINTS}
-        try:
-            from rclpy.experimental import EventsExecutor
-
-            self.executor = EventsExecutor(context=self.context)
-            self.events = True
-        except ImportError:
-            self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor, self.events = make_executor(self.context)
         self.executor.add_node(self.node)
         self._future = Future()
         self._thread = threading.Thread(target=self._spin, name=f"{self.name}-rclpy", daemon=True)

@@ -41,6 +41,7 @@ from typing import Any
 from sam_runtime.bridge.backend import BridgeConfigError
 from sam_runtime.bridge.backends.spin_thread import WaitingCalls
 from sam_runtime.bridge.lifetime import Lifetime
+from sam_runtime.common.executors import make_executor
 from sam_runtime.node_support import ParameterConfigError, declare_parameters, qos_profile
 
 __all__ = ["RosSide"]
@@ -93,7 +94,6 @@ class RosSide:
             self._open_hosted()
             return
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
         from rclpy.signals import SignalHandlerOptions
 
@@ -110,14 +110,7 @@ class RosSide:
             declare_parameters(self.node, self._parameters, self._rules, overrides=self._overrides)
         except ParameterConfigError as ex:
             raise BridgeConfigError(str(ex)) from None
-        try:
-            from rclpy.experimental import EventsExecutor
-
-            self.executor = EventsExecutor(context=self.context)
-            self._events = True
-        except ImportError:
-            self.executor = SingleThreadedExecutor(context=self.context)
-            self._events = False
+        self.executor, self._events = make_executor(self.context)
         self.executor.add_node(self.node)
 
     def _open_hosted(self) -> None:

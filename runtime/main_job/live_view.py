@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from sam_codegen.model.spec import ROS_TO_UAVCAN, UAVCAN_TO_ROS
+from sam_runtime.common.executors import make_executor
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.main_job.demo import demo_message
 from sam_runtime.main_job.diag_view import bridge_lines, interface_line, status_key
@@ -157,9 +158,7 @@ class LiveView:
                     self._demo.append((pub, cls, rate, m.topic.name))
             for i, (_pub, _cls, rate, _name) in enumerate(self._demo):
                 self.node.create_timer(1.0 / rate, lambda i=i: self._publish_demo(i))
-        from rclpy.executors import SingleThreadedExecutor
-
-        self.executor = SingleThreadedExecutor(context=self.ctx)
+        self.executor, _events = make_executor(self.ctx)
         self.executor.add_node(self.node)
 
     def _on_diag(self, arr: Any) -> None:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sam_runtime.common.executors import make_executor
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.nav.mission import MissionGoal
 from sam_runtime.nodes import ImplementationError, implemented, load_implementation, unimplemented
@@ -76,7 +77,6 @@ class NodeHost:
                  goals: tuple[MissionGoal, ...] | None = None, domain_id: int | None = None,
                  namespace: RosNamespace | None = None, ros_args: Sequence[str] = ()) -> None:
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
         from rclpy.signals import SignalHandlerOptions
 
@@ -98,7 +98,7 @@ class NodeHost:
         self.ctx = rclpy.Context()
         rclpy.init(args=["--ros-args", "--params-file", str(params), *extra], context=self.ctx, domain_id=domain_id,
                    signal_handler_options=SignalHandlerOptions.NO)
-        self.executor = SingleThreadedExecutor(context=self.ctx)
+        self.executor, _events = make_executor(self.ctx)
         self.nodes: dict[str, Any] = {}
         self.errors = 0
         self._last_error_log = -float("inf")
