@@ -1,5 +1,7 @@
-"""The rclpy executor every ROS process of the runtime spins (the bridge, the node host, the main job's view, the
-recorder): rclpy's EventsExecutor where it exists (rclpy >= 7.1.4, Jazzy), else the SingleThreadedExecutor.
+"""The rclpy executor the ROS processes of the runtime spin (the bridge, the node host, the main job's view):
+rclpy's EventsExecutor where it exists (rclpy >= 7.1.4, Jazzy), else the SingleThreadedExecutor. Not the recorder:
+rclpy 7.1.5's EventsExecutor fails on a subscription whose callback takes the message info ("SystemError: null
+argument to internal routine" at its first message), which the recorder needs for its stamps.
 
 Why: the SingleThreadedExecutor rebuilds, in Python, its wait set of every timer, subscription, guard condition and
 each publisher's and subscription's QoS event handlers at every wake-up. That was ~70 % of the node host's CPU

@@ -46,7 +46,6 @@ from sam_codegen.catalogs.ros import ros_share_dirs
 from sam_codegen.model.protocols.cyphal import CYPHAL
 from sam_codegen.model.protocols.dronecan import DRONECAN
 from sam_codegen.project.cyphal_path import dsdl_lookup_roots
-from sam_runtime.common.executors import make_executor
 from sam_runtime.common.ros_namespace import RosNamespace
 from sam_runtime.common.run_names import RECORDING_METADATA, recorded_metadata
 from sam_runtime.cyphal_io.transport import aclose, make_transport
@@ -299,6 +298,7 @@ class Recorder:
         import importlib
 
         import rclpy
+        from rclpy.executors import SingleThreadedExecutor
         from rclpy.node import Node
         from rclpy.signals import SignalHandlerOptions
 
@@ -314,7 +314,9 @@ class Recorder:
                 log.error("%s is not recorded: %s", topic, ex)
                 continue
             self._node.create_subscription(cls, topic, self._ros_callback(topic), qos, raw=True)
-        self._executor, _events = make_executor(self._ctx)
+        # Not the EventsExecutor (sam_runtime.common.executors): rclpy 7.1.5's fails on a callback that takes the
+        # message info, as these do ("SystemError: null argument to internal routine" at the first message).
+        self._executor = SingleThreadedExecutor(context=self._ctx)
         self._executor.add_node(self._node)
         self._spin = threading.Thread(target=self._spin_ros, name="recorder-ros", daemon=True)
         self._spin.start()
