@@ -113,8 +113,9 @@ def _bars(ax: Any, rows: dict[str, list[tuple[float, int]]], names: list[str], e
 def held_spans(samples: list[tuple[float, int]], end: float) -> list[tuple[float, float, int]]:
     """(from, to, level) for each stretch of one level: each sample holds until the next, the last until end."""
     held: list[tuple[float, float, int]] = []
-    for (a, level), (b, _) in zip(samples, [*samples[1:], (end, 0)][:len(samples)], strict=True):
-        if held and held[-1][2] == level and held[-1][1] == a:
+    ends = [t for t, _ in samples[1:]] + [end] if samples else []
+    for (a, level), b in zip(samples, ends, strict=True):
+        if held and held[-1][2] == level:  # the stretch before ends where this sample starts: extend it
             held[-1] = (held[-1][0], b, level)
         else:
             held.append((a, b, level))
